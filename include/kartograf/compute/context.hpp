@@ -1,0 +1,65 @@
+#pragma once
+// A compute context owns one backend and one device. Operations take a Context and run on it;
+// Buffers made from a Context live on its device.
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+
+#include "kartograf/compute/backend.hpp"
+
+namespace kartograf::compute {
+
+namespace detail {
+class Device;
+}
+
+struct ContextOptions {
+  BackendChoice backend = BackendChoice::automatic;
+  // Index into the backend's usable devices; empty: the best one (discrete > integrated > other).
+  std::optional<int> device_index;
+  // Vulkan only: enable VK_LAYER_KHRONOS_validation with synchronization validation, and count
+  // every error it reports (see Context::validation_errors). Ignored when the layer is missing.
+  bool vulkan_validation = false;
+
+  // KARTOGRAF_BACKEND=auto|cpu|vulkan|opencl, KARTOGRAF_DEVICE=<index>,
+  // KARTOGRAF_VULKAN_VALIDATION=1.
+  static ContextOptions from_environment();
+};
+
+class Context {
+ public:
+  // Throws Error naming the backend and why it cannot be used (no loader, no driver, no device...).
+  explicit Context(const ContextOptions& options);
+  // The backend named by KARTOGRAF_BACKEND (automatic when unset).
+  static Context from_environment();
+  static Context cpu();
+
+  Context(Context&&) noexcept;
+  Context& operator=(Context&&) noexcept;
+  ~Context();
+
+  BackendKind backend() const;
+  const DeviceInfo& device_info() const;
+  bool is_cpu() const { return backend() == BackendKind::cpu; }
+
+  // Waits until every dispatched operation has finished.
+  void finish();
+  // Compiles every embedded shader pipeline / OpenCL kernel now, so none is first compiled later.
+  void build_all_kernels();
+  // Vulkan with validation on: messages of severity error so far. Zero elsewhere.
+  std::uint64_t validation_errors() const;
+  bool validation_active() const;
+
+  // For operations' device paths (see compute/kernel.hpp). Null on the CPU backend.
+  detail::Device* device() const { return device_.get(); }
+
+ private:
+  friend class RawBuffer;
+  std::shared_ptr<detail::Device> shared_device() const { return device_; }
+  Context();
+  std::shared_ptr<detail::Device> device_;
+  DeviceInfo cpu_info_;
+};
+
+}  // namespace kartograf::compute

@@ -1,0 +1,73 @@
+#include "kartograf/compute/backend.hpp"
+
+#include <thread>
+
+#include <Eigen/Core>
+
+#include "compute/device.hpp"
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::compute {
+
+std::string_view to_string(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::cpu: return "cpu";
+    case BackendKind::vulkan: return "vulkan";
+    case BackendKind::opencl: return "opencl";
+  }
+  return "?";
+}
+
+std::string_view to_string(BackendChoice choice) {
+  switch (choice) {
+    case BackendChoice::automatic: return "auto";
+    case BackendChoice::cpu: return "cpu";
+    case BackendChoice::vulkan: return "vulkan";
+    case BackendChoice::opencl: return "opencl";
+  }
+  return "?";
+}
+
+BackendChoice parse_backend_choice(std::string_view text, std::string_view source) {
+  if (text == "auto" || text.empty()) return BackendChoice::automatic;
+  if (text == "cpu") return BackendChoice::cpu;
+  if (text == "vulkan") return BackendChoice::vulkan;
+  if (text == "opencl") return BackendChoice::opencl;
+  throw Error(std::string(source) + ": unknown backend '" + std::string(text) +
+              "' (expected auto, cpu, vulkan or opencl)");
+}
+
+std::string_view to_string(DeviceType type) {
+  switch (type) {
+    case DeviceType::cpu: return "cpu";
+    case DeviceType::integrated_gpu: return "integrated-gpu";
+    case DeviceType::discrete_gpu: return "discrete-gpu";
+    case DeviceType::virtual_gpu: return "virtual-gpu";
+    case DeviceType::other: return "other";
+  }
+  return "?";
+}
+
+namespace detail {
+DeviceInfo cpu_device_info() {
+  DeviceInfo info;
+  info.backend = BackendKind::cpu;
+  info.name = "host CPU (" + std::to_string(std::thread::hardware_concurrency()) + " threads)";
+  info.type = DeviceType::cpu;
+  info.api_version = "C++20 / Eigen " + std::to_string(EIGEN_WORLD_VERSION) + "." +
+                     std::to_string(EIGEN_MAJOR_VERSION) + "." + std::to_string(EIGEN_MINOR_VERSION);
+  info.driver = "reference implementation";
+  info.unified_memory = true;
+  return info;
+}
+}  // namespace detail
+
+std::vector<BackendStatus> probe_backends() {
+  BackendStatus cpu;
+  cpu.backend = BackendKind::cpu;
+  cpu.available = true;
+  cpu.devices.push_back(detail::cpu_device_info());
+  return {cpu, detail::probe_vulkan(), detail::probe_opencl()};
+}
+
+}  // namespace kartograf::compute

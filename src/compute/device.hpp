@@ -1,0 +1,51 @@
+#pragma once
+// The interface a GPU backend (Vulkan, OpenCL) implements. Operations never see it directly: they
+// go through compute/kernel.hpp and compute/buffer.hpp.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <span>
+
+#include "kartograf/compute/backend.hpp"
+#include "kartograf/compute/kernel.hpp"
+
+namespace kartograf::compute::detail {
+
+class DeviceBuffer {
+ public:
+  virtual ~DeviceBuffer() = default;
+};
+
+// Commands are executed in the order they are issued. dispatch and fill_zero may be deferred and
+// batched; read waits for everything issued before it.
+class Device {
+ public:
+  virtual ~Device() = default;
+  virtual const DeviceInfo& info() const = 0;
+
+  virtual std::unique_ptr<DeviceBuffer> create_buffer(std::size_t bytes) = 0;
+  virtual void write(DeviceBuffer& buffer, std::size_t offset, const void* source,
+                     std::size_t bytes) = 0;
+  virtual void read(const DeviceBuffer& buffer, std::size_t offset, void* destination,
+                    std::size_t bytes) = 0;
+  virtual void fill_zero(DeviceBuffer& buffer, std::size_t offset, std::size_t bytes) = 0;
+
+  // buffers: null entries are absent optional inputs (bind a placeholder).
+  virtual void dispatch(const KernelSpec& kernel, std::span<DeviceBuffer* const> buffers,
+                        std::span<const std::byte> params, GroupCount groups) = 0;
+  virtual void finish() = 0;
+  virtual void build_all_kernels() = 0;
+
+  virtual std::uint64_t validation_errors() const { return 0; }
+  virtual bool validation_active() const { return false; }
+};
+
+DeviceInfo cpu_device_info();
+
+// Each throws Error naming why the backend or the requested device cannot be used.
+std::shared_ptr<Device> create_vulkan_device(const ContextOptions& options);
+std::shared_ptr<Device> create_opencl_device(const ContextOptions& options);
+BackendStatus probe_vulkan();
+BackendStatus probe_opencl();
+
+}  // namespace kartograf::compute::detail

@@ -1,0 +1,116 @@
+#include "kartograf/geometry/backproject.hpp"
+
+#include <cmath>
+#include <limits>
+
+#include "kartograf/compute/kernel.hpp"
+
+namespace kartograf::geometry {
+
+namespace {
+
+constexpr compute::KernelSpec kBackprojectKernel{"backproject", 16, 16};
+
+struct BackprojectParams {  // layout of shaders/backproject.comp and kernels/backproject.cl
+  std::uint32_t width;
+  std::uint32_t height;
+  std::uint32_t min_units;
+  std::uint32_t max_units;
+  float metres_per_unit;
+};
+
+// The smallest raw value d with d / units >= metres, evaluated exactly as the reference does.
+std::uint32_t first_unit_at_least(double metres, double units) {
+  double d = std::max(0.0, std::ceil(metres * units));
+  while (d > 0 && (d - 1) / units >= metres) d -= 1;
+  while (d / units < metres) d += 1;
+  return static_cast<std::uint32_t>(std::min(d, 65536.0));
+}
+
+void backproject_cpu(const std::uint16_t* depth, int width, int height, const float* factors,
+                     float metres_per_unit, std::uint32_t min_units, std::uint32_t max_units,
+                     Point4f* points) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int y = 0; y < height; ++y) {
+    const float row_factor = factors[width + y];
+    const std::uint16_t* depth_row = depth + static_cast<std::size_t>(y) * width;
+    float* out = points[static_cast<std::size_t>(y) * width].data();
+    for (int x = 0; x < width; ++x) {
+      const std::uint32_t d = depth_row[x];
+      const bool valid = d != 0 && d >= min_units && d <= max_units;
+      const float z = static_cast<float>(d);
+      // Branch-free so that the loop vectorizes.
+      out[4 * x + 0] = valid ? z * factors[x] : nan;
+      out[4 * x + 1] = valid ? z * row_factor : nan;
+      out[4 * x + 2] = valid ? z * metres_per_unit : nan;
+      out[4 * x + 3] = valid ? 1.0f : nan;
+    }
+  }
+}
+
+}  // namespace
+
+DepthBackprojector::DepthBackprojector(const compute::Context& context,
+                                       const PinholeIntrinsics& intrinsics, const DepthRange& range)
+    : context_(&context), intrinsics_(intrinsics), range_(range) {
+  intrinsics.validate("depth back-projection intrinsics");
+  require(std::isfinite(range.units_per_metre) && range.units_per_metre > 0,
+          "depth back-projection: units_per_metre must be positive, got " +
+              std::to_string(range.units_per_metre));
+  require(std::isfinite(range.min_metres) && std::isfinite(range.max_metres) &&
+              range.min_metres >= 0 && range.min_metres <= range.max_metres,
+          "depth back-projection: need 0 <= min_metres <= max_metres, got " +
+              std::to_string(range.min_metres) + " and " + std::to_string(range.max_metres));
+  min_units_ = std::max<std::uint32_t>(1, first_unit_at_least(range.min_metres, range.units_per_metre));
+  // The largest d with d / units <= max is one below the first with d / units > max.
+  const std::uint32_t above = first_unit_at_least(
+      std::nextafter(range.max_metres, std::numeric_limits<double>::infinity()), range.units_per_metre);
+  max_units_ = std::min<std::uint32_t>(0xffff, above == 0 ? 0 : above - 1);
+
+  const double metres_per_unit = 1.0 / range.units_per_metre;
+  metres_per_unit_ = static_cast<float>(metres_per_unit);
+  factors_.resize(static_cast<std::size_t>(intrinsics.width + intrinsics.height));
+  for (int x = 0; x < intrinsics.width; ++x) {
+    factors_[x] = static_cast<float>((x - intrinsics.cx) / intrinsics.fx * metres_per_unit);
+  }
+  for (int y = 0; y < intrinsics.height; ++y) {
+    factors_[intrinsics.width + y] =
+        static_cast<float>((y - intrinsics.cy) / intrinsics.fy * metres_per_unit);
+  }
+  if (!context.is_cpu()) device_factors_ = compute::Buffer<float>::from_host(context, factors_);
+}
+
+void DepthBackprojector::run(const compute::DeviceImage<std::uint16_t>& depth,
+                             compute::DeviceImage<Point4f>& points) const {
+  const int width = intrinsics_.width;
+  const int height = intrinsics_.height;
+  require(depth.width() == width && depth.height() == height,
+          "depth back-projection: depth image is " + std::to_string(depth.width()) + "x" +
+              std::to_string(depth.height()) + " but the intrinsics are for " +
+              std::to_string(width) + "x" + std::to_string(height));
+  if (points.width() != width || points.height() != height) {
+    points = compute::DeviceImage<Point4f>(*context_, width, height);
+  }
+  if (context_->is_cpu()) {
+    backproject_cpu(depth.buffer().host_span().data(), width, height, factors_.data(),
+                    metres_per_unit_, min_units_, max_units_, points.buffer().host_span().data());
+    return;
+  }
+  const BackprojectParams params{static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height),
+                                 min_units_, max_units_, metres_per_unit_};
+  compute::dispatch(*context_, kBackprojectKernel, {depth.buffer(), device_factors_, points.buffer()},
+                    params,
+                    {compute::groups_for(width, kBackprojectKernel.local_x),
+                     compute::groups_for(height, kBackprojectKernel.local_y)});
+}
+
+PointImage backproject(const compute::Context& context, const DepthImage& depth,
+                       const PinholeIntrinsics& intrinsics, const DepthRange& range) {
+  const DepthBackprojector projector(context, intrinsics, range);
+  const auto device_depth = compute::DeviceImage<std::uint16_t>::from_host(context, depth);
+  compute::DeviceImage<Point4f> points(context, intrinsics.width, intrinsics.height);
+  projector.run(device_depth, points);
+  return points.to_image();
+}
+
+}  // namespace kartograf::geometry

@@ -1,0 +1,236 @@
+#include "kartograf/registration/icp_sums.hpp"
+
+#include <array>
+#include <cmath>
+#include <string>
+
+#include "kartograf/compute/kernel.hpp"
+
+namespace kartograf::registration {
+
+namespace {
+
+constexpr std::uint32_t kGroupSize = 64;  // KG_REDUCTION_GROUP in shaders/common.glsl
+constexpr std::size_t kMaxSums = 32;      // KG_MAX_SUMS
+constexpr std::size_t kPointToPointSums = 18;
+constexpr std::size_t kPointToPlaneSums = 30;
+constexpr std::size_t kFrameValues = 19;
+
+constexpr compute::KernelSpec kPointToPointKernel{"icp_point_to_point", kGroupSize};
+constexpr compute::KernelSpec kPointToPlaneKernel{"icp_point_to_plane", kGroupSize};
+constexpr compute::KernelSpec kReduceRowsKernel{"reduce_rows", kGroupSize};
+
+struct IcpSumsParams {  // layout of shaders/icp_*.comp and kernels/icp_sums.cl
+  std::uint32_t pair_count;
+  std::uint32_t target_count;
+  std::uint32_t has_correspondences;
+  std::uint32_t has_weights;
+};
+
+struct ReduceRowsParams {  // layout of shaders/reduce_rows.comp and kernels/reduce_rows.cl
+  std::uint32_t row_count;
+  std::uint32_t column_count;
+};
+
+using Sums = std::array<double, kMaxSums>;
+
+// R (row-major), t, pivot a, pivot b, max distance^2: what the kernels read from `frame`.
+std::array<double, kFrameValues> frame_values(const Correspondences& pairs, const Eigen::Vector3d& pivot_a,
+                                              const Eigen::Vector3d& pivot_b) {
+  std::array<double, kFrameValues> frame{};
+  const Eigen::Matrix3d rotation = pairs.source_to_target.linear();
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) frame[3 * r + c] = rotation(r, c);
+    frame[9 + r] = pairs.source_to_target.translation()(r);
+    frame[12 + r] = pivot_a(r);
+    frame[15 + r] = pivot_b(r);
+  }
+  frame[18] = pairs.max_distance * pairs.max_distance;
+  return frame;
+}
+
+void validate(const Correspondences& pairs, bool needs_normals, const char* what) {
+  const std::string name(what);
+  require(pairs.source && pairs.target, name + ": source and target buffers are required");
+  require(!needs_normals || pairs.target_normals, name + ": target normals are required");
+  require(!needs_normals || pairs.target_normals->size() == pairs.target->size(),
+          name + ": target normals and target points differ in count");
+  require(!pairs.correspondences || pairs.correspondences->size() == pairs.source->size(),
+          name + ": correspondence buffer and source points differ in count");
+  require(!pairs.weights || pairs.weights->size() == pairs.source->size(),
+          name + ": weight buffer and source points differ in count");
+  require(!(pairs.max_distance < 0) && !std::isnan(pairs.max_distance),
+          name + ": max_distance must be >= 0");
+  require(pairs.source_to_target.matrix().allFinite(), name + ": the transform has NaN/Inf entries");
+  require(pairs.source->size() < (std::size_t{1} << 31) && pairs.target->size() < (std::size_t{1} << 31),
+          name + ": more than 2^31 points");
+}
+
+// The CPU path: the kernels' per-pair arithmetic, summed sequentially in double.
+template <class AddPair>
+void for_each_pair_cpu(const Correspondences& pairs, const std::array<double, kFrameValues>& frame,
+                       AddPair&& add_pair) {
+  const auto source = pairs.source->host_span();
+  const auto target = pairs.target->host_span();
+  const std::int32_t* correspondences = pairs.correspondences ? pairs.correspondences->host_span().data() : nullptr;
+  const float* weights = pairs.weights ? pairs.weights->host_span().data() : nullptr;
+  for (std::size_t i = 0; i < source.size(); ++i) {
+    const Point4f& p = source[i];
+    if (!is_valid(p)) continue;
+    std::size_t j = i;
+    if (correspondences) {
+      if (correspondences[i] < 0 || static_cast<std::size_t>(correspondences[i]) >= target.size()) continue;
+      j = static_cast<std::size_t>(correspondences[i]);
+    } else if (i >= target.size()) {
+      continue;
+    }
+    double w = 1.0;
+    if (weights) {
+      w = weights[i];
+      if (!(w > 0.0)) continue;
+    }
+    const Point4f& q = target[j];
+    if (!is_valid(q)) continue;
+    const double px = p.x(), py = p.y(), pz = p.z();
+    const Eigen::Vector3d moved(frame[0] * px + frame[1] * py + frame[2] * pz + frame[9],
+                                frame[3] * px + frame[4] * py + frame[5] * pz + frame[10],
+                                frame[6] * px + frame[7] * py + frame[8] * pz + frame[11]);
+    const Eigen::Vector3d qd = q.head<3>().cast<double>();
+    const double distance_sq = (moved - qd).squaredNorm();
+    if (!(distance_sq <= frame[18])) continue;
+    add_pair(moved, qd, j, w, distance_sq);
+  }
+}
+
+}  // namespace
+
+IcpReduction::IcpReduction(const compute::Context& context) : context_(&context) {
+  if (context.is_cpu()) return;
+  frame_ = compute::Buffer<double>(context, kFrameValues);
+  result_ = compute::Buffer<double>(context, kMaxSums);
+}
+
+namespace {
+
+// Runs the two device passes and returns the final row.
+Sums reduce_on_device(const compute::Context& context, const compute::KernelSpec& kernel,
+                      std::initializer_list<compute::BufferArg> inputs, compute::Buffer<double>& frame,
+                      compute::Buffer<double>& partials, compute::Buffer<double>& result,
+                      const IcpSumsParams& params, std::size_t sum_count) {
+  // Few work-groups on CPU-hosted drivers, where barriers are expensive; enough to fill a GPU.
+  const std::uint32_t max_groups = context.device_info().is_gpu() ? 1024 : 16;
+  const std::uint32_t groups =
+      std::max<std::uint32_t>(1, std::min(max_groups, compute::groups_for(params.pair_count, kGroupSize)));
+  if (partials.size() < std::size_t{groups} * sum_count) {
+    partials = compute::Buffer<double>(context, std::size_t{max_groups} * kMaxSums);
+  }
+  std::vector<compute::BufferArg> args(inputs);
+  args.push_back(frame);
+  args.push_back(partials);
+  compute::dispatch_raw(context, kernel, args, std::as_bytes(std::span(&params, 1)), {groups, 1});
+  const ReduceRowsParams reduce{groups, static_cast<std::uint32_t>(sum_count)};
+  compute::dispatch(context, kReduceRowsKernel, {partials, result}, reduce, {1, 1});
+  Sums sums{};
+  result.download(std::span(sums.data(), sum_count));
+  return sums;
+}
+
+IcpSumsParams kernel_params(const Correspondences& pairs) {
+  return {static_cast<std::uint32_t>(pairs.source->size()),
+          static_cast<std::uint32_t>(pairs.target->size()), pairs.correspondences ? 1u : 0u,
+          pairs.weights ? 1u : 0u};
+}
+
+}  // namespace
+
+PointToPointSums IcpReduction::point_to_point(const Correspondences& pairs,
+                                              const Eigen::Vector3d& source_pivot,
+                                              const Eigen::Vector3d& target_pivot) {
+  validate(pairs, false, "point-to-point ICP sums");
+  const auto frame = frame_values(pairs, source_pivot, target_pivot);
+  Sums sums{};
+  if (context_->is_cpu()) {
+    for_each_pair_cpu(pairs, frame, [&](const Eigen::Vector3d& moved, const Eigen::Vector3d& q,
+                                        std::size_t, double w, double distance_sq) {
+      const Eigen::Vector3d a = moved - source_pivot;
+      const Eigen::Vector3d b = q - target_pivot;
+      sums[0] += 1.0;
+      sums[1] += w;
+      for (int r = 0; r < 3; ++r) {
+        sums[2 + r] += w * a(r);
+        sums[5 + r] += w * b(r);
+        for (int c = 0; c < 3; ++c) sums[8 + 3 * r + c] += w * a(r) * b(c);
+      }
+      sums[17] += w * distance_sq;
+    });
+  } else {
+    frame_.upload(frame);
+    sums = reduce_on_device(*context_, kPointToPointKernel,
+                            {*pairs.source, *pairs.target,
+                             pairs.correspondences ? compute::BufferArg(*pairs.correspondences) : compute::BufferArg(),
+                             pairs.weights ? compute::BufferArg(*pairs.weights) : compute::BufferArg()},
+                            frame_, partials_, result_, kernel_params(pairs), kPointToPointSums);
+  }
+  PointToPointSums result;
+  result.pair_count = static_cast<std::uint64_t>(sums[0]);
+  result.weight_sum = sums[1];
+  result.squared_error_sum = sums[17];
+  if (result.weight_sum <= 0) return result;
+  const Eigen::Vector3d sum_a(sums[2], sums[3], sums[4]);
+  const Eigen::Vector3d sum_b(sums[5], sums[6], sums[7]);
+  Eigen::Matrix3d sum_ab;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) sum_ab(r, c) = sums[8 + 3 * r + c];
+  }
+  result.source_mean = source_pivot + sum_a / result.weight_sum;
+  result.target_mean = target_pivot + sum_b / result.weight_sum;
+  result.cross_covariance = sum_ab - sum_a * sum_b.transpose() / result.weight_sum;
+  return result;
+}
+
+PointToPlaneSystem IcpReduction::point_to_plane(const Correspondences& pairs, const Eigen::Vector3d& pivot) {
+  validate(pairs, true, "point-to-plane ICP sums");
+  const auto frame = frame_values(pairs, pivot, Eigen::Vector3d::Zero());
+  Sums sums{};
+  if (context_->is_cpu()) {
+    const auto normals = pairs.target_normals->host_span();
+    for_each_pair_cpu(pairs, frame, [&](const Eigen::Vector3d& moved, const Eigen::Vector3d& q,
+                                        std::size_t j, double w, double) {
+      if (!is_valid(normals[j])) return;
+      const Eigen::Vector3d n = normals[j].head<3>().cast<double>();
+      Eigen::Matrix<double, 6, 1> jacobian;
+      jacobian << (moved - pivot).cross(n), n;
+      const double r = (moved - q).dot(n);
+      sums[0] += 1.0;
+      sums[1] += w;
+      std::size_t slot = 2;
+      for (int row = 0; row < 6; ++row) {
+        for (int col = row; col < 6; ++col) sums[slot++] += w * jacobian(row) * jacobian(col);
+      }
+      for (int row = 0; row < 6; ++row) sums[23 + row] += w * jacobian(row) * r;
+      sums[29] += w * r * r;
+    });
+  } else {
+    frame_.upload(frame);
+    sums = reduce_on_device(*context_, kPointToPlaneKernel,
+                            {*pairs.source, *pairs.target, *pairs.target_normals,
+                             pairs.correspondences ? compute::BufferArg(*pairs.correspondences) : compute::BufferArg(),
+                             pairs.weights ? compute::BufferArg(*pairs.weights) : compute::BufferArg()},
+                            frame_, partials_, result_, kernel_params(pairs), kPointToPlaneSums);
+  }
+  PointToPlaneSystem system;
+  system.pair_count = static_cast<std::uint64_t>(sums[0]);
+  system.weight_sum = sums[1];
+  system.pivot = pivot;
+  std::size_t slot = 2;
+  for (int row = 0; row < 6; ++row) {
+    for (int col = row; col < 6; ++col) {
+      system.jtj(row, col) = system.jtj(col, row) = sums[slot++];
+    }
+  }
+  for (int row = 0; row < 6; ++row) system.jtr(row) = sums[23 + row];
+  system.squared_error_sum = sums[29];
+  return system;
+}
+
+}  // namespace kartograf::registration

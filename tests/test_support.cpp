@@ -1,0 +1,66 @@
+#include "test_support.hpp"
+
+#include <cstdlib>
+#include <sstream>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::testing {
+
+std::vector<compute::BackendKind> backends_under_test() {
+  const char* listed = std::getenv("KARTOGRAF_TEST_BACKENDS");
+  if (!listed || !*listed) {
+    return {compute::BackendKind::cpu, compute::BackendKind::vulkan, compute::BackendKind::opencl};
+  }
+  std::vector<compute::BackendKind> kinds;
+  std::stringstream stream(listed);
+  std::string name;
+  while (std::getline(stream, name, ',')) {
+    const auto choice = compute::parse_backend_choice(name, "KARTOGRAF_TEST_BACKENDS");
+    if (choice == compute::BackendChoice::cpu) kinds.push_back(compute::BackendKind::cpu);
+    if (choice == compute::BackendChoice::vulkan) kinds.push_back(compute::BackendKind::vulkan);
+    if (choice == compute::BackendChoice::opencl) kinds.push_back(compute::BackendKind::opencl);
+  }
+  return kinds;
+}
+
+compute::Context make_context(compute::BackendKind kind) {
+  compute::ContextOptions options;
+  options.backend = kind == compute::BackendKind::cpu      ? compute::BackendChoice::cpu
+                    : kind == compute::BackendKind::vulkan ? compute::BackendChoice::vulkan
+                                                           : compute::BackendChoice::opencl;
+  options.vulkan_validation = true;
+  return compute::Context(options);
+}
+
+std::filesystem::path data_dir() {
+  const char* configured = std::getenv("KARTOGRAF_DATA_DIR");
+  const std::filesystem::path dir = configured ? configured : KARTOGRAF_DEFAULT_DATA_DIR;
+  if (!std::filesystem::is_directory(dir)) {
+    ADD_FAILURE() << "test data directory " << dir << " is missing (set KARTOGRAF_DATA_DIR)";
+  }
+  return dir;
+}
+
+std::string backend_test_name(const ::testing::TestParamInfo<compute::BackendKind>& info) {
+  return std::string(compute::to_string(info.param));
+}
+
+void BackendTest::SetUp() {
+  try {
+    context_ = std::make_unique<compute::Context>(make_context(GetParam()));
+  } catch (const Error& error) {
+    FAIL() << "backend " << compute::to_string(GetParam()) << " is unavailable: " << error.what();
+  }
+  if (GetParam() == compute::BackendKind::vulkan && !context_->validation_active()) {
+    std::cerr << "note: VK_LAYER_KHRONOS_validation is not installed; Vulkan runs unvalidated\n";
+  }
+}
+
+void BackendTest::TearDown() {
+  if (!context_) return;
+  context_->finish();
+  EXPECT_EQ(context_->validation_errors(), 0u) << "the Vulkan validation layer reported errors";
+}
+
+}  // namespace kartograf::testing
