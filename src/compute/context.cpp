@@ -90,10 +90,10 @@ Context::~Context() = default;
 BackendKind Context::backend() const { return device_ ? device_->info().backend : BackendKind::cpu; }
 const DeviceInfo& Context::device_info() const { return device_ ? device_->info() : cpu_info_; }
 
-void Context::finish() {
+void Context::finish() const {
   if (device_) device_->finish();
 }
-void Context::build_all_kernels() {
+void Context::build_all_kernels() const {
   if (device_) device_->build_all_kernels();
 }
 std::uint64_t Context::validation_errors() const {

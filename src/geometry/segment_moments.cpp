@@ -88,10 +88,21 @@ Eigen::Matrix3d SegmentMomentSet::covariance(std::uint32_t label) const {
   return m.sum_outer / n - mean * mean.transpose();
 }
 
+SegmentMomentReducer::SegmentMomentReducer(const compute::Context& context) : context_(&context) {
+  if (!context.is_cpu()) status_ = compute::Buffer<std::uint32_t>(context, 2);
+}
+
 SegmentMomentSet segment_moments(const compute::Context& context,
                                  const compute::Buffer<Point4f>& points,
                                  const compute::Buffer<std::uint32_t>& labels,
                                  const SegmentMomentParams& params) {
+  return SegmentMomentReducer(context).run(points, labels, params);
+}
+
+SegmentMomentSet SegmentMomentReducer::run(const compute::Buffer<Point4f>& points,
+                                           const compute::Buffer<std::uint32_t>& labels,
+                                           const SegmentMomentParams& params) {
+  const compute::Context& context = *context_;
   require(params.label_count >= 1 && params.label_count <= kMaxSegmentLabels,
           "segment moments: label_count must be 1.." + std::to_string(kMaxSegmentLabels) + ", got " +
               std::to_string(params.label_count));
@@ -115,15 +126,16 @@ SegmentMomentSet segment_moments(const compute::Context& context,
   if (context.is_cpu()) {
     accumulate_cpu(points.host_span(), labels.host_span(), kernel_params, accumulation);
   } else {
-    compute::Buffer<std::int64_t> moments(context, accumulation.moments.size());
-    compute::Buffer<std::uint32_t> status(context, 2);
-    moments.fill_zero();
-    status.fill_zero();
-    compute::dispatch(context, kSegmentMomentsKernel, {points, labels, moments, status}, kernel_params,
+    if (moments_.size() < accumulation.moments.size()) {
+      moments_ = compute::Buffer<std::int64_t>(context, accumulation.moments.size());
+    }
+    moments_.fill_zero();
+    status_.fill_zero();
+    compute::dispatch(context, kSegmentMomentsKernel, {points, labels, moments_, status_}, kernel_params,
                       {compute::groups_for(points.size(), kSegmentMomentsKernel.local_x), 1});
-    moments.download(accumulation.moments);
+    moments_.download(std::span<std::int64_t>(accumulation.moments));
     std::uint32_t counters[2] = {};
-    status.download(counters);
+    status_.download(counters);
     accumulation.points_too_far = counters[0];
     accumulation.bad_labels = counters[1];
   }

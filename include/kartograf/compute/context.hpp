@@ -44,9 +44,9 @@ class Context {
   bool is_cpu() const { return backend() == BackendKind::cpu; }
 
   // Waits until every dispatched operation has finished.
-  void finish();
+  void finish() const;
   // Compiles every embedded shader pipeline / OpenCL kernel now, so none is first compiled later.
-  void build_all_kernels();
+  void build_all_kernels() const;
   // Vulkan with validation on: messages of severity error so far. Zero elsewhere.
   std::uint64_t validation_errors() const;
   bool validation_active() const;

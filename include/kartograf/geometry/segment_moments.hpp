@@ -43,8 +43,23 @@ struct SegmentMomentSet {
   Eigen::Matrix3d covariance(std::uint32_t label) const;
 };
 
-// points and labels have the same length. Throws Error for a label >= label_count (other than
-// kNoLabel), a point beyond max_offset, or label_count outside 1..65536.
+// Keeps the device accumulators between calls (one frame after another allocates nothing).
+class SegmentMomentReducer {
+ public:
+  explicit SegmentMomentReducer(const compute::Context& context);
+
+  // points and labels have the same length. Throws Error for a label >= label_count (other than
+  // kNoLabel), a point beyond max_offset, or label_count outside 1..65536.
+  SegmentMomentSet run(const compute::Buffer<Point4f>& points,
+                       const compute::Buffer<std::uint32_t>& labels, const SegmentMomentParams& params);
+
+ private:
+  const compute::Context* context_;
+  compute::Buffer<std::int64_t> moments_;
+  compute::Buffer<std::uint32_t> status_;
+};
+
+// One-off convenience over SegmentMomentReducer.
 SegmentMomentSet segment_moments(const compute::Context& context,
                                  const compute::Buffer<Point4f>& points,
                                  const compute::Buffer<std::uint32_t>& labels,

@@ -1,0 +1,28 @@
+#pragma once
+// The CLI's subcommands. Each returns the process exit code and throws kartograf::Error on
+// failure (main reports it).
+#include <filesystem>
+#include <iosfwd>
+#include <string>
+#include <vector>
+
+#include "kartograf/compute/backend.hpp"
+
+namespace kartograf::cli {
+
+// Every backend and its devices in detail.
+int run_devices_command(std::ostream& out);
+
+// One line per backend: available with its devices, or why not.
+void print_backend_summary(std::ostream& out, const std::vector<compute::BackendStatus>& backends);
+
+struct DemoOptions {
+  std::filesystem::path out_dir = "kartograf-demo";
+  std::string backend = "auto";
+  std::string backend_source = "--backend";  // names the setting in errors
+};
+
+// Synthesizes a depth frame, back-projects it, estimates normals and writes pictures and a cloud.
+int run_demo_command(const DemoOptions& options, std::ostream& out);
+
+}  // namespace kartograf::cli

@@ -1,0 +1,45 @@
+// kartograf: the command-line front end. Subcommands live in *_command.cpp.
+#include <cstdlib>
+#include <exception>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+
+#include "commands.hpp"
+
+int main(int argc, char** argv) {
+  CLI::App app{"Kartograf: dense RGB-D mapping on CPU, Vulkan and OpenCL"};
+  app.require_subcommand(1);
+
+  CLI::App* devices = app.add_subcommand("devices", "List compute backends and their devices");
+
+  kartograf::cli::DemoOptions demo_options;
+  // The environment supplies the default backend; --backend overrides it.
+  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
+    demo_options.backend = env_backend;
+    demo_options.backend_source = "KARTOGRAF_BACKEND";
+  }
+  CLI::App* demo = app.add_subcommand(
+      "demo", "Back-project a synthetic depth frame, estimate normals, write pictures and a PLY");
+  demo->add_option("--out", demo_options.out_dir, "Output directory")->capture_default_str();
+  CLI::Option* backend_option =
+      demo->add_option("--backend", demo_options.backend,
+                       "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)");
+
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    return app.exit(e) == 0 ? 0 : 1;
+  }
+  if (backend_option->count() > 0) demo_options.backend_source = "--backend";
+
+  try {
+    if (*devices) return kartograf::cli::run_devices_command(std::cout);
+    if (*demo) return kartograf::cli::run_demo_command(demo_options, std::cout);
+  } catch (const std::exception& e) {
+    std::cout.flush();
+    std::cerr << "kartograf: error: " << e.what() << "\n";
+    return 1;
+  }
+  return 1;
+}

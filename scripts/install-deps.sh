@@ -1,0 +1,35 @@
+#!/usr/bin/env bash
+# Installs the Debian (bookworm) packages Kartograf needs to build, test and run, and only those
+# that are missing; prints what it installs. Safe to run again.
+set -euo pipefail
+
+packages=(
+  cmake ninja-build g++ pkg-config
+  libeigen3-dev                                    # core and compute
+  libvulkan-dev glslang-tools                      # Vulkan headers + loader, GLSL -> SPIR-V
+  mesa-vulkan-drivers vulkan-validationlayers      # lavapipe + the validation layer for tests
+  ocl-icd-opencl-dev ocl-icd-libopencl1 pocl-opencl-icd  # OpenCL headers, ICD loader, PoCL
+  libopencv-dev                                    # io: PNG/JPEG
+  libcli11-dev                                     # the kartograf CLI
+  libgtest-dev libbenchmark-dev                    # tests and benchmarks
+)
+
+missing=()
+for package in "${packages[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$package" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$package")
+  fi
+done
+
+if [ ${#missing[@]} -eq 0 ]; then
+  echo "install-deps: all ${#packages[@]} packages already installed"
+  exit 0
+fi
+
+echo "install-deps: installing ${missing[*]}"
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then sudo="sudo"; fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"
+echo "install-deps: done"
