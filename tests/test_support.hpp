@@ -4,11 +4,17 @@
 
 #include <filesystem>
 #include <memory>
+#include <ostream>
 #include <random>
 #include <string>
 #include <vector>
 
 #include "kartograf/compute/context.hpp"
+
+namespace kartograf::compute {
+// So that test names and ctest show "vulkan", not a byte dump.
+inline void PrintTo(BackendKind kind, std::ostream* out) { *out << to_string(kind); }
+}  // namespace kartograf::compute
 
 namespace kartograf::testing {
 

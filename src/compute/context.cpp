@@ -15,20 +15,37 @@ const char* env(const char* name) {
   return (value && *value) ? value : nullptr;
 }
 
-// A GPU device of `backend` that `automatic` would take, if any.
+// The usable GPU of a backend that `automatic` would take, if any.
 std::optional<int> best_gpu(const BackendStatus& status) {
-  std::optional<int> best;
-  int usable_index = 0;
+  std::vector<const DeviceInfo*> usable;
   for (const DeviceInfo& device : status.devices) {
-    if (!device.usable) continue;
-    if (device.type == DeviceType::discrete_gpu) return usable_index;
-    if (device.type == DeviceType::integrated_gpu && !best) best = usable_index;
-    ++usable_index;
+    if (device.usable) usable.push_back(&device);
   }
-  return best;
+  if (usable.empty()) return std::nullopt;
+  const std::size_t index = detail::choose_device(usable, ContextOptions{}, to_string(status.backend));
+  if (!usable[index]->is_gpu()) return std::nullopt;
+  return static_cast<int>(index);
 }
 
 }  // namespace
+
+namespace detail {
+std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextOptions& options,
+                          std::string_view backend) {
+  if (options.device_index) {
+    require(*options.device_index < static_cast<int>(usable.size()),
+            std::string(backend) + ": device index " + std::to_string(*options.device_index) +
+                " requested, " + std::to_string(usable.size()) + " usable device(s) present");
+    return static_cast<std::size_t>(*options.device_index);
+  }
+  for (DeviceType preferred : {DeviceType::discrete_gpu, DeviceType::integrated_gpu}) {
+    for (std::size_t i = 0; i < usable.size(); ++i) {
+      if (usable[i]->type == preferred) return i;
+    }
+  }
+  return 0;
+}
+}  // namespace detail
 
 ContextOptions ContextOptions::from_environment() {
   ContextOptions options;

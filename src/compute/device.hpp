@@ -5,6 +5,8 @@
 #include <cstdint>
 #include <memory>
 #include <span>
+#include <string_view>
+#include <vector>
 
 #include "kartograf/compute/backend.hpp"
 #include "kartograf/compute/kernel.hpp"
@@ -41,6 +43,11 @@ class Device {
 };
 
 DeviceInfo cpu_device_info();
+
+// Which of a backend's usable devices a context takes: options.device_index if given (checked),
+// else a discrete GPU, else an integrated GPU, else the first.
+std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextOptions& options,
+                          std::string_view backend);
 
 // Each throws Error naming why the backend or the requested device cannot be used.
 std::shared_ptr<Device> create_vulkan_device(const ContextOptions& options);

@@ -135,6 +135,11 @@ Sums reduce_on_device(const compute::Context& context, const compute::KernelSpec
   return sums;
 }
 
+template <class T>
+compute::BufferArg optional_buffer(const compute::Buffer<T>* buffer) {
+  return buffer ? compute::BufferArg(*buffer) : compute::BufferArg();
+}
+
 IcpSumsParams kernel_params(const Correspondences& pairs) {
   return {static_cast<std::uint32_t>(pairs.source->size()),
           static_cast<std::uint32_t>(pairs.target->size()), pairs.correspondences ? 1u : 0u,
@@ -166,9 +171,8 @@ PointToPointSums IcpReduction::point_to_point(const Correspondences& pairs,
   } else {
     frame_.upload(frame);
     sums = reduce_on_device(*context_, kPointToPointKernel,
-                            {*pairs.source, *pairs.target,
-                             pairs.correspondences ? compute::BufferArg(*pairs.correspondences) : compute::BufferArg(),
-                             pairs.weights ? compute::BufferArg(*pairs.weights) : compute::BufferArg()},
+                            {*pairs.source, *pairs.target, optional_buffer(pairs.correspondences),
+                             optional_buffer(pairs.weights)},
                             frame_, partials_, result_, kernel_params(pairs), kPointToPointSums);
   }
   PointToPointSums result;
@@ -214,8 +218,7 @@ PointToPlaneSystem IcpReduction::point_to_plane(const Correspondences& pairs, co
     frame_.upload(frame);
     sums = reduce_on_device(*context_, kPointToPlaneKernel,
                             {*pairs.source, *pairs.target, *pairs.target_normals,
-                             pairs.correspondences ? compute::BufferArg(*pairs.correspondences) : compute::BufferArg(),
-                             pairs.weights ? compute::BufferArg(*pairs.weights) : compute::BufferArg()},
+                             optional_buffer(pairs.correspondences), optional_buffer(pairs.weights)},
                             frame_, partials_, result_, kernel_params(pairs), kPointToPlaneSums);
   }
   PointToPlaneSystem system;

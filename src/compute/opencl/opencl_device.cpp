@@ -391,20 +391,9 @@ std::shared_ptr<Device> create_opencl_device(const ContextOptions& options) {
     throw Error("OpenCL backend unavailable: " + found.devices.front().info.name + " " +
                 found.devices.front().info.unusable_reason);
   }
-  std::size_t index = 0;
-  if (options.device_index) {
-    require(*options.device_index < static_cast<int>(usable.size()),
-            "OpenCL: device index " + std::to_string(*options.device_index) + " requested, " +
-                std::to_string(usable.size()) + " usable device(s) present");
-    index = static_cast<std::size_t>(*options.device_index);
-  } else {
-    for (std::size_t i = 0; i < usable.size(); ++i) {
-      if (usable[i]->info.type == DeviceType::discrete_gpu) {
-        index = i;
-        break;
-      }
-    }
-  }
+  std::vector<const DeviceInfo*> infos;
+  for (const FoundDevice* device : usable) infos.push_back(&device->info);
+  const std::size_t index = choose_device(infos, options, "OpenCL");
   return std::make_shared<OpenclDevice>(usable[index]->id, usable[index]->info);
 }
 

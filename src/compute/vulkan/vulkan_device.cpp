@@ -602,20 +602,9 @@ std::shared_ptr<Device> create_vulkan_device(const ContextOptions& options) {
     throw Error("Vulkan backend unavailable: no usable physical device" +
                 (reasons.empty() ? std::string(" (zero devices)") : reasons));
   }
-  std::size_t index = 0;
-  if (options.device_index) {
-    require(*options.device_index < static_cast<int>(usable.size()),
-            "Vulkan: device index " + std::to_string(*options.device_index) + " requested, " +
-                std::to_string(usable.size()) + " usable device(s) present");
-    index = static_cast<std::size_t>(*options.device_index);
-  } else {
-    for (std::size_t i = 0; i < usable.size(); ++i) {
-      if (usable[i].info.type == DeviceType::discrete_gpu) {
-        index = i;
-        break;
-      }
-    }
-  }
+  std::vector<const DeviceInfo*> infos;
+  for (const PhysicalDevice& device : usable) infos.push_back(&device.info);
+  const std::size_t index = choose_device(infos, options, "Vulkan");
   return std::make_shared<VulkanDevice>(std::move(instance), usable[index]);
 }
 
