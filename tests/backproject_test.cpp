@@ -61,7 +61,7 @@ TEST_P(BackprojectTest, MatchesDoubleReferenceOnRandomDepth) {
     EXPECT_EQ(c.mask_mismatches, 0u) << width << "x" << height;
     EXPECT_GT(c.valid, depth.size() / 2);
     EXPECT_LE(c.max_error, 1e-6) << width << "x" << height;
-    RecordProperty("max_abs_error_m_" + std::to_string(width), std::to_string(c.max_error));
+    RecordProperty("max_abs_error_m_" + std::to_string(width), testing::scientific(c.max_error));
   }
 }
 
@@ -98,7 +98,7 @@ TEST_P(BackprojectTest, MatchesDoubleReferenceOnSevenScenesFrames) {
     EXPECT_EQ(c.mask_mismatches, 0u) << frame;
     EXPECT_GT(c.valid, 200000u) << frame;
     EXPECT_LE(c.max_error, 1e-6) << frame;
-    RecordProperty(std::string("max_abs_error_m_") + frame, std::to_string(c.max_error));
+    RecordProperty(std::string("max_abs_error_m_") + frame, testing::scientific(c.max_error));
   }
 }
 

@@ -170,7 +170,7 @@ TEST_P(IcpSumsTest, MatchesReferenceOnRandomPairs) {
     h.transform = Eigen::Translation3d(0.0005, 0, 0) * truth;
     h.max_distance = count > 1 ? 0.004 : 1.0;
     const double worst = check_against_reference(context(), h, std::to_string(count) + " pairs");
-    RecordProperty("max_relative_error_" + std::to_string(count), std::to_string(worst));
+    RecordProperty("max_relative_error_" + std::to_string(count), testing::scientific(worst));
   }
 }
 
@@ -222,7 +222,7 @@ TEST_P(IcpSumsTest, MatchesReferenceOnSevenScenesFramePair) {
     if (p.z() > 0 && u >= 0 && v >= 0 && u < k.width && v < k.height) h.correspondences[i] = static_cast<std::int32_t>(v * k.width + u);
   }
   const double worst = check_against_reference(context(), h, "7-Scenes 0 -> 10");
-  RecordProperty("max_relative_error_7scenes", std::to_string(worst));
+  RecordProperty("max_relative_error_7scenes", testing::scientific(worst));
 }
 
 TEST_P(IcpSumsTest, ReproducibleRunToRun) {

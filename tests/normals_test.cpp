@@ -126,7 +126,7 @@ TEST_P(NormalsTest, MatchesReferenceOnSevenScenesFrames) {
     EXPECT_EQ(c.mask_mismatches, 0u) << frame;
     EXPECT_GT(c.valid, 150000u) << frame;
     EXPECT_LE(c.max_error, 1e-5) << frame;
-    RecordProperty(std::string("max_abs_error_") + frame, std::to_string(c.max_error));
+    RecordProperty(std::string("max_abs_error_") + frame, testing::scientific(c.max_error));
   }
 }
 

@@ -84,7 +84,7 @@ TEST_P(SegmentMomentsTest, MatchesReferenceOnRandomLabels) {
     params.origin = Eigen::Vector3f(0.1f, -0.2f, 3.4f);
     params.max_offset = 8.0f;
     const double worst = check(context(), points, labels, params, std::to_string(label_count) + " labels");
-    RecordProperty("max_relative_error_" + std::to_string(label_count), std::to_string(worst));
+    RecordProperty("max_relative_error_" + std::to_string(label_count), testing::scientific(worst));
   }
 }
 
@@ -104,7 +104,7 @@ TEST_P(SegmentMomentsTest, MatchesReferenceAndCpuBitForBitOnSevenScenes) {
   params.label_count = tiles_x * ((k.height + 19) / 20);
   params.origin = Eigen::Vector3f(0.0f, 0.0f, 2.0f);
   const double worst = check(context(), points, labels, params, "7-Scenes frame 100");
-  RecordProperty("max_relative_error_7scenes", std::to_string(worst));
+  RecordProperty("max_relative_error_7scenes", testing::scientific(worst));
 
   const SegmentMomentSet mine = run(context(), points, labels, params);
   const SegmentMomentSet reference = run(cpu, points, labels, params);

@@ -1,5 +1,6 @@
 #include "test_support.hpp"
 
+#include <cstdio>
 #include <cstdlib>
 #include <sstream>
 
@@ -40,6 +41,12 @@ std::filesystem::path data_dir() {
     ADD_FAILURE() << "test data directory " << dir << " is missing (set KARTOGRAF_DATA_DIR)";
   }
   return dir;
+}
+
+std::string scientific(double value) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%.3e", value);
+  return text;
 }
 
 std::string backend_test_name(const ::testing::TestParamInfo<compute::BackendKind>& info) {

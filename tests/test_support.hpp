@@ -28,6 +28,9 @@ compute::Context make_context(compute::BackendKind kind);
 // ../shared/data (or KARTOGRAF_DATA_DIR): fails the test if missing.
 std::filesystem::path data_dir();
 
+// For RecordProperty: an error figure in %.3e form (std::to_string would print 0.000001).
+std::string scientific(double value);
+
 std::string backend_test_name(const ::testing::TestParamInfo<compute::BackendKind>& info);
 
 // Fixture: one context per test on the parameter's backend; after the test, the Vulkan validation
