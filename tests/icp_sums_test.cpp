@@ -9,6 +9,7 @@
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/normals.hpp"
 #include "kartograf/io/image_io.hpp"
+#include "kartograf/io/sequence.hpp"
 #include "kartograf/registration/icp_sums.hpp"
 #include "test_support.hpp"
 
@@ -191,12 +192,8 @@ Eigen::Isometry3d read_pose(const std::filesystem::path& path) {
   for (int r = 0; r < 4; ++r) {
     for (int c = 0; c < 4; ++c) in >> m(r, c);
   }
-  EXPECT_TRUE(in.good() || in.eof()) << path;
-  Eigen::JacobiSVD<Eigen::Matrix3d> svd(m.topLeftCorner<3, 3>(), Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = svd.matrixU() * svd.matrixV().transpose();  // re-orthonormalised
-  pose.translation() = m.topRightCorner<3, 1>();
-  return pose;
+  EXPECT_FALSE(in.fail()) << path;
+  return io::orthonormalized_pose(m);
 }
 
 TEST_P(IcpSumsTest, MatchesReferenceOnSevenScenesFramePair) {

@@ -2,8 +2,6 @@
 #include <cmath>
 #include <fstream>
 
-#include <unistd.h>
-
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/sequence.hpp"
@@ -41,16 +39,14 @@ TEST(Sequences, RedwoodLogOfOpen3dTestData) {
   EXPECT_DOUBLE_EQ(log[4].timestamp, 4.0);
 }
 
-class TempFolder : public ::testing::Test {
+class TempFolder : public testing::TempDirTest {
  protected:
   void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("kartograf-seq-test-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
+    TempDirTest::SetUp();
+    dir_ = dir();
     std::filesystem::create_directories(dir_ / "rgb");
     std::filesystem::create_directories(dir_ / "depth");
   }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path dir_;
 };
 

@@ -4,6 +4,8 @@
 #include <cstdlib>
 #include <sstream>
 
+#include <unistd.h>
+
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::testing {
@@ -52,6 +54,15 @@ std::string scientific(double value) {
 std::string backend_test_name(const ::testing::TestParamInfo<compute::BackendKind>& info) {
   return std::string(compute::to_string(info.param));
 }
+
+void TempDirTest::SetUp() {
+  const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
+  dir_ = std::filesystem::temp_directory_path() /
+         ("kartograf-test-" + std::to_string(::getpid()) + "-" + test->test_suite_name() + "-" + test->name());
+  std::filesystem::create_directories(dir_);
+}
+
+void TempDirTest::TearDown() { std::filesystem::remove_all(dir_); }
 
 void BackendTest::SetUp() {
   try {

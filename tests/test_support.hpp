@@ -47,6 +47,17 @@ class BackendTest : public ::testing::TestWithParam<compute::BackendKind> {
   std::unique_ptr<compute::Context> context_;
 };
 
+// Fixture: a fresh temporary directory per test, removed afterwards.
+class TempDirTest : public ::testing::Test {
+ protected:
+  void SetUp() override;
+  void TearDown() override;
+  const std::filesystem::path& dir() const { return dir_; }
+
+ private:
+  std::filesystem::path dir_;
+};
+
 #define KARTOGRAF_INSTANTIATE_BACKEND_TESTS(fixture)                                     \
   INSTANTIATE_TEST_SUITE_P(Backends, fixture,                                           \
                            ::testing::ValuesIn(::kartograf::testing::backends_under_test()), \

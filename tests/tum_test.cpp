@@ -3,8 +3,6 @@
 #include <fstream>
 #include <string>
 
-#include <unistd.h>
-
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/tum.hpp"
 #include "test_support.hpp"
@@ -14,20 +12,12 @@ namespace {
 
 std::filesystem::path tum_dir() { return testing::data_dir() / "tum_fr1_xyz_lists_only"; }
 
-class TumFiles : public ::testing::Test {
+class TumFiles : public testing::TempDirTest {
  protected:
-  void SetUp() override {
-    dir_ = std::filesystem::temp_directory_path() /
-           ("kartograf-tum-test-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    std::filesystem::create_directories(dir_);
-  }
-  void TearDown() override { std::filesystem::remove_all(dir_); }
   std::filesystem::path write(const std::string& name, const std::string& text) {
-    std::ofstream(dir_ / name) << text;
-    return dir_ / name;
+    std::ofstream(dir() / name) << text;
+    return dir() / name;
   }
-  std::filesystem::path dir_;
 };
 
 TEST_F(TumFiles, ReadsGenuineFr1XyzGroundTruthAndLists) {
@@ -83,7 +73,7 @@ TEST_F(TumFiles, TrajectoryRoundTrips) {
     p.pose = Eigen::Translation3d(0.1 * i, -0.2, 1.5) * Eigen::AngleAxisd(0.3 * i, Eigen::Vector3d(1, 2, 2).normalized());
     trajectory.push_back(p);
   }
-  const auto path = dir_ / "out.txt";
+  const auto path = dir() / "out.txt";
   io::write_tum_trajectory(path, trajectory);
   const Trajectory back = io::read_tum_trajectory(path);
   ASSERT_EQ(back.size(), trajectory.size());
@@ -112,7 +102,7 @@ TEST_F(TumFiles, MalformedInputNamesFileAndLine) {
   EXPECT_NE(message([&] { io::read_tum_trajectory(nan); }).find("line 1"), std::string::npos);
   const auto list = write("e.txt", "timestamp filename\n1.0 rgb/1.png\n2.0\n");
   EXPECT_NE(message([&] { io::read_tum_file_list(list); }).find("line 3"), std::string::npos);
-  EXPECT_NE(message([&] { io::read_tum_file_list(dir_ / "missing.txt"); }).find("cannot open"), std::string::npos);
+  EXPECT_NE(message([&] { io::read_tum_file_list(dir() / "missing.txt"); }).find("cannot open"), std::string::npos);
 }
 
 }  // namespace
