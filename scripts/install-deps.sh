@@ -10,6 +10,9 @@ packages=(
   mesa-vulkan-drivers vulkan-validationlayers      # lavapipe + the validation layer for tests
   ocl-icd-opencl-dev ocl-icd-libopencl1 pocl-opencl-icd  # OpenCL headers, ICD loader, PoCL
   libopencv-dev                                    # io: PNG/JPEG
+  liblzf-dev                                       # io: PCD binary_compressed
+  libyaml-cpp-dev                                  # io: ROS map_server YAML
+  nlohmann-json3-dev                               # io and CLI: JSON files
   libcli11-dev                                     # the kartograf CLI
   libgtest-dev libbenchmark-dev                    # tests and benchmarks
 )
