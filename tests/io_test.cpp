@@ -812,6 +812,67 @@ TEST_F(IoPly, EmptyCloudRoundTrips) {
   EXPECT_EQ(read_text(path("none.ply")), expected_header(0, false, false));
 }
 
+TEST_F(IoPly, AsciiWriterWritesShortestExactFloats) {
+  PointCloud cloud;
+  cloud.points = {{1, 2, 3}, {-0.0f, 1e-30f, 3.4e38f}};
+  cloud.normals = {{0, 0, 1}, {0.1f, -1, 0}};
+  cloud.colors = {{1, 2, 3}, {255, 254, 253}};
+  io::write_ply(path("cloud.ply"), cloud, io::PlyEncoding::ascii);
+  std::string expected = expected_header(2, true, true);
+  expected.replace(expected.find("binary_little_endian"), 20, "ascii");
+  EXPECT_EQ(read_text(path("cloud.ply")), expected +
+                                              "1 2 3 0 0 1 1 2 3\n"
+                                              "-0 1e-30 3.4e+38 0.1 -1 0 255 254 253\n");
+  const PointCloud back = io::read_ply(path("cloud.ply"));
+  EXPECT_TRUE(back.points == cloud.points);
+  EXPECT_TRUE(std::signbit(back.points[1].x()));
+  EXPECT_TRUE(back.normals == cloud.normals);
+  EXPECT_TRUE(back.colors == cloud.colors);
+}
+
+TEST_F(IoPly, AsciiAndBinaryWritersAgreeOnRandomClouds) {
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<float> coordinate(-1e4f, 1e4f);
+  std::uniform_real_distribution<float> small(-1e-6f, 1e-6f);
+  PointCloud cloud;
+  for (int i = 0; i < 5000; ++i) {
+    cloud.points.emplace_back(coordinate(rng), small(rng), coordinate(rng) * small(rng));
+    cloud.normals.emplace_back(small(rng), 1.0f / float(i + 1), -coordinate(rng));
+    cloud.colors.push_back({static_cast<std::uint8_t>(i), static_cast<std::uint8_t>(i >> 4),
+                            static_cast<std::uint8_t>(i >> 8)});
+  }
+  io::write_ply(path("ascii.ply"), cloud, io::PlyEncoding::ascii);
+  const PointCloud back = io::read_ply(path("ascii.ply"));
+  EXPECT_TRUE(back.points == cloud.points);
+  EXPECT_TRUE(back.normals == cloud.normals);
+  EXPECT_TRUE(back.colors == cloud.colors);
+
+  // The organized writer too: the same vertices as its binary form.
+  const OrganizedCloud organized = organized_cloud();
+  io::write_ply(path("image_ascii.ply"), organized.points, &organized.normals, &organized.colors,
+                io::PlyEncoding::ascii);
+  io::write_ply(path("image_binary.ply"), organized.points, &organized.normals, &organized.colors);
+  const PointCloud from_ascii = io::read_ply(path("image_ascii.ply"));
+  const PointCloud from_binary = io::read_ply(path("image_binary.ply"));
+  ASSERT_EQ(from_ascii.size(), organized.valid.size());
+  EXPECT_TRUE(from_ascii.points == from_binary.points);
+  EXPECT_TRUE(from_ascii.normals == from_binary.normals);
+  EXPECT_TRUE(from_ascii.colors == from_binary.colors);
+}
+
+TEST_F(IoPly, ParsesBytesInMemoryNamingThemInMessages) {
+  const std::string text =
+      "ply\nformat ascii 1.0\nelement vertex 2\nproperty float x\nproperty float y\n"
+      "property float z\nend_header\n1 2 3\n4 5 6\n";
+  const std::vector<std::uint8_t> bytes(text.begin(), text.end());
+  const PointCloud cloud = io::parse_ply(bytes, "memory.ply");
+  ASSERT_EQ(cloud.size(), 2u);
+  EXPECT_EQ(cloud.points[1], Eigen::Vector3f(4, 5, 6));
+  const std::vector<std::uint8_t> cut(bytes.begin(), bytes.end() - 6);
+  EXPECT_IO_ERROR(io::parse_ply(cut, "memory.ply"), "PLY file 'memory.ply'", "truncated");
+  EXPECT_IO_ERROR(io::parse_ply({}, "nothing"), "PLY file 'nothing'", "not a PLY file");
+}
+
 TEST_F(IoPly, WriterRejectsMismatchedSizes) {
   const OrganizedCloud cloud = organized_cloud();
   const NormalImage small_normals(5, 3, invalid_point());

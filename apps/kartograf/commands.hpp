@@ -8,6 +8,10 @@
 
 #include "kartograf/compute/backend.hpp"
 
+namespace CLI {
+class App;
+}  // namespace CLI
+
 namespace kartograf::cli {
 
 // Every backend and its devices in detail.
@@ -24,5 +28,20 @@ struct DemoOptions {
 
 // Synthesizes a depth frame, back-projects it, estimates normals and writes pictures and a cloud.
 int run_demo_command(const DemoOptions& options, std::ostream& out);
+
+// `eval traj|planes|rooms|semantic GT PREDICTION`: add_eval_command registers the subcommands
+// (parsing fills options); run_eval_command prints the chosen metric's table or JSON object.
+struct EvalOptions {
+  std::string metric;  // the subcommand given
+  std::filesystem::path ground_truth, prediction;
+  bool json = false;
+  double delta = 1;                   // traj
+  std::string delta_unit = "frames";  // traj
+  bool sim3 = false;                  // traj
+  double max_difference = 0.02;       // traj
+  double threshold = 0.8;             // planes
+};
+CLI::App* add_eval_command(CLI::App& app, EvalOptions& options);
+int run_eval_command(const EvalOptions& options, std::ostream& out);
 
 }  // namespace kartograf::cli

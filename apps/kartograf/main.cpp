@@ -26,6 +26,9 @@ int main(int argc, char** argv) {
       demo->add_option("--backend", demo_options.backend,
                        "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)");
 
+  kartograf::cli::EvalOptions eval_options;
+  CLI::App* eval = kartograf::cli::add_eval_command(app, eval_options);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -36,6 +39,7 @@ int main(int argc, char** argv) {
   try {
     if (*devices) return kartograf::cli::run_devices_command(std::cout);
     if (*demo) return kartograf::cli::run_demo_command(demo_options, std::cout);
+    if (*eval) return kartograf::cli::run_eval_command(eval_options, std::cout);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

@@ -12,6 +12,7 @@
 #include <iterator>
 #include <limits>
 #include <optional>
+#include <span>
 #include <string>
 #include <string_view>
 #include <utility>
@@ -29,11 +30,12 @@ using detail::quoted;
 // ---------------------------------------------------------------------------------------------
 // Writing
 
-// Appends values in little-endian byte order whatever the host's order is.
+// Appends values in little-endian byte order whatever the host's order is, or as text.
 class LittleEndianBuffer {
  public:
   void put(float value) { put_bytes(std::bit_cast<std::uint32_t>(value)); }
   void put(std::uint8_t value) { bytes_.push_back(value); }
+  void put_text(std::string_view text) { bytes_.insert(bytes_.end(), text.begin(), text.end()); }
 
   std::size_t size() const { return bytes_.size(); }
   const std::uint8_t* data() const { return bytes_.data(); }
@@ -48,17 +50,18 @@ class LittleEndianBuffer {
   std::vector<std::uint8_t> bytes_;
 };
 
-std::string vertex_header(std::size_t count, bool with_normals, bool with_colors) {
-  std::string header =
-      "ply\n"
-      "format binary_little_endian 1.0\n"
-      "comment written by kartograf\n"
-      "element vertex " +
-      std::to_string(count) +
-      "\n"
-      "property float x\n"
-      "property float y\n"
-      "property float z\n";
+std::string vertex_header(std::size_t count, bool with_normals, bool with_colors,
+                          PlyEncoding encoding) {
+  std::string header = std::string("ply\nformat ") +
+                       (encoding == PlyEncoding::ascii ? "ascii" : "binary_little_endian") +
+                       " 1.0\n"
+                       "comment written by kartograf\n"
+                       "element vertex " +
+                       std::to_string(count) +
+                       "\n"
+                       "property float x\n"
+                       "property float y\n"
+                       "property float z\n";
   if (with_normals) header += "property float nx\nproperty float ny\nproperty float nz\n";
   if (with_colors) header += "property uchar red\nproperty uchar green\nproperty uchar blue\n";
   header += "end_header\n";
@@ -69,18 +72,16 @@ std::string vertex_header(std::size_t count, bool with_normals, bool with_colors
 class VertexWriter {
  public:
   VertexWriter(const std::filesystem::path& path, std::size_t count, bool with_normals,
-               bool with_colors)
-      : file_(path), with_normals_(with_normals), with_colors_(with_colors) {
-    file_.write(vertex_header(count, with_normals, with_colors));
+               bool with_colors, PlyEncoding encoding)
+      : file_(path), with_normals_(with_normals), with_colors_(with_colors), encoding_(encoding) {
+    file_.write(vertex_header(count, with_normals, with_colors, encoding));
   }
 
   void add(const Eigen::Vector3f& point, const Eigen::Vector3f& normal, const Rgb8& color) {
-    for (int i = 0; i < 3; ++i) buffer_.put(point[i]);
-    if (with_normals_) {
-      for (int i = 0; i < 3; ++i) buffer_.put(normal[i]);
-    }
-    if (with_colors_) {
-      for (std::uint8_t channel : color) buffer_.put(channel);
+    if (encoding_ == PlyEncoding::ascii) {
+      add_text(point, normal, color);
+    } else {
+      add_binary(point, normal, color);
     }
     if (buffer_.size() >= kBlockBytes) flush();
   }
@@ -92,6 +93,36 @@ class VertexWriter {
 
  private:
   static constexpr std::size_t kBlockBytes = 1 << 20;
+
+  // Floats in their shortest form that reads back exactly.
+  void add_text(const Eigen::Vector3f& point, const Eigen::Vector3f& normal, const Rgb8& color) {
+    line_.clear();
+    auto put = [&](auto value) {
+      std::array<char, 32> text;
+      line_.append(text.data(), std::to_chars(text.data(), text.data() + text.size(), value).ptr);
+      line_ += ' ';
+    };
+    for (int i = 0; i < 3; ++i) put(point[i]);
+    if (with_normals_) {
+      for (int i = 0; i < 3; ++i) put(normal[i]);
+    }
+    if (with_colors_) {
+      for (std::uint8_t channel : color) put(int{channel});
+    }
+    line_.back() = '\n';
+    buffer_.put_text(line_);
+  }
+
+  void add_binary(const Eigen::Vector3f& point, const Eigen::Vector3f& normal, const Rgb8& color) {
+    for (int i = 0; i < 3; ++i) buffer_.put(point[i]);
+    if (with_normals_) {
+      for (int i = 0; i < 3; ++i) buffer_.put(normal[i]);
+    }
+    if (with_colors_) {
+      for (std::uint8_t channel : color) buffer_.put(channel);
+    }
+  }
+
   void flush() {
     file_.write(buffer_.data(), buffer_.size());
     buffer_.clear();
@@ -101,6 +132,8 @@ class VertexWriter {
   LittleEndianBuffer buffer_;
   bool with_normals_;
   bool with_colors_;
+  PlyEncoding encoding_;
+  std::string line_;  // ascii: the vertex being formatted
 };
 
 bool is_finite(const Eigen::Vector3f& v) {
@@ -281,8 +314,8 @@ struct VertexFields {
 
 class PlyReader {
  public:
-  PlyReader(const std::filesystem::path& path, std::vector<std::uint8_t> bytes)
-      : path_(path), bytes_(std::move(bytes)) {}
+  PlyReader(const std::filesystem::path& path, std::span<const std::uint8_t> bytes)
+      : path_(path), bytes_(bytes) {}
 
   PointCloud read() {
     header_ = parse_header();
@@ -581,7 +614,7 @@ class PlyReader {
   }
 
   std::filesystem::path path_;
-  std::vector<std::uint8_t> bytes_;
+  std::span<const std::uint8_t> bytes_;
   Header header_;
   std::size_t position_ = 0;  // byte offset of the next unread byte
   std::size_t line_ = 0;      // 1-based number of the last line read (ascii and header)
@@ -609,7 +642,7 @@ std::vector<std::uint8_t> read_whole_file(const std::filesystem::path& path) {
 }  // namespace
 
 void write_ply(const std::filesystem::path& path, const PointImage& points,
-               const NormalImage* normals, const RgbImage* colors) {
+               const NormalImage* normals, const RgbImage* colors, PlyEncoding encoding) {
   if (normals) require_same_size(path, points, *normals, "the normals");
   if (colors) require_same_size(path, points, *colors, "the colours");
   const auto all_points = points.pixels();
@@ -617,7 +650,7 @@ void write_ply(const std::filesystem::path& path, const PointImage& points,
       std::count_if(all_points.begin(), all_points.end(),
                     [](const Point4f& p) { return is_finite(Eigen::Vector3f(p.head<3>())); }));
 
-  VertexWriter writer(path, count, normals != nullptr, colors != nullptr);
+  VertexWriter writer(path, count, normals != nullptr, colors != nullptr, encoding);
   const Rgb8 no_color{0, 0, 0};
   for (std::size_t i = 0; i < all_points.size(); ++i) {
     const Eigen::Vector3f point = all_points[i].head<3>();
@@ -628,7 +661,7 @@ void write_ply(const std::filesystem::path& path, const PointImage& points,
   writer.commit();
 }
 
-void write_ply(const std::filesystem::path& path, const PointCloud& cloud) {
+void write_ply(const std::filesystem::path& path, const PointCloud& cloud, PlyEncoding encoding) {
   auto check_count = [&](std::size_t count, const char* what) {
     require(count == 0 || count == cloud.size(), "cannot write " + quoted(path) + ": " +
                                                      std::to_string(count) + " " + what + " for " +
@@ -639,7 +672,7 @@ void write_ply(const std::filesystem::path& path, const PointCloud& cloud) {
   const std::size_t count =
       static_cast<std::size_t>(std::count_if(cloud.points.begin(), cloud.points.end(), is_finite));
 
-  VertexWriter writer(path, count, cloud.has_normals(), cloud.has_colors());
+  VertexWriter writer(path, count, cloud.has_normals(), cloud.has_colors(), encoding);
   const Rgb8 no_color{0, 0, 0};
   for (std::size_t i = 0; i < cloud.size(); ++i) {
     if (!is_finite(cloud.points[i])) continue;
@@ -652,7 +685,12 @@ void write_ply(const std::filesystem::path& path, const PointCloud& cloud) {
 }
 
 PointCloud read_ply(const std::filesystem::path& path) {
-  return PlyReader(path, read_whole_file(path)).read();
+  const std::vector<std::uint8_t> bytes = read_whole_file(path);
+  return PlyReader(path, bytes).read();
+}
+
+PointCloud parse_ply(std::span<const std::uint8_t> bytes, const std::string& name) {
+  return PlyReader(std::filesystem::path(name), bytes).read();
 }
 
 }  // namespace kartograf::io

@@ -1,0 +1,97 @@
+#pragma once
+// Trajectory accuracy as the TUM RGB-D benchmark defines it (J. Sturm et al., "A benchmark for the
+// evaluation of RGB-D SLAM systems", IROS 2012, and its tools evaluate_ate.py / evaluate_rpe.py).
+//
+// Everything works on matched poses: ground_truth[k] and estimate[k] are the same instant. Match
+// by timestamp with io::associate_timestamps (TUM associate.py's rule: nearest within a maximum
+// difference, closest pairs first, each pose used once), then match_poses().
+//
+// ATE: the estimate's positions are aligned to the ground truth's by least squares (Umeyama 1991:
+//   SE(3) = Horn's method, what evaluate_ate.py does; Sim(3) also fits a scale, for monocular
+//   estimates), then per pose |x_gt - (s R x_est + t)|.
+// RPE: for every pair (i, j) delta apart, E = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j) with Q the ground truth
+//   and P the estimate; translational error |trans(E)| [m], rotational error
+//   acos((trace(rot(E)) - 1) / 2) [deg], summarised over all pairs (evaluate_rpe.py --fixed_delta
+//   with all pairs). Pairs are taken over the matched list:
+//   - frames: j = i + delta;
+//   - seconds: j = the pose whose ground-truth time is nearest to t_i + delta, for every i with
+//     t_i + delta <= t_last. (evaluate_rpe.py drops every pair ending at the last pose, a slip that
+//     also drops the genuine last one; it looks ground truth up per estimate pose instead of
+//     matching first, as evo does.)
+//   With Sim(3) alignment, RPE is measured on the scaled estimate; a rigid alignment does not
+//   change relative motion.
+#include <cstddef>
+#include <span>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/core/trajectory.hpp"
+
+namespace kartograf::eval {
+
+// ground_truth[k] and estimate[k] are the same instant.
+struct MatchedPoses {
+  Trajectory ground_truth;
+  Trajectory estimate;
+  std::size_t size() const { return ground_truth.size(); }
+};
+
+// pairs: (ground-truth index, estimate index), e.g. from io::associate_timestamps(gt times,
+// estimate times, max_difference). Throws Error on an index out of range.
+MatchedPoses match_poses(const Trajectory& ground_truth, const Trajectory& estimate,
+                         std::span<const std::pair<std::size_t, std::size_t>> pairs);
+
+// count, RMSE, mean, median, population standard deviation, min and max of a list of errors.
+struct ErrorStatistics {
+  std::size_t count = 0;
+  double rmse = 0, mean = 0, median = 0, std_dev = 0, min = 0, max = 0;
+};
+ErrorStatistics summarize_errors(std::vector<double> errors);  // all zero when empty
+
+enum class Alignment { none, se3, sim3 };
+
+// x_ground_truth ≈ scale * rotation * x_estimate + translation.
+struct SimilarityTransform {
+  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();
+  Eigen::Vector3d translation = Eigen::Vector3d::Zero();
+  double scale = 1;
+};
+
+// Least squares over the matched positions; identity for Alignment::none. SE(3) and Sim(3) need
+// at least 3 poses, Sim(3) estimate positions that are not all the same.
+SimilarityTransform align_positions(const MatchedPoses& poses, Alignment alignment);
+
+// Poses moved by a similarity: position s R x + t, orientation R R_i.
+Trajectory transform_trajectory(const Trajectory& trajectory, const SimilarityTransform& transform);
+
+struct AteResult {
+  SimilarityTransform alignment;
+  ErrorStatistics translation_m;
+};
+AteResult compute_ate(const MatchedPoses& poses, Alignment alignment);
+
+enum class DeltaUnit { frames, seconds };
+
+struct RpeOptions {
+  double delta = 1;  // frames (a positive whole number) or seconds (> 0)
+  DeltaUnit unit = DeltaUnit::frames;
+};
+
+struct RpeResult {
+  ErrorStatistics translation_m;
+  ErrorStatistics rotation_deg;
+};
+// Throws Error when no pair is delta apart (or, for seconds, the timestamps are not increasing).
+RpeResult compute_rpe(const MatchedPoses& poses, const RpeOptions& options);
+
+// ATE with the given alignment, and RPE on the estimate that alignment moved.
+struct TrajectoryEvaluation {
+  AteResult ate;
+  RpeResult rpe;
+};
+TrajectoryEvaluation evaluate_trajectory(const MatchedPoses& poses, Alignment alignment,
+                                         const RpeOptions& rpe_options);
+
+}  // namespace kartograf::eval

@@ -1,0 +1,163 @@
+// Room metrics (eval/room_metrics.hpp) and connected-component labelling on hand-made label
+// images with hand-computed answers, and on the real ipa_room_segmentation ground truth.
+#include <cmath>
+#include <string>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/eval/connected_components.hpp"
+#include "kartograf/eval/room_metrics.hpp"
+#include "kartograf/io/occupancy_map_io.hpp"
+#include "test_support.hpp"
+
+namespace kartograf {
+namespace {
+
+void fill(LabelImage& image, int x0, int y0, int x1, int y1, Label label) {
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) image(x, y) = label;
+  }
+}
+
+// Rooms A (label 1) and B (label 2), 30x10 = 300 pixels each, side by side behind a 1-pixel
+// wall column (label 0) in a 61x10 map.
+LabelImage two_rooms() {
+  LabelImage rooms(61, 10, kUnlabeled);
+  fill(rooms, 0, 0, 30, 10, 1);
+  fill(rooms, 31, 0, 61, 10, 2);
+  return rooms;
+}
+
+TEST(EvalRooms, IdenticalSegmentationScoresOne) {
+  const auto scores = eval::evaluate_room_segmentation(two_rooms(), two_rooms());
+  EXPECT_EQ(scores.ground_truth_rooms, 2);
+  EXPECT_EQ(scores.segments, 2);
+  EXPECT_DOUBLE_EQ(scores.recall_mean, 1);
+  EXPECT_DOUBLE_EQ(scores.recall_total, 1);
+  EXPECT_DOUBLE_EQ(scores.precision_mean, 1);
+  EXPECT_DOUBLE_EQ(scores.precision_total, 1);
+  EXPECT_DOUBLE_EQ(scores.mcc, 1);
+  EXPECT_EQ(scores.mcc_matched_pairs, 2);
+  EXPECT_EQ(scores.mcc_unmatched_regions, 0);
+}
+
+TEST(EvalRooms, ARoomSplitInHalvesHasHalfRecallAndFullPrecision) {
+  LabelImage segmentation = two_rooms();
+  fill(segmentation, 15, 0, 30, 10, 3);  // room A: segments 1 (150 px) and 3 (150 px)
+  const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
+  ASSERT_EQ(scores.room_recall.size(), 2u);
+  EXPECT_DOUBLE_EQ(scores.room_recall[0], 0.5);
+  EXPECT_DOUBLE_EQ(scores.room_recall[1], 1.0);
+  EXPECT_DOUBLE_EQ(scores.recall_mean, 0.75);
+  EXPECT_DOUBLE_EQ(scores.recall_total, (150.0 + 300.0) / 600.0);
+  EXPECT_DOUBLE_EQ(scores.precision_mean, 1);
+  EXPECT_DOUBLE_EQ(scores.precision_total, 1);
+  // MCC over the N = 600 pixels labelled in both. Segment 2 takes room B (largest overlap, 300):
+  // TP 300, FP 0, FN 0, TN 300 -> 1. Segment 1 (150, lower label than 3) takes room A:
+  // TP 150, FP 0, FN 150, TN 300 -> 150 * 300 / sqrt(150 * 300 * 300 * 450) = 1 / sqrt(3).
+  // Segment 3 finds room A taken: unmatched, 0. Mean (1 + 1/sqrt(3) + 0) / 3.
+  EXPECT_NEAR(scores.mcc, (1 + 1 / std::sqrt(3.0)) / 3, 1e-12);
+  EXPECT_EQ(scores.mcc_matched_pairs, 2);
+  EXPECT_EQ(scores.mcc_unmatched_regions, 1);
+}
+
+TEST(EvalRooms, MergedRoomsAreTheMirrorCase) {
+  LabelImage segmentation(61, 10, kUnlabeled);
+  fill(segmentation, 0, 0, 61, 10, 5);  // one segment over both rooms and the wall: 610 px
+  const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
+  EXPECT_DOUBLE_EQ(scores.recall_mean, 1);
+  EXPECT_DOUBLE_EQ(scores.recall_total, 1);
+  EXPECT_DOUBLE_EQ(scores.precision_mean, 300.0 / 610.0);
+  EXPECT_DOUBLE_EQ(scores.precision_total, 300.0 / 610.0);
+  // The segment takes room A (tie with B, lower label): TP 300, FP 300, FN 0, TN 0 -> the
+  // denominator is 0 with FP > 0: 0. Room B unmatched: 0.
+  EXPECT_DOUBLE_EQ(scores.mcc, 0);
+}
+
+TEST(EvalRooms, SegmentsSpillingIntoWallsLosePrecisionButNotMcc) {
+  LabelImage segmentation = two_rooms();
+  fill(segmentation, 30, 0, 31, 10, 1);  // segment 1 also covers the 10 wall pixels
+  const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
+  EXPECT_DOUBLE_EQ(scores.precision_mean, (300.0 / 310.0 + 1.0) / 2);
+  EXPECT_DOUBLE_EQ(scores.precision_total, 600.0 / 610.0);
+  EXPECT_DOUBLE_EQ(scores.recall_mean, 1);
+  EXPECT_DOUBLE_EQ(scores.mcc, 1);  // MAORIS counts only pixels labelled in both
+}
+
+TEST(EvalRooms, RegionsOfAHundredPixelsOrLessAreIgnoredLikeIpa) {
+  LabelImage segmentation = two_rooms();
+  fill(segmentation, 0, 0, 10, 10, 8);  // 100 px: dropped; segment 1 keeps 200 px of room A
+  const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
+  EXPECT_EQ(scores.segments, 2);
+  EXPECT_DOUBLE_EQ(scores.room_recall[0], 200.0 / 300.0);
+  EXPECT_DOUBLE_EQ(scores.precision_mean, 1);
+  eval::RoomEvaluationOptions keep_all;
+  keep_all.min_region_pixels = 1;
+  EXPECT_EQ(eval::evaluate_room_segmentation(two_rooms(), segmentation, keep_all).segments, 3);
+}
+
+TEST(EvalRooms, RejectsBadInput) {
+  EXPECT_THROW(eval::evaluate_room_segmentation(two_rooms(), LabelImage(60, 10, 0)), Error);
+  EXPECT_THROW(eval::evaluate_room_segmentation(LabelImage(61, 10, 0), two_rooms()), Error);
+  LabelImage empty_segmentation(61, 10, kUnlabeled);
+  const auto scores = eval::evaluate_room_segmentation(two_rooms(), empty_segmentation);
+  EXPECT_EQ(scores.segments, 0);
+  EXPECT_DOUBLE_EQ(scores.recall_mean, 0);
+  EXPECT_DOUBLE_EQ(scores.precision_mean, 0);
+  EXPECT_DOUBLE_EQ(scores.mcc, 0);
+}
+
+TEST(EvalConnectedComponents, NumbersRegionsInRasterOrderAndDropsSpecks) {
+  // Region a (top left, 4 px) touches region b (5 px) only diagonally; c is a 1-px speck; d
+  // (2 px) starts on row 0 to the right of a, so it is numbered before b.
+  const char* rows[] = {
+      "aa..d",  //
+      "aa..d",  //
+      "..b..",  //
+      "..bb.",  //
+      "c.bb.",  //
+  };
+  Image<std::uint8_t> mask(5, 5, 0);
+  for (int y = 0; y < 5; ++y) {
+    for (int x = 0; x < 5; ++x) mask(x, y) = rows[y][x] != '.';
+  }
+  const LabelImage four = eval::label_connected_components(mask, {eval::Connectivity::four, 2});
+  EXPECT_EQ(four(0, 0), 1);  // a
+  EXPECT_EQ(four(4, 0), 2);  // d
+  EXPECT_EQ(four(2, 2), 3);  // b
+  EXPECT_EQ(four(3, 4), 3);
+  EXPECT_EQ(four(0, 4), 0);  // c: a speck of 1 < 2 pixels
+  EXPECT_EQ(four(2, 0), 0);  // background
+  const LabelImage eight = eval::label_connected_components(mask, {eval::Connectivity::eight, 1});
+  EXPECT_EQ(eight(0, 0), 1);  // a and b joined through the diagonal, d stays apart
+  EXPECT_EQ(eight(2, 2), 1);
+  EXPECT_EQ(eight(4, 0), 2);
+  EXPECT_EQ(eight(0, 4), 3);  // c kept with min_pixels 1
+  EXPECT_THROW(eval::label_connected_components(mask, {eval::Connectivity::four, 0}), Error);
+}
+
+TEST(EvalRooms, RealGroundTruthAgainstItselfScoresOne) {
+  // lab_ipa: 11 rooms as 4-connected white regions (what the data's SOURCE.txt states); ipa's own
+  // evaluation flood-fills 8-connected and sees 10, two rooms meeting at a diagonal. Scored
+  // against the 4-connected truth, that 8-connected reading loses precision only.
+  const auto maps = testing::data_dir() / "ipa_room_maps" / "test_maps";
+  const LabelImage rooms = io::read_room_ground_truth_png(maps / "lab_ipa_gt_segmentation.png");
+  const auto self = eval::evaluate_room_segmentation(rooms, rooms);
+  EXPECT_EQ(self.ground_truth_rooms, 11);
+  EXPECT_DOUBLE_EQ(self.recall_mean, 1);
+  EXPECT_DOUBLE_EQ(self.precision_mean, 1);
+  EXPECT_DOUBLE_EQ(self.precision_total, 1);
+  EXPECT_DOUBLE_EQ(self.mcc, 1);
+
+  io::RoomGroundTruthOptions ipa_flood_fill;
+  ipa_flood_fill.connectivity = eval::Connectivity::eight;
+  const LabelImage eight =
+      io::read_room_ground_truth_png(maps / "lab_ipa_gt_segmentation.png", ipa_flood_fill);
+  const auto merged = eval::evaluate_room_segmentation(rooms, eight);
+  EXPECT_EQ(merged.segments, 10);
+  EXPECT_DOUBLE_EQ(merged.recall_mean, 1);
+  EXPECT_LT(merged.precision_mean, 1);
+  EXPECT_LT(merged.mcc, 1);
+}
+
+}  // namespace
+}  // namespace kartograf
