@@ -2,7 +2,8 @@
 # Point-cloud interop check: clouds Kartograf writes (PCD ascii / binary / binary_compressed, PLY
 # binary and ascii) are read by Open3D and by PCL's command-line tools with the expected counts and
 # values, and what PCL and Open3D write from them is read back by Kartograf to the same values.
-# Exits non-zero on any mismatch. Builds nothing: pass a build folder with kartograf_tests built.
+# Exits non-zero on any mismatch. Builds nothing: pass a build folder where the Kartograf side,
+# kartograf_interop_samples (tests/pcd_interop_samples.cpp), is built and up to date.
 #
 #   scripts/check-interop.sh <build-dir> [work-dir]
 #
@@ -14,11 +15,18 @@ if [ $# -lt 1 ] || [ $# -gt 2 ]; then
   echo "usage: $0 <build-dir> [work-dir]" >&2
   exit 2
 fi
-tests="$1/tests/kartograf_tests"
+samples="$1/tests/kartograf_interop_samples"
 work="${2:-$(mktemp -d "${TMPDIR:-/tmp}/kartograf-interop.XXXXXX")}"
 python=/usr/bin/python3  # Open3D is installed for the system Python, not a pyenv one on PATH
 
-[ -x "$tests" ] || { echo "FAIL: $tests is not built (ninja -C $1 kartograf_tests)" >&2; exit 2; }
+build_hint="ninja -C $1 kartograf_interop_samples"
+[ -x "$samples" ] || { echo "FAIL: $samples is not built ($build_hint)" >&2; exit 2; }
+# A stale program would check an older reader or writer. (Not `ninja -n`: with CMake's
+# CONFIGURE_DEPENDS globs a dry run always reports that CMake would run again.)
+repo="$(cd "$(dirname "$0")/.." && pwd)"
+newer=$(find "$repo/src/io" "$repo/include/kartograf/io" "$repo/tests/pcd_interop_samples.cpp" \
+  -type f -newer "$samples" -print -quit)
+[ -z "$newer" ] || { echo "FAIL: $samples is older than $newer ($build_hint)" >&2; exit 2; }
 "$python" -c 'import open3d' 2>/dev/null || { echo "FAIL: $python cannot import open3d" >&2; exit 2; }
 for tool in pcl_pcd2ply pcl_ply2pcd pcl_convert_pcd_ascii_binary pcl_fpfh_estimation; do
   command -v "$tool" >/dev/null || { echo "FAIL: $tool is missing (apt-get install pcl-tools)" >&2; exit 2; }
@@ -31,7 +39,7 @@ ok() { echo "ok    $*"; }
 rm -rf "$work/pcl" "$work/open3d"
 mkdir -p "$work/pcl" "$work/open3d"
 echo "== Kartograf writes the samples into $work"
-KARTOGRAF_INTEROP_DIR="$work" "$tests" --gtest_filter=PcdInterop.WriteSamples --gtest_brief=1 \
+KARTOGRAF_INTEROP_DIR="$work" "$samples" --gtest_filter=PcdInterop.WriteSamples --gtest_brief=1 \
   >"$work/write.log" 2>&1 || { cat "$work/write.log"; echo "FAIL: writing the samples" >&2; exit 1; }
 cat "$work/expected.txt"
 
@@ -120,7 +128,7 @@ pcl_check 500 "$work/pcl/fpfh.pcd" \
 head -11 "$work/pcl/fpfh.pcd" | grep -E '^(FIELDS|COUNT|DATA)' | sed 's/^/      fpfh.pcd: /'
 
 echo "== Kartograf reads what PCL and Open3D wrote"
-if KARTOGRAF_INTEROP_DIR="$work" "$tests" --gtest_filter='PcdInterop.Reads*' \
+if KARTOGRAF_INTEROP_DIR="$work" "$samples" --gtest_filter='PcdInterop.Reads*' \
   >"$work/read.log" 2>&1; then
   grep -E '^\[ +(OK|PASSED) ' "$work/read.log" | sed 's/^/      /'
 else

@@ -2,8 +2,8 @@
 // colours and labels (bit-exact, NaNs kept); known answers from hand-written ascii text, a
 // hand-built binary buffer, and binary_compressed data compressed here with liblzf; every field
 // type PCL writes; the exact bytes the writer produces; malformed input (each message names the
-// file and the problem, and oversized headers fail fast without allocating); and the sample files
-// scripts/check-interop.sh hands to Open3D and PCL.
+// file and the problem, and oversized headers fail fast without allocating). The samples that
+// scripts/check-interop.sh hands to Open3D and PCL are written by pcd_interop_samples.cpp.
 #include <lzf.h>
 
 #include <algorithm>
@@ -11,7 +11,6 @@
 #include <chrono>
 #include <cmath>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <fstream>
 #include <functional>
@@ -848,136 +847,6 @@ TEST_F(Pcd, WriterRejectsInconsistentCloudsAndLeavesNoFile) {
   EXPECT_FALSE(fs::exists(path("bad.pcd")));
   EXPECT_PCD_ERROR(
       io::write_pcd(path("missing/dir/x.pcd"), make_cloud(2, 1, false, false, false, 2)), "x.pcd");
-}
-
-// ---------------------------------------------------------------------------------------------
-// Samples for scripts/check-interop.sh (skipped unless KARTOGRAF_INTEROP_DIR names a folder)
-
-fs::path interop_dir() {
-  const char* dir = std::getenv("KARTOGRAF_INTEROP_DIR");
-  return dir ? fs::path(dir) : fs::path();
-}
-
-// Deterministic and exactly representable in PCL's default 8-digit ascii output.
-PcdCloud interop_cloud(bool organized) {
-  PcdCloud cloud;
-  cloud.width = organized ? 16 : 500;
-  cloud.height = organized ? 12 : 1;
-  for (int i = 0; i < cloud.width * cloud.height; ++i) {
-    const bool hole = organized && i % 7 == 3;
-    cloud.points.push_back(hole ? Eigen::Vector3f(kNan, kNan, kNan)
-                                : Eigen::Vector3f(0.25f * float(i % 16), -0.5f * float(i / 16),
-                                                  1.0f + 0.125f * float(i % 5)));
-    if (!organized) cloud.normals.push_back(Eigen::Vector3f(0.0f, 0.6f, -0.8f));
-    cloud.colors.push_back({static_cast<std::uint8_t>(i % 256), static_cast<std::uint8_t>(200),
-                            static_cast<std::uint8_t>(255 - i % 256)});
-    if (!organized) cloud.labels.push_back(static_cast<std::uint32_t>(i / 100));
-  }
-  return cloud;
-}
-
-constexpr std::array<std::pair<PcdEncoding, const char*>, 3> kEncodings = {{
-    {PcdEncoding::ascii, "ascii"},
-    {PcdEncoding::binary, "binary"},
-    {PcdEncoding::binary_compressed, "binary_compressed"},
-}};
-
-TEST(PcdInterop, WriteSamples) {
-  const fs::path dir = interop_dir();
-  if (dir.empty()) GTEST_SKIP() << "KARTOGRAF_INTEROP_DIR is not set";
-  fs::create_directories(dir);
-  // expected.txt: file, points in the file, normals, colours, first point, its colour.
-  std::ofstream manifest(dir / "expected.txt");
-  for (bool organized : {false, true}) {
-    const PcdCloud cloud = interop_cloud(organized);
-    const std::string kind = organized ? "organized" : "unorganized";
-    for (const auto& [encoding, name] : kEncodings) {
-      const std::string file = "kartograf_" + kind + "_" + name + ".pcd";
-      io::write_pcd(dir / file, cloud, encoding);
-      manifest << file << ' ' << cloud.size() << ' ' << !cloud.normals.empty() << " 1 "
-               << cloud.points[0].x() << ' ' << cloud.points[0].y() << ' ' << cloud.points[0].z()
-               << ' ' << int{cloud.colors[0][0]} << ' ' << int{cloud.colors[0][1]} << ' '
-               << int{cloud.colors[0][2]} << '\n';
-    }
-  }
-  const PointCloud ply = interop_cloud(false).to_point_cloud();
-  for (const auto& [encoding, name] :
-       {std::pair{io::PlyEncoding::binary_little_endian, "binary_little_endian"},
-        std::pair{io::PlyEncoding::ascii, "ascii"}}) {
-    const std::string file = std::string("kartograf_unorganized_") + name + ".ply";
-    io::write_ply(dir / file, ply, encoding);
-    manifest << file << ' ' << ply.size() << " 1 1 " << ply.points[0].x() << ' '
-             << ply.points[0].y() << ' ' << ply.points[0].z() << ' ' << int{ply.colors[0][0]} << ' '
-             << int{ply.colors[0][1]} << ' ' << int{ply.colors[0][2]} << '\n';
-  }
-  ASSERT_TRUE(manifest.good());
-}
-
-void expect_same_points(const PointCloud& expected, const PointCloud& actual) {
-  ASSERT_EQ(actual.size(), expected.size());
-  EXPECT_EQ(count_differences(actual.points, expected.points), 0u);
-  EXPECT_EQ(count_differences(actual.normals, expected.normals), 0u);
-  EXPECT_EQ(actual.colors, expected.colors);
-}
-
-PointCloud points_of(const PcdCloud& cloud) {
-  return {cloud.points, cloud.normals, cloud.colors};
-}
-
-// What PCL wrote from the samples (the script puts it in <dir>/pcl): Kartograf reads it back to
-// the values it wrote.
-TEST(PcdInterop, ReadsWhatPclWrote) {
-  if (interop_dir().empty()) GTEST_SKIP() << "KARTOGRAF_INTEROP_DIR is not set";
-  const fs::path dir = interop_dir() / "pcl";
-  ASSERT_TRUE(fs::is_directory(dir)) << dir << ": run scripts/check-interop.sh";
-  int checked = 0;
-  for (bool organized : {false, true}) {
-    const PcdCloud expected = interop_cloud(organized);
-    const std::string kind = organized ? "organized" : "unorganized";
-    for (const auto& [encoding, name] : kEncodings) {
-      // pcl_convert_pcd_ascii_binary of Kartograf's binary file: PCL's PCD writer.
-      const fs::path pcd = dir / ("convert_" + kind + "_" + name + ".pcd");
-      SCOPED_TRACE(pcd.string());
-      expect_same_cloud(expected, io::read_pcd(pcd));
-      // pcl_pcd2ply of each of Kartograf's encodings: PCL keeps the NaN points in its PLY.
-      const fs::path ply = dir / ("pcd2ply_" + kind + "_" + name + ".ply");
-      SCOPED_TRACE(ply.string());
-      expect_same_points(points_of(expected), io::read_ply(ply));
-      checked += 2;
-    }
-  }
-  // pcl_ply2pcd of Kartograf's PLY files.
-  const PointCloud valid = interop_cloud(false).to_point_cloud();
-  for (const char* name : {"binary_little_endian", "ascii"}) {
-    const fs::path file = dir / (std::string("ply2pcd_") + name + ".pcd");
-    SCOPED_TRACE(file.string());
-    expect_same_points(valid, points_of(io::read_pcd(file)));
-    ++checked;
-  }
-  // pcl_fpfh_estimation's output: fpfh (COUNT 33) first, then x y z and the normals.
-  const PcdCloud fpfh = io::read_pcd(dir / "fpfh.pcd");
-  EXPECT_EQ(count_differences(fpfh.points, valid.points), 0u);
-  EXPECT_EQ(count_differences(fpfh.normals, valid.normals), 0u);
-  ++checked;
-  EXPECT_EQ(checked, 15);
-}
-
-// What Open3D wrote from the unorganized sample (<dir>/open3d).
-TEST(PcdInterop, ReadsWhatOpen3dWrote) {
-  if (interop_dir().empty()) GTEST_SKIP() << "KARTOGRAF_INTEROP_DIR is not set";
-  const fs::path dir = interop_dir() / "open3d";
-  ASSERT_TRUE(fs::is_directory(dir)) << dir << ": run scripts/check-interop.sh";
-  const PointCloud valid = interop_cloud(false).to_point_cloud();
-  for (const char* name : {"ascii", "binary", "binary_compressed"}) {
-    const fs::path file = dir / (std::string("open3d_") + name + ".pcd");
-    SCOPED_TRACE(file.string());
-    expect_same_points(valid, points_of(io::read_pcd(file)));
-  }
-  for (const char* name : {"binary", "ascii"}) {
-    const fs::path file = dir / (std::string("open3d_") + name + ".ply");
-    SCOPED_TRACE(file.string());
-    expect_same_points(valid, io::read_ply(file));
-  }
 }
 
 }  // namespace

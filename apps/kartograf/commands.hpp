@@ -1,12 +1,14 @@
 #pragma once
 // The CLI's subcommands. Each returns the process exit code and throws kartograf::Error on
 // failure (main reports it).
+#include <cstdint>
 #include <filesystem>
 #include <iosfwd>
 #include <string>
 #include <vector>
 
 #include "kartograf/compute/backend.hpp"
+#include "kartograf/core/intrinsics.hpp"
 
 namespace CLI {
 class App;
@@ -26,7 +28,8 @@ struct DemoOptions {
   std::string backend_source = "--backend";  // names the setting in errors
 };
 
-// Synthesizes a depth frame, back-projects it, estimates normals and writes pictures and a cloud.
+// Renders a depth frame of the default synthetic world (synth/), back-projects it, estimates
+// normals and writes pictures and a cloud.
 int run_demo_command(const DemoOptions& options, std::ostream& out);
 
 // `eval traj|planes|rooms|semantic GT PREDICTION`: add_eval_command registers the subcommands
@@ -43,5 +46,20 @@ struct EvalOptions {
 };
 CLI::App* add_eval_command(CLI::App& app, EvalOptions& options);
 int run_eval_command(const EvalOptions& options, std::ostream& out);
+
+// `synth --out DIR ...`: a synthetic RGB-D data set with exact ground truth; progress on err.
+struct SynthOptions {
+  std::filesystem::path out_dir;
+  std::uint64_t seed = 1;
+  int frames = 300;
+  std::string trajectory = "robot";  // robot | handheld
+  int room = 0;                      // handheld: room id, 0 = the largest
+  PinholeIntrinsics intrinsics{640, 480, 525.0, 525.0, 319.5, 239.5};
+  bool no_noise = false;
+  bool force = false;
+  int threads = 0;
+};
+CLI::App* add_synth_command(CLI::App& app, SynthOptions& options);
+int run_synth_command(const SynthOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace kartograf::cli

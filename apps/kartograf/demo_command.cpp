@@ -12,7 +12,6 @@
 #include <vector>
 
 #include "commands.hpp"
-#include "demo_scene.hpp"
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
@@ -20,13 +19,35 @@
 #include "kartograf/geometry/normals.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/ply.hpp"
+#include "kartograf/synth/render.hpp"
+#include "kartograf/synth/trajectory.hpp"
 
 namespace kartograf::cli {
 
 namespace {
 
-constexpr double kMillimetresPerMetre = 1000.0;
+constexpr double kUnitsPerMetre = synth::kTumDepthUnitsPerMetre;
 constexpr double kMaxMetres = 10.0;
+
+// The demo's input: one frame of the default synthetic world (seed 1), seen by a Kinect-like
+// sensor from the robot tour inside the first room.
+struct DemoFrame {
+  PinholeIntrinsics intrinsics;
+  DepthImage depth;  // 5000 units per metre
+};
+
+DemoFrame render_demo_frame() {
+  constexpr std::uint64_t kSeed = 1;
+  constexpr int kTourFrames = 300, kFrame = 20;
+  const synth::World world = synth::make_building(kSeed);
+  const Trajectory tour = synth::robot_tour(world, kTourFrames);
+  DemoFrame frame;
+  frame.intrinsics = {640, 480, 525.0, 525.0, 319.5, 239.5};
+  frame.depth =
+      synth::render(world, frame.intrinsics, tour[kFrame].pose, synth::NoiseModel::kinect(), kSeed)
+          .depth;
+  return frame;
+}
 
 // Wall-clock durations of the demo's stages, in the order they ran.
 class StageTimer {
@@ -96,10 +117,10 @@ int run_demo_command(const DemoOptions& options, std::ostream& out) {
   print_backend_summary(out, compute::probe_backends());
 
   StageTimer timer;
-  const demo::DemoFrame frame = timer.time("synthesize", [] { return demo::render_demo_room(); });
+  const DemoFrame frame = timer.time("synthesize", [] { return render_demo_frame(); });
   const PinholeIntrinsics& intrinsics = frame.intrinsics;
-  out << "input: synthetic room, " << intrinsics.width << "x" << intrinsics.height
-      << " depth in millimetres, fx=fy=" << intrinsics.fx << "\n";
+  out << "input: synthetic world (seed 1, Kinect noise), " << intrinsics.width << "x"
+      << intrinsics.height << " depth in 1/5000 m, fx=fy=" << intrinsics.fx << "\n";
 
   compute::Context context =
       timer.time("context", [&] { return compute::Context(context_options); });
@@ -109,7 +130,7 @@ int run_demo_command(const DemoOptions& options, std::ostream& out) {
   timer.time("kernels", [&] { context.build_all_kernels(); });
 
   const geometry::DepthBackprojector projector(
-      context, intrinsics, geometry::DepthRange{kMillimetresPerMetre, 0.1, kMaxMetres});
+      context, intrinsics, geometry::DepthRange{kUnitsPerMetre, 0.1, kMaxMetres});
   compute::DeviceImage<Point4f> device_points(context, intrinsics.width, intrinsics.height);
   compute::DeviceImage<Point4f> device_normals(context, intrinsics.width, intrinsics.height);
   // Each stage ends with finish() so that its time is its own, not the next stage's.
@@ -133,13 +154,13 @@ int run_demo_command(const DemoOptions& options, std::ostream& out) {
   // The colormap spans the frame's own depths, not the 10 m valid range: more contrast.
   const auto depths = frame.depth.pixels();
   const double colormap_max_metres =
-      std::max<double>(1, *std::max_element(depths.begin(), depths.end())) / kMillimetresPerMetre;
+      std::max<double>(1, *std::max_element(depths.begin(), depths.end())) / kUnitsPerMetre;
 
   const std::filesystem::path& dir = options.out_dir;
   const std::vector<std::filesystem::path> written = timer.time("write", [&] {
     io::write_png(dir / "depth.png", frame.depth);
     io::write_png(dir / "depth_color.png",
-                  io::colorize_depth(frame.depth, kMillimetresPerMetre, colormap_max_metres));
+                  io::colorize_depth(frame.depth, kUnitsPerMetre, colormap_max_metres));
     io::write_png(dir / "normals.png", io::colorize_normals(normals));
     io::write_ply(dir / "cloud.ply", points, &normals);
     return std::vector<std::filesystem::path>{dir / "depth.png", dir / "depth_color.png",

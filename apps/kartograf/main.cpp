@@ -20,7 +20,7 @@ int main(int argc, char** argv) {
     demo_options.backend_source = "KARTOGRAF_BACKEND";
   }
   CLI::App* demo = app.add_subcommand(
-      "demo", "Back-project a synthetic depth frame, estimate normals, write pictures and a PLY");
+      "demo", "Render a frame of the synthetic world, back-project, estimate normals, write pictures and a PLY");
   demo->add_option("--out", demo_options.out_dir, "Output directory")->capture_default_str();
   CLI::Option* backend_option =
       demo->add_option("--backend", demo_options.backend,
@@ -28,6 +28,8 @@ int main(int argc, char** argv) {
 
   kartograf::cli::EvalOptions eval_options;
   CLI::App* eval = kartograf::cli::add_eval_command(app, eval_options);
+  kartograf::cli::SynthOptions synth_options;
+  CLI::App* synth = kartograf::cli::add_synth_command(app, synth_options);
 
   try {
     app.parse(argc, argv);
@@ -40,6 +42,7 @@ int main(int argc, char** argv) {
     if (*devices) return kartograf::cli::run_devices_command(std::cout);
     if (*demo) return kartograf::cli::run_demo_command(demo_options, std::cout);
     if (*eval) return kartograf::cli::run_eval_command(eval_options, std::cout);
+    if (*synth) return kartograf::cli::run_synth_command(synth_options, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

@@ -1,12 +1,8 @@
 #include "kartograf/io/image_io.hpp"
 
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -15,6 +11,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "io/atomic_file.hpp"
+#include "io/opencv_decode.hpp"
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::io {
@@ -22,65 +19,6 @@ namespace kartograf::io {
 namespace {
 
 using detail::quoted;
-
-// The whole file, or an Error saying why it cannot be read.
-std::vector<std::uint8_t> read_file(const std::filesystem::path& path, const std::string& what) {
-  const std::string name = what + " " + quoted(path);
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (status.type() == std::filesystem::file_type::not_found) throw Error(name + ": no such file");
-  if (error) throw Error(name + ": cannot access: " + error.message());
-  if (std::filesystem::is_directory(status)) throw Error(name + ": is a directory, not a file");
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw Error(name + ": cannot open: " + std::strerror(errno));
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(stream)),
-                                  std::istreambuf_iterator<char>());
-  if (stream.bad()) throw Error(name + ": read failed: " + std::strerror(errno));
-  if (bytes.empty()) throw Error(name + ": file is empty");
-  return bytes;
-}
-
-std::string describe_bit_depth(int depth) {
-  switch (depth) {
-    case CV_8U:
-      return "8-bit";
-    case CV_8S:
-      return "8-bit signed";
-    case CV_16U:
-      return "16-bit";
-    case CV_16S:
-      return "16-bit signed";
-    case CV_32S:
-      return "32-bit integer";
-    case CV_32F:
-      return "32-bit float";
-    case CV_64F:
-      return "64-bit float";
-    default:
-      return "unknown bit depth";
-  }
-}
-
-std::string describe(const cv::Mat& image) {
-  return describe_bit_depth(image.depth()) + " " + std::to_string(image.channels()) + "-channel";
-}
-
-// Decodes exactly what the file stores: IMREAD_UNCHANGED keeps 16 bits, every channel, and the
-// stored pixel order (no EXIF rotation).
-cv::Mat decode(const std::filesystem::path& path, const std::string& what) {
-  const std::vector<std::uint8_t> bytes = read_file(path, what);
-  cv::Mat image;
-  try {
-    image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw Error(what + " " + quoted(path) + ": cannot decode: " + e.what());
-  }
-  if (image.empty()) {
-    throw Error(what + " " + quoted(path) +
-                ": cannot decode: not an image file in a format OpenCV reads, or corrupt");
-  }
-  return image;
-}
 
 template <class Pixel>
 void require_writable(const std::filesystem::path& path, const Image<Pixel>& image) {
@@ -125,32 +63,25 @@ const std::array<Rgb8, 256>& viridis() {
 }  // namespace
 
 DepthImage read_depth_png(const std::filesystem::path& path) {
-  const std::string what = "depth image";
-  const cv::Mat image = decode(path, what);
+  const std::string name = "depth image " + quoted(path);
+  const cv::Mat image = detail::decode_image(path, name);
   if (image.depth() != CV_16U) {
-    throw Error(what + " " + quoted(path) + ": is " + describe_bit_depth(image.depth()) +
+    throw Error(name + ": is " + detail::bit_depth_name(image.depth()) +
                 ", expected 16-bit (raw depth units); an 8-bit file is a visualization, not depth");
   }
   if (image.channels() != 1) {
-    throw Error(what + " " + quoted(path) + ": has " + std::to_string(image.channels()) +
-                " channels, expected 1");
+    throw Error(name + ": has " + std::to_string(image.channels()) + " channels, expected 1");
   }
-  DepthImage depth(image.cols, image.rows);
-  for (int y = 0; y < image.rows; ++y) {
-    const auto* row = image.ptr<std::uint16_t>(y);
-    std::copy(row, row + image.cols, &depth(0, y));
-  }
-  return depth;
+  return detail::copy_single_channel<std::uint16_t>(image);
 }
 
 RgbImage read_color_image(const std::filesystem::path& path) {
-  const std::string what = "colour image";
-  const cv::Mat image = decode(path, what);
-  if (image.depth() != CV_8U) {
-    throw Error(what + " " + quoted(path) + ": is " + describe(image) + ", expected 8-bit");
-  }
+  const std::string name = "colour image " + quoted(path);
+  const cv::Mat image = detail::decode_image(path, name);
+  if (image.depth() != CV_8U)
+    throw Error(name + ": is " + detail::pixel_format_name(image) + ", expected 8-bit");
   if (image.channels() != 3 && image.channels() != 4) {
-    throw Error(what + " " + quoted(path) + ": has " + std::to_string(image.channels()) +
+    throw Error(name + ": has " + std::to_string(image.channels()) +
                 " channel(s), expected 3 (RGB) or 4 (RGBA)");
   }
   const int channels = image.channels();

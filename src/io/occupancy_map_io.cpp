@@ -2,23 +2,22 @@
 
 #include <unistd.h>
 
+#include <array>
 #include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <system_error>
 #include <vector>
 
 #include <yaml-cpp/yaml.h>
 #include <opencv2/core.hpp>
-#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include "io/atomic_file.hpp"
+#include "io/opencv_decode.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/image_io.hpp"
 
@@ -29,46 +28,14 @@ namespace {
 namespace fs = std::filesystem;
 using detail::quoted;
 
-// ---- Image decoding ---------------------------------------------------------------------------
+// ---- Images ----------------------------------------------------------------------------------
 
-// The file as stored (IMREAD_UNCHANGED: bit depth and channels kept), or an Error saying why not.
-// `name` says what the file is, e.g. "label image 'a.png'".
-cv::Mat decode_image(const fs::path& path, const std::string& name) {
-  std::error_code error;
-  const auto status = fs::status(path, error);
-  if (status.type() == fs::file_type::not_found) throw Error(name + ": no such file");
-  if (error) throw Error(name + ": cannot access: " + error.message());
-  if (fs::is_directory(status)) throw Error(name + ": is a directory, not a file");
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw Error(name + ": cannot open: " + std::strerror(errno));
-  const std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(stream)),
-                                        std::istreambuf_iterator<char>());
-  if (stream.bad()) throw Error(name + ": read failed: " + std::strerror(errno));
-  if (bytes.empty()) throw Error(name + ": file is empty");
-  cv::Mat image;
-  try {
-    image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);
-  } catch (const cv::Exception& e) {
-    throw Error(name + ": cannot decode: " + e.what());
-  }
-  if (image.empty()) {
-    throw Error(name + ": cannot decode: not an image file in a format OpenCV reads, or corrupt");
-  }
-  return image;
-}
-
-std::string describe(const cv::Mat& image) {
-  const int depth = image.depth();
-  const std::string bits = depth == CV_8U                      ? "8-bit"
-                           : depth == CV_16U                   ? "16-bit"
-                           : depth == CV_8S || depth == CV_16S ? "signed integer"
-                                                               : "floating-point or 32-bit";
-  return bits + " " + std::to_string(image.channels()) + "-channel";
-}
+using detail::decode_image;
+using detail::pixel_format_name;
 
 void require_8bit(const cv::Mat& image, const std::string& name) {
   require(image.depth() == CV_8U && image.channels() >= 1 && image.channels() <= 4,
-          name + ": is " + describe(image) + ", expected 8-bit with 1 to 4 channels");
+          name + ": is " + pixel_format_name(image) + ", expected 8-bit with 1 to 4 channels");
 }
 
 // Luminance of an 8-bit image of 1 to 4 channels (OpenCV BGR order; alpha ignored), as
@@ -89,12 +56,7 @@ GrayImage to_gray(const cv::Mat& image) {
       cv::cvtColor(image, gray, cv::COLOR_BGRA2GRAY);
       break;
   }
-  GrayImage result(gray.cols, gray.rows);
-  for (int y = 0; y < gray.rows; ++y) {
-    const std::uint8_t* row = gray.ptr<std::uint8_t>(y);
-    std::copy(row, row + gray.cols, &result(0, y));
-  }
-  return result;
+  return detail::copy_single_channel<std::uint8_t>(gray);
 }
 
 void require_writable_grid(const fs::path& path, const OccupancyGrid& grid) {
@@ -285,14 +247,9 @@ class StagedFile {
 
 LabelImage labels_from(const cv::Mat& image, const std::string& name) {
   require(image.depth() == CV_16U && image.channels() == 1,
-          name + ": is " + describe(image) +
+          name + ": is " + pixel_format_name(image) +
               ", expected 16-bit single-channel (labels 0..65535, 0 = no label)");
-  LabelImage labels(image.cols, image.rows);
-  for (int y = 0; y < image.rows; ++y) {
-    const auto* row = image.ptr<std::uint16_t>(y);
-    std::copy(row, row + image.cols, &labels(0, y));
-  }
-  return labels;
+  return detail::copy_single_channel<Label>(image);
 }
 
 LabelImage rooms_from(const cv::Mat& image, const std::string& name,
@@ -308,34 +265,19 @@ LabelImage rooms_from(const cv::Mat& image, const std::string& name,
   return eval::label_connected_components(white, {options.connectivity, options.min_room_pixels});
 }
 
+// hue in [0, 1) (a fraction of the circle), saturation and value in [0, 1].
 Rgb8 hsv_to_rgb(double hue, double saturation, double value) {
   const double sector = hue * 6.0;
   const int i = static_cast<int>(sector) % 6;
   const double f = sector - std::floor(sector);
   const double p = value * (1 - saturation), q = value * (1 - saturation * f),
                t = value * (1 - saturation * (1 - f));
-  double r = value, g = t, b = p;
-  switch (i) {
-    case 1:
-      r = q, g = value, b = p;
-      break;
-    case 2:
-      r = p, g = value, b = t;
-      break;
-    case 3:
-      r = p, g = q, b = value;
-      break;
-    case 4:
-      r = t, g = p, b = value;
-      break;
-    case 5:
-      r = value, g = p, b = q;
-      break;
-    default:
-      break;
-  }
+  // (r, g, b) in each sixth of the hue circle.
+  const std::array<std::array<double, 3>, 6> sectors = {
+      {{value, t, p}, {q, value, p}, {p, value, t}, {p, q, value}, {t, p, value}, {value, p, q}}};
+  const std::array<double, 3>& rgb = sectors[i];
   const auto byte = [](double c) { return static_cast<std::uint8_t>(std::lround(c * 255.0)); };
-  return {byte(r), byte(g), byte(b)};
+  return {byte(rgb[0]), byte(rgb[1]), byte(rgb[2])};
 }
 
 }  // namespace
@@ -472,7 +414,7 @@ SemanticImage read_semantic_png(const fs::path& path) {
   const std::string name = "semantic image " + quoted(path);
   const cv::Mat image = decode_image(path, name);
   require(image.depth() == CV_8U && image.channels() == 1,
-          name + ": is " + describe(image) +
+          name + ": is " + pixel_format_name(image) +
               ", expected 8-bit single-channel (one SemanticClass value per pixel)");
   SemanticImage classes(image.cols, image.rows);
   for (int y = 0; y < image.rows; ++y) {

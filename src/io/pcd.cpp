@@ -5,19 +5,18 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdlib>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <optional>
 #include <string_view>
 #include <utility>
 
 #include "io/atomic_file.hpp"
+#include "io/byte_order.hpp"
+#include "io/input_file.hpp"
+#include "io/text_fields.hpp"
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::io {
@@ -46,38 +45,27 @@ std::string product_text(std::uint64_t a, std::uint64_t b) {
 // Bytes and numbers
 
 // PCD binary data is in the writer's byte order, which is little-endian on every platform PCL
-// and Open3D run on.
-template <class T>
-T load(const std::uint8_t* bytes) {
-  std::array<std::uint8_t, sizeof(T)> raw;
-  std::memcpy(raw.data(), bytes, sizeof(T));
-  if constexpr (std::endian::native == std::endian::big) std::reverse(raw.begin(), raw.end());
-  return std::bit_cast<T>(raw);
-}
+// and Open3D run on: detail::load's default.
+using detail::append_little_endian;
+using detail::load;
 
-void put_u32(std::vector<std::uint8_t>& out, std::uint32_t bits) {
-  for (int shift = 0; shift < 32; shift += 8)
-    out.push_back(static_cast<std::uint8_t>(bits >> shift));
-}
-
+// Fields are separated by blanks; a '\r' anywhere (CRLF files) is one too.
 std::vector<std::string_view> split_whitespace(std::string_view line) {
-  std::vector<std::string_view> tokens;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t' || line[i] == '\r')) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t' && line[i] != '\r') ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
-  }
-  return tokens;
+  return detail::split_fields(line, " \t\r");
 }
 
-// Decimal numbers as PCL writes them: "nan", "inf", exponents; a leading '+' is accepted too.
-// Parsed straight to Real so that floats are rounded once; a value beyond Real's range becomes
-// 0 or infinity, as strtof makes it.
+// PCD numbers may carry a leading '+', which std::from_chars does not take.
+std::string_view without_plus(std::string_view token) {
+  if (token.size() > 1 && token[0] == '+') token.remove_prefix(1);
+  return token;
+}
+
+// Decimal numbers as PCL writes them: "nan", "inf", exponents, a leading '+'. Parsed straight to
+// Real so that floats are rounded once; a value beyond Real's range becomes 0 or infinity, as
+// strtof makes it (where detail::parse_number refuses it).
 template <class Real>
 std::optional<Real> parse_real(std::string_view token) {
-  if (token.size() > 1 && token[0] == '+') token.remove_prefix(1);
+  token = without_plus(token);
   Real value = 0;
   const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
   if (end != token.data() + token.size()) return std::nullopt;
@@ -91,11 +79,7 @@ std::optional<Real> parse_real(std::string_view token) {
 
 template <class Integer>
 std::optional<Integer> parse_integer(std::string_view token) {
-  if (token.size() > 1 && token[0] == '+') token.remove_prefix(1);
-  Integer value = 0;
-  const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
-  if (error != std::errc() || end != token.data() + token.size()) return std::nullopt;
-  return value;
+  return detail::parse_number<Integer>(without_plus(token));
 }
 
 bool all_digits(std::string_view token) {
@@ -227,15 +211,7 @@ class PcdParser {
 
   // The next line from position_ (without its newline), or nothing at the end of the bytes.
   std::optional<std::string_view> next_line() {
-    if (position_ >= bytes_.size()) return std::nullopt;
-    const char* begin = reinterpret_cast<const char*>(bytes_.data()) + position_;
-    const std::size_t remaining = bytes_.size() - position_;
-    const void* newline = std::memchr(begin, '\n', remaining);
-    const std::size_t length =
-        newline ? static_cast<std::size_t>(static_cast<const char*>(newline) - begin) : remaining;
-    position_ += newline ? length + 1 : length;
-    ++line_;
-    return std::string_view(begin, length);
+    return detail::next_line(bytes_, position_, line_);
   }
 
   std::size_t remaining() const { return bytes_.size() - position_; }
@@ -715,28 +691,6 @@ class PcdParser {
   std::size_t line_ = 0;      // 1-based number of the last line read
 };
 
-std::vector<std::uint8_t> read_whole_file(const std::filesystem::path& path) {
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (status.type() == std::filesystem::file_type::not_found) {
-    throw Error("PCD file " + quoted(path.string()) + ": no such file");
-  }
-  if (error)
-    throw Error("PCD file " + quoted(path.string()) + ": cannot access: " + error.message());
-  if (std::filesystem::is_directory(status)) {
-    throw Error("PCD file " + quoted(path.string()) + ": is a directory, not a file");
-  }
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream)
-    throw Error("PCD file " + quoted(path.string()) + ": cannot open: " + std::strerror(errno));
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(stream)),
-                                  std::istreambuf_iterator<char>());
-  if (stream.bad()) {
-    throw Error("PCD file " + quoted(path.string()) + ": read failed: " + std::strerror(errno));
-  }
-  return bytes;
-}
-
 // ---------------------------------------------------------------------------------------------
 // Writing
 
@@ -857,7 +811,8 @@ PcdCloud parse_pcd(std::span<const std::uint8_t> bytes, const std::string& name)
 }
 
 PcdCloud read_pcd(const std::filesystem::path& path) {
-  const std::vector<std::uint8_t> bytes = read_whole_file(path);
+  const std::vector<std::uint8_t> bytes =
+      detail::read_file_bytes(path, "PCD file " + quoted(path.string()));
   return parse_pcd(bytes, path.string());
 }
 
@@ -892,14 +847,14 @@ std::vector<std::uint8_t> encode_pcd(const PcdCloud& cloud, PcdEncoding encoding
     case PcdEncoding::binary:
       out.reserve(out.size() + n * columns.size() * 4);
       for (std::size_t i = 0; i < n; ++i) {
-        for (const Column& column : columns) put_u32(out, column.bits[i]);
+        for (const Column& column : columns) append_little_endian(out, column.bits[i]);
       }
       break;
     case PcdEncoding::binary_compressed: {
       std::vector<std::uint8_t> soa;  // field by field, as PCL stores compressed data
       soa.reserve(n * columns.size() * 4);
       for (const Column& column : columns) {
-        for (std::uint32_t bits : column.bits) put_u32(soa, bits);
+        for (std::uint32_t bits : column.bits) append_little_endian(soa, bits);
       }
       // Incompressible data grows by at most ~3% under LZF; a larger buffer always suffices.
       const std::size_t capacity = soa.size() + soa.size() / 16 + 64;
@@ -914,8 +869,8 @@ std::vector<std::uint8_t> encode_pcd(const PcdCloud& cloud, PcdEncoding encoding
                             static_cast<unsigned int>(capacity));
         require(size != 0, "cannot write PCD " + quoted(name) + ": LZF compression failed");
       }
-      put_u32(out, size);
-      put_u32(out, static_cast<std::uint32_t>(soa.size()));
+      append_little_endian(out, std::uint32_t{size});
+      append_little_endian(out, static_cast<std::uint32_t>(soa.size()));
       out.insert(out.end(), compressed.begin(), compressed.begin() + size);
       break;
     }

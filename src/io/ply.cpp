@@ -3,13 +3,9 @@
 #include <algorithm>
 #include <array>
 #include <bit>
-#include <cerrno>
 #include <charconv>
 #include <cmath>
 #include <cstdint>
-#include <cstring>
-#include <fstream>
-#include <iterator>
 #include <limits>
 #include <optional>
 #include <span>
@@ -19,36 +15,21 @@
 #include <vector>
 
 #include "io/atomic_file.hpp"
+#include "io/byte_order.hpp"
+#include "io/input_file.hpp"
+#include "io/text_fields.hpp"
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::io {
 
 namespace {
 
+using detail::append_little_endian;
+using detail::load;
 using detail::quoted;
 
 // ---------------------------------------------------------------------------------------------
 // Writing
-
-// Appends values in little-endian byte order whatever the host's order is, or as text.
-class LittleEndianBuffer {
- public:
-  void put(float value) { put_bytes(std::bit_cast<std::uint32_t>(value)); }
-  void put(std::uint8_t value) { bytes_.push_back(value); }
-  void put_text(std::string_view text) { bytes_.insert(bytes_.end(), text.begin(), text.end()); }
-
-  std::size_t size() const { return bytes_.size(); }
-  const std::uint8_t* data() const { return bytes_.data(); }
-  void clear() { bytes_.clear(); }
-
- private:
-  void put_bytes(std::uint32_t bits) {
-    for (int shift = 0; shift < 32; shift += 8) {
-      bytes_.push_back(static_cast<std::uint8_t>(bits >> shift));
-    }
-  }
-  std::vector<std::uint8_t> bytes_;
-};
 
 std::string vertex_header(std::size_t count, bool with_normals, bool with_colors,
                           PlyEncoding encoding) {
@@ -110,17 +91,15 @@ class VertexWriter {
       for (std::uint8_t channel : color) put(int{channel});
     }
     line_.back() = '\n';
-    buffer_.put_text(line_);
+    buffer_.insert(buffer_.end(), line_.begin(), line_.end());
   }
 
   void add_binary(const Eigen::Vector3f& point, const Eigen::Vector3f& normal, const Rgb8& color) {
-    for (int i = 0; i < 3; ++i) buffer_.put(point[i]);
+    for (int i = 0; i < 3; ++i) append_little_endian(buffer_, point[i]);
     if (with_normals_) {
-      for (int i = 0; i < 3; ++i) buffer_.put(normal[i]);
+      for (int i = 0; i < 3; ++i) append_little_endian(buffer_, normal[i]);
     }
-    if (with_colors_) {
-      for (std::uint8_t channel : color) buffer_.put(channel);
-    }
+    if (with_colors_) buffer_.insert(buffer_.end(), color.begin(), color.end());
   }
 
   void flush() {
@@ -129,7 +108,7 @@ class VertexWriter {
   }
 
   detail::AtomicFileWriter file_;
-  LittleEndianBuffer buffer_;
+  std::vector<std::uint8_t> buffer_;  // the next block: vertices in little-endian binary or text
   bool with_normals_;
   bool with_colors_;
   PlyEncoding encoding_;
@@ -256,16 +235,9 @@ struct Header {
   std::size_t lines = 0;        // header lines, so that body line numbers count from the file start
 };
 
+// Fields are separated by spaces and tabs (a line's final '\r' is stripped first).
 std::vector<std::string_view> split_whitespace(std::string_view line) {
-  std::vector<std::string_view> tokens;
-  std::size_t i = 0;
-  while (i < line.size()) {
-    while (i < line.size() && (line[i] == ' ' || line[i] == '\t')) ++i;
-    const std::size_t start = i;
-    while (i < line.size() && line[i] != ' ' && line[i] != '\t') ++i;
-    if (i > start) tokens.push_back(line.substr(start, i - start));
-  }
-  return tokens;
+  return detail::split_fields(line, " \t");
 }
 
 std::string_view strip_carriage_return(std::string_view line) {
@@ -273,32 +245,24 @@ std::string_view strip_carriage_return(std::string_view line) {
   return line;
 }
 
-template <class T>
-T load(const std::uint8_t* bytes, bool big_endian) {
-  std::array<std::uint8_t, sizeof(T)> raw;
-  std::memcpy(raw.data(), bytes, sizeof(T));
-  if (big_endian != (std::endian::native == std::endian::big)) std::reverse(raw.begin(), raw.end());
-  return std::bit_cast<T>(raw);
-}
-
-double load_scalar(Scalar type, const std::uint8_t* bytes, bool big_endian) {
+double load_scalar(Scalar type, const std::uint8_t* bytes, std::endian order) {
   switch (type) {
     case Scalar::int8:
-      return load<std::int8_t>(bytes, big_endian);
+      return load<std::int8_t>(bytes, order);
     case Scalar::uint8:
-      return load<std::uint8_t>(bytes, big_endian);
+      return load<std::uint8_t>(bytes, order);
     case Scalar::int16:
-      return load<std::int16_t>(bytes, big_endian);
+      return load<std::int16_t>(bytes, order);
     case Scalar::uint16:
-      return load<std::uint16_t>(bytes, big_endian);
+      return load<std::uint16_t>(bytes, order);
     case Scalar::int32:
-      return load<std::int32_t>(bytes, big_endian);
+      return load<std::int32_t>(bytes, order);
     case Scalar::uint32:
-      return load<std::uint32_t>(bytes, big_endian);
+      return load<std::uint32_t>(bytes, order);
     case Scalar::float32:
-      return load<float>(bytes, big_endian);
+      return load<float>(bytes, order);
     case Scalar::float64:
-      return load<double>(bytes, big_endian);
+      return load<double>(bytes, order);
   }
   return 0;
 }
@@ -343,19 +307,15 @@ class PlyReader {
   }
 
   bool binary() const { return header_.format != Format::ascii; }
-  bool big_endian() const { return header_.format == Format::binary_big_endian; }
+  std::endian byte_order() const {
+    return header_.format == Format::binary_big_endian ? std::endian::big : std::endian::little;
+  }
 
   // The next line from position_ (without its newline), or nothing at the end of the file.
   std::optional<std::string_view> next_line() {
-    if (position_ >= bytes_.size()) return std::nullopt;
-    const char* begin = reinterpret_cast<const char*>(bytes_.data()) + position_;
-    const std::size_t remaining = bytes_.size() - position_;
-    const void* newline = std::memchr(begin, '\n', remaining);
-    const std::size_t length =
-        newline ? static_cast<std::size_t>(static_cast<const char*>(newline) - begin) : remaining;
-    position_ += newline ? length + 1 : length;
-    ++line_;
-    return strip_carriage_return(std::string_view(begin, length));
+    const auto line = detail::next_line(bytes_, position_, line_);
+    if (!line) return std::nullopt;
+    return strip_carriage_return(*line);
   }
 
   Header parse_header() {
@@ -392,12 +352,12 @@ class PlyReader {
         if (tokens.size() != 3) fail_header(line_, "expected 'element <name> <count>'");
         Element element;
         element.name = tokens[1];
-        const auto [end, error] =
-            std::from_chars(tokens[2].data(), tokens[2].data() + tokens[2].size(), element.count);
-        if (error != std::errc() || end != tokens[2].data() + tokens[2].size()) {
+        const auto count = detail::parse_number<std::uint64_t>(tokens[2]);
+        if (!count) {
           fail_header(line_, "element count '" + std::string(tokens[2]) +
                                  "' is not a non-negative integer");
         }
+        element.count = *count;
         header.elements.push_back(std::move(element));
       } else if (keyword == "property") {
         if (header.elements.empty()) fail_header(line_, "property before any element");
@@ -542,7 +502,7 @@ class PlyReader {
       const Property& property = element.properties[p];
       if (property.list_count_type) {
         const double count = load_scalar(*property.list_count_type,
-                                         take(size_of(*property.list_count_type)), big_endian());
+                                         take(size_of(*property.list_count_type)), byte_order());
         if (count < 0) {
           fail_at_byte(start, instance_name(element, index) + ": list '" + property.name +
                                   "' has negative length " + std::to_string(count));
@@ -552,7 +512,7 @@ class PlyReader {
                                                         : static_cast<std::size_t>(bytes));
         values[p] = 0;
       } else {
-        values[p] = load_scalar(property.type, take(size_of(property.type)), big_endian());
+        values[p] = load_scalar(property.type, take(size_of(property.type)), byte_order());
       }
     }
   }
@@ -576,12 +536,12 @@ class PlyReader {
         fail_at_line(instance_name(element, index) + ": too few values (missing " + what + ")");
       }
       const std::string_view token = tokens[next++];
-      double value = 0;
-      const auto [end, error] = std::from_chars(token.data(), token.data() + token.size(), value);
-      if (error != std::errc() || end != token.data() + token.size()) {
+      const auto parsed = detail::parse_number<double>(token);
+      if (!parsed) {
         fail_at_line(instance_name(element, index) + ": " + what + " is '" + std::string(token) +
                      "', not a number");
       }
+      const double value = *parsed;
       if (is_integer(type)) {
         const auto [low, high] = integer_range(type);
         if (value != std::floor(value) || value < low || value > high) {
@@ -619,25 +579,6 @@ class PlyReader {
   std::size_t position_ = 0;  // byte offset of the next unread byte
   std::size_t line_ = 0;      // 1-based number of the last line read (ascii and header)
 };
-
-std::vector<std::uint8_t> read_whole_file(const std::filesystem::path& path) {
-  std::error_code error;
-  const auto status = std::filesystem::status(path, error);
-  if (status.type() == std::filesystem::file_type::not_found) {
-    throw Error("PLY file " + quoted(path) + ": no such file");
-  }
-  if (error) throw Error("PLY file " + quoted(path) + ": cannot access: " + error.message());
-  if (std::filesystem::is_directory(status)) {
-    throw Error("PLY file " + quoted(path) + ": is a directory, not a file");
-  }
-  std::ifstream stream(path, std::ios::binary);
-  if (!stream) throw Error("PLY file " + quoted(path) + ": cannot open: " + std::strerror(errno));
-  std::vector<std::uint8_t> bytes((std::istreambuf_iterator<char>(stream)),
-                                  std::istreambuf_iterator<char>());
-  if (stream.bad())
-    throw Error("PLY file " + quoted(path) + ": read failed: " + std::strerror(errno));
-  return bytes;
-}
 
 }  // namespace
 
@@ -685,7 +626,7 @@ void write_ply(const std::filesystem::path& path, const PointCloud& cloud, PlyEn
 }
 
 PointCloud read_ply(const std::filesystem::path& path) {
-  const std::vector<std::uint8_t> bytes = read_whole_file(path);
+  const std::vector<std::uint8_t> bytes = detail::read_file_bytes(path, "PLY file " + quoted(path));
   return PlyReader(path, bytes).read();
 }
 

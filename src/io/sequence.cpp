@@ -8,7 +8,10 @@
 #include <string>
 #include <vector>
 
+#include <nlohmann/json.hpp>
+
 #include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/tum.hpp"
@@ -21,8 +24,7 @@ using detail::quoted;
 
 // Reads `count` whitespace-separated finite numbers; throws naming the file.
 std::vector<double> read_numbers(const std::filesystem::path& path, std::size_t count) {
-  std::ifstream in(path);
-  require(in.is_open(), quoted(path) + ": cannot open");
+  std::ifstream in = detail::open_text_file(path);
   std::vector<double> values(count);
   for (std::size_t k = 0; k < count; ++k) {
     require(static_cast<bool>(in >> values[k]) && std::isfinite(values[k]),
@@ -154,8 +156,62 @@ Eigen::Isometry3d orthonormalized_pose(const Eigen::Matrix4d& matrix) {
   return pose;
 }
 
+PinholeIntrinsics read_camera_intrinsics_json(const std::filesystem::path& path) {
+  std::ifstream in = detail::open_text_file(path);
+  nlohmann::json json;
+  try {
+    in >> json;
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(quoted(path) + ": not valid JSON: " + e.what());
+  }
+  auto field = [&](const char* name) -> const nlohmann::json& {
+    require(json.is_object() && json.contains(name), quoted(path) + ": missing field '" + name + "'");
+    return json.at(name);
+  };
+  auto number = [&](const nlohmann::json& value, const std::string& what) {
+    require(value.is_number() && std::isfinite(value.get<double>()),
+            quoted(path) + ": field '" + what + "' must be a finite number");
+    return value.get<double>();
+  };
+  auto integer = [&](const char* name) {
+    const nlohmann::json& value = field(name);
+    require(value.is_number_integer() && value.get<long long>() > 0 && value.get<long long>() <= 1 << 20,
+            quoted(path) + ": field '" + name + "' must be a positive integer");
+    return static_cast<int>(value.get<long long>());
+  };
+  const nlohmann::json& matrix = field("intrinsic_matrix");
+  require(matrix.is_array() && matrix.size() == 9,
+          quoted(path) + ": field 'intrinsic_matrix' must be an array of 9 numbers (column-major 3x3)");
+  double m[9];
+  for (int i = 0; i < 9; ++i) m[i] = number(matrix[i], "intrinsic_matrix[" + std::to_string(i) + "]");
+  PinholeIntrinsics k;
+  k.width = integer("width");
+  k.height = integer("height");
+  k.fx = m[0];
+  k.fy = m[4];
+  k.cx = m[6];
+  k.cy = m[7];
+  require(m[1] == 0 && m[2] == 0 && m[3] == 0 && m[5] == 0 && m[8] == 1,
+          quoted(path) + ": field 'intrinsic_matrix' is not a pinhole matrix [fx 0 0 0 fy 0 cx cy 1] "
+                         "(skew or a non-unit last element)");
+  k.validate(quoted(path));
+  return k;
+}
+
+void write_camera_intrinsics_json(const std::filesystem::path& path, const PinholeIntrinsics& k) {
+  k.validate("camera intrinsics for " + quoted(path));
+  nlohmann::ordered_json json;
+  json["width"] = k.width;
+  json["height"] = k.height;
+  json["intrinsic_matrix"] = {k.fx, 0.0, 0.0, 0.0, k.fy, 0.0, k.cx, k.cy, 1.0};
+  const std::string text = json.dump(4) + "\n";
+  detail::write_file_atomically(path, text.data(), text.size());
+}
+
 std::unique_ptr<Sequence> open_tum_sequence(const std::filesystem::path& folder, double max_difference,
                                             std::optional<PinholeIntrinsics> intrinsics) {
+  const std::filesystem::path json = folder / "camera_intrinsics.json";
+  if (!intrinsics && std::filesystem::exists(json)) intrinsics = read_camera_intrinsics_json(json);
   const PinholeIntrinsics k = intrinsics.value_or(PinholeIntrinsics{640, 480, 525.0, 525.0, 319.5, 239.5});
   k.validate("TUM intrinsics");
   return std::make_unique<TumSequence>(folder, max_difference, k);
@@ -166,8 +222,7 @@ std::unique_ptr<Sequence> open_seven_scenes(const std::filesystem::path& folder)
 }
 
 Trajectory read_redwood_log(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  require(in.is_open(), quoted(path) + ": cannot open");
+  std::ifstream in = detail::open_text_file(path);
   Trajectory trajectory;
   std::string line;
   std::size_t line_number = 0;

@@ -1,13 +1,17 @@
 #include "kartograf/io/tum.hpp"
 
 #include <algorithm>
-#include <charconv>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <sstream>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
 
 #include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
+#include "io/text_fields.hpp"
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::io {
@@ -16,31 +20,27 @@ namespace {
 
 using detail::quoted;
 
-bool parse_number(const std::string& token, double& value) {
-  const char* end = token.data() + token.size();
-  const auto result = std::from_chars(token.data(), end, value);
-  return result.ec == std::errc() && result.ptr == end && std::isfinite(value);
+// A finite number, all of token.
+std::optional<double> finite_number(std::string_view token) {
+  const auto value = detail::parse_number<double>(token);
+  return value && std::isfinite(*value) ? value : std::nullopt;
 }
 
-// Calls on_line(tokens, line_number) for every data line; skips comments as documented.
+// Calls on_line(fields, line_number) for every data line; skips comments as documented. Fields
+// are separated by any white space (as the TUM tools' split() does).
 template <class OnLine>
 void for_each_data_line(const std::filesystem::path& path, OnLine&& on_line) {
-  std::ifstream in(path);
-  require(in.is_open(), quoted(path) + ": cannot open");
+  std::ifstream in = detail::open_text_file(path);
   std::string line;
   std::size_t line_number = 0;
   bool seen_data = false;
   while (std::getline(in, line)) {
     ++line_number;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    std::istringstream words(line);
-    std::vector<std::string> tokens;
-    for (std::string token; words >> token;) tokens.push_back(token);
-    if (tokens.empty() || tokens[0][0] == '#') continue;
-    double first = 0;
-    if (!seen_data && !parse_number(tokens[0], first)) continue;  // a header line without '#'
+    const std::vector<std::string_view> fields = detail::split_fields(line, " \t\v\f\r");
+    if (fields.empty() || fields[0][0] == '#') continue;
+    if (!seen_data && !finite_number(fields[0])) continue;  // a header line without '#'
     seen_data = true;
-    on_line(tokens, line_number);
+    on_line(fields, line_number);
   }
   require(!in.bad(), quoted(path) + ": read error");
 }
@@ -53,12 +53,16 @@ std::string where(const std::filesystem::path& path, std::size_t line) {
 
 Trajectory read_tum_trajectory(const std::filesystem::path& path) {
   Trajectory trajectory;
-  for_each_data_line(path, [&](const std::vector<std::string>& tokens, std::size_t line) {
-    require(tokens.size() == 8, where(path, line) + "expected 8 numbers (timestamp tx ty tz qx qy qz qw), got " +
-                                    std::to_string(tokens.size()) + " fields");
+  for_each_data_line(path, [&](const std::vector<std::string_view>& fields, std::size_t line) {
+    require(fields.size() == 8, where(path, line) +
+                                    "expected 8 numbers (timestamp tx ty tz qx qy qz qw), got " +
+                                    std::to_string(fields.size()) + " fields");
     double v[8];
     for (int i = 0; i < 8; ++i) {
-      require(parse_number(tokens[i], v[i]), where(path, line) + "'" + tokens[i] + "' is not a finite number");
+      const auto value = finite_number(fields[i]);
+      require(value.has_value(),
+              where(path, line) + "'" + std::string(fields[i]) + "' is not a finite number");
+      v[i] = *value;
     }
     Eigen::Quaterniond q(v[7], v[4], v[5], v[6]);
     require(std::fabs(q.norm() - 1.0) <= 0.01,
@@ -79,9 +83,10 @@ void write_tum_trajectory(const std::filesystem::path& path, const Trajectory& t
     const Eigen::Vector3d t = stamped.pose.translation();
     const Eigen::Quaterniond q(stamped.pose.rotation());
     require(std::isfinite(stamped.timestamp) && t.allFinite() && q.coeffs().allFinite(),
-            quoted(path) + ": trajectory has a non-finite pose at t = " + std::to_string(stamped.timestamp));
-    std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n", stamped.timestamp, t.x(),
-                  t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
+            quoted(path) +
+                ": trajectory has a non-finite pose at t = " + std::to_string(stamped.timestamp));
+    std::snprintf(line, sizeof(line), "%.6f %.9g %.9g %.9g %.9g %.9g %.9g %.9g\n",
+                  stamped.timestamp, t.x(), t.y(), t.z(), q.x(), q.y(), q.z(), q.w());
     text += line;
   }
   detail::write_file_atomically(path, text.data(), text.size());
@@ -89,13 +94,15 @@ void write_tum_trajectory(const std::filesystem::path& path, const Trajectory& t
 
 std::vector<TimestampedFile> read_tum_file_list(const std::filesystem::path& path) {
   std::vector<TimestampedFile> files;
-  for_each_data_line(path, [&](const std::vector<std::string>& tokens, std::size_t line) {
-    require(tokens.size() == 2, where(path, line) + "expected 'timestamp filename', got " +
-                                    std::to_string(tokens.size()) + " fields");
+  for_each_data_line(path, [&](const std::vector<std::string_view>& fields, std::size_t line) {
+    require(fields.size() == 2, where(path, line) + "expected 'timestamp filename', got " +
+                                    std::to_string(fields.size()) + " fields");
+    const auto timestamp = finite_number(fields[0]);
+    require(timestamp.has_value(),
+            where(path, line) + "'" + std::string(fields[0]) + "' is not a finite timestamp");
     TimestampedFile file;
-    require(parse_number(tokens[0], file.timestamp),
-            where(path, line) + "'" + tokens[0] + "' is not a finite timestamp");
-    file.file = tokens[1];
+    file.timestamp = *timestamp;
+    file.file = fields[1];
     files.push_back(std::move(file));
   });
   return files;
@@ -108,7 +115,8 @@ std::vector<std::pair<std::size_t, std::size_t>> associate_timestamps(const std:
   // Every candidate pair within the window, found through b sorted by time.
   std::vector<std::size_t> b_order(b.size());
   for (std::size_t j = 0; j < b.size(); ++j) b_order[j] = j;
-  std::sort(b_order.begin(), b_order.end(), [&](std::size_t x, std::size_t y) { return b[x] < b[y]; });
+  std::sort(b_order.begin(), b_order.end(),
+            [&](std::size_t x, std::size_t y) { return b[x] < b[y]; });
   struct Candidate {
     double difference;
     std::size_t i, j;
@@ -121,8 +129,9 @@ std::vector<std::pair<std::size_t, std::size_t>> associate_timestamps(const std:
       candidates.push_back({std::fabs(a[i] - b[*it]), i, *it});
     }
   }
-  std::stable_sort(candidates.begin(), candidates.end(),
-                   [](const Candidate& x, const Candidate& y) { return x.difference < y.difference; });
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const Candidate& x, const Candidate& y) { return x.difference < y.difference; });
   std::vector<bool> a_used(a.size()), b_used(b.size());
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
   for (const Candidate& c : candidates) {

@@ -34,11 +34,18 @@ class Sequence {
 
 // A TUM RGB-D folder: rgb and depth associated within max_difference seconds (TUM's 0.02); the
 // ground-truth pose is the nearest ground-truth sample within max_difference of the depth frame
-// (frames without one have no pose). Intrinsics: TUM's default Kinect
-// (fx = fy = 525, cx = 319.5, cy = 239.5) unless given; depth scale 5000.
+// (frames without one have no pose). Intrinsics: the argument when given, else the folder's
+// camera_intrinsics.json when present (see read_camera_intrinsics_json), else TUM's default
+// Kinect (fx = fy = 525, cx = 319.5, cy = 239.5); depth scale 5000.
 std::unique_ptr<Sequence> open_tum_sequence(const std::filesystem::path& folder,
                                             double max_difference = 0.02,
                                             std::optional<PinholeIntrinsics> intrinsics = std::nullopt);
+
+// Open3D's PinholeCameraIntrinsic JSON: {"width": W, "height": H, "intrinsic_matrix": [9 numbers]},
+// the 3x3 matrix column-major ([fx, 0, 0, 0, fy, 0, cx, cy, 1]). Errors name the file and field.
+PinholeIntrinsics read_camera_intrinsics_json(const std::filesystem::path& path);
+// Writes that format (atomic).
+void write_camera_intrinsics_json(const std::filesystem::path& path, const PinholeIntrinsics& intrinsics);
 
 // A 7-Scenes folder (frames/ inside it, or the frames themselves): intrinsics from
 // camera-intrinsics.txt when present (else 585/320/240), depth in millimetres, poses
