@@ -1,10 +1,12 @@
 // ICP sums, first pass; see shaders/icp_point_to_point.comp and shaders/icp_point_to_plane.comp
 // for the row layouts. Per-pair arithmetic is in double (millimetre residuals on metre coordinates).
+// Rules in include/kartograf/registration/icp_sums.hpp, robust kernels in robust_kernel.hpp.
 typedef struct {
   uint pair_count;
   uint target_count;
   uint has_correspondences;
   uint has_weights;
+  uint robust_kernel;  // 0 none, 1 Huber, 2 Tukey
 } IcpSumsParams;
 
 typedef struct {
@@ -45,6 +47,27 @@ inline bool kg_load_pair(uint i, __global const float4* source, __global const f
   return pair->distance_sq <= frame[18];
 }
 
+// A valid source point whose entry is not kNotSelected (-2 or lower): the fitness denominator.
+inline bool kg_is_considered(uint i, __global const float4* source, __global const int* correspondences,
+                             const IcpSumsParams* params) {
+  if (!kg_is_valid_point(source[i])) return false;
+  return params->has_correspondences == 0 || correspondences[i] >= -1;
+}
+
+// The robust kernel's weight of a residual; frame[19] is its scale c.
+inline double kg_robust_weight(double residual, __global const double* frame, const IcpSumsParams* params) {
+  const double r = fabs(residual);
+  const double c = frame[19];
+  if (params->robust_kernel == 1) return r <= c ? 1.0 : c / r;  // Huber
+  if (params->robust_kernel == 2) {                             // Tukey
+    if (!(r < c)) return 0.0;
+    const double u = r / c;
+    const double s = 1.0 - u * u;
+    return s * s;
+  }
+  return 1.0;
+}
+
 __kernel void icp_point_to_point(__global const float4* source, __global const float4* target,
                                  __global const int* correspondences, __global const float* weights,
                                  __global const double* frame, __global double* partials,
@@ -56,13 +79,14 @@ __kernel void icp_point_to_point(__global const float4* source, __global const f
   const double3 target_pivot = (double3)(frame[15], frame[16], frame[17]);
   const uint stride = get_num_groups(0) * KG_REDUCTION_GROUP;
   for (uint i = get_global_id(0); i < params.pair_count; i += stride) {
+    if (kg_is_considered(i, source, correspondences, &params)) sums[19] += 1.0;
     KgPair pair;
     if (!kg_load_pair(i, source, target, correspondences, weights, frame, &params, &pair)) continue;
     const double a[3] = {pair.moved.x - source_pivot.x, pair.moved.y - source_pivot.y,
                          pair.moved.z - source_pivot.z};
     const double b[3] = {pair.target.x - target_pivot.x, pair.target.y - target_pivot.y,
                          pair.target.z - target_pivot.z};
-    const double w = pair.weight;
+    const double w = pair.weight * kg_robust_weight(sqrt(pair.distance_sq), frame, &params);
     sums[0] += 1.0;
     sums[1] += w;
     for (int r = 0; r < 3; ++r) {
@@ -71,8 +95,13 @@ __kernel void icp_point_to_point(__global const float4* source, __global const f
       for (int c = 0; c < 3; ++c) sums[8 + 3 * r + c] += w * a[r] * b[c];
     }
     sums[17] += w * pair.distance_sq;
+    sums[18] += pair.distance_sq;
+    uint slot = 20;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = r; c < 3; ++c) sums[slot++] += w * a[r] * a[c];
+    }
   }
-  kg_store_group_sums(sums, 18, shared_sums, partials);
+  kg_store_group_sums(sums, 26, shared_sums, partials);
 }
 
 __kernel void icp_point_to_plane(__global const float4* source, __global const float4* target,
@@ -86,6 +115,7 @@ __kernel void icp_point_to_plane(__global const float4* source, __global const f
   const double3 pivot = (double3)(frame[12], frame[13], frame[14]);
   const uint stride = get_num_groups(0) * KG_REDUCTION_GROUP;
   for (uint i = get_global_id(0); i < params.pair_count; i += stride) {
+    if (kg_is_considered(i, source, correspondences, &params)) sums[31] += 1.0;
     KgPair pair;
     if (!kg_load_pair(i, source, target, correspondences, weights, frame, &params, &pair)) continue;
     const float4 normal = target_normals[pair.target_index];
@@ -94,7 +124,7 @@ __kernel void icp_point_to_plane(__global const float4* source, __global const f
     const double3 arm = cross(pair.moved - pivot, n);
     const double j[6] = {arm.x, arm.y, arm.z, n.x, n.y, n.z};
     const double r = dot(pair.moved - pair.target, n);
-    const double w = pair.weight;
+    const double w = pair.weight * kg_robust_weight(r, frame, &params);
     sums[0] += 1.0;
     sums[1] += w;
     uint slot = 2;
@@ -103,6 +133,7 @@ __kernel void icp_point_to_plane(__global const float4* source, __global const f
     }
     for (int row = 0; row < 6; ++row) sums[23 + row] += w * j[row] * r;
     sums[29] += w * r * r;
+    sums[30] += r * r;
   }
-  kg_store_group_sums(sums, 30, shared_sums, partials);
+  kg_store_group_sums(sums, 32, shared_sums, partials);
 }

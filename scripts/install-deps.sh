@@ -6,6 +6,7 @@ set -euo pipefail
 packages=(
   cmake ninja-build g++ pkg-config
   libeigen3-dev                                    # core and compute
+  libnanoflann-dev                                 # compute: k-d tree correspondences (header-only)
   libvulkan-dev glslang-tools                      # Vulkan headers + loader, GLSL -> SPIR-V
   mesa-vulkan-drivers vulkan-validationlayers      # lavapipe + the validation layer for tests
   ocl-icd-opencl-dev ocl-icd-libopencl1 pocl-opencl-icd  # OpenCL headers, ICD loader, PoCL

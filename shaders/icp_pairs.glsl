@@ -1,5 +1,6 @@
 // Loading one correspondence for the ICP sums. Per-pair arithmetic is in double: residuals near
 // convergence are millimetres on coordinates of metres, which float would resolve to ~1e-4.
+// Rules in include/kartograf/registration/icp_sums.hpp, robust kernels in robust_kernel.hpp.
 struct Pair {
   dvec3 moved;   // R p + t
   dvec3 target;  // q
@@ -37,4 +38,24 @@ bool load_pair(uint i, out Pair pair) {
   const dvec3 d = pair.moved - pair.target;
   pair.distance_sq = dot(d, d);
   return pair.distance_sq <= frame[18];
+}
+
+// A valid source point whose entry is not kNotSelected (-2 or lower): the fitness denominator.
+bool is_considered(uint i) {
+  if (!is_valid_point(source[i])) return false;
+  return params.has_correspondences == 0u || correspondences[i] >= -1;
+}
+
+// The robust kernel's weight of a residual; frame[19] is its scale c.
+double robust_weight(double residual) {
+  const double r = abs(residual);
+  const double c = frame[19];
+  if (params.robust_kernel == 1u) return r <= c ? 1.0 : c / r;  // Huber
+  if (params.robust_kernel == 2u) {                              // Tukey
+    if (!(r < c)) return 0.0;
+    const double u = r / c;
+    const double s = 1.0 - u * u;
+    return s * s;
+  }
+  return 1.0;
 }

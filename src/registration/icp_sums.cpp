@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
+#include "registration/cpu_parallel.hpp"
 
 namespace kartograf::registration {
 
@@ -12,9 +13,9 @@ namespace {
 
 constexpr std::uint32_t kGroupSize = 64;  // KG_REDUCTION_GROUP in shaders/common.glsl
 constexpr std::size_t kMaxSums = 32;      // KG_MAX_SUMS
-constexpr std::size_t kPointToPointSums = 18;
-constexpr std::size_t kPointToPlaneSums = 30;
-constexpr std::size_t kFrameValues = 19;
+constexpr std::size_t kPointToPointSums = 26;
+constexpr std::size_t kPointToPlaneSums = 32;
+constexpr std::size_t kFrameValues = 20;
 
 constexpr compute::KernelSpec kPointToPointKernel{"icp_point_to_point", kGroupSize};
 constexpr compute::KernelSpec kPointToPlaneKernel{"icp_point_to_plane", kGroupSize};
@@ -25,6 +26,7 @@ struct IcpSumsParams {  // layout of shaders/icp_*.comp and kernels/icp_sums.cl
   std::uint32_t target_count;
   std::uint32_t has_correspondences;
   std::uint32_t has_weights;
+  std::uint32_t robust_kernel;
 };
 
 struct ReduceRowsParams {  // layout of shaders/reduce_rows.comp and kernels/reduce_rows.cl
@@ -34,8 +36,9 @@ struct ReduceRowsParams {  // layout of shaders/reduce_rows.comp and kernels/red
 
 using Sums = std::array<double, kMaxSums>;
 
-// R (row-major), t, pivot a, pivot b, max distance^2: what the kernels read from `frame`.
-std::array<double, kFrameValues> frame_values(const Correspondences& pairs, const Eigen::Vector3d& pivot_a,
+// R (row-major), t, pivot a, pivot b, max distance^2, robust scale: what the kernels read.
+std::array<double, kFrameValues> frame_values(const Correspondences& pairs,
+                                              const Eigen::Vector3d& pivot_a,
                                               const Eigen::Vector3d& pivot_b) {
   std::array<double, kFrameValues> frame{};
   const Eigen::Matrix3d rotation = pairs.source_to_target.linear();
@@ -46,6 +49,7 @@ std::array<double, kFrameValues> frame_values(const Correspondences& pairs, cons
     frame[15 + r] = pivot_b(r);
   }
   frame[18] = pairs.max_distance * pairs.max_distance;
+  frame[19] = pairs.robust.scale;
   return frame;
 }
 
@@ -61,25 +65,38 @@ void validate(const Correspondences& pairs, bool needs_normals, const char* what
           name + ": weight buffer and source points differ in count");
   require(!(pairs.max_distance < 0) && !std::isnan(pairs.max_distance),
           name + ": max_distance must be >= 0");
-  require(pairs.source_to_target.matrix().allFinite(), name + ": the transform has NaN/Inf entries");
-  require(pairs.source->size() < (std::size_t{1} << 31) && pairs.target->size() < (std::size_t{1} << 31),
+  require(pairs.source_to_target.matrix().allFinite(),
+          name + ": the transform has NaN/Inf entries");
+  require(pairs.robust.kernel == RobustKernel::none ||
+              (std::isfinite(pairs.robust.scale) && pairs.robust.scale > 0),
+          name + ": the robust kernel's scale must be finite and > 0");
+  require(pairs.source->size() < (std::size_t{1} << 31) &&
+              pairs.target->size() < (std::size_t{1} << 31),
           name + ": more than 2^31 points");
 }
 
-// The CPU path: the kernels' per-pair arithmetic, summed sequentially in double.
+// The CPU path: the kernels' per-pair arithmetic in double, over source points [begin, end).
+// Returns the number of considered source points (valid, not kNotSelected).
 template <class AddPair>
-void for_each_pair_cpu(const Correspondences& pairs, const std::array<double, kFrameValues>& frame,
-                       AddPair&& add_pair) {
+std::uint64_t for_each_pair_cpu(const Correspondences& pairs,
+                                const std::array<double, kFrameValues>& frame, std::size_t begin,
+                                std::size_t end, AddPair&& add_pair) {
   const auto source = pairs.source->host_span();
   const auto target = pairs.target->host_span();
-  const std::int32_t* correspondences = pairs.correspondences ? pairs.correspondences->host_span().data() : nullptr;
+  const std::int32_t* correspondences =
+      pairs.correspondences ? pairs.correspondences->host_span().data() : nullptr;
   const float* weights = pairs.weights ? pairs.weights->host_span().data() : nullptr;
-  for (std::size_t i = 0; i < source.size(); ++i) {
+  std::uint64_t considered = 0;
+  for (std::size_t i = begin; i < end; ++i) {
+    // The entry first: with 1-in-k selection most points are skipped without touching them.
+    if (correspondences && correspondences[i] < kNoMatch) continue;
     const Point4f& p = source[i];
     if (!is_valid(p)) continue;
+    ++considered;
     std::size_t j = i;
     if (correspondences) {
-      if (correspondences[i] < 0 || static_cast<std::size_t>(correspondences[i]) >= target.size()) continue;
+      if (correspondences[i] < 0 || static_cast<std::size_t>(correspondences[i]) >= target.size())
+        continue;
       j = static_cast<std::size_t>(correspondences[i]);
     } else if (i >= target.size()) {
       continue;
@@ -100,6 +117,30 @@ void for_each_pair_cpu(const Correspondences& pairs, const std::array<double, kF
     if (!(distance_sq <= frame[18])) continue;
     add_pair(moved, qd, j, w, distance_sq);
   }
+  return considered;
+}
+
+// Sums add_pair(sums, pair...) over all pairs: per-chunk rows (detail::for_each_chunk, on up to
+// two threads on this machine), added in chunk order as the device adds its work-group rows.
+// The considered count goes to sums[considered_slot].
+template <class AddPair>
+Sums reduce_cpu(const Correspondences& pairs, const std::array<double, kFrameValues>& frame,
+                std::size_t considered_slot, const AddPair& add_pair) {
+  struct alignas(64) Row {
+    Sums sums{};
+  };
+  std::array<Row, detail::kCpuChunks> rows{};
+  const std::size_t count = pairs.source->size();
+  detail::for_each_chunk(count, count, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+    Sums& sums = rows[chunk].sums;
+    sums[considered_slot] = static_cast<double>(for_each_pair_cpu(
+        pairs, frame, begin, end, [&](auto&&... pair) { add_pair(sums, pair...); }));
+  });
+  Sums total{};
+  for (const Row& row : rows) {
+    for (std::size_t k = 0; k < kMaxSums; ++k) total[k] += row.sums[k];
+  }
+  return total;
 }
 
 }  // namespace
@@ -114,13 +155,14 @@ namespace {
 
 // Runs the two device passes and returns the final row.
 Sums reduce_on_device(const compute::Context& context, const compute::KernelSpec& kernel,
-                      std::initializer_list<compute::BufferArg> inputs, compute::Buffer<double>& frame,
-                      compute::Buffer<double>& partials, compute::Buffer<double>& result,
-                      const IcpSumsParams& params, std::size_t sum_count) {
+                      std::initializer_list<compute::BufferArg> inputs,
+                      compute::Buffer<double>& frame, compute::Buffer<double>& partials,
+                      compute::Buffer<double>& result, const IcpSumsParams& params,
+                      std::size_t sum_count) {
   // Few work-groups on CPU-hosted drivers, where barriers are expensive; enough to fill a GPU.
   const std::uint32_t max_groups = context.device_info().is_gpu() ? 1024 : 16;
-  const std::uint32_t groups =
-      std::max<std::uint32_t>(1, std::min(max_groups, compute::groups_for(params.pair_count, kGroupSize)));
+  const std::uint32_t groups = std::max<std::uint32_t>(
+      1, std::min(max_groups, compute::groups_for(params.pair_count, kGroupSize)));
   if (partials.size() < std::size_t{groups} * sum_count) {
     partials = compute::Buffer<double>(context, std::size_t{max_groups} * kMaxSums);
   }
@@ -143,7 +185,7 @@ compute::BufferArg optional_buffer(const compute::Buffer<T>* buffer) {
 IcpSumsParams kernel_params(const Correspondences& pairs) {
   return {static_cast<std::uint32_t>(pairs.source->size()),
           static_cast<std::uint32_t>(pairs.target->size()), pairs.correspondences ? 1u : 0u,
-          pairs.weights ? 1u : 0u};
+          pairs.weights ? 1u : 0u, static_cast<std::uint32_t>(pairs.robust.kernel)};
 }
 
 }  // namespace
@@ -155,10 +197,11 @@ PointToPointSums IcpReduction::point_to_point(const Correspondences& pairs,
   const auto frame = frame_values(pairs, source_pivot, target_pivot);
   Sums sums{};
   if (context_->is_cpu()) {
-    for_each_pair_cpu(pairs, frame, [&](const Eigen::Vector3d& moved, const Eigen::Vector3d& q,
-                                        std::size_t, double w, double distance_sq) {
+    const auto add_pair = [&](Sums& sums, const Eigen::Vector3d& moved, const Eigen::Vector3d& q,
+                              std::size_t, double user_weight, double distance_sq) {
       const Eigen::Vector3d a = moved - source_pivot;
       const Eigen::Vector3d b = q - target_pivot;
+      const double w = user_weight * robust_weight(pairs.robust, std::sqrt(distance_sq));
       sums[0] += 1.0;
       sums[1] += w;
       for (int r = 0; r < 3; ++r) {
@@ -167,7 +210,13 @@ PointToPointSums IcpReduction::point_to_point(const Correspondences& pairs,
         for (int c = 0; c < 3; ++c) sums[8 + 3 * r + c] += w * a(r) * b(c);
       }
       sums[17] += w * distance_sq;
-    });
+      sums[18] += distance_sq;
+      std::size_t slot = 20;
+      for (int r = 0; r < 3; ++r) {
+        for (int c = r; c < 3; ++c) sums[slot++] += w * a(r) * a(c);
+      }
+    };
+    sums = reduce_cpu(pairs, frame, 19, add_pair);
   } else {
     frame_.upload(frame);
     sums = reduce_on_device(*context_, kPointToPointKernel,
@@ -179,6 +228,8 @@ PointToPointSums IcpReduction::point_to_point(const Correspondences& pairs,
   result.pair_count = static_cast<std::uint64_t>(sums[0]);
   result.weight_sum = sums[1];
   result.squared_error_sum = sums[17];
+  result.unweighted_squared_error_sum = sums[18];
+  result.considered_count = static_cast<std::uint64_t>(sums[19]);
   if (result.weight_sum <= 0) return result;
   const Eigen::Vector3d sum_a(sums[2], sums[3], sums[4]);
   const Eigen::Vector3d sum_b(sums[5], sums[6], sums[7]);
@@ -189,37 +240,53 @@ PointToPointSums IcpReduction::point_to_point(const Correspondences& pairs,
   result.source_mean = source_pivot + sum_a / result.weight_sum;
   result.target_mean = target_pivot + sum_b / result.weight_sum;
   result.cross_covariance = sum_ab - sum_a * sum_b.transpose() / result.weight_sum;
+  Eigen::Matrix3d sum_aa;
+  std::size_t slot = 20;
+  for (int r = 0; r < 3; ++r) {
+    for (int c = r; c < 3; ++c) sum_aa(r, c) = sum_aa(c, r) = sums[slot++];
+  }
+  result.source_scatter = sum_aa - sum_a * sum_a.transpose() / result.weight_sum;
   return result;
 }
 
-PointToPlaneSystem IcpReduction::point_to_plane(const Correspondences& pairs, const Eigen::Vector3d& pivot) {
+PointToPlaneSystem IcpReduction::point_to_plane(const Correspondences& pairs,
+                                                const Eigen::Vector3d& pivot) {
   validate(pairs, true, "point-to-plane ICP sums");
   const auto frame = frame_values(pairs, pivot, Eigen::Vector3d::Zero());
   Sums sums{};
   if (context_->is_cpu()) {
     const auto normals = pairs.target_normals->host_span();
-    for_each_pair_cpu(pairs, frame, [&](const Eigen::Vector3d& moved, const Eigen::Vector3d& q,
-                                        std::size_t j, double w, double) {
+    const auto add_pair = [&](Sums& sums, const Eigen::Vector3d& moved, const Eigen::Vector3d& q,
+                              std::size_t j, double user_weight, double) {
       if (!is_valid(normals[j])) return;
-      const Eigen::Vector3d n = normals[j].head<3>().cast<double>();
-      Eigen::Matrix<double, 6, 1> jacobian;
-      jacobian << (moved - pivot).cross(n), n;
-      const double r = (moved - q).dot(n);
+      // Plain scalars: this is the CPU backend's hottest loop.
+      const double nx = normals[j].x(), ny = normals[j].y(), nz = normals[j].z();
+      const double ax = moved.x() - pivot.x(), ay = moved.y() - pivot.y(),
+                   az = moved.z() - pivot.z();
+      const double jacobian[6] = {
+          ay * nz - az * ny, az * nx - ax * nz, ax * ny - ay * nx, nx, ny, nz};
+      const double r =
+          (moved.x() - q.x()) * nx + (moved.y() - q.y()) * ny + (moved.z() - q.z()) * nz;
+      const double w = user_weight * robust_weight(pairs.robust, r);
       sums[0] += 1.0;
       sums[1] += w;
       std::size_t slot = 2;
       for (int row = 0; row < 6; ++row) {
-        for (int col = row; col < 6; ++col) sums[slot++] += w * jacobian(row) * jacobian(col);
+        const double weighted = w * jacobian[row];
+        for (int col = row; col < 6; ++col) sums[slot++] += weighted * jacobian[col];
+        sums[23 + row] += weighted * r;
       }
-      for (int row = 0; row < 6; ++row) sums[23 + row] += w * jacobian(row) * r;
       sums[29] += w * r * r;
-    });
+      sums[30] += r * r;
+    };
+    sums = reduce_cpu(pairs, frame, 31, add_pair);
   } else {
     frame_.upload(frame);
-    sums = reduce_on_device(*context_, kPointToPlaneKernel,
-                            {*pairs.source, *pairs.target, *pairs.target_normals,
-                             optional_buffer(pairs.correspondences), optional_buffer(pairs.weights)},
-                            frame_, partials_, result_, kernel_params(pairs), kPointToPlaneSums);
+    sums =
+        reduce_on_device(*context_, kPointToPlaneKernel,
+                         {*pairs.source, *pairs.target, *pairs.target_normals,
+                          optional_buffer(pairs.correspondences), optional_buffer(pairs.weights)},
+                         frame_, partials_, result_, kernel_params(pairs), kPointToPlaneSums);
   }
   PointToPlaneSystem system;
   system.pair_count = static_cast<std::uint64_t>(sums[0]);
@@ -233,6 +300,8 @@ PointToPlaneSystem IcpReduction::point_to_plane(const Correspondences& pairs, co
   }
   for (int row = 0; row < 6; ++row) system.jtr(row) = sums[23 + row];
   system.squared_error_sum = sums[29];
+  system.unweighted_squared_error_sum = sums[30];
+  system.considered_count = static_cast<std::uint64_t>(sums[31]);
   return system;
 }
 

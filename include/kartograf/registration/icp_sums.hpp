@@ -4,6 +4,8 @@
 // equations (point-to-plane, Gauss-Newton). Two passes, no atomics: per-work-group partial sums,
 // then one fixed-order final pass, so results are reproducible run to run. Per-pair arithmetic and
 // accumulation are in double: relative error vs an all-double reference is ~1e-12.
+// Pair weights are the caller's per-source weight times a robust kernel of the residual
+// (robust_kernel.hpp), so one reduction is one iteratively reweighted least-squares step.
 #include <cstdint>
 #include <limits>
 
@@ -12,20 +14,29 @@
 
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/core/point_image.hpp"
+#include "kartograf/registration/robust_kernel.hpp"
 
 namespace kartograf::registration {
 
+// Correspondence entries below 0: kNoMatch means the source point was looked at and has no partner
+// (it counts as "considered", the denominator of ICP's fitness); kNotSelected (or lower) means it
+// was left out by point selection (e.g. 1-in-k subsampling).
+inline constexpr std::int32_t kNoMatch = -1;
+inline constexpr std::int32_t kNotSelected = -2;
+
 // Pair i is (R source[i] + t, target[j]) with j = correspondences[i], or j = i without that buffer.
-// A pair counts when source, target (and normal) are valid points, j is in range (-1: no match),
-// its weight is > 0, and |R p + t - q| <= max_distance.
+// A pair counts when source, target (and normal) are valid points, j is in range, its weight is
+// > 0, and |R p + t - q| <= max_distance. Its weight in the sums is the caller's weight (1 without
+// the buffer) times robust_weight(robust, residual); a pair the kernel weights 0 still counts.
 struct Correspondences {
   const compute::Buffer<Point4f>* source = nullptr;
   const compute::Buffer<Point4f>* target = nullptr;
-  const compute::Buffer<Point4f>* target_normals = nullptr;       // point-to-plane only
+  const compute::Buffer<Point4f>* target_normals = nullptr;        // point-to-plane only
   const compute::Buffer<std::int32_t>* correspondences = nullptr;  // optional
   const compute::Buffer<float>* weights = nullptr;                 // optional, per source point
   Eigen::Isometry3d source_to_target = Eigen::Isometry3d::Identity();
   double max_distance = std::numeric_limits<double>::infinity();
+  RobustLoss robust;
 };
 
 struct PointToPointSums {
@@ -36,6 +47,10 @@ struct PointToPointSums {
   // sum w (R p + t - source_mean)(q - target_mean)^T, not normalised.
   Eigen::Matrix3d cross_covariance = Eigen::Matrix3d::Zero();
   double squared_error_sum = 0;  // sum w |R p + t - q|^2
+  // sum w (R p + t - source_mean)(R p + t - source_mean)^T: the point-to-point J^T J needs it.
+  Eigen::Matrix3d source_scatter = Eigen::Matrix3d::Zero();
+  double unweighted_squared_error_sum = 0;  // sum |R p + t - q|^2 over the counted pairs
+  std::uint64_t considered_count = 0;       // valid source points whose entry is not kNotSelected
 };
 
 // The linearisation about `pivot`: a small motion x = (omega, v) moves p' to
@@ -45,8 +60,10 @@ struct PointToPlaneSystem {
   double weight_sum = 0;
   Eigen::Matrix<double, 6, 6> jtj = Eigen::Matrix<double, 6, 6>::Zero();  // sum w J^T J
   Eigen::Matrix<double, 6, 1> jtr = Eigen::Matrix<double, 6, 1>::Zero();  // sum w J^T r
-  double squared_error_sum = 0;                                             // sum w r^2
+  double squared_error_sum = 0;                                           // sum w r^2
   Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+  double unweighted_squared_error_sum = 0;  // sum r^2 over the counted pairs
+  std::uint64_t considered_count = 0;       // valid source points whose entry is not kNotSelected
 };
 
 // Holds the device scratch buffers, so that ICP iterations allocate nothing.

@@ -1,0 +1,19 @@
+// Uniform 1-in-k subsampling; see shaders/subsample.comp.
+typedef struct {
+  uint out_count;
+  uint k;
+  uint has_normals;
+  uint has_colors;
+} SubsampleParams;
+
+__kernel void subsample(__global const float4* points, __global const float4* normals,
+                        __global const uint* colors, __global float4* out_points,
+                        __global float4* out_normals, __global uint* out_colors,
+                        const SubsampleParams params) {
+  const uint m = get_global_id(0);
+  if (m >= params.out_count) return;
+  const uint i = m * params.k;
+  out_points[m] = points[i];
+  if (params.has_normals != 0u) out_normals[m] = normals[i];
+  if (params.has_colors != 0u) out_colors[m] = colors[i];
+}
