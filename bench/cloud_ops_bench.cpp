@@ -12,19 +12,16 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <functional>
-#include <iostream>
 #include <map>
 #include <memory>
 #include <numbers>
 #include <random>
-#include <sstream>
 #include <string>
 
 #include <Eigen/Geometry>
 
-#include "kartograf/compute/backend.hpp"
+#include "bench_support.hpp"
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
@@ -198,11 +195,7 @@ Factory nearest(bool rebuild) {
 
 void run_benchmark(benchmark::State& state, BackendKind backend, const Factory& factory,
                    std::size_t n) {
-  compute::ContextOptions options;
-  options.backend = backend == BackendKind::vulkan   ? compute::BackendChoice::vulkan
-                    : backend == BackendKind::opencl ? compute::BackendChoice::opencl
-                                                     : compute::BackendChoice::cpu;
-  const compute::Context context(options);
+  const compute::Context context(bench::context_options(backend));
   Scene scene(context, n);
   const Measured measured = factory(context);
   measured.run(scene);  // warm-up: pipelines built, driver JIT done, grids and tables built
@@ -219,17 +212,6 @@ void run_benchmark(benchmark::State& state, BackendKind backend, const Factory& 
   state.SetLabel(context.device_info().name);
 }
 
-bool wanted(BackendKind kind) {
-  const char* listed = std::getenv("KARTOGRAF_BENCH_BACKENDS");
-  if (!listed || !*listed) return true;
-  std::stringstream stream(listed);
-  std::string name;
-  while (std::getline(stream, name, ',')) {
-    if (name == compute::to_string(kind)) return true;
-  }
-  return false;
-}
-
 void register_benchmarks() {
   struct Entry {
     std::string name;
@@ -244,27 +226,17 @@ void register_benchmarks() {
       {"nn_kdtree/query", nearest<registration::KdTreeCorrespondences>(false), true},
       {"nn_kdtree/build+query", nearest<registration::KdTreeCorrespondences>(true), true},
   };
-  for (const auto& status : compute::probe_backends()) {
-    if (!wanted(status.backend)) continue;
-    if (!status.available) {
-      std::cerr << "skipping " << compute::to_string(status.backend) << ": " << status.reason
-                << "\n";
-      continue;
-    }
+  for (const BackendKind backend : bench::backends_to_run()) {
     for (const Entry& entry : entries) {
-      if (entry.cpu_only && status.backend != BackendKind::cpu) continue;
+      if (entry.cpu_only && backend != BackendKind::cpu) continue;
       for (std::size_t n : {std::size_t{20000}, std::size_t{300000}}) {
         const auto slash = entry.name.find('/');
         const std::string op = entry.name.substr(0, slash);
         const std::string variant = slash == std::string::npos ? "" : entry.name.substr(slash);
-        const std::string name = op + "/" + std::string(compute::to_string(status.backend)) + "/" +
-                                 std::to_string(n) + variant;
-        benchmark::RegisterBenchmark(name.c_str(), run_benchmark, status.backend, entry.factory, n)
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime()
-            ->MinTime(0.2)
-            ->Repetitions(3)
-            ->ReportAggregatesOnly(true);
+        const std::string name = bench::case_name(op, backend, std::to_string(n)) + variant;
+        bench::repeated(
+            benchmark::RegisterBenchmark(name.c_str(), run_benchmark, backend, entry.factory, n), 3)
+            ->MinTime(0.2);
       }
     }
   }
@@ -274,9 +246,5 @@ void register_benchmarks() {
 }  // namespace kartograf
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  kartograf::register_benchmarks();
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return kartograf::bench::run(argc, argv, kartograf::register_benchmarks);
 }

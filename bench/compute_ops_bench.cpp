@@ -7,14 +7,11 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <functional>
-#include <iostream>
 #include <memory>
-#include <sstream>
 #include <string>
 
-#include "kartograf/compute/backend.hpp"
+#include "bench_support.hpp"
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/geometry/backproject.hpp"
@@ -26,14 +23,6 @@ namespace kartograf {
 namespace {
 
 using compute::BackendKind;
-
-compute::BackendChoice choice_of(BackendKind kind) {
-  switch (kind) {
-    case BackendKind::vulkan: return compute::BackendChoice::vulkan;
-    case BackendKind::opencl: return compute::BackendChoice::opencl;
-    default: return compute::BackendChoice::cpu;
-  }
-}
 
 PinholeIntrinsics camera(int width, int height) {
   const double f = 525.0 * width / 640.0;
@@ -138,9 +127,7 @@ const std::vector<std::pair<std::string, Operation>>& operations() {
 
 void steady_state(benchmark::State& state, BackendKind backend, const Operation& operation, int width,
                   int height) {
-  compute::ContextOptions options;
-  options.backend = choice_of(backend);
-  const compute::Context context(options);
+  const compute::Context context(bench::context_options(backend));
   Frame frame(context, host_frame(width));
   operation(context, frame);  // warm-up: pipelines built, driver JIT done
   context.finish();
@@ -155,8 +142,7 @@ void steady_state(benchmark::State& state, BackendKind backend, const Operation&
 void cold_start(benchmark::State& state, BackendKind backend, const Operation& operation, int width,
                 int height) {
   state.SetItemsProcessed(static_cast<std::int64_t>(width) * height);
-  compute::ContextOptions options;
-  options.backend = choice_of(backend);
+  const compute::ContextOptions options = bench::context_options(backend);
   for (auto _ : state) {
     state.PauseTiming();
     auto context = std::make_unique<compute::Context>(options);
@@ -172,42 +158,20 @@ void cold_start(benchmark::State& state, BackendKind backend, const Operation& o
   }
 }
 
-bool wanted(BackendKind kind) {
-  const char* listed = std::getenv("KARTOGRAF_BENCH_BACKENDS");
-  if (!listed || !*listed) return true;
-  std::stringstream stream(listed);
-  std::string name;
-  while (std::getline(stream, name, ',')) {
-    if (name == compute::to_string(kind)) return true;
-  }
-  return false;
-}
-
 void register_benchmarks() {
-  for (const auto& status : compute::probe_backends()) {
-    if (!wanted(status.backend)) continue;
-    if (!status.available) {
-      std::cerr << "skipping " << compute::to_string(status.backend) << ": " << status.reason << "\n";
-      continue;
-    }
+  for (const BackendKind backend : bench::backends_to_run()) {
     for (const auto& [name, operation] : operations()) {
       for (auto [width, height] : {std::pair{640, 480}, std::pair{1280, 720}}) {
-        const std::string prefix = name + "/" + std::string(compute::to_string(status.backend)) + "/" +
-                                   std::to_string(width) + "x" + std::to_string(height);
-        benchmark::RegisterBenchmark((prefix + "/steady").c_str(), steady_state, status.backend, operation,
-                                     width, height)
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime()
-            ->MinTime(0.2)
-            ->Repetitions(5)
-            ->ReportAggregatesOnly(true);
-        benchmark::RegisterBenchmark((prefix + "/cold").c_str(), cold_start, status.backend, operation, width,
-                                     height)
-            ->Unit(benchmark::kMillisecond)
-            ->UseRealTime()
-            ->Iterations(1)
-            ->Repetitions(3)
-            ->ReportAggregatesOnly(true);
+        const std::string prefix =
+            bench::case_name(name, backend, std::to_string(width) + "x" + std::to_string(height));
+        bench::repeated(benchmark::RegisterBenchmark((prefix + "/steady").c_str(), steady_state,
+                                                     backend, operation, width, height),
+                        5)
+            ->MinTime(0.2);
+        bench::repeated(benchmark::RegisterBenchmark((prefix + "/cold").c_str(), cold_start,
+                                                     backend, operation, width, height),
+                        3)
+            ->Iterations(1);
       }
     }
   }
@@ -217,9 +181,5 @@ void register_benchmarks() {
 }  // namespace kartograf
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  kartograf::register_benchmarks();
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return kartograf::bench::run(argc, argv, kartograf::register_benchmarks);
 }

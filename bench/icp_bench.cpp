@@ -11,15 +11,11 @@
 #include <benchmark/benchmark.h>
 
 #include <cmath>
-#include <cstdlib>
-#include <iostream>
-#include <memory>
 #include <numbers>
-#include <sstream>
 #include <string>
 
 #include "../tests/icp_test_scene.hpp"
-#include "kartograf/compute/backend.hpp"
+#include "bench_support.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/registration/frame_pyramid.hpp"
@@ -29,17 +25,6 @@ namespace kartograf {
 namespace {
 
 using compute::BackendKind;
-
-compute::BackendChoice choice_of(BackendKind kind) {
-  switch (kind) {
-    case BackendKind::vulkan:
-      return compute::BackendChoice::vulkan;
-    case BackendKind::opencl:
-      return compute::BackendChoice::opencl;
-    default:
-      return compute::BackendChoice::cpu;
-  }
-}
 
 DepthImage to_depth(const PointImage& points) {
   DepthImage depth(points.width(), points.height(), 0);
@@ -96,9 +81,7 @@ struct Odometry {
 enum class Part { whole, pyramid, align };
 
 void run(benchmark::State& state, BackendKind backend, Part part) {
-  compute::ContextOptions options;
-  options.backend = choice_of(backend);
-  const compute::Context context(options);
+  const compute::Context context(bench::context_options(backend));
   Odometry odometry(context);
   registration::IcpResult result;
   const auto step = [&] {
@@ -120,36 +103,14 @@ void run(benchmark::State& state, BackendKind backend, Part part) {
   state.SetLabel(context.device_info().name);
 }
 
-bool wanted(BackendKind kind) {
-  const char* listed = std::getenv("KARTOGRAF_BENCH_BACKENDS");
-  if (!listed || !*listed) return true;
-  std::stringstream stream(listed);
-  std::string name;
-  while (std::getline(stream, name, ',')) {
-    if (name == compute::to_string(kind)) return true;
-  }
-  return false;
-}
-
 void register_benchmarks() {
-  for (const auto& status : compute::probe_backends()) {
-    if (!wanted(status.backend)) continue;
-    if (!status.available) {
-      std::cerr << "skipping " << compute::to_string(status.backend) << ": " << status.reason
-                << "\n";
-      continue;
-    }
+  for (const BackendKind backend : bench::backends_to_run()) {
     for (const auto& [name, part] :
          {std::pair{"icp_odometry", Part::whole}, std::pair{"icp_pyramid", Part::pyramid},
           std::pair{"icp_align", Part::align}}) {
-      const std::string label =
-          std::string(name) + "/" + std::string(compute::to_string(status.backend)) + "/640x480";
-      benchmark::RegisterBenchmark(label.c_str(), run, status.backend, part)
-          ->Unit(benchmark::kMillisecond)
-          ->UseRealTime()
-          ->MinTime(0.5)
-          ->Repetitions(5)
-          ->ReportAggregatesOnly(true);
+      const std::string label = bench::case_name(name, backend, "640x480");
+      bench::repeated(benchmark::RegisterBenchmark(label.c_str(), run, backend, part), 5)
+          ->MinTime(0.5);
     }
   }
 }
@@ -158,9 +119,5 @@ void register_benchmarks() {
 }  // namespace kartograf
 
 int main(int argc, char** argv) {
-  benchmark::Initialize(&argc, argv);
-  kartograf::register_benchmarks();
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return kartograf::bench::run(argc, argv, kartograf::register_benchmarks);
 }

@@ -8,6 +8,12 @@
 
 inline bool kg_is_valid_point(float4 p) { return !isnan(p.x); }
 
+// Adds value as a 64-bit fixed-point integer (value * scale, rounded to nearest even) with an
+// atomic: integer addition is exact and associative, so the sum does not depend on the order.
+inline void kg_add_fixed(__global long* sums, uint slot, double value, double scale) {
+  atom_add(&sums[slot], convert_long_rte(value * scale));
+}
+
 // The first pass of a two-pass reduction: each work-item has summed its share into `sums`; the
 // work-group adds those in local memory (a fixed-order tree: results do not vary from run to run)
 // and writes one row of `sum_count` doubles per work-group to `partials`.

@@ -10,10 +10,6 @@ typedef struct {
   float second_scale;
 } SegmentMomentParams;
 
-inline void kg_add_fixed(__global long* moments, uint slot, double value, double scale) {
-  atom_add(&moments[slot], convert_long_rte(value * scale));
-}
-
 __kernel void segment_moments(__global const float4* points, __global const uint* labels,
                               __global long* moments, __global uint* status,
                               const SegmentMomentParams params) {

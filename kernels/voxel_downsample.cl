@@ -127,10 +127,6 @@ __kernel void voxel_downsample_assign(__global const int* point_slots, __global 
   }
 }
 
-inline void kg_add_voxel_sum(__global long* sums, uint slot, double value, double scale) {
-  atom_add(&sums[slot], convert_long_rte(value * scale));
-}
-
 __kernel void voxel_downsample_accumulate(__global const float4* points, __global const float4* normals,
                                           __global const uint* colors, __global const int* point_slots,
                                           __global const uint* voxel_of_slot, __global long* sums,
@@ -144,16 +140,16 @@ __kernel void voxel_downsample_accumulate(__global const float4* points, __globa
   const double3 fraction = scaled - floor(scaled);
   const double position_scale = (double)params.position_scale;
   atom_add(&sums[base], 1L);
-  kg_add_voxel_sum(sums, base + 1u, fraction.x, position_scale);
-  kg_add_voxel_sum(sums, base + 2u, fraction.y, position_scale);
-  kg_add_voxel_sum(sums, base + 3u, fraction.z, position_scale);
+  kg_add_fixed(sums, base + 1u, fraction.x, position_scale);
+  kg_add_fixed(sums, base + 2u, fraction.y, position_scale);
+  kg_add_fixed(sums, base + 3u, fraction.z, position_scale);
   if (params.has_normals != 0u) {
     const float4 n = normals[i];
     if (kg_is_valid_point(n) && kg_is_unit_bounded(n)) {
       const double normal_scale = (double)params.normal_scale;
-      kg_add_voxel_sum(sums, base + 4u, (double)n.x, normal_scale);
-      kg_add_voxel_sum(sums, base + 5u, (double)n.y, normal_scale);
-      kg_add_voxel_sum(sums, base + 6u, (double)n.z, normal_scale);
+      kg_add_fixed(sums, base + 4u, (double)n.x, normal_scale);
+      kg_add_fixed(sums, base + 5u, (double)n.y, normal_scale);
+      kg_add_fixed(sums, base + 6u, (double)n.z, normal_scale);
       atom_add(&sums[base + 7u], 1L);
     }
   }

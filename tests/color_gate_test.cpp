@@ -51,7 +51,7 @@ double circular_deg(double a, double b) {
 }
 
 std::uint32_t pack(int r, int g, int b) {
-  return registration::pack_rgb(
+  return pack_rgb(
       {static_cast<std::uint8_t>(r), static_cast<std::uint8_t>(g), static_cast<std::uint8_t>(b)});
 }
 
@@ -299,7 +299,7 @@ TEST_P(ColorGateTest, MatchesTheReferenceOnSevenScenesColours) {
   const RgbImage image = io::read_color_image(testing::data_dir() / "7scenes_redkitchen" /
                                               "frames" / "frame-000100.color.jpg");
   GateCase c;
-  for (const Rgb8& pixel : image.pixels()) c.target_colors.push_back(registration::pack_rgb(pixel));
+  for (const Rgb8& pixel : image.pixels()) c.target_colors.push_back(pack_rgb(pixel));
   const auto count = static_cast<std::int32_t>(c.target_colors.size());
   for (std::int32_t i = 0; i < count; ++i) {
     c.source_colors.push_back(c.target_colors[i]);

@@ -7,24 +7,18 @@
 #include "kartograf/eval/connected_components.hpp"
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/io/occupancy_map_io.hpp"
+#include "label_image_builders.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
 namespace {
 
-void fill(LabelImage& image, int x0, int y0, int x1, int y1, Label label) {
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) image(x, y) = label;
-  }
-}
+using testing::paint;
 
 // Rooms A (label 1) and B (label 2), 30x10 = 300 pixels each, side by side behind a 1-pixel
 // wall column (label 0) in a 61x10 map.
 LabelImage two_rooms() {
-  LabelImage rooms(61, 10, kUnlabeled);
-  fill(rooms, 0, 0, 30, 10, 1);
-  fill(rooms, 31, 0, 61, 10, 2);
-  return rooms;
+  return testing::label_rectangles(61, 10, {{0, 0, 30, 10, 1}, {31, 0, 61, 10, 2}});
 }
 
 TEST(EvalRooms, IdenticalSegmentationScoresOne) {
@@ -42,7 +36,7 @@ TEST(EvalRooms, IdenticalSegmentationScoresOne) {
 
 TEST(EvalRooms, ARoomSplitInHalvesHasHalfRecallAndFullPrecision) {
   LabelImage segmentation = two_rooms();
-  fill(segmentation, 15, 0, 30, 10, 3);  // room A: segments 1 (150 px) and 3 (150 px)
+  paint(segmentation, {{15, 0, 30, 10, 3}});  // room A: segments 1 (150 px) and 3 (150 px)
   const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
   ASSERT_EQ(scores.room_recall.size(), 2u);
   EXPECT_DOUBLE_EQ(scores.room_recall[0], 0.5);
@@ -61,8 +55,7 @@ TEST(EvalRooms, ARoomSplitInHalvesHasHalfRecallAndFullPrecision) {
 }
 
 TEST(EvalRooms, MergedRoomsAreTheMirrorCase) {
-  LabelImage segmentation(61, 10, kUnlabeled);
-  fill(segmentation, 0, 0, 61, 10, 5);  // one segment over both rooms and the wall: 610 px
+  const LabelImage segmentation(61, 10, 5);  // one segment over both rooms and the wall: 610 px
   const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
   EXPECT_DOUBLE_EQ(scores.recall_mean, 1);
   EXPECT_DOUBLE_EQ(scores.recall_total, 1);
@@ -75,7 +68,7 @@ TEST(EvalRooms, MergedRoomsAreTheMirrorCase) {
 
 TEST(EvalRooms, SegmentsSpillingIntoWallsLosePrecisionButNotMcc) {
   LabelImage segmentation = two_rooms();
-  fill(segmentation, 30, 0, 31, 10, 1);  // segment 1 also covers the 10 wall pixels
+  paint(segmentation, {{30, 0, 31, 10, 1}});  // segment 1 also covers the 10 wall pixels
   const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
   EXPECT_DOUBLE_EQ(scores.precision_mean, (300.0 / 310.0 + 1.0) / 2);
   EXPECT_DOUBLE_EQ(scores.precision_total, 600.0 / 610.0);
@@ -85,7 +78,7 @@ TEST(EvalRooms, SegmentsSpillingIntoWallsLosePrecisionButNotMcc) {
 
 TEST(EvalRooms, RegionsOfAHundredPixelsOrLessAreIgnoredLikeIpa) {
   LabelImage segmentation = two_rooms();
-  fill(segmentation, 0, 0, 10, 10, 8);  // 100 px: dropped; segment 1 keeps 200 px of room A
+  paint(segmentation, {{0, 0, 10, 10, 8}});  // 100 px: dropped; segment 1 keeps 200 px of room A
   const auto scores = eval::evaluate_room_segmentation(two_rooms(), segmentation);
   EXPECT_EQ(scores.segments, 2);
   EXPECT_DOUBLE_EQ(scores.room_recall[0], 200.0 / 300.0);

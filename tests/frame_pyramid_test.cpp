@@ -42,7 +42,7 @@ Coarse reference_downsample(const PointImage& fine, const Image<std::uint32_t>& 
       for (const auto& [u, v] : valid) {
         if (!(fine(u, v).z() - z_min <= max_depth_jump * z_min)) continue;
         sum += fine(u, v).head<3>().cast<double>();
-        for (int c = 0; c < 3; ++c) channel[c] += registration::unpack_rgb(fine_colors(u, v))[c];
+        for (int c = 0; c < 3; ++c) channel[c] += unpack_rgb(fine_colors(u, v))[c];
         ++count;
       }
       const Eigen::Vector3d mean = sum / count;
@@ -51,7 +51,7 @@ Coarse reference_downsample(const PointImage& fine, const Image<std::uint32_t>& 
       for (int c = 0; c < 3; ++c) {
         color[c] = static_cast<std::uint8_t>(std::floor(channel[c] / double(count) + 0.5));
       }
-      coarse.colors(x, y) = registration::pack_rgb(color);
+      coarse.colors(x, y) = pack_rgb(color);
     }
   }
   return coarse;
@@ -202,8 +202,8 @@ TEST_P(FramePyramidTest, BuildsFromDepthAndRejectsBadInput) {
 
 TEST(PackedRgb, RoundTrips) {
   const Rgb8 color{12, 200, 255};
-  EXPECT_EQ(registration::pack_rgb(color), 12u | 200u << 8 | 255u << 16);
-  EXPECT_EQ(registration::unpack_rgb(registration::pack_rgb(color)), color);
+  EXPECT_EQ(pack_rgb(color), 12u | 200u << 8 | 255u << 16);
+  EXPECT_EQ(unpack_rgb(pack_rgb(color)), color);
 }
 
 KARTOGRAF_INSTANTIATE_BACKEND_TESTS(FramePyramidTest);

@@ -4,10 +4,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <filesystem>
-#include <fstream>
-#include <functional>
 #include <initializer_list>
-#include <iterator>
 #include <set>
 #include <string>
 #include <string_view>
@@ -24,31 +21,8 @@ namespace {
 namespace fs = std::filesystem;
 using testing::TempDirTest;
 
-void write_text(const fs::path& path, std::string_view text) {
-  std::ofstream stream(path, std::ios::binary | std::ios::trunc);
-  stream.write(text.data(), static_cast<std::streamsize>(text.size()));
-  ASSERT_TRUE(stream) << "cannot write " << path;
-}
-
-std::string read_text(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return std::string((std::istreambuf_iterator<char>(stream)), std::istreambuf_iterator<char>());
-}
-
-// The message of the kartograf::Error that f throws, checked to mention every part.
-void expect_error(const std::function<void()>& f, std::initializer_list<std::string_view> parts) {
-  try {
-    f();
-  } catch (const Error& error) {
-    const std::string message = error.what();
-    for (std::string_view part : parts) {
-      EXPECT_NE(message.find(part), std::string::npos)
-          << "the message does not mention \"" << part << "\":\n  " << message;
-    }
-    return;
-  }
-  ADD_FAILURE() << "expected a kartograf::Error, but nothing was thrown";
-}
+using testing::read_text;
+using testing::write_file;
 
 // An ASCII PGM (P2): one row of 8-bit grey levels.
 std::string pgm_row(const std::vector<int>& levels) {
@@ -76,26 +50,26 @@ TEST_F(OccupancyMapIo, RosMapFollowsMapServerThresholds) {
   // p = (255 - v) / 255: 0 -> 1, 50 -> .804 (> .65: occupied); 100 -> .608, 150 -> .412,
   // 200 -> .216, 205 -> .19608 (between: unknown; 205 is map_saver's unknown, just above .196);
   // 230 -> .098, 254, 255 (< .196: free).
-  write_text(dir() / "m.pgm", pgm_row({0, 50, 100, 150, 200, 205, 230, 254, 255}));
-  write_text(dir() / "m.yaml", ros_yaml("m.pgm"));
+  write_file(dir() / "m.pgm", pgm_row({0, 50, 100, 150, 200, 205, 230, 254, 255}));
+  write_file(dir() / "m.yaml", ros_yaml("m.pgm"));
   const OccupancyGrid grid = io::read_ros_map(dir() / "m.yaml");
   EXPECT_EQ(row_of(grid), (std::vector<CellState>{O, O, U, U, U, U, F, F, F}));
   EXPECT_DOUBLE_EQ(grid.resolution, 0.05);
   EXPECT_EQ(grid.origin, Eigen::Vector3d(1.5, -2.0, 0.25));
 
   // negate: p = v / 255: 0 free; 50 -> .19608 unknown; ... 200 -> .784 occupied.
-  write_text(dir() / "n.yaml", ros_yaml("m.pgm", "negate: 1\n"));
+  write_file(dir() / "n.yaml", ros_yaml("m.pgm", "negate: 1\n"));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "n.yaml")),
             (std::vector<CellState>{F, U, U, U, O, O, O, O, O}));
-  write_text(dir() / "t.yaml", ros_yaml("m.pgm", "negate: true\nmode: scale\n"));
+  write_file(dir() / "t.yaml", ros_yaml("m.pgm", "negate: true\nmode: scale\n"));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "t.yaml")),
             (std::vector<CellState>{F, U, U, U, O, O, O, O, O}));
 }
 
 TEST_F(OccupancyMapIo, RosMapThresholdsAreStrict) {
   // (255 - 102) / 255 is exactly 0.6: not above occupied_thresh 0.6, so unknown; 101 is above.
-  write_text(dir() / "m.pgm", pgm_row({101, 102}));
-  write_text(dir() / "m.yaml",
+  write_file(dir() / "m.pgm", pgm_row({101, 102}));
+  write_file(dir() / "m.yaml",
              "image: m.pgm\nresolution: 0.1\norigin: [0, 0, 0]\noccupied_thresh: 0.6\n"
              "free_thresh: 0.1\nnegate: 0\n");
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "m.yaml")), (std::vector<CellState>{O, U}));
@@ -107,26 +81,26 @@ TEST_F(OccupancyMapIo, RosMapAveragesChannelsLikeMapServer) {
   rgb(0, 0) = {255, 0, 0};
   rgb(1, 0) = {255, 255, 235};
   io::write_png(dir() / "rgb.png", rgb);
-  write_text(dir() / "rgb.yaml", ros_yaml("rgb.png"));
+  write_file(dir() / "rgb.yaml", ros_yaml("rgb.png"));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "rgb.yaml")), (std::vector<CellState>{O, F}));
 
   // RGBA (a PAM file): opaque grey 205. Trinary averages alpha in, as map_server does:
   // (3 * 205 + 255) / 4 = 217.5, p = .147: free. Scale leaves alpha out: 205, unknown.
   std::string pam = "P7\nWIDTH 1\nHEIGHT 1\nDEPTH 4\nMAXVAL 255\nTUPLTYPE RGB_ALPHA\nENDHDR\n";
   pam += std::string{char(205), char(205), char(205), char(255)};
-  write_text(dir() / "rgba.pam", pam);
-  write_text(dir() / "tri.yaml", ros_yaml("rgba.pam"));
+  write_file(dir() / "rgba.pam", pam);
+  write_file(dir() / "tri.yaml", ros_yaml("rgba.pam"));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "tri.yaml")), (std::vector<CellState>{F}));
-  write_text(dir() / "scale.yaml", ros_yaml("rgba.pam", "negate: 0\nmode: scale\n"));
+  write_file(dir() / "scale.yaml", ros_yaml("rgba.pam", "negate: 0\nmode: scale\n"));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "scale.yaml")), (std::vector<CellState>{U}));
 }
 
 TEST_F(OccupancyMapIo, RosMapImagePathsAreRelativeToTheYaml) {
   fs::create_directories(dir() / "maps" / "images");
-  write_text(dir() / "maps" / "images" / "m.pgm", pgm_row({0, 255}));
-  write_text(dir() / "maps" / "m.yaml", ros_yaml("images/m.pgm"));
+  write_file(dir() / "maps" / "images" / "m.pgm", pgm_row({0, 255}));
+  write_file(dir() / "maps" / "m.yaml", ros_yaml("images/m.pgm"));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "maps" / "m.yaml")), (std::vector<CellState>{O, F}));
-  write_text(dir() / "abs.yaml", ros_yaml((dir() / "maps" / "images" / "m.pgm").string()));
+  write_file(dir() / "abs.yaml", ros_yaml((dir() / "maps" / "images" / "m.pgm").string()));
   EXPECT_EQ(row_of(io::read_ros_map(dir() / "abs.yaml")), (std::vector<CellState>{O, F}));
 }
 
@@ -177,27 +151,27 @@ TEST_F(OccupancyMapIo, RosMapWriteFailureLeavesNoHalfPair) {
   // The image name is taken by a folder: staging works, publishing the image fails, and neither
   // a YAML nor a staged file may remain.
   fs::create_directory(dir() / "blocked.pgm");
-  expect_error([&] { io::write_ros_map(dir() / "blocked.yaml", sample_grid()); }, {"blocked.pgm"});
+  EXPECT_ERROR_MENTIONS(io::write_ros_map(dir() / "blocked.yaml", sample_grid()), "blocked.pgm");
   std::set<std::string> names;
   for (const auto& entry : fs::directory_iterator(dir())) names.insert(entry.path().filename());
   EXPECT_EQ(names, (std::set<std::string>{"blocked.pgm"}));
 
-  expect_error([&] { io::write_ros_map(dir() / "missing" / "m.yaml", sample_grid()); },
-               {"missing"});
-  expect_error([&] { io::write_ros_map(dir() / "m.pgm", sample_grid()); }, {".pgm"});
+  EXPECT_ERROR_MENTIONS(io::write_ros_map(dir() / "missing" / "m.yaml", sample_grid()), "missing");
+  EXPECT_ERROR_MENTIONS(io::write_ros_map(dir() / "m.pgm", sample_grid()), ".pgm");
   OccupancyGrid bad = sample_grid();
   bad.resolution = 0;
-  expect_error([&] { io::write_ros_map(dir() / "r.yaml", bad); }, {"resolution"});
-  expect_error([&] { io::write_ros_map(dir() / "e.yaml", OccupancyGrid{}); }, {"empty"});
+  EXPECT_ERROR_MENTIONS(io::write_ros_map(dir() / "r.yaml", bad), "resolution");
+  EXPECT_ERROR_MENTIONS(io::write_ros_map(dir() / "e.yaml", OccupancyGrid{}), "empty");
   EXPECT_FALSE(fs::exists(dir() / "r.yaml"));
 }
 
 TEST_F(OccupancyMapIo, RosMapErrorsNameTheKeyAndTheProblem) {
-  write_text(dir() / "m.pgm", pgm_row({0, 255}));
+  write_file(dir() / "m.pgm", pgm_row({0, 255}));
   const auto yaml_error = [&](const std::string& text,
                               std::initializer_list<std::string_view> parts) {
-    write_text(dir() / "bad.yaml", text);
-    expect_error([&] { io::read_ros_map(dir() / "bad.yaml"); }, parts);
+    write_file(dir() / "bad.yaml", text);
+    testing::expect_mentions(testing::error_message([&] { io::read_ros_map(dir() / "bad.yaml"); }),
+                             parts);
   };
   yaml_error(
       "resolution: 0.05\norigin: [0, 0, 0]\noccupied_thresh: 0.65\nfree_thresh: 0.2\n"
@@ -229,7 +203,7 @@ TEST_F(OccupancyMapIo, RosMapErrorsNameTheKeyAndTheProblem) {
   LabelImage sixteen(2, 1, 7);
   io::write_label_png(dir() / "deep.png", sixteen);
   yaml_error(ros_yaml("deep.png"), {"deep.png", "16-bit", "expected 8-bit"});
-  expect_error([&] { io::read_ros_map(dir() / "nothing.yaml"); }, {"nothing.yaml", "no such file"});
+  EXPECT_ERROR_MENTIONS(io::read_ros_map(dir() / "nothing.yaml"), "nothing.yaml", "no such file");
 }
 
 TEST_F(OccupancyMapIo, PngMapThresholdsGrey) {
@@ -255,12 +229,12 @@ TEST_F(OccupancyMapIo, PngMapThresholdsGrey) {
     EXPECT_EQ(back.cells.pixels()[i], expected) << "cell " << i;
   }
 
-  expect_error([&] { io::read_png_map(dir() / "map.png", 0); }, {"map.png", "resolution"});
-  expect_error([&] { io::read_png_map(dir() / "map.png", 0.05, 256); }, {"threshold", "256"});
+  EXPECT_ERROR_MENTIONS(io::read_png_map(dir() / "map.png", 0), "map.png", "resolution");
+  EXPECT_ERROR_MENTIONS(io::read_png_map(dir() / "map.png", 0.05, 256), "threshold", "256");
   io::write_label_png(dir() / "deep.png", LabelImage(2, 2, 1));
-  expect_error([&] { io::read_png_map(dir() / "deep.png"); }, {"deep.png", "16-bit"});
-  write_text(dir() / "junk.png", "not a png");
-  expect_error([&] { io::read_png_map(dir() / "junk.png"); }, {"junk.png", "cannot decode"});
+  EXPECT_ERROR_MENTIONS(io::read_png_map(dir() / "deep.png"), "deep.png", "16-bit");
+  write_file(dir() / "junk.png", "not a png");
+  EXPECT_ERROR_MENTIONS(io::read_png_map(dir() / "junk.png"), "junk.png", "cannot decode");
 }
 
 TEST_F(OccupancyMapIo, ReadsRealIpaMaps) {
@@ -331,9 +305,9 @@ TEST_F(OccupancyMapIo, LabelImagesRoundTripAndColorize) {
   EXPECT_TRUE(std::equal(back.pixels().begin(), back.pixels().end(), labels.pixels().begin()));
 
   io::write_png(dir() / "gray.png", GrayImage(2, 2, 1));
-  expect_error([&] { io::read_label_png(dir() / "gray.png"); },
-               {"label image", "gray.png", "8-bit", "expected 16-bit"});
-  expect_error([&] { io::read_label_png(dir() / "none.png"); }, {"none.png", "no such file"});
+  EXPECT_ERROR_MENTIONS(io::read_label_png(dir() / "gray.png"), "label image", "gray.png", "8-bit",
+                        "expected 16-bit");
+  EXPECT_ERROR_MENTIONS(io::read_label_png(dir() / "none.png"), "none.png", "no such file");
 
   LabelImage ramp(64, 1);
   for (int i = 0; i < 64; ++i) ramp(i, 0) = static_cast<Label>(i);
@@ -355,10 +329,10 @@ TEST_F(OccupancyMapIo, SemanticImagesRoundTripAndRejectUnknownValues) {
   GrayImage bad(3, 2, 1);
   bad(2, 1) = 9;
   io::write_png(dir() / "bad.png", bad);
-  expect_error([&] { io::read_semantic_png(dir() / "bad.png"); },
-               {"bad.png", "pixel (2, 1)", "value 9"});
+  EXPECT_ERROR_MENTIONS(io::read_semantic_png(dir() / "bad.png"), "bad.png", "pixel (2, 1)",
+                        "value 9");
   io::write_label_png(dir() / "deep.png", LabelImage(2, 2, 1));
-  expect_error([&] { io::read_semantic_png(dir() / "deep.png"); }, {"deep.png", "expected 8-bit"});
+  EXPECT_ERROR_MENTIONS(io::read_semantic_png(dir() / "deep.png"), "deep.png", "expected 8-bit");
 }
 
 }  // namespace

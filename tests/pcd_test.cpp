@@ -12,7 +12,6 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
-#include <fstream>
 #include <functional>
 #include <initializer_list>
 #include <limits>
@@ -32,6 +31,10 @@ namespace {
 namespace fs = std::filesystem;
 using io::PcdCloud;
 using io::PcdEncoding;
+using testing::error_message;
+using testing::expect_mentions;
+using testing::read_bytes;
+using testing::write_file;
 
 constexpr float kNan = std::numeric_limits<float>::quiet_NaN();
 constexpr float kInf = std::numeric_limits<float>::infinity();
@@ -40,49 +43,12 @@ std::vector<std::uint8_t> bytes_of(std::string_view text) {
   return std::vector<std::uint8_t>(text.begin(), text.end());
 }
 
-void write_file(const fs::path& path, const std::vector<std::uint8_t>& bytes) {
-  std::ofstream stream(path, std::ios::binary | std::ios::trunc);
-  stream.write(reinterpret_cast<const char*>(bytes.data()),
-               static_cast<std::streamsize>(bytes.size()));
-  ASSERT_TRUE(stream) << path;
-}
-
-std::vector<std::uint8_t> read_file(const fs::path& path) {
-  std::ifstream stream(path, std::ios::binary);
-  return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(stream)),
-                                   std::istreambuf_iterator<char>());
-}
-
 std::string replaced(std::string text, std::string_view from, std::string_view to) {
   const auto at = text.find(from);
   EXPECT_NE(at, std::string::npos) << "test bug: '" << from << "' not in the text";
   if (at != std::string::npos) text.replace(at, from.size(), to);
   return text;
 }
-
-// The message of the kartograf::Error that f throws (a failure if it throws nothing).
-std::string error_message(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& error) {
-    return error.what();
-  }
-  ADD_FAILURE() << "expected a kartograf::Error, but nothing was thrown";
-  return "";
-}
-
-void expect_mentions(const std::string& message, std::initializer_list<std::string_view> parts) {
-  for (std::string_view part : parts) {
-    EXPECT_NE(message.find(part), std::string::npos)
-        << "the message does not mention \"" << part << "\":\n  " << message;
-  }
-}
-
-#define EXPECT_PCD_ERROR(statement, ...)                               \
-  do {                                                                 \
-    SCOPED_TRACE(#statement);                                          \
-    expect_mentions(error_message([&] { statement; }), {__VA_ARGS__}); \
-  } while (0)
 
 // Appends little-endian values, independently of the reader's own decoding.
 struct Bytes {
@@ -201,7 +167,7 @@ TEST_F(Pcd, EveryEncodingLayoutAndFieldSetRoundTripsBitExactly) {
         expect_same_cloud(cloud, back);
         EXPECT_EQ(back.organized(), organized);
         // Memory and file agree.
-        EXPECT_EQ(io::encode_pcd(cloud, encoding), read_file(file));
+        EXPECT_EQ(io::encode_pcd(cloud, encoding), read_bytes(file));
         ++cases;
       }
     }
@@ -436,8 +402,8 @@ TEST_F(Pcd, HandBuiltBinaryWithMixedTypesPaddingAndHistogram) {
   longer.push_back(0);
   EXPECT_EQ(io::parse_pcd(longer, "longer.pcd").size(), 2u);
   std::vector<std::uint8_t> shorter(file.data.begin(), file.data.end() - 1);
-  EXPECT_PCD_ERROR(io::parse_pcd(shorter, "short.pcd"), "'short.pcd'",
-                   "byte offset " + std::to_string(data_start), "truncated", "POINTS 2");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(shorter, "short.pcd"), "'short.pcd'",
+                        "byte offset " + std::to_string(data_start), "truncated", "POINTS 2");
 }
 
 // binary_compressed: uint32 compressed size, uint32 uncompressed size, LZF data of the fields
@@ -609,26 +575,26 @@ TEST_F(Pcd, ConversionsBetweenKartografTypes) {
   EXPECT_EQ(unorganized.width, 2);
   EXPECT_EQ(unorganized.height, 1);
   EXPECT_EQ(unorganized.colors, cloud.colors);
-  EXPECT_PCD_ERROR(unorganized.to_point_image(), "not organized");
+  EXPECT_ERROR_MENTIONS(unorganized.to_point_image(), "not organized");
 
   cloud.normals = {{0, 0, 1}};
-  EXPECT_PCD_ERROR(io::to_pcd(cloud), "1 normals for 2 points");
+  EXPECT_ERROR_MENTIONS(io::to_pcd(cloud), "1 normals for 2 points");
   const RgbImage small(2, 2);
-  EXPECT_PCD_ERROR(io::to_pcd(image, nullptr, &small),
-                   "the colours are 2x2 but the points are 3x2");
+  EXPECT_ERROR_MENTIONS(io::to_pcd(image, nullptr, &small),
+                        "the colours are 2x2 but the points are 3x2");
 }
 
 // ---------------------------------------------------------------------------------------------
 // Malformed input
 
 TEST_F(Pcd, MissingEmptyAndDirectory) {
-  EXPECT_PCD_ERROR(io::read_pcd(path("absent.pcd")), "absent.pcd", "no such file");
-  EXPECT_PCD_ERROR(io::read_pcd(dir()), dir().string(), "is a directory");
-  write_file(path("empty.pcd"), {});
-  EXPECT_PCD_ERROR(io::read_pcd(path("empty.pcd")), "empty.pcd", "empty file");
+  EXPECT_ERROR_MENTIONS(io::read_pcd(path("absent.pcd")), "absent.pcd", "no such file");
+  EXPECT_ERROR_MENTIONS(io::read_pcd(dir()), dir().string(), "is a directory");
+  write_file(path("empty.pcd"), "");
+  EXPECT_ERROR_MENTIONS(io::read_pcd(path("empty.pcd")), "empty.pcd", "empty file");
   write_file(path("cloud.ply"), bytes_of("ply\nformat ascii 1.0\nend_header\n"));
-  EXPECT_PCD_ERROR(io::read_pcd(path("cloud.ply")), "cloud.ply", "header line 1",
-                   "unknown keyword 'ply'");
+  EXPECT_ERROR_MENTIONS(io::read_pcd(path("cloud.ply")), "cloud.ply", "header line 1",
+                        "unknown keyword 'ply'");
 }
 
 TEST_F(Pcd, BadHeadersSayWhichLineAndWhat) {
@@ -727,9 +693,9 @@ TEST_F(Pcd, BadBinaryDataSaysWhere) {
     file.put(3.0f);
     file.put(static_cast<std::int16_t>(i == 1 ? -5 : 5));
   }
-  EXPECT_PCD_ERROR(io::parse_pcd(file.data, "neg.pcd"), "'neg.pcd'",
-                   "byte offset " + std::to_string(header.size() + 14), "point 1 (of 2)",
-                   "label is negative");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(file.data, "neg.pcd"), "'neg.pcd'",
+                        "byte offset " + std::to_string(header.size() + 14), "point 1 (of 2)",
+                        "label is negative");
 }
 
 TEST_F(Pcd, BadCompressedDataSaysWhat) {
@@ -738,26 +704,29 @@ TEST_F(Pcd, BadCompressedDataSaysWhat) {
   EXPECT_EQ(io::parse_pcd(good, "good.pcd").size(), 6u);
 
   // The uncompressed size disagrees with POINTS x bytes per point (6 x 20 = 120).
-  EXPECT_PCD_ERROR(io::parse_pcd(compressed_pcd(kCompressedHeader, compressed_soa(), 124), "a.pcd"),
-                   "'a.pcd'", "byte offset " + std::to_string(data_start + 4), "LZF size mismatch",
-                   "claims 124 bytes", "= 120");
+  EXPECT_ERROR_MENTIONS(
+      io::parse_pcd(compressed_pcd(kCompressedHeader, compressed_soa(), 124), "a.pcd"), "'a.pcd'",
+      "byte offset " + std::to_string(data_start + 4), "LZF size mismatch", "claims 124 bytes",
+      "= 120");
   // The data decompresses to fewer bytes than announced (a stream made from 116 bytes).
   Bytes short_soa = compressed_soa();
   short_soa.data.resize(116);
-  EXPECT_PCD_ERROR(io::parse_pcd(compressed_pcd(kCompressedHeader, short_soa, 120), "b.pcd"),
-                   "'b.pcd'", "LZF size mismatch", "decompresses to 116 bytes, expected 120");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(compressed_pcd(kCompressedHeader, short_soa, 120), "b.pcd"),
+                        "'b.pcd'", "LZF size mismatch", "decompresses to 116 bytes, expected 120");
   // Cut off inside the LZF data, and inside the size header.
   std::vector<std::uint8_t> cut(good.begin(), good.end() - 3);
-  EXPECT_PCD_ERROR(io::parse_pcd(cut, "c.pcd"), "'c.pcd'",
-                   "byte offset " + std::to_string(data_start), "truncated", "bytes of LZF data");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(cut, "c.pcd"), "'c.pcd'",
+                        "byte offset " + std::to_string(data_start), "truncated",
+                        "bytes of LZF data");
   std::vector<std::uint8_t> no_sizes(good.begin(), good.begin() + data_start + 5);
-  EXPECT_PCD_ERROR(io::parse_pcd(no_sizes, "d.pcd"), "'d.pcd'", "truncated", "8-byte size header");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(no_sizes, "d.pcd"), "'d.pcd'", "truncated",
+                        "8-byte size header");
   // A corrupt stream: a back reference before the start of the output.
   std::vector<std::uint8_t> corrupt = good;
   corrupt[data_start + 8] = 0xE0;  // first control byte: a long back reference
   corrupt[data_start + 9] = 0x10;
   corrupt[data_start + 10] = 0xFF;
-  EXPECT_PCD_ERROR(io::parse_pcd(corrupt, "e.pcd"), "'e.pcd'", "LZF size mismatch");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(corrupt, "e.pcd"), "'e.pcd'", "LZF size mismatch");
 }
 
 // A header that claims far more than the file holds fails at once, without allocating it.
@@ -766,17 +735,18 @@ TEST_F(Pcd, OversizedHeadersFailFastWithoutAllocating) {
   const std::string header =
       "FIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1000000\nHEIGHT 1000000\n";
   std::string filler(1000, '1');
-  EXPECT_PCD_ERROR(io::parse_pcd(bytes_of(header + "DATA binary\n" + filler), "bomb.pcd"),
-                   "'bomb.pcd'", "truncated", "POINTS 1000000000000 x 12 bytes per point",
-                   "the file has 1000");
-  EXPECT_PCD_ERROR(io::parse_pcd(bytes_of(header + "DATA ascii\n" + filler), "bomb.pcd"),
-                   "'bomb.pcd'", "truncated", "POINTS 1000000000000");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(bytes_of(header + "DATA binary\n" + filler), "bomb.pcd"),
+                        "'bomb.pcd'", "truncated", "POINTS 1000000000000 x 12 bytes per point",
+                        "the file has 1000");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(bytes_of(header + "DATA ascii\n" + filler), "bomb.pcd"),
+                        "'bomb.pcd'", "truncated", "POINTS 1000000000000");
   Bytes compressed;
   compressed.put_text(header + "DATA binary_compressed\n");
   compressed.put(std::uint32_t{16});
   compressed.put(std::uint32_t{0xFFFFFFF0u});
   compressed.put_text(std::string(16, '\0'));
-  EXPECT_PCD_ERROR(io::parse_pcd(compressed.data, "bomb.pcd"), "'bomb.pcd'", "LZF size mismatch");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(compressed.data, "bomb.pcd"), "'bomb.pcd'",
+                        "LZF size mismatch");
   // POINTS x 12 matches the 4 GiB claim exactly, but 16 bytes of LZF cannot hold it.
   Bytes consistent;
   consistent.put_text(
@@ -784,13 +754,13 @@ TEST_F(Pcd, OversizedHeadersFailFastWithoutAllocating) {
   consistent.put(std::uint32_t{16});
   consistent.put(std::uint32_t{357913941u * 12u});
   consistent.put_text(std::string(16, '\0'));
-  EXPECT_PCD_ERROR(io::parse_pcd(consistent.data, "bomb.pcd"), "'bomb.pcd'",
-                   "16 compressed bytes cannot hold 4294967292 bytes");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(consistent.data, "bomb.pcd"), "'bomb.pcd'",
+                        "16 compressed bytes cannot hold 4294967292 bytes");
   // COUNT so large that one point would take more than 2^32 bytes.
-  EXPECT_PCD_ERROR(io::parse_pcd(bytes_of("FIELDS x y z h\nSIZE 4 4 4 8\nTYPE F F F F\n"
-                                          "COUNT 1 1 1 4294967295\nWIDTH 1\nDATA binary\n"),
-                                 "bomb.pcd"),
-                   "'bomb.pcd'", "bytes per point");
+  EXPECT_ERROR_MENTIONS(io::parse_pcd(bytes_of("FIELDS x y z h\nSIZE 4 4 4 8\nTYPE F F F F\n"
+                                               "COUNT 1 1 1 4294967295\nWIDTH 1\nDATA binary\n"),
+                                      "bomb.pcd"),
+                        "'bomb.pcd'", "bytes per point");
   const double seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   EXPECT_LT(seconds, 0.5);
@@ -836,16 +806,18 @@ TEST_F(Pcd, CorruptedBytesGiveACloudOrAnError) {
 TEST_F(Pcd, WriterRejectsInconsistentCloudsAndLeavesNoFile) {
   PcdCloud cloud = make_cloud(4, 3, true, true, true, 1);
   cloud.width = 5;
-  EXPECT_PCD_ERROR(io::write_pcd(path("bad.pcd"), cloud), "bad.pcd",
-                   "12 points for WIDTH x HEIGHT = 5 x 3");
+  EXPECT_ERROR_MENTIONS(io::write_pcd(path("bad.pcd"), cloud), "bad.pcd",
+                        "12 points for WIDTH x HEIGHT = 5 x 3");
   cloud.width = 4;
   cloud.colors.pop_back();
-  EXPECT_PCD_ERROR(io::write_pcd(path("bad.pcd"), cloud), "bad.pcd", "11 colours for 12 points");
+  EXPECT_ERROR_MENTIONS(io::write_pcd(path("bad.pcd"), cloud), "bad.pcd",
+                        "11 colours for 12 points");
   cloud.colors.clear();
   cloud.labels.push_back(1);
-  EXPECT_PCD_ERROR(io::write_pcd(path("bad.pcd"), cloud), "bad.pcd", "13 labels for 12 points");
+  EXPECT_ERROR_MENTIONS(io::write_pcd(path("bad.pcd"), cloud), "bad.pcd",
+                        "13 labels for 12 points");
   EXPECT_FALSE(fs::exists(path("bad.pcd")));
-  EXPECT_PCD_ERROR(
+  EXPECT_ERROR_MENTIONS(
       io::write_pcd(path("missing/dir/x.pcd"), make_cloud(2, 1, false, false, false, 2)), "x.pcd");
 }
 

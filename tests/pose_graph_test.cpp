@@ -7,6 +7,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/se3.hpp"
 #include "kartograf/mapping/pose_graph.hpp"
+#include "test_support.hpp"
 
 namespace kartograf {
 namespace {
@@ -165,12 +166,7 @@ TEST(PoseGraph, RejectsEdgesToMissingNodes) {
   mapping::PoseGraphEdge edge;
   edge.to = 3;
   graph.edges.push_back(edge);
-  try {
-    mapping::optimize_pose_graph(graph);
-    FAIL() << "expected an error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("missing node"), std::string::npos) << e.what();
-  }
+  EXPECT_ERROR_MENTIONS(mapping::optimize_pose_graph(graph), "missing node");
   mapping::PoseGraph empty;
   EXPECT_THROW(mapping::optimize_pose_graph(empty), Error);
 }

@@ -74,12 +74,7 @@ TEST_F(TempFolder, MalformedFoldersAndLogs) {
   EXPECT_THROW(io::open_seven_scenes(dir_), Error);
   EXPECT_THROW(io::open_tum_sequence(dir_), Error);  // no rgb.txt
   std::ofstream(dir_ / "bad.log") << "0 0 1\n1 0 0 0\n0 1 0 0\n";
-  try {
-    io::read_redwood_log(dir_ / "bad.log");
-    FAIL();
-  } catch (const Error& error) {
-    EXPECT_NE(std::string(error.what()).find("truncated"), std::string::npos) << error.what();
-  }
+  EXPECT_ERROR_MENTIONS(io::read_redwood_log(dir_ / "bad.log"), "truncated");
 }
 
 }  // namespace

@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <fstream>
-#include <iterator>
 #include <map>
 #include <set>
 
@@ -33,18 +32,22 @@ io::SyntheticDatasetOptions small_options() {
   return o;
 }
 
-std::string bytes(const fs::path& path) {
-  std::ifstream in(path, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>()};
-}
-
 std::map<std::string, std::string> folder_bytes(const fs::path& dir) {
   std::map<std::string, std::string> files;
   for (const auto& entry : fs::recursive_directory_iterator(dir)) {
     if (entry.is_regular_file())
-      files[fs::relative(entry.path(), dir).string()] = bytes(entry.path());
+      files[fs::relative(entry.path(), dir).string()] = testing::read_text(entry.path());
   }
   return files;
+}
+
+void expect_intrinsics(const PinholeIntrinsics& actual, const PinholeIntrinsics& expected) {
+  EXPECT_EQ(actual.width, expected.width);
+  EXPECT_EQ(actual.height, expected.height);
+  EXPECT_DOUBLE_EQ(actual.fx, expected.fx);
+  EXPECT_DOUBLE_EQ(actual.fy, expected.fy);
+  EXPECT_DOUBLE_EQ(actual.cx, expected.cx);
+  EXPECT_DOUBLE_EQ(actual.cy, expected.cy);
 }
 
 class SynthDataset : public testing::TempDirTest {};
@@ -54,13 +57,7 @@ TEST_F(SynthDataset, OpensAsTumSequenceWithIntrinsicsAndPoses) {
   const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(dir() / "set", options);
   const auto sequence = io::open_tum_sequence(dir() / "set");
   ASSERT_EQ(sequence->size(), 4u);
-  const PinholeIntrinsics k = sequence->intrinsics();
-  EXPECT_EQ(k.width, 80);
-  EXPECT_EQ(k.height, 60);
-  EXPECT_DOUBLE_EQ(k.fx, 65.625);
-  EXPECT_DOUBLE_EQ(k.fy, 66.0);
-  EXPECT_DOUBLE_EQ(k.cx, 39.5);
-  EXPECT_DOUBLE_EQ(k.cy, 29.75);
+  expect_intrinsics(sequence->intrinsics(), {80, 60, 65.625, 66.0, 39.5, 29.75});
   EXPECT_DOUBLE_EQ(sequence->depth_units_per_metre(), 5000.0);
   for (std::size_t i = 0; i < sequence->size(); ++i) {
     const io::RgbdFrame frame = sequence->frame(i);
@@ -93,19 +90,15 @@ TEST_F(SynthDataset, ByteIdenticalAcrossRunsAndThreadCounts) {
   io::SyntheticDatasetOptions c = small_options();
   c.seed = 2;
   io::write_synthetic_dataset(dir() / "c", c);
-  EXPECT_NE(bytes(dir() / "a" / "world.json"), bytes(dir() / "c" / "world.json"));
+  EXPECT_NE(testing::read_text(dir() / "a" / "world.json"),
+            testing::read_text(dir() / "c" / "world.json"));
 }
 
 TEST_F(SynthDataset, RefusesANonEmptyFolderUnlessForced) {
   io::SyntheticDatasetOptions options = small_options();
   options.frames = 1;
   io::write_synthetic_dataset(dir() / "set", options);
-  try {
-    io::write_synthetic_dataset(dir() / "set", options);
-    FAIL() << "wrote into a non-empty folder";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("--force"), std::string::npos) << e.what();
-  }
+  EXPECT_ERROR_MENTIONS(io::write_synthetic_dataset(dir() / "set", options), "--force");
   options.force = true;
   EXPECT_NO_THROW(io::write_synthetic_dataset(dir() / "set", options));
   std::ofstream(dir() / "file") << "x";
@@ -174,13 +167,7 @@ TEST_F(SynthDataset, GroundTruthFilesAgreeWithWorldJson) {
 TEST_F(SynthDataset, CameraIntrinsicsJsonRoundTripAndErrors) {
   const PinholeIntrinsics k{320, 240, 262.5, 263.0, 159.5, 119.25};
   io::write_camera_intrinsics_json(dir() / "k.json", k);
-  const PinholeIntrinsics back = io::read_camera_intrinsics_json(dir() / "k.json");
-  EXPECT_EQ(back.width, 320);
-  EXPECT_EQ(back.height, 240);
-  EXPECT_DOUBLE_EQ(back.fx, 262.5);
-  EXPECT_DOUBLE_EQ(back.fy, 263.0);
-  EXPECT_DOUBLE_EQ(back.cx, 159.5);
-  EXPECT_DOUBLE_EQ(back.cy, 119.25);
+  expect_intrinsics(io::read_camera_intrinsics_json(dir() / "k.json"), k);
   // Open3D's own file (column-major matrix), as in open3d_testdata's camera_primesense.json.
   std::ofstream(dir() / "open3d.json")
       << R"({"width": 640, "height": 480, "intrinsic_matrix": [525.0, 0.0, 0.0, 0.0, 525.0, 0.0, 319.5, 239.5, 1.0]})";
@@ -188,13 +175,8 @@ TEST_F(SynthDataset, CameraIntrinsicsJsonRoundTripAndErrors) {
 
   auto expect_error = [&](const std::string& text, const std::string& words) {
     std::ofstream(dir() / "bad.json") << text;
-    try {
-      io::read_camera_intrinsics_json(dir() / "bad.json");
-      FAIL() << "accepted " << text;
-    } catch (const Error& e) {
-      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
-      EXPECT_NE(std::string(e.what()).find("bad.json"), std::string::npos) << e.what();
-    }
+    SCOPED_TRACE(text);
+    EXPECT_ERROR_MENTIONS(io::read_camera_intrinsics_json(dir() / "bad.json"), words, "bad.json");
   };
   expect_error("{", "not valid JSON");
   expect_error(R"({"height": 4, "intrinsic_matrix": [1,0,0,0,1,0,0,0,1]})", "'width'");

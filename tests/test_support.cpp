@@ -2,6 +2,8 @@
 
 #include <cstdio>
 #include <cstdlib>
+#include <fstream>
+#include <iterator>
 #include <sstream>
 
 #include <unistd.h>
@@ -29,9 +31,7 @@ std::vector<compute::BackendKind> backends_under_test() {
 
 compute::Context make_context(compute::BackendKind kind) {
   compute::ContextOptions options;
-  options.backend = kind == compute::BackendKind::cpu      ? compute::BackendChoice::cpu
-                    : kind == compute::BackendKind::vulkan ? compute::BackendChoice::vulkan
-                                                           : compute::BackendChoice::opencl;
+  options.backend = compute::choice_of(kind);
   options.vulkan_validation = true;
   return compute::Context(options);
 }
@@ -53,6 +53,46 @@ std::string scientific(double value) {
 
 std::string backend_test_name(const ::testing::TestParamInfo<compute::BackendKind>& info) {
   return std::string(compute::to_string(info.param));
+}
+
+std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path) {
+  std::ifstream stream(path, std::ios::binary);
+  EXPECT_TRUE(stream) << "cannot open " << path;
+  return std::vector<std::uint8_t>((std::istreambuf_iterator<char>(stream)),
+                                   std::istreambuf_iterator<char>());
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  const std::vector<std::uint8_t> bytes = read_bytes(path);
+  return std::string(bytes.begin(), bytes.end());
+}
+
+void write_file(const std::filesystem::path& path, std::string_view contents) {
+  std::ofstream stream(path, std::ios::binary | std::ios::trunc);
+  stream.write(contents.data(), static_cast<std::streamsize>(contents.size()));
+  EXPECT_TRUE(stream) << "cannot write " << path;
+}
+
+void write_file(const std::filesystem::path& path, const std::vector<std::uint8_t>& contents) {
+  write_file(path,
+             std::string_view(reinterpret_cast<const char*>(contents.data()), contents.size()));
+}
+
+std::string error_message(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& error) {
+    return error.what();
+  }
+  ADD_FAILURE() << "expected a kartograf::Error, but nothing was thrown";
+  return "";
+}
+
+void expect_mentions(const std::string& message, std::initializer_list<std::string_view> parts) {
+  for (std::string_view part : parts) {
+    EXPECT_NE(message.find(part), std::string::npos)
+        << "the message does not mention \"" << part << "\":\n  " << message;
+  }
 }
 
 void TempDirTest::SetUp() {

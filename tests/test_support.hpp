@@ -1,12 +1,17 @@
 #pragma once
-// Shared by every test: the backends under test, contexts with Vulkan validation, real data.
+// Shared by every test: the backends under test, contexts with Vulkan validation, real data,
+// whole-file reads and writes, and checks of what an Error says.
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <filesystem>
+#include <functional>
+#include <initializer_list>
 #include <memory>
 #include <ostream>
 #include <random>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "kartograf/compute/context.hpp"
@@ -32,6 +37,29 @@ std::filesystem::path data_dir();
 std::string scientific(double value);
 
 std::string backend_test_name(const ::testing::TestParamInfo<compute::BackendKind>& info);
+
+// Whole files, in binary mode (read_text: the bytes as a string). A file that cannot be opened or
+// written fails the test.
+std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path);
+std::string read_text(const std::filesystem::path& path);
+void write_file(const std::filesystem::path& path, std::string_view contents);
+void write_file(const std::filesystem::path& path, const std::vector<std::uint8_t>& contents);
+
+// The message of the kartograf::Error that f throws; a test failure (and "") if it throws nothing.
+// Any other exception escapes and fails the test too.
+std::string error_message(const std::function<void()>& f);
+
+// Expects `message` to contain every part; a failure names the missing part and the message.
+void expect_mentions(const std::string& message, std::initializer_list<std::string_view> parts);
+
+// EXPECT_ERROR_MENTIONS(statement, "part", ...): statement throws a kartograf::Error whose message
+// mentions every part.
+#define EXPECT_ERROR_MENTIONS(statement, ...)                                                      \
+  do {                                                                                             \
+    SCOPED_TRACE(#statement);                                                                      \
+    ::kartograf::testing::expect_mentions(::kartograf::testing::error_message([&] { statement; }), \
+                                          {__VA_ARGS__});                                          \
+  } while (0)
 
 // Fixture: one context per test on the parameter's backend; after the test, the Vulkan validation
 // layer must have reported no error.

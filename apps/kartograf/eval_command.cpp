@@ -42,6 +42,9 @@ class Report {
   void add(const std::string& key, std::int64_t value, std::string meaning) {
     add_row(key, value, std::to_string(value), std::move(meaning));
   }
+  void add(const std::string& key, int value, std::string meaning) {
+    add(key, std::int64_t{value}, std::move(meaning));
+  }
   void add(const std::string& key, const std::optional<double>& value, std::string meaning) {
     if (value) return add(key, *value, std::move(meaning));
     add_row(key, nullptr, "-", std::move(meaning));
@@ -91,6 +94,15 @@ std::string number_text(double value) {
   char text[64];
   const auto result = std::to_chars(text, text + sizeof(text), value);
   return std::string(text, result.ptr);
+}
+
+// The report on a pair of images, noting both files: "ground truth <GT>, <predicted_as> <file>".
+Report image_pair_report(std::string title, const EvalOptions& options,
+                         const std::string& predicted_as = "prediction") {
+  Report report(std::move(title));
+  report.note("ground truth " + options.ground_truth.string() + ", " + predicted_as + " " +
+              options.prediction.string());
+  return report;
 }
 
 std::vector<double> timestamps(const Trajectory& trajectory) {
@@ -147,21 +159,18 @@ Report plane_report(const EvalOptions& options) {
   const LabelImage predicted = io::read_label_png(options.prediction);
   const eval::SegCompResult result =
       eval::compare_plane_segmentations(ground_truth, predicted, {options.threshold});
-  Report report("plane segmentation (SegComp, Hoover et al. 1996), overlap threshold " +
-                number_text(options.threshold));
-  report.note("ground truth " + options.ground_truth.string() + ", prediction " +
-              options.prediction.string());
-  report.add("ground_truth_regions", std::int64_t{result.ground_truth_regions},
-             "regions in the ground truth");
-  report.add("predicted_regions", std::int64_t{result.predicted_regions},
-             "regions in the prediction");
-  report.add("correct", std::int64_t{result.correct}, "correct detections");
-  report.add("over_segmented", std::int64_t{result.over_segmented},
-             "ground-truth regions split into several");
-  report.add("under_segmented", std::int64_t{result.under_segmented},
+  Report report =
+      image_pair_report("plane segmentation (SegComp, Hoover et al. 1996), overlap threshold " +
+                            number_text(options.threshold),
+                        options);
+  report.add("ground_truth_regions", result.ground_truth_regions, "regions in the ground truth");
+  report.add("predicted_regions", result.predicted_regions, "regions in the prediction");
+  report.add("correct", result.correct, "correct detections");
+  report.add("over_segmented", result.over_segmented, "ground-truth regions split into several");
+  report.add("under_segmented", result.under_segmented,
              "predicted regions merging several ground-truth regions");
-  report.add("missed", std::int64_t{result.missed}, "ground-truth regions not found");
-  report.add("noise", std::int64_t{result.noise}, "predicted regions matching nothing");
+  report.add("missed", result.missed, "ground-truth regions not found");
+  report.add("noise", result.noise, "predicted regions matching nothing");
   report.add_json("threshold", options.threshold);
   return report;
 }
@@ -171,18 +180,17 @@ Report room_report(const EvalOptions& options) {
   const LabelImage segmentation = io::read_ground_truth_rooms(options.prediction);
   const eval::RoomSegmentationScores scores =
       eval::evaluate_room_segmentation(ground_truth, segmentation);
-  Report report("room segmentation (ipa_room_segmentation recall/precision, MAORIS MCC)");
-  report.note("ground truth " + options.ground_truth.string() + ", segmentation " +
-              options.prediction.string());
+  Report report =
+      image_pair_report("room segmentation (ipa_room_segmentation recall/precision, MAORIS MCC)",
+                        options, "segmentation");
   report.add("recall_mean", scores.recall_mean, "mean over rooms of best overlap / room area");
   report.add("recall_total", scores.recall_total, "the same, area-weighted");
   report.add("precision_mean", scores.precision_mean,
              "mean over segments of best overlap / segment area");
   report.add("precision_total", scores.precision_total, "the same, area-weighted");
   report.add("mcc", scores.mcc, "Matthews correlation coefficient (MAORIS)");
-  report.add("ground_truth_rooms", std::int64_t{scores.ground_truth_rooms},
-             "rooms of > 100 pixels");
-  report.add("segments", std::int64_t{scores.segments}, "segments of > 100 pixels");
+  report.add("ground_truth_rooms", scores.ground_truth_rooms, "rooms of > 100 pixels");
+  report.add("segments", scores.segments, "segments of > 100 pixels");
   return report;
 }
 
@@ -190,9 +198,8 @@ Report semantic_report(const EvalOptions& options) {
   const SemanticImage ground_truth = io::read_semantic_png(options.ground_truth);
   const SemanticImage predicted = io::read_semantic_png(options.prediction);
   const eval::SemanticScores scores = eval::evaluate_semantic_segmentation(ground_truth, predicted);
-  Report report("semantic segmentation (pixels with unknown ground truth ignored)");
-  report.note("ground truth " + options.ground_truth.string() + ", prediction " +
-              options.prediction.string());
+  Report report = image_pair_report(
+      "semantic segmentation (pixels with unknown ground truth ignored)", options);
   report.add("overall_accuracy", scores.overall_accuracy, "correctly classified pixels");
   report.add("mean_iou", scores.mean_iou, "mean intersection over union of the classes present");
   for (int c = 1; c < kSemanticClassCount; ++c) {

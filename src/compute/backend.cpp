@@ -37,6 +37,15 @@ BackendChoice parse_backend_choice(std::string_view text, std::string_view sourc
               "' (expected auto, cpu, vulkan or opencl)");
 }
 
+BackendChoice choice_of(BackendKind kind) {
+  switch (kind) {
+    case BackendKind::cpu: return BackendChoice::cpu;
+    case BackendKind::vulkan: return BackendChoice::vulkan;
+    case BackendKind::opencl: return BackendChoice::opencl;
+  }
+  return BackendChoice::cpu;
+}
+
 std::string_view to_string(DeviceType type) {
   switch (type) {
     case DeviceType::cpu: return "cpu";

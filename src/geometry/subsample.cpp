@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "kartograf/compute/kernel.hpp"
+#include "kartograf/core/color.hpp"
 
 namespace kartograf::geometry {
 
@@ -17,15 +18,6 @@ struct SubsampleParams {  // layout of shaders/subsample.comp and kernels/subsam
   std::uint32_t has_normals;
   std::uint32_t has_colors;
 };
-
-// The colour layout of DeviceCloud (and of registration::pack_rgb).
-std::uint32_t pack(const Rgb8& c) {
-  return std::uint32_t{c[0]} | std::uint32_t{c[1]} << 8 | std::uint32_t{c[2]} << 16;
-}
-Rgb8 unpack(std::uint32_t packed) {
-  return {static_cast<std::uint8_t>(packed), static_cast<std::uint8_t>(packed >> 8),
-          static_cast<std::uint8_t>(packed >> 16)};
-}
 
 template <class T>
 void copy_every_kth(std::span<const T> in, std::span<T> out, std::size_t k) {
@@ -53,7 +45,7 @@ DeviceCloud DeviceCloud::from_host(const compute::Context& context, const PointC
   for (std::size_t i = 0; i < points.size(); ++i) points[i] << cloud.points[i], 1.0f;
   for (std::size_t i = 0; i < normals.size(); ++i) normals[i] << cloud.normals[i], 0.0f;
   std::vector<std::uint32_t> colors(cloud.colors.size());
-  for (std::size_t i = 0; i < colors.size(); ++i) colors[i] = pack(cloud.colors[i]);
+  for (std::size_t i = 0; i < colors.size(); ++i) colors[i] = pack_rgb(cloud.colors[i]);
   DeviceCloud out;
   out.points = compute::Buffer<Point4f>::from_host(context, points);
   if (!normals.empty()) out.normals = compute::Buffer<Point4f>::from_host(context, normals);
@@ -70,7 +62,7 @@ PointCloud DeviceCloud::to_host() const {
     if (!is_valid(host_points[i])) continue;
     cloud.points.push_back(host_points[i].head<3>());
     if (has_normals()) cloud.normals.push_back(host_normals[i].head<3>());
-    if (has_colors()) cloud.colors.push_back(unpack(host_colors[i]));
+    if (has_colors()) cloud.colors.push_back(unpack_rgb(host_colors[i]));
   }
   return cloud;
 }

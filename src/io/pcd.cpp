@@ -108,11 +108,12 @@ void append_double(std::string& out, double value) {
   out.append(text.data(), result.ptr);
 }
 
-std::uint32_t pack_rgb(const Rgb8& color) {
+// PCL's colour word, r << 16 | g << 8 | b: not the device layout of kartograf::pack_rgb.
+std::uint32_t pack_pcl_rgb(const Rgb8& color) {
   return (std::uint32_t{color[0]} << 16) | (std::uint32_t{color[1]} << 8) | color[2];
 }
 
-Rgb8 unpack_rgb(std::uint32_t packed) {
+Rgb8 unpack_pcl_rgb(std::uint32_t packed) {
   return {static_cast<std::uint8_t>(packed >> 16), static_cast<std::uint8_t>(packed >> 8),
           static_cast<std::uint8_t>(packed)};
 }
@@ -481,7 +482,7 @@ class PcdParser {
     if (known.color) {
       cloud.colors.resize(n);
       for (std::size_t i = 0; i < n; ++i) {
-        cloud.colors[i] = unpack_rgb(load<std::uint32_t>(value(*known.color, i)));
+        cloud.colors[i] = unpack_pcl_rgb(load<std::uint32_t>(value(*known.color, i)));
       }
     }
     if (known.label) {
@@ -672,7 +673,7 @@ class PcdParser {
                    "colour field '" + field.name + "' is '" + std::string(token.substr(0, 40)) +
                        "', not a packed colour");
     }
-    return unpack_rgb(*bits);
+    return unpack_pcl_rgb(*bits);
   }
 
   std::uint32_t ascii_label(std::string_view token, std::size_t i, std::size_t n) const {
@@ -720,7 +721,7 @@ std::vector<Column> columns_of(const PcdCloud& cloud) {
     // there as TYPE U, which its own pcl_pcd2ply then turns into a corrupt PLY (PCL 1.13), while
     // TYPE F with the float's text is read right by PCL and Open3D alike.
     Column column{"rgb", 'F', std::vector<std::uint32_t>(n)};
-    for (std::size_t i = 0; i < n; ++i) column.bits[i] = pack_rgb(cloud.colors[i]);
+    for (std::size_t i = 0; i < n; ++i) column.bits[i] = pack_pcl_rgb(cloud.colors[i]);
     columns.push_back(std::move(column));
   }
   if (!cloud.labels.empty()) columns.push_back({"label", 'U', cloud.labels});

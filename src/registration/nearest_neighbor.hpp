@@ -13,6 +13,7 @@
 
 #include "kartograf/registration/correspondence_finder.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
+#include "registration/association_checks.hpp"
 
 namespace kartograf::registration::detail {
 
@@ -67,28 +68,12 @@ struct Nearest {
   double distance_sq;
 };
 
+// The common rules, and a search radius (max_distance) that a grid or tree can bound.
 inline void validate(const CloudView& source, const CloudView& target,
                      const AssociationParams& params, bool use_normals, const std::string& what) {
-  require(source.points && target.points, what + ": source and target points are required");
-  require(!source.camera || source.size() == static_cast<std::size_t>(source.camera->width) *
-                                                 static_cast<std::size_t>(source.camera->height),
-          what + ": source points do not match the source camera's image size");
-  require(source.size() < (std::size_t{1} << 31) && target.size() < (std::size_t{1} << 31),
-          what + ": more than 2^31 points");
-  require(params.subsample >= 1,
-          what + ": subsample must be >= 1, got " + std::to_string(params.subsample));
+  check_association_inputs(source, target, params, use_normals, what);
   require(std::isfinite(params.max_distance) && params.max_distance > 0,
           what + ": max_distance must be finite and > 0");
-  require(!std::isnan(params.max_normal_angle_deg) && params.max_normal_angle_deg >= 0,
-          what + ": max_normal_angle_deg must be >= 0");
-  if (use_normals) {
-    require(
-        source.normals && target.normals,
-        what +
-            ": the normal gate needs source and target normals (or max_normal_angle_deg >= 180)");
-    require(source.normals->size() == source.size() && target.normals->size() == target.size(),
-            what + ": normals and points differ in count");
-  }
 }
 
 // Fills out[i] for every source point: kNotSelected, kNoMatch, or search(moved, gate) with the

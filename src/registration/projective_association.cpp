@@ -7,6 +7,7 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
+#include "registration/association_checks.hpp"
 #include "registration/cpu_parallel.hpp"
 
 namespace kartograf::registration {
@@ -135,7 +136,7 @@ void associate_cpu(const Frame& frame, const CloudView& source, const CloudView&
 void validate(const CloudView& source, const CloudView& target, const AssociationParams& params,
               bool use_normals) {
   const std::string what = "projective association: ";
-  require(source.points && target.points, what + "source and target points are required");
+  detail::check_association_inputs(source, target, params, use_normals, "projective association");
   require(target.camera.has_value(), what + "the target must be organized (have a camera)");
   target.camera->validate(what + "target camera");
   require(target.points->size() == static_cast<std::size_t>(target.camera->width) *
@@ -143,27 +144,10 @@ void validate(const CloudView& source, const CloudView& target, const Associatio
           what + "target points (" + std::to_string(target.points->size()) +
               ") do not match the target camera's " + std::to_string(target.camera->width) + "x" +
               std::to_string(target.camera->height));
-  require(!source.camera ||
-              source.points->size() == static_cast<std::size_t>(source.camera->width) *
-                                           static_cast<std::size_t>(source.camera->height),
-          what + "source points do not match the source camera's image size");
-  require(source.size() < (std::size_t{1} << 31) && target.size() < (std::size_t{1} << 31),
-          what + "more than 2^31 points");
-  require(params.subsample >= 1,
-          what + "subsample must be >= 1, got " + std::to_string(params.subsample));
   require(params.search_radius >= 0 && params.search_radius <= 16,
           what + "search_radius must be 0..16, got " + std::to_string(params.search_radius));
   require(params.max_distance >= 0 && std::isfinite(params.max_distance),
           what + "max_distance must be finite and >= 0");
-  require(!std::isnan(params.max_normal_angle_deg) && params.max_normal_angle_deg >= 0,
-          what + "max_normal_angle_deg must be >= 0");
-  if (use_normals) {
-    require(
-        source.normals && target.normals,
-        what + "the normal gate needs source and target normals (or max_normal_angle_deg >= 180)");
-    require(source.normals->size() == source.size() && target.normals->size() == target.size(),
-            what + "normals and points differ in count");
-  }
 }
 
 }  // namespace

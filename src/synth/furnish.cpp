@@ -68,24 +68,31 @@ struct Design {
   std::vector<LocalBox> parts;
 };
 
-Design cabinet(Rng& rng) {
+struct Range {
+  double low, high;
+};
+
+// A design of `kind` with its width, depth and height drawn from the ranges, in that order (the
+// order of the draws fixes the world a seed makes).
+Design sized(FurnitureKind kind, Rng& rng, Range width, Range depth, Range height) {
   Design d;
-  d.kind = FurnitureKind::cabinet;
-  d.width = rng.uniform(0.5, 1.2);
-  d.depth = rng.uniform(0.4, 0.6);
-  d.height = rng.uniform(0.7, 1.3);
+  d.kind = kind;
+  d.width = rng.uniform(width.low, width.high);
+  d.depth = rng.uniform(depth.low, depth.high);
+  d.height = rng.uniform(height.low, height.high);
+  return d;
+}
+
+Design cabinet(Rng& rng) {
+  Design d = sized(FurnitureKind::cabinet, rng, {0.5, 1.2}, {0.4, 0.6}, {0.7, 1.3});
   d.parts.push_back({0, d.width, 0, d.depth, 0, d.height, kOnFloor, "body"});
   return d;
 }
 
 Design crate(Rng& rng) {
-  Design d;
-  d.kind = FurnitureKind::crate;
-  d.width = rng.uniform(0.3, 0.6);
-  d.depth = rng.uniform(0.3, 0.6);
-  const double lower = rng.uniform(0.25, 0.5);
+  Design d = sized(FurnitureKind::crate, rng, {0.3, 0.6}, {0.3, 0.6}, {0.25, 0.5});
+  const double lower = d.height;
   d.parts.push_back({0, d.width, 0, d.depth, 0, lower, kOnFloor, "lower"});
-  d.height = lower;
   if (rng.bernoulli(0.5)) {  // a smaller crate on top, set back from the front edge
     const double w = d.width * rng.uniform(0.5, 0.9), dd = d.depth * rng.uniform(0.5, 0.9);
     const double u0 = rng.uniform(0.0, d.width - w);
@@ -97,11 +104,7 @@ Design crate(Rng& rng) {
 }
 
 Design table(Rng& rng) {
-  Design d;
-  d.kind = FurnitureKind::table;
-  d.width = rng.uniform(0.8, 1.6);
-  d.depth = rng.uniform(0.6, 1.0);
-  d.height = rng.uniform(0.72, 0.76);
+  Design d = sized(FurnitureKind::table, rng, {0.8, 1.6}, {0.6, 1.0}, {0.72, 0.76});
   const double top = rng.uniform(0.03, 0.04), leg = 0.05, inset = 0.04;
   d.parts.push_back({0, d.width, 0, d.depth, d.height - top, d.height, {}, "top"});
   const std::array<bool, kFaceCount> leg_hidden = {false, false, false, false, true, true};
@@ -117,11 +120,7 @@ Design table(Rng& rng) {
 }
 
 Design shelf(Rng& rng) {
-  Design d;
-  d.kind = FurnitureKind::shelf;
-  d.width = rng.uniform(0.6, 1.2);
-  d.depth = rng.uniform(0.28, 0.4);
-  d.height = rng.uniform(1.5, 2.0);
+  Design d = sized(FurnitureKind::shelf, rng, {0.6, 1.2}, {0.28, 0.4}, {1.5, 2.0});
   const double p = 0.02, back = 0.01;
   d.parts.push_back({0, p, 0, d.depth, 0, d.height, kOnFloor, "side 1"});
   d.parts.push_back({d.width - p, d.width, 0, d.depth, 0, d.height, kOnFloor, "side 2"});

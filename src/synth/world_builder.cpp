@@ -21,6 +21,16 @@ const Color& choose(Rng& rng, const std::array<Color, N>& palette) {
   return palette[static_cast<std::size_t>(rng.uniform_int(0, static_cast<int>(N) - 1))];
 }
 
+// The start of every textured recipe: `pattern` in `color` and that colour darkened by `shade`.
+Material two_tone(const std::string& name, Pattern pattern, const Color& color, double shade) {
+  Material m;
+  m.name = name;
+  m.pattern = pattern;
+  m.color_a = color;
+  m.color_b = (color * shade).cwiseMin(1.0);
+  return m;
+}
+
 int add_material(World& world, Material material, Rng& rng) {
   material.seed = rng.bits();
   world.materials.push_back(std::move(material));
@@ -37,17 +47,14 @@ const std::array<Color, 3> kWoods = {Color(0.55, 0.38, 0.22), Color(0.68, 0.52, 
 }  // namespace
 
 int add_wall_material(World& world, Rng& rng, const std::string& name) {
+  const Color paint = jitter(rng, choose(rng, kPaints), 0.04);
   Material m;
-  m.name = name;
-  m.color_a = jitter(rng, choose(rng, kPaints), 0.04);
   if (rng.bernoulli(0.35)) {  // wallpaper
-    m.pattern = Pattern::stripes;
-    m.color_b = (m.color_a * rng.uniform(0.72, 0.85)).cwiseMin(1.0);
+    m = two_tone(name, Pattern::stripes, paint, rng.uniform(0.72, 0.85));
     m.period = rng.uniform(0.15, 0.4);
     m.noise_amplitude = 0.04;
   } else {  // paint with a visible roller texture
-    m.pattern = Pattern::noise;
-    m.color_b = (m.color_a * 0.82).cwiseMin(1.0);
+    m = two_tone(name, Pattern::noise, paint, 0.82);
     m.noise_scale = rng.uniform(0.2, 0.4);
     m.noise_amplitude = 0.05;
   }
@@ -55,27 +62,21 @@ int add_wall_material(World& world, Rng& rng, const std::string& name) {
 }
 
 int add_floor_material(World& world, Rng& rng, const std::string& name, bool corridor) {
-  Material m;
-  m.name = name;
   const double choice = corridor ? 0.5 : rng.uniform();
+  Material m;
   if (choice < 0.35) {  // wooden planks
-    m.pattern = Pattern::wood;
-    m.color_a = jitter(rng, choose(rng, kWoods), 0.03);
-    m.color_b = m.color_a * 0.75;
+    m = two_tone(name, Pattern::wood, jitter(rng, choose(rng, kWoods), 0.03), 0.75);
     m.period = rng.uniform(0.12, 0.2);
     m.noise_scale = 0.1;
     m.noise_amplitude = 0.06;
   } else if (choice < 0.75) {  // tiles
-    m.pattern = Pattern::checker;
     const double light = rng.uniform(0.6, 0.8);
-    m.color_a = jitter(rng, Color(light, light * 0.97, light * 0.9), 0.03);
-    m.color_b = m.color_a * rng.uniform(0.6, 0.8);
+    const Color tile = jitter(rng, Color(light, light * 0.97, light * 0.9), 0.03);
+    m = two_tone(name, Pattern::checker, tile, rng.uniform(0.6, 0.8));
     m.period = rng.uniform(0.3, 0.5);
     m.noise_amplitude = 0.05;
   } else {  // carpet
-    m.pattern = Pattern::noise;
-    m.color_a = jitter(rng, choose(rng, kPaints) * 0.55, 0.05);
-    m.color_b = m.color_a * 0.7;
+    m = two_tone(name, Pattern::noise, jitter(rng, choose(rng, kPaints) * 0.55, 0.05), 0.7);
     m.noise_scale = 0.04;
     m.noise_amplitude = 0.12;
   }
@@ -95,23 +96,17 @@ int add_ceiling_material(World& world, Rng& rng) {
 
 int add_furniture_material(World& world, Rng& rng, const std::string& name, bool dark) {
   Material m;
-  m.name = name;
   if (dark) {  // black lacquer / dark fabric: the IR sensor loses it
-    m.pattern = Pattern::noise;
-    m.color_a = Color::Constant(rng.uniform(0.03, 0.06));
-    m.color_b = m.color_a * 0.7;
+    m = two_tone(name, Pattern::noise, Color::Constant(rng.uniform(0.03, 0.06)), 0.7);
     m.noise_scale = 0.1;
     m.noise_amplitude = 0.1;
   } else if (rng.bernoulli(0.5)) {
-    m.pattern = Pattern::wood;
-    m.color_a = jitter(rng, choose(rng, kWoods), 0.04);
-    m.color_b = m.color_a * 0.7;
+    m = two_tone(name, Pattern::wood, jitter(rng, choose(rng, kWoods), 0.04), 0.7);
     m.period = rng.uniform(0.02, 0.05);
     m.noise_scale = 0.05;
   } else {
-    m.pattern = Pattern::noise;
-    m.color_a = jitter(rng, choose(rng, kPaints) * rng.uniform(0.6, 1.0), 0.05);
-    m.color_b = m.color_a * 0.8;
+    const Color paint = jitter(rng, choose(rng, kPaints) * rng.uniform(0.6, 1.0), 0.05);
+    m = two_tone(name, Pattern::noise, paint, 0.8);
     m.noise_scale = 0.08;
     m.noise_amplitude = 0.06;
   }
@@ -119,11 +114,8 @@ int add_furniture_material(World& world, Rng& rng, const std::string& name, bool
 }
 
 int add_door_material(World& world, Rng& rng, const std::string& name, bool dark) {
-  Material m;
-  m.name = name;
-  m.pattern = Pattern::wood;
-  m.color_a = dark ? Color(0.06, 0.045, 0.035) : jitter(rng, choose(rng, kWoods), 0.04);
-  m.color_b = m.color_a * 0.75;
+  const Color wood = dark ? Color(0.06, 0.045, 0.035) : jitter(rng, choose(rng, kWoods), 0.04);
+  Material m = two_tone(name, Pattern::wood, wood, 0.75);
   m.period = rng.uniform(0.03, 0.06);
   m.noise_scale = 0.05;
   return add_material(world, std::move(m), rng);

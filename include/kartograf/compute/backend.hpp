@@ -16,6 +16,8 @@ std::string_view to_string(BackendKind kind);
 std::string_view to_string(BackendChoice choice);
 // Parses "auto|cpu|vulkan|opencl"; throws Error naming `source` (e.g. "KARTOGRAF_BACKEND").
 BackendChoice parse_backend_choice(std::string_view text, std::string_view source);
+// The choice that asks for exactly `kind`.
+BackendChoice choice_of(BackendKind kind);
 
 enum class DeviceType { cpu, integrated_gpu, discrete_gpu, virtual_gpu, other };
 std::string_view to_string(DeviceType type);

@@ -16,7 +16,7 @@ namespace kartograf::geometry {
 
 // normals and colors are empty (absent) or hold one entry per point. Points are (x, y, z, 1) or
 // all-NaN (invalid); normals (nx, ny, nz, 0) or all-NaN; colours packed r | g << 8 | b << 16
-// (registration::pack_rgb).
+// (pack_rgb, core/color.hpp).
 struct DeviceCloud {
   compute::Buffer<Point4f> points;
   compute::Buffer<Point4f> normals;

@@ -24,14 +24,9 @@
 
 namespace kartograf::registration {
 
-// Colours travel as one 32-bit word per pixel: r | g << 8 | b << 16.
-inline std::uint32_t pack_rgb(const Rgb8& c) {
-  return std::uint32_t{c[0]} | std::uint32_t{c[1]} << 8 | std::uint32_t{c[2]} << 16;
-}
-inline Rgb8 unpack_rgb(std::uint32_t packed) {
-  return {static_cast<std::uint8_t>(packed & 0xff), static_cast<std::uint8_t>((packed >> 8) & 0xff),
-          static_cast<std::uint8_t>((packed >> 16) & 0xff)};
-}
+// Colours travel as one 32-bit word per pixel (core/color.hpp); the names stay usable here.
+using kartograf::pack_rgb;
+using kartograf::unpack_rgb;
 
 // The camera of a level made by 2x2 blocks: pixel centres at integers on both levels.
 PinholeIntrinsics half_resolution(const PinholeIntrinsics& camera);

@@ -11,7 +11,7 @@
 // hue (the denominator is 0) and black has S = 0.
 //
 // Table entries are 2 bytes (32 MiB for 2^24 colours), indexed by the packed colour
-// r | g << 8 | b << 16 (CloudView::colors, registration::pack_rgb):
+// r | g << 8 | b << 16 (CloudView::colors, core/color.hpp pack_rgb):
 //   low byte   hue code h = round(H * 255 / 360) mod 255, in 0..254 (bins of 360/255 = 1.41 deg),
 //              or kNoHue (255) for grey;
 //   high byte  saturation code s = round(S * 255), in 0..255.
