@@ -1,0 +1,307 @@
+// kartograf_peer_bench: Kartograf's registration against Open3D and PCL on the same frame pairs,
+// in one run (issue 4, part 6; docs/benchmarks.md holds the results).
+//
+//   pairs   7-Scenes RedKitchen frames (i + 1, i) and (i + 5, i) for several i, and the same on a
+//           synthetic hand-held sequence. Every method gets the same inputs: RGB-D frames for the
+//           odometry methods; clouds cut once by Kartograf (valid points with organized normals and
+//           colours, full and voxel-downsampled to ~20k points) for the cloud ICPs, converted to
+//           each library's types outside the timing.
+//   timing  per method and pair: one untimed warm-up call on the first pair, then calls until
+//           --min-time seconds have passed (at least 1, at most --max-calls); the pair's time is
+//           their median, the method's time the median over pairs. Wall clock, steady_clock.
+//   chain   frame k aligned to frame k - 1 over a whole sequence (Kartograf's CPU odometry and
+//           Open3D's RGB-D odometry in lockstep, each frame read once), ATE and RPE against the
+//           ground truth (eval::evaluate_trajectory, SE(3) alignment).
+// Threads are whatever the environment pins: OMP_NUM_THREADS (Open3D's OpenMP loops) and
+// KARTOGRAF_CPU_THREADS (Kartograf's CPU loops; 1 when unset); both are printed.
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <ctime>
+#include <exception>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <numbers>
+#include <string>
+#include <thread>
+#include <utility>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/eval/trajectory_metrics.hpp"
+#include "kartograf/io/tum.hpp"
+#include "peer_methods.hpp"
+#include "peer_report.hpp"
+
+namespace kartograf::peer {
+namespace {
+
+struct Options {
+  std::filesystem::path seven_scenes;
+  std::filesystem::path synthetic;
+  int synthetic_frames = 60;
+  std::vector<std::size_t> seven_scenes_starts = {0, 60, 120, 180, 240};
+  std::vector<std::size_t> synthetic_starts = {0, 15, 30};
+  std::vector<int> gaps = {1, 5};
+  std::size_t target_points = 20000;
+  double min_time = 0.3;
+  int max_calls = 9;
+  bool chain = true;
+  bool device_backends = true;
+  bool details = false;                // every pair's errors and time on stderr
+  std::string only;                    // run only methods whose name contains this
+  std::filesystem::path trajectories;  // write the chained trajectories here (TUM format)
+};
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// CPU time of every thread of the process (Open3D's OpenMP workers, the drivers' threads).
+double process_cpu_seconds() {
+  timespec now{};
+  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
+  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
+}
+
+std::vector<MethodOutcome> run_pairs(const std::vector<Method>& methods,
+                                     const std::vector<FramePair>& pairs, const Options& options) {
+  std::vector<MethodOutcome> outcomes;
+  for (const Method& method : methods) {
+    std::cerr << "  " << method.name << std::flush;
+    MethodOutcome outcome{&method, {}};
+    method.prepare(pairs.front())();  // warm-up: lazy initialisation, first allocations
+    for (const FramePair& pair : pairs) {
+      const std::function<Estimate()> call = method.prepare(pair);
+      std::vector<double> seconds, cpu_seconds;
+      Estimate estimate;
+      const Clock::time_point first = Clock::now();
+      do {
+        const double cpu_start = process_cpu_seconds();
+        const Clock::time_point start = Clock::now();
+        estimate = call();
+        seconds.push_back(seconds_since(start));
+        cpu_seconds.push_back(process_cpu_seconds() - cpu_start);
+      } while (seconds_since(first) < options.min_time &&
+               static_cast<int>(seconds.size()) < options.max_calls);
+      outcome.pairs.push_back(score(pair, estimate, std::move(seconds), std::move(cpu_seconds)));
+    }
+    std::cerr << ": " << 1000 * outcome.median_seconds() << " ms\n";
+    outcomes.push_back(std::move(outcome));
+  }
+  return outcomes;
+}
+
+struct Tracker {
+  Tracker(std::string name, std::string threads, std::unique_ptr<OdometryFrontEnd> odometry)
+      : name(std::move(name)), threads(std::move(threads)), odometry(std::move(odometry)) {}
+  std::string name;
+  std::string threads;
+  std::unique_ptr<OdometryFrontEnd> odometry;
+  Trajectory trajectory;
+  std::vector<double> seconds;
+  std::size_t failures = 0;
+};
+
+std::vector<ChainOutcome> run_chain(const Dataset& dataset, const Options& options) {
+  std::vector<Tracker> trackers;
+  trackers.emplace_back(kKartografOdometry, kartograf_threads(),
+                        kartograf_odometry_factory()(dataset));
+  trackers.emplace_back("open3d RGB-D odometry, hybrid term", openmp_threads(),
+                        open3d_odometry_factory()(dataset));
+  Trajectory ground_truth;
+  for (std::size_t k = 0; k < dataset.size(); ++k) {
+    const Frame frame = dataset.frame(k);
+    const double timestamp = static_cast<double>(k) / 30.0;
+    ground_truth.push_back({timestamp, frame.pose});
+    for (Tracker& tracker : trackers) {
+      if (k == 0) {
+        tracker.odometry->set_reference(frame);
+        tracker.trajectory.push_back({timestamp, frame.pose});
+        continue;
+      }
+      const Clock::time_point start = Clock::now();
+      Estimate estimate = tracker.odometry->track(frame);
+      tracker.seconds.push_back(seconds_since(start));
+      tracker.odometry->advance();
+      if (!estimate.success) {
+        ++tracker.failures;
+        estimate.source_to_target = Eigen::Isometry3d::Identity();
+      }
+      tracker.trajectory.push_back(
+          {timestamp, tracker.trajectory.back().pose * estimate.source_to_target});
+    }
+    if (k % 50 == 49) std::cerr << "  " << dataset.name << " frame " << k + 1 << "\n";
+  }
+  std::vector<ChainOutcome> outcomes;
+  for (Tracker& tracker : trackers) {
+    const eval::MatchedPoses matched{ground_truth, tracker.trajectory};
+    const eval::TrajectoryEvaluation evaluation =
+        eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeOptions{});
+    outcomes.push_back({dataset.name, tracker.name, tracker.threads, dataset.size(),
+                        1000 * median(tracker.seconds), evaluation.ate.translation_m.rmse,
+                        1000 * evaluation.rpe.translation_m.rmse, evaluation.rpe.rotation_deg.rmse,
+                        tracker.failures});
+    if (!options.trajectories.empty()) {
+      std::filesystem::create_directories(options.trajectories);
+      const std::string stem =
+          dataset.name + "_" + (tracker.name.rfind("open3d", 0) == 0 ? "open3d" : "kartograf");
+      io::write_tum_trajectory(options.trajectories / (stem + ".txt"), tracker.trajectory);
+      io::write_tum_trajectory(options.trajectories / (dataset.name + "_groundtruth.txt"),
+                               ground_truth);
+    }
+  }
+  return outcomes;
+}
+
+std::string cpu_model() {
+  std::ifstream cpuinfo("/proc/cpuinfo");
+  for (std::string line; std::getline(cpuinfo, line);) {
+    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
+  }
+  return "unknown CPU";
+}
+
+std::string load_average() {
+  std::ifstream file("/proc/loadavg");
+  std::string one, five, fifteen;
+  file >> one >> five >> fifteen;
+  return one + " " + five + " " + fifteen;
+}
+
+std::size_t median_size(const std::vector<FramePair>& pairs, bool full) {
+  std::vector<double> sizes;
+  for (const FramePair& pair : pairs) {
+    for (const FrameClouds* clouds : {&pair.source_clouds, &pair.target_clouds}) {
+      sizes.push_back(static_cast<double>(full ? clouds->full.size() : clouds->sampled.size()));
+    }
+  }
+  return static_cast<std::size_t>(median(sizes));
+}
+
+std::vector<Method> all_methods(const Options& options, const CloudIcpSettings& settings) {
+  std::vector<Method> methods;
+  for (auto&& list : {kartograf_methods(settings, options.device_backends),
+                      open3d_methods(settings), pcl_methods(settings)}) {
+    for (const Method& method : list) {
+      if (options.only.empty() || method.name.find(options.only) != std::string::npos ||
+          method.name == kKartografOdometry) {
+        methods.push_back(method);
+      }
+    }
+  }
+  return methods;
+}
+
+int run(const Options& options) {
+  const Clock::time_point start = Clock::now();
+  const CloudIcpSettings settings;
+  std::cout << "# Kartograf peer benchmark\n\n"
+            << "- machine: " << cpu_model() << ", " << std::thread::hardware_concurrency()
+            << " cores; load average at start " << load_average() << "\n"
+            << "- Open3D " << open3d_version() << ", PCL " << pcl_version() << "\n"
+            << "- threads: " << kartograf_threads() << ", " << openmp_threads()
+            << ", PCL single-threaded\n"
+            << "- cloud ICP (all libraries): max correspondence distance " << settings.max_distance
+            << " m, at most " << settings.max_iterations
+            << " iterations, identity start; odometry: each library's defaults, identity start, "
+               "depth "
+            << kMinDepthMetres << "-" << kMaxDepthMetres << " m\n"
+            << "- timing: per pair the median of 1-" << options.max_calls << " calls (until "
+            << options.min_time
+            << " s have passed) after one warm-up call, per method the median over pairs; wall "
+               "clock and process CPU time (all threads); ratio = method time / Kartograf time\n";
+
+  std::vector<Dataset> datasets;
+  std::vector<std::vector<std::size_t>> starts;
+  if (!options.seven_scenes.empty()) {
+    datasets.push_back(open_seven_scenes_dataset(options.seven_scenes));
+    starts.push_back(options.seven_scenes_starts);
+  }
+  if (!options.synthetic.empty()) {
+    if (!std::filesystem::exists(options.synthetic / "rgb.txt")) {
+      std::cerr << "writing a synthetic sequence into " << options.synthetic << "\n";
+      write_synthetic_sequence(options.synthetic, options.synthetic_frames);
+    }
+    datasets.push_back(open_synthetic_dataset(options.synthetic));
+    starts.push_back(options.synthetic_starts);
+  }
+  require(!datasets.empty(), "no data set: give --seven-scenes and/or --synthetic");
+
+  const std::vector<Method> methods = all_methods(options, settings);
+  std::vector<ChainOutcome> chains;
+  for (std::size_t d = 0; d < datasets.size(); ++d) {
+    const Dataset& dataset = datasets[d];
+    std::cerr << "preparing " << dataset.name << " pairs\n";
+    const CloudMaker clouds(dataset, options.target_points);
+    const std::vector<FramePair> pairs = make_pairs(dataset, clouds, starts[d], options.gaps);
+    std::cout << "\n## " << dataset.name << ": " << pairs.size() << " pairs\n\n"
+              << dataset.note << ". Pairs (target -> source):";
+    for (const FramePair& pair : pairs)
+      std::cout << " " << pair.label().substr(dataset.name.size() + 1);
+    std::cout << ". Clouds: median " << median_size(pairs, true) << " points full, "
+              << median_size(pairs, false) << " after " << std::fixed << std::setprecision(2)
+              << 100 * clouds.voxel_size() << std::defaultfloat << " cm voxels.\n\n";
+    const std::vector<MethodOutcome> outcomes = run_pairs(methods, pairs, options);
+    print_pair_table(std::cout, outcomes);
+    if (options.details) print_pair_details(std::cerr, outcomes);
+    std::cout.flush();
+    if (options.chain) {
+      std::cerr << "chaining " << dataset.name << " (" << dataset.size() << " frames)\n";
+      const auto outcomes = run_chain(dataset, options);
+      chains.insert(chains.end(), outcomes.begin(), outcomes.end());
+    }
+  }
+  if (!chains.empty()) {
+    std::cout << "\n## Chained odometry (frame k to k - 1 from the identity, whole sequence)\n\n";
+    print_chain_table(std::cout, chains);
+  }
+  std::cout << "\nload average at the end " << load_average() << "; run took "
+            << std::lround(seconds_since(start)) << " s\n";
+  return 0;
+}
+
+}  // namespace
+}  // namespace kartograf::peer
+
+int main(int argc, char** argv) {
+  kartograf::peer::Options options;
+  CLI::App app{"Kartograf against Open3D and PCL on the same frame pairs (docs/benchmarks.md)"};
+  const char* data = std::getenv("KARTOGRAF_DATA_DIR");
+  const std::filesystem::path data_dir = data && *data ? data : KARTOGRAF_DEFAULT_DATA_DIR;
+  options.seven_scenes = data_dir / "7scenes_redkitchen";
+  app.add_option("--seven-scenes", options.seven_scenes, "7-Scenes folder ('' to skip)")
+      ->capture_default_str();
+  options.synthetic = std::filesystem::temp_directory_path() / "kartograf-peer-synthetic";
+  app.add_option("--synthetic", options.synthetic,
+                 "Synthetic TUM folder (kartograf synth); written there when it has no rgb.txt "
+                 "('' to skip)")
+      ->capture_default_str();
+  app.add_option("--synthetic-frames", options.synthetic_frames, "Frames when writing it")
+      ->capture_default_str();
+  app.add_option("--min-time", options.min_time, "Seconds of calls per method and pair")
+      ->capture_default_str();
+  app.add_option("--max-calls", options.max_calls, "Most timed calls per method and pair")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  app.add_flag("!--no-chain", options.chain, "Skip the chained trajectories");
+  app.add_flag("!--no-device-backends", options.device_backends,
+               "Kartograf odometry on the CPU backend only");
+  app.add_flag("--details", options.details, "Every pair's errors and time on stderr");
+  app.add_option("--only", options.only, "Only methods whose name contains this");
+  app.add_option("--trajectories", options.trajectories,
+                 "Write the chained trajectories here (TUM), for `kartograf eval traj`");
+  CLI11_PARSE(app, argc, argv);
+  try {
+    return kartograf::peer::run(options);
+  } catch (const std::exception& error) {
+    std::cerr << "kartograf_peer_bench: " << error.what() << "\n";
+    return 1;
+  }
+}
