@@ -62,4 +62,36 @@ struct SynthOptions {
 CLI::App* add_synth_command(CLI::App& app, SynthOptions& options);
 int run_synth_command(const SynthOptions& options, std::ostream& out, std::ostream& err);
 
+// Options shared by `odometry` and `slam` (sequence_run.hpp).
+struct SequenceRunOptions {
+  std::filesystem::path sequence;  // a folder in any supported layout (io/sequence_detect.hpp)
+  std::string method = "p2plane";  // p2p | p2plane | color
+  std::string backend = "auto";
+  std::string backend_source = "--backend";  // names the setting in errors
+  int reestimate_interval = 5;
+  std::size_t frames = 0;  // 0: all
+  bool progress = true;
+};
+
+// `odometry SEQUENCE --out traj.txt`: frame-to-frame odometry, a TUM trajectory and a summary
+// (ATE when the sequence has ground truth); --stats writes per-frame statistics as JSON.
+struct OdometryOptions {
+  SequenceRunOptions run;
+  std::filesystem::path out, stats;
+};
+CLI::App* add_odometry_command(CLI::App& app, OdometryOptions& options);
+int run_odometry_command(const OdometryOptions& options, std::ostream& out, std::ostream& err);
+
+// `slam SEQUENCE --out DIR`: odometry, loop closure, pose graph and map: DIR/trajectory.txt,
+// map.ply, top_view.png, stats.json (and groundtruth.txt when the sequence has ground truth).
+struct SlamOptions {
+  SequenceRunOptions run;
+  std::filesystem::path out_dir;
+  bool no_loop_closure = false;
+  bool no_map = false;
+  double voxel_size = 0.02;
+};
+CLI::App* add_slam_command(CLI::App& app, SlamOptions& options);
+int run_slam_command(const SlamOptions& options, std::ostream& out, std::ostream& err);
+
 }  // namespace kartograf::cli

@@ -19,8 +19,9 @@ int main(int argc, char** argv) {
     demo_options.backend = env_backend;
     demo_options.backend_source = "KARTOGRAF_BACKEND";
   }
-  CLI::App* demo = app.add_subcommand(
-      "demo", "Render a frame of the synthetic world, back-project, estimate normals, write pictures and a PLY");
+  CLI::App* demo = app.add_subcommand("demo",
+                                      "Render a frame of the synthetic world, back-project, "
+                                      "estimate normals, write pictures and a PLY");
   demo->add_option("--out", demo_options.out_dir, "Output directory")->capture_default_str();
   CLI::Option* backend_option =
       demo->add_option("--backend", demo_options.backend,
@@ -30,6 +31,10 @@ int main(int argc, char** argv) {
   CLI::App* eval = kartograf::cli::add_eval_command(app, eval_options);
   kartograf::cli::SynthOptions synth_options;
   CLI::App* synth = kartograf::cli::add_synth_command(app, synth_options);
+  kartograf::cli::OdometryOptions odometry_options;
+  CLI::App* odometry = kartograf::cli::add_odometry_command(app, odometry_options);
+  kartograf::cli::SlamOptions slam_options;
+  CLI::App* slam = kartograf::cli::add_slam_command(app, slam_options);
 
   try {
     app.parse(argc, argv);
@@ -43,6 +48,10 @@ int main(int argc, char** argv) {
     if (*demo) return kartograf::cli::run_demo_command(demo_options, std::cout);
     if (*eval) return kartograf::cli::run_eval_command(eval_options, std::cout);
     if (*synth) return kartograf::cli::run_synth_command(synth_options, std::cout, std::cerr);
+    if (*odometry) {
+      return kartograf::cli::run_odometry_command(odometry_options, std::cout, std::cerr);
+    }
+    if (*slam) return kartograf::cli::run_slam_command(slam_options, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

@@ -1,6 +1,8 @@
-// Kartograf's side of the peer benchmark: projective point-to-plane odometry (the IcpEngine with
-// its defaults, what odometry runs every frame) per backend, and k-d tree ICP on the shared clouds.
+// Kartograf's side of the peer benchmark: projective point-to-plane ICP between two frames (the
+// IcpEngine with its defaults) per backend, the full RGB-D odometry (chained runs), and k-d tree
+// ICP on the shared clouds.
 #include <memory>
+#include <optional>
 #include <span>
 #include <utility>
 
@@ -11,6 +13,7 @@
 #include "kartograf/registration/frame_pyramid.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
+#include "kartograf/registration/odometry.hpp"
 #include "peer_methods.hpp"
 
 namespace kartograf::peer {
@@ -113,7 +116,47 @@ Method cloud_icp(const char* name, InputKind input, const CloudIcpSettings& sett
   return method;
 }
 
+// The whole odometry of `kartograf odometry` (registration/odometry.hpp: motion model, depth
+// weights, re-estimation against frame n-5), chained only: it keeps its own frames, so track()
+// returns the motion from the pose it returned last to the (re-estimated) pose of the new frame,
+// and the chained trajectory equals the odometry's poses frame by frame.
+class KartografRgbdOdometry : public OdometryFrontEnd {
+ public:
+  KartografRgbdOdometry(ContextPtr context, const Dataset& dataset)
+      : context_(std::move(context)), camera_(dataset.camera()), range_(dataset.range) {}
+
+  void set_reference(const Frame& frame) override {
+    registration::OdometryParams params;
+    params.depth_range = range_;
+    odometry_.emplace(*context_, camera_, params);
+    odometry_->track(frame.depth, &frame.color);
+    last_ = Eigen::Isometry3d::Identity();
+  }
+  Estimate track(const Frame& frame) override {
+    const registration::OdometryFrame& report = odometry_->track(frame.depth, &frame.color);
+    const Eigen::Isometry3d pose = odometry_->poses().back();
+    const Eigen::Isometry3d motion = last_.inverse() * pose;
+    last_ = pose;
+    return {motion, !report.fallback};
+  }
+  void advance() override {}
+
+ private:
+  ContextPtr context_;
+  PinholeIntrinsics camera_;
+  geometry::DepthRange range_;
+  std::optional<registration::RgbdOdometry> odometry_;
+  Eigen::Isometry3d last_ = Eigen::Isometry3d::Identity();
+};
+
 }  // namespace
+
+OdometryFactory kartograf_rgbd_odometry_factory() {
+  return [context = make_context(compute::BackendChoice::cpu)](
+             const Dataset& dataset) -> std::unique_ptr<OdometryFrontEnd> {
+    return std::make_unique<KartografRgbdOdometry>(context, dataset);
+  };
+}
 
 OdometryFactory kartograf_odometry_factory() {
   return odometry_factory(make_context(compute::BackendChoice::cpu));

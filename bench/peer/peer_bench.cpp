@@ -9,9 +9,10 @@
 //   timing  per method and pair: one untimed warm-up call on the first pair, then calls until
 //           --min-time seconds have passed (at least 1, at most --max-calls); the pair's time is
 //           their median, the method's time the median over pairs. Wall clock, steady_clock.
-//   chain   frame k aligned to frame k - 1 over a whole sequence (Kartograf's CPU odometry and
-//           Open3D's RGB-D odometry in lockstep, each frame read once), ATE and RPE against the
-//           ground truth (eval::evaluate_trajectory, SE(3) alignment).
+//   chain   frame k aligned to frame k - 1 over a whole sequence (Kartograf's two-frame ICP, its
+//           full RgbdOdometry with the motion model and re-estimation, and Open3D's RGB-D odometry
+//           in lockstep, each frame read once), ATE and RPE against the ground truth
+//           (eval::evaluate_trajectory, SE(3) alignment).
 // Threads are whatever the environment pins: OMP_NUM_THREADS (Open3D's OpenMP loops) and
 // KARTOGRAF_CPU_THREADS (Kartograf's CPU loops; 1 when unset); both are printed.
 #include <chrono>
@@ -113,6 +114,8 @@ std::vector<ChainOutcome> run_chain(const Dataset& dataset, const Options& optio
   std::vector<Tracker> trackers;
   trackers.emplace_back(kKartografOdometry, kartograf_threads(),
                         kartograf_odometry_factory()(dataset));
+  trackers.emplace_back(kKartografRgbdOdometry, kartograf_threads(),
+                        kartograf_rgbd_odometry_factory()(dataset));
   trackers.emplace_back("open3d RGB-D odometry, hybrid term", openmp_threads(),
                         open3d_odometry_factory()(dataset));
   Trajectory ground_truth;
@@ -150,8 +153,10 @@ std::vector<ChainOutcome> run_chain(const Dataset& dataset, const Options& optio
                         tracker.failures});
     if (!options.trajectories.empty()) {
       std::filesystem::create_directories(options.trajectories);
-      const std::string stem =
-          dataset.name + "_" + (tracker.name.rfind("open3d", 0) == 0 ? "open3d" : "kartograf");
+      const std::string stem = dataset.name + "_" +
+                               (tracker.name.rfind("open3d", 0) == 0     ? "open3d"
+                                : tracker.name == kKartografRgbdOdometry ? "kartograf_rgbd_odometry"
+                                                                         : "kartograf");
       io::write_tum_trajectory(options.trajectories / (stem + ".txt"), tracker.trajectory);
       io::write_tum_trajectory(options.trajectories / (dataset.name + "_groundtruth.txt"),
                                ground_truth);

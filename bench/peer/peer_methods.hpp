@@ -71,6 +71,10 @@ std::string openmp_threads();     // "OMP_NUM_THREADS=n" or "OMP_NUM_THREADS uns
 std::vector<Method> kartograf_methods(const CloudIcpSettings& settings, bool device_backends);
 // The CPU odometry front end (chained trajectories).
 OdometryFactory kartograf_odometry_factory();
+// registration::RgbdOdometry with its defaults on the CPU (chained trajectories only).
+OdometryFactory kartograf_rgbd_odometry_factory();
+inline constexpr const char* kKartografRgbdOdometry =
+    "kartograf RGB-D odometry (RgbdOdometry: motion model, k = 5) (cpu)";
 inline constexpr const char* kKartografOdometry = "kartograf p2plane odometry (cpu)";
 inline constexpr const char* kKartografCloudFull = "kartograf p2plane ICP k-d tree (cpu)";
 inline constexpr const char* kKartografCloudSampled = "kartograf p2plane ICP k-d tree (cpu) 20k";

@@ -1,0 +1,226 @@
+#include "sequence_run.hpp"
+
+#include <unistd.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <iostream>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::cli {
+
+void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
+  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
+    o.backend = env_backend;
+    o.backend_source = "KARTOGRAF_BACKEND";
+  }
+  command
+      .add_option("SEQUENCE", o.sequence,
+                  "RGB-D sequence folder: TUM (rgb.txt, depth.txt), kartograf synth, or 7-Scenes")
+      ->required();
+  command.add_option("--method", o.method, "ICP error metric and pair rejection")
+      ->check(CLI::IsMember({"p2p", "p2plane", "color"}))
+      ->capture_default_str();
+  command
+      .add_option("--backend", o.backend,
+                  "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)")
+      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
+  command
+      .add_option("--reestimate-every", o.reestimate_interval,
+                  "Re-register every k-th frame against frame n-k (the M3 paper's drift "
+                  "reduction; 0: off)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  command.add_option("--frames", o.frames, "Use only the first N frames (0: all)");
+  command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
+}
+
+registration::OdometryParams odometry_params(const SequenceRunOptions& options) {
+  registration::OdometryParams params;
+  params.method = options.method == "p2p"     ? registration::OdometryMethod::point_to_point
+                  : options.method == "color" ? registration::OdometryMethod::color
+                                              : registration::OdometryMethod::point_to_plane;
+  params.icp = registration::odometry_icp_params(params.method);
+  params.reestimate_interval = options.reestimate_interval;
+  return params;
+}
+
+compute::Context make_run_context(const SequenceRunOptions& options) {
+  compute::ContextOptions context_options;
+  context_options.backend = compute::parse_backend_choice(options.backend, options.backend_source);
+  return compute::Context(context_options);
+}
+
+OpenedRun open_run(const SequenceRunOptions& options) {
+  OpenedRun run;
+  run.opened = io::open_sequence(options.sequence);
+  const std::optional<std::size_t> count =
+      options.frames > 0 ? std::optional<std::size_t>(options.frames) : std::nullopt;
+  run.source = std::make_unique<io::SequenceFrameSource>(*run.opened.sequence, count);
+  return run;
+}
+
+ProgressBar::ProgressBar(std::ostream& err, bool enabled)
+    : err_(&err), enabled_(enabled), terminal_(enabled && &err == &std::cerr && isatty(2) == 1) {}
+
+void ProgressBar::update(std::string_view stage, std::size_t done, std::size_t total) {
+  if (!enabled_ || total == 0) return;
+  if (stage != stage_) {
+    finish();
+    stage_ = std::string(stage);
+    last_step_ = -1;
+    stage_start_ = std::chrono::steady_clock::now();
+  }
+  const double fraction = static_cast<double>(done) / static_cast<double>(total);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - stage_start_).count();
+  // The stage started with its first frame: a rate needs some time behind it.
+  char rate[48] = "";
+  if (seconds > 0.2) {
+    std::snprintf(rate, sizeof(rate), " (%.1f frames/s)", static_cast<double>(done - 1) / seconds);
+  }
+  char line[160];
+  if (terminal_) {
+    constexpr int kWidth = 30;
+    const int filled = static_cast<int>(fraction * kWidth);
+    std::snprintf(line, sizeof(line), "\r%-8s [%-*s] %zu/%zu%s", stage_.c_str(), kWidth,
+                  std::string(static_cast<std::size_t>(filled), '#').c_str(), done, total, rate);
+    *err_ << line << std::flush;
+    open_line_ = true;
+    return;
+  }
+  const int step = static_cast<int>(fraction * 10);
+  if (step == last_step_) return;
+  last_step_ = step;
+  std::snprintf(line, sizeof(line), "%s: %zu/%zu frames%s\n", stage_.c_str(), done, total, rate);
+  *err_ << line << std::flush;
+}
+
+void ProgressBar::finish() {
+  if (open_line_) *err_ << "\n" << std::flush;
+  open_line_ = false;
+}
+
+void warn_about(std::ostream& err, ProgressBar& bar, const registration::OdometryFrame& frame) {
+  const auto describe = [](const registration::RegistrationReport& r) {
+    char text[160];
+    std::snprintf(text, sizeof(text), "%s (fitness %.2f, rmse %.1f mm, eigenvalue ratio %.3f)",
+                  std::string(registration::to_string(r.verdict)).c_str(), r.fitness,
+                  1000.0 * r.inlier_rmse, r.eigenvalue_ratio);
+    return std::string(text);
+  };
+  if (frame.fallback && frame.previous) {
+    bar.finish();
+    err << "warning: frame " << frame.index
+        << ": registration to the previous frame rejected: " << describe(*frame.previous)
+        << "; using the constant-velocity motion\n";
+  }
+  if (frame.reestimate && !frame.reestimate->accepted()) {
+    bar.finish();
+    err << "warning: frame " << frame.index
+        << ": re-estimate rejected: " << describe(*frame.reestimate)
+        << "; keeping the chained estimate\n";
+  }
+}
+
+Trajectory stamped_trajectory(const std::vector<Eigen::Isometry3d>& poses,
+                              const std::vector<double>& timestamps, bool has_timestamps) {
+  Trajectory trajectory;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    trajectory.push_back({has_timestamps ? timestamps.at(i) : static_cast<double>(i), poses[i]});
+  }
+  return trajectory;
+}
+
+Trajectory ground_truth_trajectory(const io::SequenceFrameSource& source,
+                                   const std::vector<double>& timestamps, bool has_timestamps) {
+  Trajectory trajectory;
+  const auto& truth = source.ground_truth();
+  for (std::size_t i = 0; i < truth.size() && i < timestamps.size(); ++i) {
+    if (truth[i]) {
+      trajectory.push_back({has_timestamps ? timestamps[i] : static_cast<double>(i), *truth[i]});
+    }
+  }
+  return trajectory;
+}
+
+std::optional<eval::AteResult> absolute_trajectory_error(
+    const io::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses) {
+  eval::MatchedPoses matched;
+  const auto& truth = source.ground_truth();
+  for (std::size_t i = 0; i < truth.size() && i < poses.size(); ++i) {
+    if (!truth[i]) continue;
+    const double t = static_cast<double>(i);
+    matched.ground_truth.push_back({t, *truth[i]});
+    matched.estimate.push_back({t, poses[i]});
+  }
+  if (matched.size() < 3) return std::nullopt;
+  return eval::compute_ate(matched, eval::Alignment::se3);
+}
+
+Json report_json(const registration::RegistrationReport& r) {
+  Json json;
+  json["verdict"] = registration::to_string(r.verdict);
+  json["fitness"] = r.fitness;
+  json["inlier_rmse_m"] = r.inlier_rmse;
+  json["inliers"] = r.inliers;
+  json["iterations"] = r.iterations;
+  json["converged"] = r.converged;
+  json["degenerate"] = r.degenerate;
+  json["eigenvalue_ratio"] = r.eigenvalue_ratio;
+  json["correction_m"] = r.correction_m;
+  json["correction_deg"] = r.correction_deg;
+  return json;
+}
+
+Json frame_json(const registration::OdometryFrame& frame) {
+  Json json;
+  json["frame"] = frame.index;
+  json["keyframe"] = frame.keyframe;
+  json["fallback"] = frame.fallback;
+  json["retried"] = frame.retried;
+  json["degenerate"] = frame.degenerate;
+  json["photometric"] = frame.photometric;
+  json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
+  json["previous"] = frame.previous ? report_json(*frame.previous) : Json();
+  json["reestimate"] = frame.reestimate ? report_json(*frame.reestimate) : Json();
+  json["seconds"] = frame.seconds;
+  return json;
+}
+
+Json frame_summary_json(const std::vector<registration::OdometryFrame>& frames) {
+  std::size_t fallbacks = 0, retried = 0, degenerate = 0, photometric = 0, keyframes = 0,
+              reestimates = 0, reestimates_rejected = 0;
+  for (const auto& f : frames) {
+    fallbacks += f.fallback;
+    retried += f.retried;
+    keyframes += f.keyframe;
+    degenerate += f.degenerate;
+    photometric += f.photometric;
+    reestimates += f.reestimate.has_value();
+    reestimates_rejected += f.reestimate && !f.reestimate->accepted();
+  }
+  Json json;
+  json["frames"] = frames.size();
+  json["keyframes"] = keyframes;
+  json["fallbacks"] = fallbacks;
+  json["retried_from_identity"] = retried;
+  json["degenerate_frames"] = degenerate;
+  json["photometric_frames"] = photometric;
+  json["reestimates"] = reestimates;
+  json["reestimates_rejected"] = reestimates_rejected;
+  return json;
+}
+
+std::string frame_summary_line(const Json& summary) {
+  const auto count = [&](const char* key) {
+    return std::to_string(summary[key].get<std::size_t>());
+  };
+  return "keyframes " + count("keyframes") + ", fallbacks " + count("fallbacks") +
+         ", re-estimates " + count("reestimates") + " (rejected " + count("reestimates_rejected") +
+         "), degenerate frames " + count("degenerate_frames") + " (" + count("photometric_frames") +
+         " measured by image intensity)";
+}
+
+}  // namespace kartograf::cli

@@ -1,0 +1,79 @@
+#pragma once
+// What `kartograf odometry` and `kartograf slam` share: options, opening the sequence, the compute
+// context, a progress bar, warnings about rejected registrations, trajectories in TUM format,
+// scoring against ground truth and per-frame statistics as JSON. Wiring only.
+#include <chrono>
+#include <cstddef>
+#include <filesystem>
+#include <memory>
+#include <optional>
+#include <ostream>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/trajectory.hpp"
+#include "kartograf/eval/trajectory_metrics.hpp"
+#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/registration/odometry.hpp"
+
+namespace kartograf::cli {
+
+using Json = nlohmann::ordered_json;
+
+// Registers SEQUENCE, --method, --backend, --reestimate-every, --frames, --no-progress.
+void add_sequence_run_options(CLI::App& command, SequenceRunOptions& options);
+
+registration::OdometryParams odometry_params(const SequenceRunOptions& options);
+compute::Context make_run_context(const SequenceRunOptions& options);
+
+// The opened sequence and the pipeline's view of it.
+struct OpenedRun {
+  io::OpenedSequence opened;
+  std::unique_ptr<io::SequenceFrameSource> source;
+};
+OpenedRun open_run(const SequenceRunOptions& options);
+
+// A bar on a terminal (redrawn in place), else a line every 10 %.
+class ProgressBar {
+ public:
+  ProgressBar(std::ostream& err, bool enabled);
+  void update(std::string_view stage, std::size_t done, std::size_t total);
+  void finish();  // ends the bar's line
+
+ private:
+  std::ostream* err_;
+  bool enabled_;
+  bool terminal_;
+  std::string stage_;
+  int last_step_ = -1;
+  bool open_line_ = false;
+  std::chrono::steady_clock::time_point stage_start_;
+};
+
+// A warning line on `err` for each rejected registration or fallback of a frame.
+void warn_about(std::ostream& err, ProgressBar& bar, const registration::OdometryFrame& frame);
+
+// Timestamps: the sequence's, or the frame number where it has none (7-Scenes).
+Trajectory stamped_trajectory(const std::vector<Eigen::Isometry3d>& poses,
+                              const std::vector<double>& timestamps, bool has_timestamps);
+// The ground truth of the frames that have one, stamped like the estimate.
+Trajectory ground_truth_trajectory(const io::SequenceFrameSource& source,
+                                   const std::vector<double>& timestamps, bool has_timestamps);
+// ATE (SE(3) alignment) of the estimate's frames that have ground truth; empty without any.
+std::optional<eval::AteResult> absolute_trajectory_error(
+    const io::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
+
+Json report_json(const registration::RegistrationReport& report);
+Json frame_json(const registration::OdometryFrame& frame);
+// Counts over frames: fallbacks, retried, rejected re-estimates, degenerate, keyframes.
+Json frame_summary_json(const std::vector<registration::OdometryFrame>& frames);
+// One line of those counts, for the summaries on stdout.
+std::string frame_summary_line(const Json& summary);
+
+}  // namespace kartograf::cli

@@ -1,0 +1,172 @@
+// `kartograf slam SEQUENCE --out DIR`: odometry, loop closure, pose graph and fused map
+// (mapping::run_slam) over a sequence folder. Writes DIR/trajectory.txt (TUM; the frame number is
+// the timestamp where the sequence has none), odometry.txt (before the pose graph), map.ply,
+// top_view.png, stats.json and, when the sequence has ground truth, groundtruth.txt stamped the
+// same way (for `kartograf eval traj`). Wiring only.
+#include <cstdio>
+#include <filesystem>
+#include <ostream>
+#include <string>
+
+#include "commands.hpp"
+#include "kartograf/io/ply.hpp"
+#include "kartograf/io/text_file.hpp"
+#include "kartograf/io/top_view.hpp"
+#include "kartograf/io/tum.hpp"
+#include "kartograf/mapping/slam.hpp"
+#include "sequence_run.hpp"
+
+namespace kartograf::cli {
+
+namespace {
+
+Json loop_closure_json(const mapping::LoopClosureRecord& record) {
+  const mapping::LoopCandidate& c = record.closure.candidate;
+  Json json;
+  json["query_frame"] = c.query_frame;
+  json["match_frame"] = c.match_frame;
+  json["distance_m"] = c.distance_m;
+  json["view_angle_deg"] = c.view_angle_deg;
+  json["overlap"] = c.overlap;
+  json["registration"] = report_json(record.closure.report);
+  const Eigen::Isometry3d& motion = record.closure.constraint.motion;
+  const Eigen::Quaterniond rotation(motion.linear());
+  json["motion"] = {motion.translation().x(),
+                    motion.translation().y(),
+                    motion.translation().z(),
+                    rotation.x(),
+                    rotation.y(),
+                    rotation.z(),
+                    rotation.w()};
+  json["chi2"] = record.chi2;
+  json["residual_m"] = record.residual_m;
+  json["residual_deg"] = record.residual_deg;
+  json["pruned"] = record.pruned;
+  return json;
+}
+
+}  // namespace
+
+CLI::App* add_slam_command(CLI::App& app, SlamOptions& o) {
+  CLI::App* command = app.add_subcommand(
+      "slam", "RGB-D SLAM: odometry, loop closure, pose graph and a fused map of a sequence");
+  add_sequence_run_options(*command, o.run);
+  command->add_option("--out", o.out_dir, "Output folder (created if missing)")->required();
+  command->add_flag("--no-loop-closure", o.no_loop_closure,
+                    "Optimise odometry edges only (frame-to-frame and k-back)");
+  command->add_flag("--no-map", o.no_map, "Skip the map (no second pass over the frames)");
+  command->add_option("--voxel", o.voxel_size, "Map voxel size [m]")
+      ->check(CLI::Range(0.001, 10.0))
+      ->capture_default_str();
+  return command;
+}
+
+int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err) {
+  const OpenedRun run = open_run(o.run);
+  const compute::Context context = make_run_context(o.run);
+  mapping::SlamParams params;
+  params.odometry = odometry_params(o.run);
+  params.loop_closure = !o.no_loop_closure;
+  params.build_map = !o.no_map;
+  params.map.voxel_size = o.voxel_size;
+  const bool has_timestamps = run.opened.detected.has_timestamps;
+  std::filesystem::create_directories(o.out_dir);
+
+  ProgressBar bar(err, o.run.progress);
+  mapping::SlamObserver observer;
+  observer.on_frame = [&](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
+  observer.on_progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
+    bar.update(stage, done, total);
+  };
+  const mapping::SlamResult result = mapping::run_slam(context, *run.source, params, observer);
+  bar.finish();
+
+  const std::vector<double>& timestamps = result.odometry.timestamps;
+  io::write_tum_trajectory(o.out_dir / "trajectory.txt",
+                           stamped_trajectory(result.poses, timestamps, has_timestamps));
+  io::write_tum_trajectory(o.out_dir / "odometry.txt",
+                           stamped_trajectory(result.odometry.poses, timestamps, has_timestamps));
+  const Trajectory truth = ground_truth_trajectory(*run.source, timestamps, has_timestamps);
+  if (!truth.empty()) io::write_tum_trajectory(o.out_dir / "groundtruth.txt", truth);
+  if (params.build_map) io::write_ply(o.out_dir / "map.ply", result.map);
+  io::write_top_view_png(o.out_dir / "top_view.png", result.map, result.poses);
+
+  const auto slam_ate = absolute_trajectory_error(*run.source, result.poses);
+  const auto odometry_ate = absolute_trajectory_error(*run.source, result.odometry.poses);
+  std::size_t accepted = 0, pruned = 0;
+  Json loops = Json::array();
+  for (const auto& record : result.loop_closures) {
+    accepted += record.closure.report.accepted();
+    pruned += record.pruned;
+    loops.push_back(loop_closure_json(record));
+  }
+  const mapping::SlamTimings& t = result.timing;
+  const double frames = static_cast<double>(result.poses.size());
+
+  Json json;
+  json["sequence"] = o.run.sequence.string();
+  json["layout"] = io::to_string(run.opened.detected.layout);
+  json["frames"] = result.poses.size();
+  json["method"] = o.run.method;
+  json["backend"] = compute::to_string(context.backend());
+  json["device"] = context.device_info().name;
+  json["reestimate_interval"] = params.odometry.reestimate_interval;
+  json["odometry_ate_rmse_m"] = odometry_ate ? Json(odometry_ate->translation_m.rmse) : Json();
+  json["slam_ate_rmse_m"] = slam_ate ? Json(slam_ate->translation_m.rmse) : Json();
+  json["timing_s"] = {{"total", t.total_seconds},
+                      {"odometry", t.odometry_seconds},
+                      {"loop_closure", t.loop_closure_seconds},
+                      {"optimisation", t.optimisation_seconds},
+                      {"map", t.map_seconds},
+                      {"loading", t.load_seconds}};
+  json["loop_closure"] = {{"enabled", params.loop_closure},
+                          {"candidates", result.loop_candidates},
+                          {"accepted", accepted},
+                          {"pruned", pruned},
+                          {"closures", loops}};
+  json["pose_graph"] = {{"nodes", result.poses.size()},
+                        {"edges", result.graph_edges},
+                        {"optimisations", result.graph_optimisations},
+                        {"iterations", result.final_graph.iterations},
+                        {"initial_cost", result.final_graph.initial_cost},
+                        {"final_cost", result.final_graph.final_cost},
+                        {"converged", result.final_graph.converged}};
+  json["map"] = {{"points", result.map.size()},
+                 {"voxels", result.map_voxels},
+                 {"voxel_size_m", params.map.voxel_size}};
+  json["odometry"] = frame_summary_json(result.odometry.frames);
+  Json per_frame = Json::array();
+  for (const auto& f : result.odometry.frames) per_frame.push_back(frame_json(f));
+  json["per_frame"] = std::move(per_frame);
+  io::write_text_file(o.out_dir / "stats.json", json.dump(1) + "\n");
+
+  char line[256];
+  out << "slam: " << o.run.sequence.string() << " (" << io::to_string(run.opened.detected.layout)
+      << ", " << result.poses.size() << " frames), method " << o.run.method << ", backend "
+      << compute::to_string(context.backend()) << " (" << context.device_info().name << ")\n";
+  out << "  " << frame_summary_line(json["odometry"]) << "\n";
+  std::snprintf(line, sizeof(line),
+                "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",
+                accepted, result.loop_candidates, pruned);
+  out << line;
+  std::snprintf(line, sizeof(line), "  map_points %zu (voxel %.3f m)\n", result.map.size(),
+                params.map.voxel_size);
+  out << line;
+  if (odometry_ate && slam_ate) {
+    std::snprintf(line, sizeof(line), "  odometry_ate_rmse_m %.6f\n  slam_ate_rmse_m %.6f\n",
+                  odometry_ate->translation_m.rmse, slam_ate->translation_m.rmse);
+    out << line;
+  }
+  std::snprintf(line, sizeof(line),
+                "  seconds %.2f total: odometry %.2f, loop closure %.2f, pose graph %.2f, map "
+                "%.2f, file loading %.2f (prefetched); %.1f frames/s overall\n",
+                t.total_seconds, t.odometry_seconds, t.loop_closure_seconds, t.optimisation_seconds,
+                t.map_seconds, t.load_seconds,
+                t.total_seconds > 0 ? frames / t.total_seconds : 0.0);
+  out << line << "  wrote " << o.out_dir.string() << "/{trajectory.txt, odometry.txt, "
+      << (params.build_map ? "map.ply, " : "") << "top_view.png, stats.json"
+      << (truth.empty() ? "" : ", groundtruth.txt") << "}\n";
+  return 0;
+}
+
+}  // namespace kartograf::cli

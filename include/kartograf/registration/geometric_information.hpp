@@ -1,0 +1,65 @@
+#pragma once
+// How well a frame's own geometry pins down each direction of motion, from a coarse pyramid level.
+//
+// ICP's J^T W J (icp_result.hpp) is built from the finest level's normals. On Kinect-class depth,
+// 4-neighbour normals at 320x240 or 640x480 scatter by tens of degrees, and that scatter reads as
+// constraint: a view of one wall and the floor, which leaves the motion along their intersection
+// free, gave a balanced eigenvalue ratio of 0.07 from ICP's sums at 320x240, and 0.0004 from the
+// 80x60 level's normals (averages over 8x8 pixels). Odometry and loop closure judge degeneracy and
+// weight pose-graph edges with this honest version.
+//
+// For the valid points p of a cloud with valid normals n (its own frame) and weights w (the depth
+// weights of depth_weighted_finder.hpp, or 1):
+//   H = sum w J J^T / sum w,   J = [p x n; n]
+// is the mean Gauss-Newton information of the plane distances for the right perturbation
+// T exp(xi), xi = (omega, v), of a motion T applied to the cloud (the source of a registration):
+// with the source frame j and the target frame i, that of the pose-graph edge from i to j.
+// `about_centre` is the same sum with p taken relative to the weighted centroid; degeneracy is
+// analyse_degeneracy() of it.
+#include <cstddef>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/core/se3.hpp"
+#include "kartograf/registration/correspondence_finder.hpp"
+#include "kartograf/registration/rigid_solvers.hpp"
+
+namespace kartograf::registration {
+
+struct GeometricInformation {
+  se3::Matrix6d information = se3::Matrix6d::Zero();   // right perturbation, per unit weight
+  se3::Matrix6d about_centre = se3::Matrix6d::Zero();  // per unit weight
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();    // weighted centroid
+  DegeneracyReport degeneracy;
+  std::size_t points = 0;  // points with a normal
+  double weight_sum = 0;
+};
+
+// cloud needs points and normals (downloaded from a device). reference_depth > 0 applies the depth
+// weights of DepthWeightedFinder; 0 weighs every point 1.
+GeometricInformation geometric_information(const CloudView& cloud, double reference_depth,
+                                           double min_eigenvalue_ratio);
+
+// GeometricInformation::information without its weak directions (balanced eigenvalue below
+// min_eigenvalue_ratio x the largest, about the centroid): what a registration whose weak
+// directions came from elsewhere (keep_constrained_directions) measured.
+se3::Matrix6d constrained_information(const GeometricInformation& geometry,
+                                      double min_eigenvalue_ratio);
+
+// The weak directions (balanced eigenvalue below min_eigenvalue_ratio x the largest) as tangent
+// vectors of the right perturbation of a motion applied to the cloud, weakest first.
+std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
+                                           double min_eigenvalue_ratio);
+
+// The motion that keeps `measured` in the well-constrained directions of `geometry` and takes
+// `predicted` (e.g. the motion model's) in those whose balanced eigenvalue is below
+// min_eigenvalue_ratio x the largest: the difference log(measured^-1 predicted) is projected on
+// the weak eigenvectors (about the centroid, in balanced coordinates). Both motions map the
+// geometry's cloud (the source) into the target.
+Eigen::Isometry3d keep_constrained_directions(const Eigen::Isometry3d& measured,
+                                              const Eigen::Isometry3d& predicted,
+                                              const GeometricInformation& geometry,
+                                              double min_eigenvalue_ratio);
+
+}  // namespace kartograf::registration

@@ -1,0 +1,187 @@
+#pragma once
+// Frame-to-frame RGB-D odometry (methods.md M3 "localisation") with the M3 paper's drift
+// reduction, degeneracy handling, motion-model fallbacks and keyframe selection.
+//
+// Each new frame n becomes a FramePyramid and is registered by the ICP engine against frame n-1,
+// starting from the motion model's prediction, on pyramid levels from the first one at most
+// icp_width wide (320x240 of 640x480), never the full resolution, and coarser: the full-resolution
+// 4-neighbour normals of Kinect-class depth are mostly noise, and starting at 320x240 was both more
+// accurate (0.45 vs 1.5-2.4 mm per frame on the synthetic tour, the same on 7-Scenes) and three
+// times faster. Pairs are weighted by depth noise (depth_weighted_finder.hpp).
+//
+// Every result is judged (registration_check.hpp) with the degeneracy of the frame's own geometry
+// (geometric_information.hpp, from the first pyramid level at most information_width wide):
+//   - degenerate (a wall and the floor, a corridor without ends): the result is kept in the
+//     constrained directions and the initial guess (the motion model) is taken in the weak ones;
+//   - rejected (too few pairs, RMSE, an implausible jump): ICP is retried from the identity; when
+//     that is rejected too, the frame takes the motion model's prediction and is flagged as a
+//     fallback (its pose-graph edge gets only the weak prior information).
+//
+// Drift reduction (the paper's "iterative estimation every 5 images"): every k-th frame is
+// registered again against frame n-k, starting from the chained estimate T_{n-k}^-1 T_n. When the
+// re-estimate is accepted it replaces frame n's pose, and the correction is spread over frames
+// n-k+1..n-1 in proportion to their position (so the trajectory has no jump); chaining then
+// continues from the corrected pose. Every registration is kept as a RelativePose, so a pose graph
+// (mapping/) can use both the frame-to-frame and the k-back measurements.
+//
+// Information of an edge: InformationModel applied to the geometric information, plus the weak
+// prior of an unmeasured step (fallback_sigma_*) so that no direction is entirely free.
+//
+// Keyframes: frame 0, then any frame that moved more than KeyframePolicy's distance or angle from
+// the last keyframe, or is max_interval frames after it, or is a fallback. SLAM uses them as
+// loop-closure nodes.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/se3.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/registration/color_gate.hpp"
+#include "kartograf/registration/depth_weighted_finder.hpp"
+#include "kartograf/registration/geometric_information.hpp"
+#include "kartograf/registration/icp.hpp"
+#include "kartograf/registration/photometric_refinement.hpp"
+#include "kartograf/registration/registration_check.hpp"
+#include "kartograf/registration/rgbd_frame.hpp"
+
+namespace kartograf::registration {
+
+enum class OdometryMethod {
+  point_to_point,  // the M3 paper's metric (Arun's closed form), closest point in a 3x3 window
+  point_to_plane,  // Gauss-Newton on plane distances
+  color,           // point-to-plane on pairs that pass the M3 paper's HSI colour gate
+};
+
+// The ICP parameters of each method; levels[0] runs on the pyramid level of
+// OdometryParams::icp_width.
+IcpParams odometry_icp_params(OdometryMethod method);
+
+enum class MotionModel { still, velocity, acceleration };
+
+struct KeyframePolicy {
+  double min_translation = 0.15;  // metres from the last keyframe
+  double min_rotation_deg = 10;
+  int max_interval = 30;  // frames
+};
+
+struct OdometryParams {
+  OdometryMethod method = OdometryMethod::point_to_plane;
+  IcpParams icp = odometry_icp_params(OdometryMethod::point_to_plane);  // keep it the method's
+  // ICP's levels[0] runs on the first pyramid level at most icp_width wide and at least
+  // min_icp_level: full-resolution normals are noise at any resolution (synthetic tour at
+  // 320x240: 60 mm ATE over 60 frames starting at 320x240, 3 mm starting at 160x120).
+  int icp_width = 320;
+  int min_icp_level = 1;
+  int information_width = 80;  // the geometric information's level (80x60 of 640x480)
+  ColorGateParams color_gate;  // OdometryMethod::color
+  // Degenerate frames with colour: measure the weak directions by image intensity
+  // (photometric_refinement.hpp) instead of taking the prediction.
+  bool photometric_refinement = true;
+  PhotometricParams photometric;
+  bool depth_weighting = true;  // weight pairs by depth noise
+  DepthWeightParams depth_weights;
+  geometry::DepthRange depth_range;
+  // The paper's k: re-estimate every k-th frame against frame n-k (0: off).
+  int reestimate_interval = 5;
+  // The prediction (initial guess, and the weak directions of degenerate frames): still: the
+  // identity; velocity: the last turn (camera frame) and the last step of the camera centre
+  // (world frame); acceleration: that step changed as it changed from the one before.
+  MotionModel motion_model = MotionModel::velocity;
+  // Frame-to-frame acceptance; the correction is relative to the initial guess.
+  RegistrationLimits frame_limits{200, 0.1, 0.02, false, 0.3, 20};
+  // Re-estimation acceptance; the correction is relative to the chained estimate.
+  RegistrationLimits reestimate_limits{200, 0.1, 0.02, false, 0.03, 2};
+  InformationModel information;
+  // The prior of an unmeasured step (fallbacks) and the floor of every edge's information.
+  double fallback_sigma_m = 0.05;
+  double fallback_sigma_deg = 5;
+  KeyframePolicy keyframes;
+};
+
+// A measured (or, for fallbacks, predicted) motion between two frames, for a pose graph:
+// motion = T_from^-1 T_to, information for the right perturbation of that motion.
+struct RelativePose {
+  std::size_t from = 0;
+  std::size_t to = 0;
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  se3::Matrix6d information = se3::Matrix6d::Identity();
+  bool fallback = false;  // predicted by the motion model, not measured
+};
+
+// Everything the odometry decided about one frame.
+struct OdometryFrame {
+  std::size_t index = 0;
+  // Against frame index-1 (frame 0: none). When the first attempt was rejected and the retry from
+  // the identity accepted, this is the retry; `retried` says so.
+  std::optional<RegistrationReport> previous;
+  bool retried = false;
+  bool fallback = false;  // both attempts rejected: the pose comes from the motion model
+  // Against frame index-k (every k-th frame).
+  std::optional<RegistrationReport> reestimate;
+  // The frame's geometry leaves some direction free: weak directions came from the prediction,
+  // or from image intensity when `photometric`.
+  bool degenerate = false;
+  bool photometric = false;
+  double eigenvalue_ratio = 0;  // of the frame's geometric information
+  bool keyframe = false;
+  double seconds = 0;  // processing time of track() (no file I/O)
+};
+
+class RgbdOdometry {
+ public:
+  // Throws Error on invalid intrinsics, depth range or parameters.
+  RgbdOdometry(const compute::Context& context, const PinholeIntrinsics& camera,
+               OdometryParams params = {});
+
+  // Registers the next frame (depth in params.depth_range's units; colour on the depth camera's
+  // pixel grid, required by OdometryMethod::color). Returns its report; poses() grows by one.
+  const OdometryFrame& track(const DepthImage& depth, const RgbImage* color = nullptr);
+
+  std::size_t frame_count() const { return poses_.size(); }
+  // Camera-to-world; frame 0 is the identity. A re-estimate updates the last k poses.
+  const std::vector<Eigen::Isometry3d>& poses() const { return poses_; }
+  const std::vector<OdometryFrame>& frames() const { return frames_; }
+  const std::vector<RelativePose>& constraints() const { return constraints_; }
+  const std::vector<std::size_t>& keyframes() const { return keyframes_; }
+  const OdometryParams& params() const { return params_; }
+
+ private:
+  struct Attempt {
+    Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // after degeneracy handling
+    double inlier_rmse = 0;
+    bool photometric = false;  // weak directions measured by intensity
+    RegistrationReport report;
+  };
+  // Registers the current frame against an earlier one.
+  Attempt register_frames(std::size_t target, const Eigen::Isometry3d& initial,
+                          const RegistrationLimits& limits);
+  se3::Matrix6d information_of(const Attempt& attempt) const;
+  void track_previous(OdometryFrame& frame);
+  void reestimate(OdometryFrame& frame);
+  bool is_keyframe(const OdometryFrame& frame) const;
+  FramePyramid& pyramid_of(std::size_t frame);
+  std::size_t slot_of(std::size_t frame) const { return frame % ring_.size(); }
+
+  const compute::Context* context_;
+  OdometryParams params_;
+  int finest_level_;       // pyramid level of icp.levels[0]
+  int information_level_;  // pyramid level of the geometric information
+  RgbdPyramidBuilder builder_;
+  IcpEngine engine_;
+  std::vector<FramePyramid> ring_;     // the last max(k, 1) + 1 frames
+  std::vector<RgbImage> colors_;       // their colours (photometric refinement), same slots
+  GeometricInformation geometry_;      // of the frame being tracked
+  const DepthImage* depth_ = nullptr;  // of the frame being tracked
+  const RgbImage* color_ = nullptr;
+  std::vector<Eigen::Isometry3d> poses_;
+  std::vector<OdometryFrame> frames_;
+  std::vector<RelativePose> constraints_;
+  std::vector<std::size_t> keyframes_;
+  // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses.
+  Eigen::Isometry3d predict() const;
+};
+
+}  // namespace kartograf::registration

@@ -1,0 +1,54 @@
+#pragma once
+// Appearance for what geometry cannot see. When a frame's surfaces leave directions of motion free
+// (a wall and the floor: sliding along the wall changes no distance), ICP cannot measure them, but
+// a textured floor still shows the slide. This refines only those directions of a registration by
+// image intensity (a direct method restricted to the weak subspace), so that a degenerate stretch
+// of a trajectory is measured instead of predicted.
+//
+// Residuals: for source pixels x_i (every pixel_step pixels, valid depth, intensity gradient at
+// least min_gradient), r_i(s) = I_t(pi(T exp(sum_k s_k d_k) p_i)) - I_s(x_i), with I the grey level
+// ((r + g + b) / 3) smoothed by a 5-tap binomial filter (applied `blur_passes` times on the coarse
+// pass, once on the fine pass, which widens the basin to a few pixels), bilinear lookups, p_i the
+// back-projected source pixel and d_k the given tangent directions (right perturbation, tangent
+// (omega, v), geometric_information.hpp's weak_directions). Gauss-Newton on s with Huber weights
+// (huber_levels grey levels); a step is kept only if it lowers the robust cost.
+#include <cstddef>
+#include <span>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/core/color.hpp"
+#include "kartograf/core/intrinsics.hpp"
+#include "kartograf/core/point_image.hpp"
+#include "kartograf/core/se3.hpp"
+
+namespace kartograf::registration {
+
+struct PhotometricParams {
+  int pixel_step = 2;
+  double min_gradient = 4;   // grey levels per pixel (after smoothing)
+  int iterations = 10;       // per pass
+  int blur_passes = 3;       // coarse pass; the fine pass blurs once
+  double huber_levels = 10;  // grey levels
+  std::size_t min_pixels = 200;
+  double max_depth = 4.0;  // metres
+};
+
+struct PhotometricResult {
+  Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();
+  bool refined = false;    // enough textured pixels, and the cost went down
+  std::size_t pixels = 0;  // residuals of the last evaluation
+  double rmse_before = 0;  // grey levels, at the given motion (fine pass)
+  double rmse_after = 0;
+};
+
+// The depth is in depth units (units_per_metre) on the camera's grid; both colour images too.
+// Throws Error on mismatched sizes.
+PhotometricResult refine_photometrically(const DepthImage& source_depth,
+                                         const RgbImage& source_color, const RgbImage& target_color,
+                                         const PinholeIntrinsics& camera, double units_per_metre,
+                                         const Eigen::Isometry3d& source_to_target,
+                                         std::span<const se3::Vector6d> directions,
+                                         const PhotometricParams& params = {});
+
+}  // namespace kartograf::registration

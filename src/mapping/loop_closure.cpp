@@ -1,0 +1,196 @@
+#include "kartograf/mapping/loop_closure.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <span>
+#include <string>
+
+#include "kartograf/registration/depth_weighted_finder.hpp"
+#include "kartograf/registration/geometric_information.hpp"
+#include "kartograf/registration/projective_association.hpp"
+
+namespace kartograf::mapping {
+
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+registration::PyramidParams pyramid_params(const LoopClosureParams& params, int finest_level,
+                                           int information_level) {
+  registration::PyramidParams pyramid;
+  pyramid.levels =
+      std::max(finest_level + static_cast<int>(params.icp.levels.size()), information_level + 1);
+  return pyramid;
+}
+
+void validate(const LoopClosureParams& p) {
+  require(p.max_distance >= 0 && p.drift_fraction >= 0 && p.depth_tolerance > 0 &&
+              p.min_correction_m >= 0,
+          "loop closure: distances and fractions must be >= 0 (depth_tolerance > 0)");
+  require(p.max_view_angle_deg >= 0 && p.max_view_angle_deg <= 180,
+          "loop closure: max_view_angle_deg must be in [0, 180]");
+  require(p.sample_step >= 1, "loop closure: sample_step must be >= 1");
+  require(p.baseline_error_fraction >= 0, "loop closure: baseline_error_fraction must be >= 0");
+  require(p.icp_width > 0 && p.information_width > 0 && p.min_icp_level >= 0,
+          "loop closure: icp_width and information_width must be > 0, min_icp_level >= 0");
+  require(p.min_overlap >= 0 && p.min_overlap <= 1, "loop closure: min_overlap must be in [0, 1]");
+}
+
+// Angle between the optical axes (camera z) of two camera-to-world poses.
+double view_angle_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
+  const double cosine = std::clamp(a.linear().col(2).dot(b.linear().col(2)), -1.0, 1.0);
+  return std::acos(cosine) / kDegree;
+}
+
+}  // namespace
+
+registration::IcpParams loop_closure_icp_params() {
+  registration::IcpParams params;
+  params.metric = registration::ErrorMetric::point_to_plane;
+  params.robust_kernel = registration::RobustKernel::huber;
+  params.max_normal_angle_deg = 45;  // as odometry_icp_params()
+  // Views from farther apart see fewer surface orientations; 0.01 rejects good loops.
+  params.min_eigenvalue_ratio = 0.005;
+  //      iterations, 1-in-k, max distance, robust scale
+  params.levels = {
+      {10, 2, 0.03, 0.01}, {10, 2, 0.10, 0.03}, {10, 1, 0.25, 0.08}, {15, 1, 0.50, 0.20}};
+  return params;
+}
+
+LoopClosureDetector::LoopClosureDetector(const compute::Context& context,
+                                         const PinholeIntrinsics& camera,
+                                         const geometry::DepthRange& range,
+                                         LoopClosureParams params)
+    : camera_(camera),
+      range_(range),
+      params_(std::move(params)),
+      finest_level_(std::max(
+          params_.min_icp_level,
+          registration::pyramid_level_at_most(camera.width, std::max(params_.icp_width, 1)))),
+      information_level_(registration::pyramid_level_at_most(
+          camera.width, std::max(params_.information_width, 1))),
+      builder_(context, camera, range),
+      engine_(context, params_.icp,
+              std::make_unique<registration::DepthWeightedFinder>(
+                  context, std::make_unique<registration::ProjectiveAssociation>(context),
+                  params_.depth_weights)),
+      source_(context, camera, pyramid_params(params_, finest_level_, information_level_)),
+      target_(context, camera, pyramid_params(params_, finest_level_, information_level_)) {
+  validate(params_);
+}
+
+void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& depth,
+                                       double path_length) {
+  require(keyframes_.empty() || frame > keyframes_.back().frame,
+          "loop closure: keyframe " + std::to_string(frame) + " added after frame " +
+              std::to_string(keyframes_.empty() ? 0 : keyframes_.back().frame));
+  require(
+      depth.width() == camera_.width && depth.height() == camera_.height,
+      "loop closure: keyframe " + std::to_string(frame) + " depth size differs from the camera");
+  Keyframe keyframe{frame, path_length, depth, {}};
+  const int step = params_.sample_step;
+  const double metres_per_unit = 1.0 / range_.units_per_metre;
+  for (int v = step / 2; v < depth.height(); v += step) {
+    for (int u = step / 2; u < depth.width(); u += step) {
+      const double z = depth(u, v) * metres_per_unit;
+      if (depth(u, v) == 0 || z < range_.min_metres || z > range_.max_metres) continue;
+      keyframe.samples.emplace_back(static_cast<float>((u - camera_.cx) * z / camera_.fx),
+                                    static_cast<float>((v - camera_.cy) * z / camera_.fy),
+                                    static_cast<float>(z));
+    }
+  }
+  keyframes_.push_back(std::move(keyframe));
+}
+
+void LoopClosureDetector::require_pose(std::span<const Eigen::Isometry3d> poses,
+                                       std::size_t frame) {
+  require(frame < poses.size(), "loop closure: no pose for frame " + std::to_string(frame) + " (" +
+                                    std::to_string(poses.size()) + " poses given)");
+}
+
+double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
+                                         const Eigen::Isometry3d& from_to_to,
+                                         double tolerance) const {
+  const Keyframe& source = keyframes_.at(from);
+  const Keyframe& target = keyframes_.at(to);
+  if (source.samples.empty()) return 0;
+  const double metres_per_unit = 1.0 / range_.units_per_metre;
+  std::size_t seen = 0;
+  for (const Eigen::Vector3f& sample : source.samples) {
+    const Eigen::Vector3d p = from_to_to * sample.cast<double>();
+    if (p.z() <= 0) continue;
+    const double u = std::floor(camera_.fx * p.x() / p.z() + camera_.cx + 0.5);
+    const double v = std::floor(camera_.fy * p.y() / p.z() + camera_.cy + 0.5);
+    if (u < 0 || v < 0 || u >= camera_.width || v >= camera_.height) continue;
+    const std::uint16_t d = target.depth(static_cast<int>(u), static_cast<int>(v));
+    if (d != 0 && std::abs(d * metres_per_unit - p.z()) <= tolerance) ++seen;
+  }
+  return static_cast<double>(seen) / static_cast<double>(source.samples.size());
+}
+
+std::vector<LoopCandidate> LoopClosureDetector::find_candidates(
+    std::size_t query, std::span<const Eigen::Isometry3d> poses) const {
+  const Keyframe& j = keyframes_.at(query);
+  require_pose(poses, j.frame);
+  const Eigen::Isometry3d& pose_j = poses[j.frame];
+  std::vector<LoopCandidate> candidates;
+  for (std::size_t match = 0; match < query; ++match) {
+    const Keyframe& i = keyframes_[match];
+    if (j.frame - i.frame < params_.min_frame_gap) continue;
+    require_pose(poses, i.frame);
+    const Eigen::Isometry3d& pose_i = poses[i.frame];
+    LoopCandidate c{query, match, j.frame, i.frame, 0, 0, 0, 0};
+    c.drift_allowance_m = params_.drift_fraction * std::max(0.0, j.path_length - i.path_length);
+    c.distance_m = (pose_j.translation() - pose_i.translation()).norm();
+    if (c.distance_m > params_.max_distance + c.drift_allowance_m) continue;
+    c.view_angle_deg = view_angle_deg(pose_i, pose_j);
+    if (c.view_angle_deg > params_.max_view_angle_deg) continue;
+    c.overlap = view_overlap(query, match, pose_i.inverse() * pose_j,
+                             params_.depth_tolerance + c.drift_allowance_m);
+    if (c.overlap < params_.min_overlap) continue;
+    candidates.push_back(c);
+  }
+  std::stable_sort(
+      candidates.begin(), candidates.end(),
+      [](const LoopCandidate& a, const LoopCandidate& b) { return a.overlap > b.overlap; });
+  if (candidates.size() > params_.max_candidates) candidates.resize(params_.max_candidates);
+  return candidates;
+}
+
+LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
+                                        std::span<const Eigen::Isometry3d> poses) {
+  const Keyframe& query = keyframes_.at(candidate.query);
+  const Keyframe& match = keyframes_.at(candidate.match);
+  require_pose(poses, query.frame);
+  require_pose(poses, match.frame);
+  builder_.build(query.depth, nullptr, source_);
+  builder_.build(match.depth, nullptr, target_);
+  const Eigen::Isometry3d expected = poses[match.frame].inverse() * poses[query.frame];
+  const auto first = static_cast<std::size_t>(finest_level_);
+  const std::vector<registration::CloudView> source_views = source_.views();
+  const std::vector<registration::CloudView> target_views = target_.views();
+  const registration::IcpResult result =
+      engine_.align(std::span(source_views).subspan(first, params_.icp.levels.size()),
+                    std::span(target_views).subspan(first, params_.icp.levels.size()), expected);
+  const registration::GeometricInformation geometry = registration::geometric_information(
+      source_.level(information_level_).view(), params_.depth_weights.reference_depth,
+      params_.icp.min_eigenvalue_ratio);
+
+  registration::RegistrationLimits limits = params_.verification;
+  limits.max_correction_m = params_.min_correction_m + candidate.drift_allowance_m;
+  LoopClosure closure;
+  closure.candidate = candidate;
+  closure.report = registration::judge_registration(result, expected, limits, geometry.degeneracy);
+  const Eigen::Isometry3d& motion = result.source_to_target;
+  const double fraction = params_.baseline_error_fraction;
+  const se3::Matrix6d information = registration::with_added_error(
+      registration::edge_information(geometry.information, result.inlier_rmse, params_.information),
+      fraction * Eigen::AngleAxisd(motion.rotation()).angle(),
+      fraction * motion.translation().norm());
+  closure.constraint = {match.frame, query.frame, motion, information, false};
+  return closure;
+}
+
+}  // namespace kartograf::mapping

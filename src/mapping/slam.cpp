@@ -1,0 +1,323 @@
+#include "kartograf/mapping/slam.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <numbers>
+#include <optional>
+
+namespace kartograf::mapping {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+registration::OdometryParams with_source_units(registration::OdometryParams params,
+                                               const FrameSource& source) {
+  params.depth_range.units_per_metre = source.depth_units_per_metre();
+  return params;
+}
+
+const RgbImage* color_of(const registration::RgbdImages& images) {
+  return images.color.empty() ? nullptr : &images.color;
+}
+
+void report_progress(const SlamObserver& observer, std::string_view stage, std::size_t done,
+                     std::size_t total) {
+  if (observer.on_progress) observer.on_progress(stage, done, total);
+}
+
+// Tracks every frame of a source, keeping what both runs report.
+class Tracker {
+ public:
+  Tracker(const compute::Context& context, const FrameSource& source,
+          const registration::OdometryParams& params)
+      : odometry_(context, source.camera(), with_source_units(params, source)) {}
+
+  const registration::OdometryFrame& track(const registration::RgbdImages& images) {
+    run_.timestamps.push_back(images.timestamp);
+    const registration::OdometryFrame& frame = odometry_.track(images.depth, color_of(images));
+    run_.compute_seconds += frame.seconds;
+    const auto& poses = odometry_.poses();
+    const std::size_t n = poses.size() - 1;
+    path_.push_back(
+        n == 0 ? 0.0 : path_.back() + (poses[n].translation() - poses[n - 1].translation()).norm());
+    return frame;
+  }
+
+  const registration::RgbdOdometry& odometry() const { return odometry_; }
+  double path_length(std::size_t frame) const { return path_[frame]; }
+
+  OdometryRun finish(const FrameLoopTiming& timing) {
+    run_.poses = odometry_.poses();
+    run_.frames = odometry_.frames();
+    run_.constraints = odometry_.constraints();
+    run_.keyframes = odometry_.keyframes();
+    run_.timing = timing;
+    return std::move(run_);
+  }
+
+ private:
+  registration::RgbdOdometry odometry_;
+  OdometryRun run_;
+  std::vector<double> path_;
+};
+
+PoseGraphEdge edge_of(const registration::RelativePose& pose, bool loop_closure) {
+  return {pose.from, pose.to, pose.motion, pose.information, loop_closure};
+}
+
+// The SLAM estimate while frames arrive: optimised poses up to the last optimisation (the
+// anchor), odometry-relative poses after it; loop closures kept for the graph.
+class GraphState {
+ public:
+  GraphState(const PoseGraphOptions& options, const LoopConsistency& consistency)
+      : options_(options), consistency_(consistency) {}
+
+  // Brings the estimate of frames after the anchor up to date with the odometry (whose last k
+  // poses a re-estimate may have changed).
+  void follow(const std::vector<Eigen::Isometry3d>& odometry, std::size_t reestimate_interval) {
+    const std::size_t last = odometry.size() - 1;
+    estimate_.resize(odometry.size());
+    const std::size_t first =
+        std::max(anchor_ + 1, last >= reestimate_interval ? last - reestimate_interval : 0);
+    const Eigen::Isometry3d offset = anchor_estimate_ * anchor_odometry_.inverse();
+    for (std::size_t m = first; m <= last; ++m) estimate_[m] = offset * odometry[m];
+    if (last == 0) estimate_[0] = odometry[0];
+  }
+
+  void add_loop(const LoopClosure& closure, std::size_t record) {
+    loops_.push_back({edge_of(closure.constraint, true), record});
+  }
+
+  // Optimises frames 0..estimate().size()-1 with every constraint and the active loop closures.
+  // Loop closures that the graph prunes (chi^2), or whose residual after optimisation exceeds
+  // the consistency limits (the worst one first, then optimising again), are dropped and marked
+  // in `records`.
+  PoseGraphSummary optimise(const std::vector<registration::RelativePose>& constraints,
+                            const std::vector<Eigen::Isometry3d>& odometry,
+                            std::vector<LoopClosureRecord>& records) {
+    std::vector<bool> dropped(loops_.size(), false);
+    std::vector<Eigen::Isometry3d> poses = estimate_;
+    PoseGraphSummary summary;
+    int total_iterations = 0;
+    while (true) {
+      PoseGraph graph;
+      graph.poses = poses;
+      for (const auto& c : constraints) graph.edges.push_back(edge_of(c, false));
+      std::vector<std::size_t> loop_of_edge(graph.edges.size(), loops_.size());
+      for (std::size_t l = 0; l < loops_.size(); ++l) {
+        if (dropped[l]) continue;
+        graph.edges.push_back(loops_[l].edge);
+        loop_of_edge.push_back(l);
+      }
+      summary = optimize_pose_graph(graph, options_);
+      total_iterations += summary.iterations;
+      for (const std::size_t edge : summary.pruned_edges) {
+        if (loop_of_edge[edge] < loops_.size()) dropped[loop_of_edge[edge]] = true;
+      }
+      poses = std::move(graph.poses);
+      edge_count_ = graph.edges.size();
+      const std::size_t worst = least_consistent_loop(poses, dropped);
+      if (worst == loops_.size()) break;
+      dropped[worst] = true;
+    }
+    summary.iterations = total_iterations;
+    std::vector<ActiveLoop> kept;
+    for (std::size_t l = 0; l < loops_.size(); ++l) {
+      if (dropped[l]) {
+        records[loops_[l].record].pruned = true;
+      } else {
+        kept.push_back(loops_[l]);
+      }
+    }
+    loops_ = std::move(kept);
+    estimate_ = std::move(poses);
+    anchor_ = estimate_.size() - 1;
+    anchor_estimate_ = estimate_[anchor_];
+    anchor_odometry_ = odometry[anchor_];
+    return summary;
+  }
+
+  const std::vector<Eigen::Isometry3d>& estimate() const { return estimate_; }
+  std::size_t edge_count() const { return edge_count_; }
+
+ private:
+  struct ActiveLoop {
+    PoseGraphEdge edge;
+    std::size_t record = 0;
+  };
+
+  // The active loop closure whose residual at `poses` exceeds the limits by the largest factor,
+  // or loops_.size() when all are within them.
+  std::size_t least_consistent_loop(const std::vector<Eigen::Isometry3d>& poses,
+                                    const std::vector<bool>& dropped) const {
+    std::size_t worst = loops_.size();
+    double worst_excess = 1.0;
+    for (std::size_t l = 0; l < loops_.size(); ++l) {
+      if (dropped[l]) continue;
+      const PoseGraphEdge& edge = loops_[l].edge;
+      const Eigen::Isometry3d residual =
+          edge.measurement.inverse() * poses[edge.from].inverse() * poses[edge.to];
+      const double excess =
+          std::max(residual.translation().norm() / consistency_.max_residual_m,
+                   se3::rotation_angle(residual) / (consistency_.max_residual_deg * kDegree));
+      if (excess > worst_excess) {
+        worst_excess = excess;
+        worst = l;
+      }
+    }
+    return worst;
+  }
+  PoseGraphOptions options_;
+  LoopConsistency consistency_;
+  std::vector<Eigen::Isometry3d> estimate_;
+  std::vector<ActiveLoop> loops_;
+  std::size_t anchor_ = 0;
+  Eigen::Isometry3d anchor_estimate_ = Eigen::Isometry3d::Identity();
+  Eigen::Isometry3d anchor_odometry_ = Eigen::Isometry3d::Identity();
+  std::size_t edge_count_ = 0;
+};
+
+// The colour of each pyramid pixel: the top-left pixel of its 2^level x 2^level block (the
+// pyramid averages depth; colour from an unregistered camera is only approximately aligned anyway).
+void colors_at_level(const RgbImage& color, int level, int width, int height, RgbImage& out) {
+  if (out.width() != width || out.height() != height) out = RgbImage(width, height);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) out(u, v) = color(u << level, v << level);
+  }
+}
+
+// Second pass: every frame's points and normals at its optimised pose.
+PointCloud fuse_map(const compute::Context& context, const FrameSource& source,
+                    const std::vector<Eigen::Isometry3d>& poses, const SlamParams& params,
+                    const SlamObserver& observer, SlamResult& result) {
+  const registration::OdometryParams odometry = with_source_units(params.odometry, source);
+  registration::RgbdPyramidBuilder builder(context, source.camera(), odometry.depth_range);
+  // The level at most 320 pixels wide (half resolution of 640x480): averaged points with
+  // smoother normals, a quarter of the work.
+  const int level = registration::pyramid_level_at_most(source.camera().width, 320);
+  registration::PyramidParams pyramid;
+  pyramid.levels = level + 1;
+  registration::FramePyramid frame(context, source.camera(), pyramid);
+  MapFusion fusion(params.map);
+  RgbImage level_colors;
+  double fusing = 0;
+  const FrameLoopTiming timing =
+      for_each_frame(source, 0, poses.size(), [&](std::size_t i, registration::RgbdImages& images) {
+        const auto start = Clock::now();
+        builder.build(images.depth, nullptr, frame);
+        const registration::PyramidLevel& fused = frame.level(level);
+        const PointImage points = fused.points.to_image();
+        const NormalImage normals = fused.normals.to_image();
+        const RgbImage* color = color_of(images);
+        if (color) colors_at_level(*color, level, points.width(), points.height(), level_colors);
+        fusion.add(points, normals, color ? &level_colors : nullptr, poses[i]);
+        fusing += seconds_since(start);
+        report_progress(observer, "map", i + 1, poses.size());
+      });
+  result.timing.map_seconds = fusing;
+  result.timing.load_seconds += timing.load_seconds;
+  result.map_voxels = fusion.voxel_count();
+  return fusion.cloud();
+}
+
+}  // namespace
+
+PoseGraphOptions slam_graph_options() {
+  PoseGraphOptions options;
+  options.loop_closure_kernel = 0;
+  options.prune_chi2 = 0;
+  return options;
+}
+
+OdometryRun run_odometry(const compute::Context& context, const FrameSource& source,
+                         const registration::OdometryParams& params, const SlamObserver& observer) {
+  Tracker tracker(context, source, params);
+  const std::size_t total = source.size();
+  const FrameLoopTiming timing =
+      for_each_frame(source, 0, total, [&](std::size_t i, registration::RgbdImages& images) {
+        const registration::OdometryFrame& frame = tracker.track(images);
+        if (observer.on_frame) observer.on_frame(frame);
+        report_progress(observer, "odometry", i + 1, total);
+      });
+  return tracker.finish(timing);
+}
+
+SlamResult run_slam(const compute::Context& context, const FrameSource& source,
+                    const SlamParams& params, const SlamObserver& observer) {
+  const auto start = Clock::now();
+  SlamResult result;
+  Tracker tracker(context, source, params.odometry);
+  std::optional<LoopClosureDetector> detector;
+  const registration::OdometryParams& odometry_params = tracker.odometry().params();
+  if (params.loop_closure) {
+    detector.emplace(context, source.camera(), odometry_params.depth_range, params.loops);
+  }
+  GraphState state(params.graph, params.consistency);
+  const auto reestimate_interval = static_cast<std::size_t>(odometry_params.reestimate_interval);
+  const std::size_t total = source.size();
+
+  const auto optimise = [&] {
+    const auto optimise_start = Clock::now();
+    result.final_graph = state.optimise(tracker.odometry().constraints(),
+                                        tracker.odometry().poses(), result.loop_closures);
+    ++result.graph_optimisations;
+    result.timing.optimisation_seconds += seconds_since(optimise_start);
+  };
+
+  const FrameLoopTiming timing =
+      for_each_frame(source, 0, total, [&](std::size_t i, registration::RgbdImages& images) {
+        const registration::OdometryFrame& frame = tracker.track(images);
+        state.follow(tracker.odometry().poses(), reestimate_interval);
+        if (observer.on_frame) observer.on_frame(frame);
+        if (detector && frame.keyframe) {
+          const auto loop_start = Clock::now();
+          detector->add_keyframe(i, images.depth, tracker.path_length(i));
+          bool closed = false;
+          for (const LoopCandidate& candidate :
+               detector->find_candidates(detector->keyframe_count() - 1, state.estimate())) {
+            ++result.loop_candidates;
+            LoopClosure closure = detector->verify(candidate, state.estimate());
+            if (observer.on_loop_closure) observer.on_loop_closure(closure);
+            if (closure.report.accepted()) {
+              state.add_loop(closure, result.loop_closures.size());
+              closed = true;
+            }
+            result.loop_closures.push_back({std::move(closure), false});
+          }
+          result.timing.loop_closure_seconds += seconds_since(loop_start);
+          if (closed) optimise();
+        }
+        report_progress(observer, "odometry", i + 1, total);
+      });
+  result.odometry = tracker.finish(timing);
+  result.timing.odometry_seconds = result.odometry.compute_seconds;
+  result.timing.load_seconds = timing.load_seconds;
+
+  if (total > 0) optimise();
+  result.poses = state.estimate();
+  result.graph_edges = state.edge_count();
+  PoseGraph final_poses{result.poses, {}};
+  for (LoopClosureRecord& record : result.loop_closures) {
+    if (!record.closure.report.accepted()) continue;
+    const PoseGraphEdge edge = edge_of(record.closure.constraint, true);
+    record.chi2 = edge_chi2(final_poses, edge);
+    const Eigen::Isometry3d residual =
+        edge.measurement.inverse() * result.poses[edge.from].inverse() * result.poses[edge.to];
+    record.residual_m = residual.translation().norm();
+    record.residual_deg = se3::rotation_angle(residual) / kDegree;
+  }
+  if (params.build_map && total > 0) {
+    result.map = fuse_map(context, source, result.poses, params, observer, result);
+  }
+  result.timing.total_seconds = seconds_since(start);
+  return result;
+}
+
+}  // namespace kartograf::mapping

@@ -1,0 +1,168 @@
+#include "kartograf/registration/geometric_information.hpp"
+
+#include <cmath>
+#include <span>
+#include <vector>
+
+#include <Eigen/Eigenvalues>
+
+#include "kartograf/registration/depth_weighted_finder.hpp"
+
+namespace kartograf::registration {
+
+namespace {
+
+// The cloud's points and normals on the host (in place on the CPU backend).
+struct HostCloud {
+  std::vector<Point4f> point_copy, normal_copy;
+  std::span<const Point4f> points, normals;
+};
+
+HostCloud host_cloud(const CloudView& cloud) {
+  require(cloud.points && cloud.normals && cloud.normals->size() == cloud.points->size(),
+          "geometric information: the cloud needs points and one normal per point");
+  HostCloud host;
+  if (cloud.points->raw().on_host()) {
+    host.points = cloud.points->host_span();
+    host.normals = cloud.normals->host_span();
+    return host;
+  }
+  host.point_copy = cloud.points->to_vector();
+  host.normal_copy = cloud.normals->to_vector();
+  host.points = host.point_copy;
+  host.normals = host.normal_copy;
+  return host;
+}
+
+// Balanced coordinates of analyse_degeneracy: rotations scaled by the length L.
+se3::Vector6d balance_scale(double rotation_scale) {
+  se3::Vector6d scale;
+  scale << Eigen::Vector3d::Constant(1.0 / rotation_scale), Eigen::Vector3d::Ones();
+  return scale;
+}
+
+// The balanced, trace-normalised Hessian about the centre (analyse_degeneracy's) and its
+// eigen-decomposition: B = S H_c S / normaliser, S = diag(scale).
+struct BalancedEigen {
+  bool valid = false;
+  se3::Vector6d scale = se3::Vector6d::Ones();
+  double normaliser = 1;
+  Eigen::SelfAdjointEigenSolver<se3::Matrix6d> solver;
+};
+
+BalancedEigen balanced_eigen(const GeometricInformation& geometry) {
+  BalancedEigen result;
+  if (!(geometry.degeneracy.rotation_scale > 0)) return result;
+  result.scale = balance_scale(geometry.degeneracy.rotation_scale);
+  se3::Matrix6d balanced =
+      result.scale.asDiagonal() * geometry.about_centre * result.scale.asDiagonal();
+  result.normaliser = balanced.trace() / 6.0;
+  if (!(result.normaliser > 0)) return result;
+  balanced /= result.normaliser;
+  result.solver.compute(balanced);
+  result.valid = true;
+  return result;
+}
+
+Eigen::Isometry3d centre_pose(const GeometricInformation& geometry) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.translation() = geometry.centre;
+  return pose;
+}
+
+}  // namespace
+
+GeometricInformation geometric_information(const CloudView& cloud, double reference_depth,
+                                           double min_eigenvalue_ratio) {
+  const HostCloud host = host_cloud(cloud);
+  GeometricInformation result;
+  const auto weight_of = [&](const Point4f& p) {
+    return reference_depth > 0
+               ? static_cast<double>(DepthWeightedFinder::weight(p.z(), reference_depth))
+               : 1.0;
+  };
+  Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
+  for (std::size_t i = 0; i < host.points.size(); ++i) {
+    if (!is_valid(host.points[i]) || !is_valid(host.normals[i])) continue;
+    const double w = weight_of(host.points[i]);
+    weighted_sum += w * host.points[i].head<3>().cast<double>();
+    result.weight_sum += w;
+    ++result.points;
+  }
+  if (!(result.weight_sum > 0)) return result;
+  result.centre = weighted_sum / result.weight_sum;
+  for (std::size_t i = 0; i < host.points.size(); ++i) {
+    if (!is_valid(host.points[i]) || !is_valid(host.normals[i])) continue;
+    const double w = weight_of(host.points[i]);
+    const Eigen::Vector3d p = host.points[i].head<3>().cast<double>();
+    const Eigen::Vector3d n = host.normals[i].head<3>().cast<double>();
+    se3::Vector6d j;
+    j << p.cross(n), n;
+    result.information.noalias() += w * j * j.transpose();
+    j.head<3>() = (p - result.centre).cross(n);
+    result.about_centre.noalias() += w * j * j.transpose();
+  }
+  result.information /= result.weight_sum;
+  result.about_centre /= result.weight_sum;
+  result.degeneracy = analyse_degeneracy(result.about_centre, min_eigenvalue_ratio);
+  return result;
+}
+
+se3::Matrix6d constrained_information(const GeometricInformation& geometry,
+                                      double min_eigenvalue_ratio) {
+  const BalancedEigen eigen = balanced_eigen(geometry);
+  if (!eigen.valid) return se3::Matrix6d::Zero();
+  se3::Matrix6d strong = se3::Matrix6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    const double lambda = eigen.solver.eigenvalues()(k);
+    if (lambda < min_eigenvalue_ratio * eigen.solver.eigenvalues()(5)) continue;
+    const se3::Vector6d u = eigen.solver.eigenvectors().col(k);
+    strong += lambda * u * u.transpose();
+  }
+  // Back from balanced, normalised coordinates to the sum about the centre, then to the origin:
+  // xi = Ad(T(c)) xi_c, so H = A^T H_c A with A = Ad(T(c))^-1.
+  const se3::Vector6d inverse_scale = eigen.scale.cwiseInverse();
+  const se3::Matrix6d about_centre =
+      eigen.normaliser * (inverse_scale.asDiagonal() * strong * inverse_scale.asDiagonal());
+  const se3::Matrix6d to_centre = se3::adjoint(centre_pose(geometry).inverse());
+  return to_centre.transpose() * about_centre * to_centre;
+}
+
+std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
+                                           double min_eigenvalue_ratio) {
+  std::vector<se3::Vector6d> directions;
+  const BalancedEigen eigen = balanced_eigen(geometry);
+  if (!eigen.valid) return directions;
+  const se3::Matrix6d from_centre = se3::adjoint(centre_pose(geometry));
+  for (int k = 0; k < 6; ++k) {
+    if (eigen.solver.eigenvalues()(k) >= min_eigenvalue_ratio * eigen.solver.eigenvalues()(5)) {
+      break;  // ascending
+    }
+    const se3::Vector6d u = eigen.solver.eigenvectors().col(k);
+    directions.push_back(from_centre * u.cwiseProduct(eigen.scale));
+  }
+  return directions;
+}
+
+Eigen::Isometry3d keep_constrained_directions(const Eigen::Isometry3d& measured,
+                                              const Eigen::Isometry3d& predicted,
+                                              const GeometricInformation& geometry,
+                                              double min_eigenvalue_ratio) {
+  const BalancedEigen eigen = balanced_eigen(geometry);
+  if (!eigen.valid) return predicted;  // nothing was constrained
+  const double largest = eigen.solver.eigenvalues()(5);
+  // The difference as a motion about the centre, T exp(delta) with delta = Ad(T(c)) xi_c, in
+  // balanced coordinates y (xi_c = S y).
+  const Eigen::Isometry3d to_centre = centre_pose(geometry);
+  const se3::Vector6d delta = se3::log(measured.inverse() * predicted);
+  const se3::Vector6d y = (se3::adjoint(to_centre.inverse()) * delta).cwiseQuotient(eigen.scale);
+  se3::Vector6d weak = se3::Vector6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    if (eigen.solver.eigenvalues()(k) >= min_eigenvalue_ratio * largest) continue;
+    const se3::Vector6d u = eigen.solver.eigenvectors().col(k);
+    weak += u.dot(y) * u;
+  }
+  return measured * se3::exp(se3::adjoint(to_centre) * weak.cwiseProduct(eigen.scale));
+}
+
+}  // namespace kartograf::registration

@@ -1,0 +1,289 @@
+#include "kartograf/registration/odometry.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <numbers>
+#include <span>
+#include <string>
+
+#include "kartograf/registration/depth_weighted_finder.hpp"
+#include "kartograf/registration/projective_association.hpp"
+
+namespace kartograf::registration {
+
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+std::unique_ptr<CorrespondenceFinder> finder_for(const compute::Context& context,
+                                                 const OdometryParams& params) {
+  std::unique_ptr<CorrespondenceFinder> finder = std::make_unique<ProjectiveAssociation>(context);
+  if (params.method == OdometryMethod::color) {
+    finder = std::make_unique<ColorGatedFinder>(context, std::move(finder), params.color_gate);
+  }
+  if (!params.depth_weighting) return finder;
+  return std::make_unique<DepthWeightedFinder>(context, std::move(finder), params.depth_weights);
+}
+
+PyramidParams pyramid_params(const OdometryParams& params, int finest_level,
+                             int information_level) {
+  PyramidParams pyramid;
+  pyramid.levels =
+      std::max(finest_level + static_cast<int>(params.icp.levels.size()), information_level + 1);
+  pyramid.with_colors = params.method == OdometryMethod::color;
+  return pyramid;
+}
+
+void validate(const OdometryParams& params) {
+  require(params.reestimate_interval >= 0, "odometry: reestimate_interval must be >= 0");
+  require(params.icp_width > 0 && params.information_width > 0 && params.min_icp_level >= 0,
+          "odometry: icp_width and information_width must be > 0, min_icp_level >= 0");
+  require(params.keyframes.max_interval >= 1, "odometry: keyframes.max_interval must be >= 1");
+  require(params.fallback_sigma_m > 0 && params.fallback_sigma_deg > 0,
+          "odometry: fallback standard deviations must be > 0");
+  require(params.information.effective_pairs > 0 && params.information.min_sigma > 0,
+          "odometry: information model values must be > 0");
+}
+
+// Composing poses (and inverting them by transposition, as Isometry3d does) lets rounding errors
+// in the rotation grow from one re-estimate to the next; project back onto SO(3) after each.
+Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& pose) {
+  Eigen::Isometry3d result = pose;
+  result.linear() = Eigen::Quaterniond(pose.linear()).normalized().toRotationMatrix();
+  return result;
+}
+
+bool is_identity(const Eigen::Isometry3d& pose) {
+  return pose.matrix().isApprox(Eigen::Matrix4d::Identity(), 1e-12);
+}
+
+}  // namespace
+
+IcpParams odometry_icp_params(OdometryMethod method) {
+  IcpParams params;
+  // 4-neighbour normals of Kinect-noisy depth scatter by tens of degrees: a 30 degree gate drops
+  // most good pairs (fitness 0.25 on perfectly aligned synthetic frames), 45 keeps half of them.
+  params.max_normal_angle_deg = 45;
+  // Degenerate below 0.03 (balanced eigenvalue ratio of the geometric information): on 320x240
+  // frames entering a room through a doorway towards a wall (ratio 0.018) ICP slid 5 cm along the
+  // weak direction.
+  params.min_eigenvalue_ratio = 0.03;
+  // On pyramid levels 1..3 (320x240 down to 80x60 for 640x480 frames): 1 point in 2 at 320x240
+  // is as accurate as all of them (synthetic tour: 0.45 mm and 0.009 deg per frame) at half the
+  // cost. The coarse gate is wide for 30 Hz motions of up to ~8 cm and 5 degrees.
+  //      iterations, 1-in-k, max distance, robust scale
+  params.levels = {{6, 2, 0.03, 0.01}, {6, 2, 0.10, 0.03}, {10, 1, 0.30, 0.10}};
+  switch (method) {
+    case OdometryMethod::point_to_plane:
+    case OdometryMethod::color:
+      params.metric = ErrorMetric::point_to_plane;
+      break;
+    case OdometryMethod::point_to_point:
+      // Point-to-point converges linearly and needs the closest point, not the projected one
+      // (icp.hpp): more iterations and a search window.
+      params.metric = ErrorMetric::point_to_point;
+      params.levels = {{20, 2, 0.03, 0.01, 1}, {15, 2, 0.10, 0.03, 1}, {15, 1, 0.30, 0.10, 1}};
+      break;
+  }
+  return params;
+}
+
+RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrinsics& camera,
+                           OdometryParams params)
+    : context_(&context),
+      params_(std::move(params)),
+      finest_level_(std::max(params_.min_icp_level,
+                             pyramid_level_at_most(camera.width, std::max(params_.icp_width, 1)))),
+      information_level_(
+          pyramid_level_at_most(camera.width, std::max(params_.information_width, 1))),
+      builder_(context, camera, params_.depth_range),
+      engine_(context, params_.icp, finder_for(context, params_)) {
+  validate(params_);
+  const std::size_t slots = static_cast<std::size_t>(std::max(params_.reestimate_interval, 1)) + 1;
+  ring_.reserve(slots);
+  for (std::size_t i = 0; i < slots; ++i)
+    ring_.emplace_back(context, camera, pyramid_params(params_, finest_level_, information_level_));
+  colors_.resize(slots);
+}
+
+FramePyramid& RgbdOdometry::pyramid_of(std::size_t frame) {
+  return ring_[frame % ring_.size()];
+}
+
+RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
+                                                    const Eigen::Isometry3d& initial,
+                                                    const RegistrationLimits& limits) {
+  const std::size_t current = frames_.size();  // frames_ grows when track() ends
+  const auto first = static_cast<std::size_t>(finest_level_);
+  const std::size_t count = params_.icp.levels.size();
+  const std::vector<CloudView> source_views = pyramid_of(current).views();
+  const std::vector<CloudView> target_views = pyramid_of(target).views();
+  const IcpResult result = engine_.align(std::span(source_views).subspan(first, count),
+                                         std::span(target_views).subspan(first, count), initial);
+  Attempt attempt;
+  attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
+  attempt.inlier_rmse = result.inlier_rmse;
+  attempt.motion = result.source_to_target;
+  if (!attempt.report.accepted() || !geometry_.degeneracy.degenerate) return attempt;
+
+  // What the geometry cannot tell comes from the initial guess (the motion model)...
+  const double ratio = params_.icp.min_eigenvalue_ratio;
+  attempt.motion = keep_constrained_directions(result.source_to_target, initial, geometry_, ratio);
+  // ...or from the images, when there are colours.
+  const RgbImage& target_color = colors_[slot_of(target)];
+  if (params_.photometric_refinement && color_ && !color_->empty() && !target_color.empty()) {
+    const std::vector<se3::Vector6d> directions = weak_directions(geometry_, ratio);
+    const PhotometricResult refined = refine_photometrically(
+        *depth_, *color_, target_color, builder_.camera(), params_.depth_range.units_per_metre,
+        attempt.motion, directions, params_.photometric);
+    if (refined.refined) {
+      attempt.motion = refined.motion;
+      attempt.photometric = true;
+    }
+  }
+  return attempt;
+}
+
+se3::Matrix6d RgbdOdometry::information_of(const Attempt& attempt) const {
+  // Degenerate without a photometric measurement: the weak directions are the motion model's, so
+  // only the prior speaks for them and a loop closure can move them at little cost.
+  const se3::Matrix6d measured =
+      geometry_.degeneracy.degenerate && !attempt.photometric
+          ? constrained_information(geometry_, params_.icp.min_eigenvalue_ratio)
+          : geometry_.information;
+  return edge_information(measured, attempt.inlier_rmse, params_.information) +
+         prior_information(params_.fallback_sigma_deg * kDegree, params_.fallback_sigma_m);
+}
+
+const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage* color) {
+  const auto start = std::chrono::steady_clock::now();
+  OdometryFrame frame;
+  frame.index = poses_.size();
+  FramePyramid& pyramid = pyramid_of(frame.index);
+  builder_.build(depth, color, pyramid);
+  depth_ = &depth;
+  color_ = color;
+  RgbImage& kept_color = colors_[slot_of(frame.index)];
+  if (params_.photometric_refinement && color && !color->empty()) {
+    kept_color = *color;
+  } else {
+    kept_color = RgbImage();
+  }
+  geometry_ =
+      geometric_information(pyramid.level(information_level_).view(),
+                            params_.depth_weighting ? params_.depth_weights.reference_depth : 0.0,
+                            params_.icp.min_eigenvalue_ratio);
+  frame.degenerate = geometry_.degeneracy.degenerate;
+  frame.eigenvalue_ratio = geometry_.degeneracy.eigenvalue_ratio;
+  if (frame.index == 0) {
+    poses_.push_back(Eigen::Isometry3d::Identity());
+  } else {
+    track_previous(frame);
+    const auto k = static_cast<std::size_t>(params_.reestimate_interval);
+    if (k > 0 && frame.index % k == 0) reestimate(frame);
+  }
+  frame.keyframe = is_keyframe(frame);
+  if (frame.keyframe) keyframes_.push_back(frame.index);
+  context_->finish();
+  frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  depth_ = nullptr;
+  color_ = nullptr;
+  frames_.push_back(frame);
+  return frames_.back();
+}
+
+Eigen::Isometry3d RgbdOdometry::predict() const {
+  const std::size_t n = poses_.size();  // the frame to predict
+  if (params_.motion_model == MotionModel::still || n < 2) return Eigen::Isometry3d::Identity();
+  // Rotation: the last turn again, in the camera frame. Translation: the camera centre keeps its
+  // velocity (and, with `acceleration`, its change) in the world frame, so a camera that turns
+  // while the robot drives straight is predicted right.
+  const Eigen::Isometry3d& last = poses_[n - 1];
+  const Eigen::Isometry3d& before = poses_[n - 2];
+  Eigen::Vector3d step = last.translation() - before.translation();
+  if (params_.motion_model == MotionModel::acceleration && n >= 3) {
+    step += step - (before.translation() - poses_[n - 3].translation());
+  }
+  Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
+  predicted.linear() = before.linear().transpose() * last.linear();
+  predicted.translation() = last.linear().transpose() * step;
+  return orthonormalized(predicted);
+}
+
+void RgbdOdometry::track_previous(OdometryFrame& frame) {
+  const std::size_t n = frame.index;
+  const Eigen::Isometry3d predicted = predict();
+  Attempt attempt = register_frames(n - 1, predicted, params_.frame_limits);
+  if (!attempt.report.accepted() && !is_identity(predicted)) {
+    // The motion model may have been wrong (a stop, a turn): start again from rest.
+    Attempt retry = register_frames(n - 1, Eigen::Isometry3d::Identity(), params_.frame_limits);
+    if (retry.report.accepted()) {
+      attempt = std::move(retry);
+      frame.retried = true;
+    }
+  }
+  frame.previous = attempt.report;
+  frame.photometric = attempt.photometric;
+
+  RelativePose constraint{n - 1, n, predicted, {}, false};
+  if (attempt.report.accepted()) {
+    constraint.motion = attempt.motion;
+    constraint.information = information_of(attempt);
+  } else {
+    // Keep moving as before rather than chain a registration that failed its checks.
+    frame.fallback = true;
+    constraint.fallback = true;
+    constraint.information =
+        prior_information(params_.fallback_sigma_deg * kDegree, params_.fallback_sigma_m);
+  }
+  constraints_.push_back(constraint);
+  poses_.push_back(orthonormalized(poses_.back() * constraint.motion));
+}
+
+void RgbdOdometry::reestimate(OdometryFrame& frame) {
+  const std::size_t n = frame.index;
+  const auto k = static_cast<std::size_t>(params_.reestimate_interval);
+  if (n < k) return;
+  const std::size_t anchor = n - k;
+  const Eigen::Isometry3d anchor_pose = poses_[anchor];
+  const Eigen::Isometry3d chained = anchor_pose.inverse() * poses_[n];
+  // A fallback inside the window leaves the chained estimate less certain: allow what a single
+  // frame-to-frame registration may correct.
+  RegistrationLimits limits = params_.reestimate_limits;
+  const bool after_fallback =
+      frame.fallback ||
+      std::any_of(frames_.begin() + static_cast<std::ptrdiff_t>(anchor + 1), frames_.end(),
+                  [](const OdometryFrame& f) { return f.fallback; });
+  if (after_fallback) {
+    limits.max_correction_m =
+        std::max(limits.max_correction_m, params_.frame_limits.max_correction_m);
+    limits.max_correction_deg =
+        std::max(limits.max_correction_deg, params_.frame_limits.max_correction_deg);
+  }
+  const Attempt attempt = register_frames(anchor, chained, limits);
+  frame.reestimate = attempt.report;
+  if (!attempt.report.accepted()) return;
+
+  constraints_.push_back({anchor, n, attempt.motion, information_of(attempt), false});
+  // Spread the correction (a motion in the anchor's frame) over the frames since the anchor.
+  const se3::Vector6d correction = se3::log(attempt.motion * chained.inverse());
+  for (std::size_t j = anchor + 1; j <= n; ++j) {
+    const double share = static_cast<double>(j - anchor) / static_cast<double>(k);
+    poses_[j] = orthonormalized(anchor_pose * se3::exp(share * correction) *
+                                (anchor_pose.inverse() * poses_[j]));
+  }
+}
+
+bool RgbdOdometry::is_keyframe(const OdometryFrame& frame) const {
+  if (keyframes_.empty() || frame.fallback) return true;
+  const std::size_t last = keyframes_.back();
+  const KeyframePolicy& policy = params_.keyframes;
+  if (frame.index - last >= static_cast<std::size_t>(policy.max_interval)) return true;
+  const Eigen::Isometry3d motion = poses_[last].inverse() * poses_[frame.index];
+  return motion.translation().norm() >= policy.min_translation ||
+         se3::rotation_angle(motion) >= policy.min_rotation_deg * kDegree;
+}
+
+}  // namespace kartograf::registration

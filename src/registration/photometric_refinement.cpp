@@ -1,0 +1,225 @@
+#include "kartograf/registration/photometric_refinement.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include <Eigen/Cholesky>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::registration {
+
+namespace {
+
+using GreyImage = Image<float>;
+
+GreyImage grey_of(const RgbImage& color) {
+  GreyImage grey(color.width(), color.height());
+  const auto in = color.pixels();
+  const auto out = grey.pixels();
+  for (std::size_t i = 0; i < in.size(); ++i) {
+    out[i] = (static_cast<float>(in[i][0]) + static_cast<float>(in[i][1]) +
+              static_cast<float>(in[i][2])) /
+             3.0f;
+  }
+  return grey;
+}
+
+// One pass of the separable binomial filter [1 4 6 4 1] / 16, borders clamped.
+void blur(GreyImage& image) {
+  const int w = image.width(), h = image.height();
+  const float k[5] = {1 / 16.0f, 4 / 16.0f, 6 / 16.0f, 4 / 16.0f, 1 / 16.0f};
+  GreyImage tmp(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float sum = 0;
+      for (int d = -2; d <= 2; ++d) sum += k[d + 2] * image(std::clamp(x + d, 0, w - 1), y);
+      tmp(x, y) = sum;
+    }
+  }
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      float sum = 0;
+      for (int d = -2; d <= 2; ++d) sum += k[d + 2] * tmp(x, std::clamp(y + d, 0, h - 1));
+      image(x, y) = sum;
+    }
+  }
+}
+
+GreyImage blurred(const GreyImage& grey, int passes) {
+  GreyImage result = grey;
+  for (int i = 0; i < passes; ++i) blur(result);
+  return result;
+}
+
+// An image with its central-difference gradients, sampled bilinearly.
+struct Textured {
+  GreyImage value, dx, dy;
+
+  explicit Textured(GreyImage image) : value(std::move(image)) {
+    const int w = value.width(), h = value.height();
+    dx = GreyImage(w, h, 0.0f);
+    dy = GreyImage(w, h, 0.0f);
+    for (int y = 1; y + 1 < h; ++y) {
+      for (int x = 1; x + 1 < w; ++x) {
+        dx(x, y) = 0.5f * (value(x + 1, y) - value(x - 1, y));
+        dy(x, y) = 0.5f * (value(x, y + 1) - value(x, y - 1));
+      }
+    }
+  }
+  // False outside the area where all three are defined.
+  bool sample(double u, double v, double& i, double& gx, double& gy) const {
+    if (!(u >= 1 && v >= 1 && u < value.width() - 2 && v < value.height() - 2)) return false;
+    const int x = static_cast<int>(u), y = static_cast<int>(v);
+    const double fx = u - x, fy = v - y;
+    const auto lerp = [&](const GreyImage& image) {
+      return (1 - fy) * ((1 - fx) * image(x, y) + fx * image(x + 1, y)) +
+             fy * ((1 - fx) * image(x, y + 1) + fx * image(x + 1, y + 1));
+    };
+    i = lerp(value);
+    gx = lerp(dx);
+    gy = lerp(dy);
+    return true;
+  }
+};
+
+struct Sample {
+  Eigen::Vector3d point;  // source camera frame
+  double intensity = 0;
+};
+
+// Robust Gauss-Newton sums of all residuals at `motion`.
+struct Sums {
+  Eigen::MatrixXd jtj;
+  Eigen::VectorXd jtr;
+  double cost = 0;
+  double squared = 0;
+  std::size_t count = 0;
+};
+
+Sums evaluate(const std::vector<Sample>& samples, const Textured& target,
+              const PinholeIntrinsics& k, const Eigen::Isometry3d& motion,
+              std::span<const se3::Vector6d> directions, double huber) {
+  const auto n = static_cast<Eigen::Index>(directions.size());
+  Sums sums{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n), 0, 0, 0};
+  const Eigen::Matrix3d rotation = motion.linear();
+  Eigen::VectorXd j(n);
+  for (const Sample& sample : samples) {
+    const Eigen::Vector3d q = motion * sample.point;
+    if (q.z() <= 0) continue;
+    const double u = k.fx * q.x() / q.z() + k.cx, v = k.fy * q.y() / q.z() + k.cy;
+    double intensity, gx, gy;
+    if (!target.sample(u, v, intensity, gx, gy)) continue;
+    const double r = intensity - sample.intensity;
+    // d(u, v)/dq, then dq/ds_k = R (omega_k x p + v_k).
+    const Eigen::RowVector3d du(k.fx / q.z(), 0, -k.fx * q.x() / (q.z() * q.z()));
+    const Eigen::RowVector3d dv(0, k.fy / q.z(), -k.fy * q.y() / (q.z() * q.z()));
+    const Eigen::RowVector3d dr = gx * du + gy * dv;
+    for (Eigen::Index d = 0; d < n; ++d) {
+      const se3::Vector6d& dir = directions[static_cast<std::size_t>(d)];
+      j(d) = dr * (rotation * (dir.head<3>().cross(sample.point) + dir.tail<3>()));
+    }
+    const double a = std::abs(r);
+    const double weight = a <= huber ? 1.0 : huber / a;
+    sums.cost += a <= huber ? 0.5 * r * r : huber * (a - 0.5 * huber);
+    sums.jtj.noalias() += weight * j * j.transpose();
+    sums.jtr.noalias() += weight * r * j;
+    sums.squared += r * r;
+    ++sums.count;
+  }
+  return sums;
+}
+
+Eigen::Isometry3d step(const Eigen::Isometry3d& motion, std::span<const se3::Vector6d> directions,
+                       const Eigen::VectorXd& amounts) {
+  se3::Vector6d xi = se3::Vector6d::Zero();
+  for (std::size_t d = 0; d < directions.size(); ++d) {
+    xi += amounts(static_cast<Eigen::Index>(d)) * directions[d];
+  }
+  return motion * se3::exp(xi);
+}
+
+std::vector<Sample> samples_of(const DepthImage& depth, const Textured& source,
+                               const PinholeIntrinsics& k, double units_per_metre,
+                               const PhotometricParams& params) {
+  std::vector<Sample> samples;
+  const double min_squared = params.min_gradient * params.min_gradient;
+  for (int y = 2; y + 2 < depth.height(); y += params.pixel_step) {
+    for (int x = 2; x + 2 < depth.width(); x += params.pixel_step) {
+      const double z = depth(x, y) / units_per_metre;
+      if (depth(x, y) == 0 || z > params.max_depth) continue;
+      const double gx = source.dx(x, y), gy = source.dy(x, y);
+      if (gx * gx + gy * gy < min_squared) continue;
+      samples.push_back(
+          {Eigen::Vector3d((x - k.cx) * z / k.fx, (y - k.cy) * z / k.fy, z), source.value(x, y)});
+    }
+  }
+  return samples;
+}
+
+}  // namespace
+
+PhotometricResult refine_photometrically(const DepthImage& source_depth,
+                                         const RgbImage& source_color, const RgbImage& target_color,
+                                         const PinholeIntrinsics& camera, double units_per_metre,
+                                         const Eigen::Isometry3d& source_to_target,
+                                         std::span<const se3::Vector6d> directions,
+                                         const PhotometricParams& params) {
+  const auto same_size = [&](int w, int h) { return w == camera.width && h == camera.height; };
+  require(same_size(source_depth.width(), source_depth.height()) &&
+              same_size(source_color.width(), source_color.height()) &&
+              same_size(target_color.width(), target_color.height()),
+          "photometric refinement: depth and colour images must have the camera's size " +
+              std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  require(params.pixel_step >= 1 && params.iterations >= 0 && params.blur_passes >= 1 &&
+              units_per_metre > 0,
+          "photometric refinement: pixel_step, blur_passes >= 1, iterations >= 0 and "
+          "units_per_metre > 0 are required");
+  PhotometricResult result;
+  result.motion = source_to_target;
+  if (directions.empty()) return result;
+  const GreyImage source_grey = grey_of(source_color);
+  const GreyImage target_grey = grey_of(target_color);
+  double start_cost = 0, end_cost = 0;  // mean robust costs of the fine pass
+  // Coarse (wide basin), then fine (sharp minimum).
+  for (const int passes : {params.blur_passes, 1}) {
+    const Textured source(blurred(source_grey, passes));
+    const Textured target(blurred(target_grey, passes));
+    const std::vector<Sample> samples =
+        samples_of(source_depth, source, camera, units_per_metre, params);
+    if (samples.size() < params.min_pixels) return result;
+    Sums sums = evaluate(samples, target, camera, result.motion, directions, params.huber_levels);
+    if (passes == 1) {
+      const Sums original =
+          evaluate(samples, target, camera, source_to_target, directions, params.huber_levels);
+      start_cost = original.count ? original.cost / original.count : 0.0;
+      result.rmse_before = original.count ? std::sqrt(original.squared / original.count) : 0.0;
+    }
+    for (int iteration = 0; iteration < params.iterations && sums.count >= params.min_pixels;
+         ++iteration) {
+      const Eigen::VectorXd delta = -sums.jtj.ldlt().solve(sums.jtr);
+      if (!delta.allFinite()) break;
+      const Eigen::Isometry3d candidate = step(result.motion, directions, delta);
+      Sums next = evaluate(samples, target, camera, candidate, directions, params.huber_levels);
+      // Compare mean costs: a step may move residuals in or out of the image.
+      if (next.count < params.min_pixels ||
+          next.cost / next.count >= sums.cost / std::max<std::size_t>(sums.count, 1)) {
+        break;
+      }
+      result.motion = candidate;
+      sums = std::move(next);
+    }
+    if (passes == 1) {
+      end_cost = sums.count ? sums.cost / sums.count : 0.0;
+      result.pixels = sums.count;
+      result.rmse_after = sums.count ? std::sqrt(sums.squared / sums.count) : 0.0;
+    }
+  }
+  result.refined = end_cost < start_cost && result.pixels >= params.min_pixels;
+  if (!result.refined) result.motion = source_to_target;
+  return result;
+}
+
+}  // namespace kartograf::registration

@@ -1,0 +1,55 @@
+#include "rgbd_test_sequence.hpp"
+
+#include <cmath>
+
+#include "kartograf/eval/trajectory_metrics.hpp"
+#include "kartograf/synth/render.hpp"
+
+namespace kartograf::testing {
+
+const synth::World& test_world() {
+  static const synth::World world = synth::make_building(1);
+  return world;
+}
+
+PinholeIntrinsics qvga_kinect() {
+  return {320, 240, 262.5, 262.5, 159.5, 119.5};
+}
+
+RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera, bool noise) {
+  RenderedSequence sequence;
+  sequence.camera = camera;
+  sequence.truth = poses;
+  const synth::NoiseModel model = noise ? synth::NoiseModel::kinect() : synth::NoiseModel::none();
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    synth::SyntheticFrame frame = synth::render(test_world(), camera, poses[i], model, 100 + i);
+    sequence.frames.push_back(
+        {std::move(frame.depth), std::move(frame.color), static_cast<double>(i) / 30.0});
+  }
+  return sequence;
+}
+
+double ate_rmse(const std::vector<Eigen::Isometry3d>& estimate,
+                const std::vector<Eigen::Isometry3d>& truth) {
+  eval::MatchedPoses matched;
+  for (std::size_t i = 0; i < estimate.size() && i < truth.size(); ++i) {
+    matched.ground_truth.push_back({static_cast<double>(i), truth[i]});
+    matched.estimate.push_back({static_cast<double>(i), estimate[i]});
+  }
+  return eval::compute_ate(matched, eval::Alignment::se3).translation_m.rmse;
+}
+
+DepthImage depth_of(const PointImage& points, double units_per_metre) {
+  DepthImage depth(points.width(), points.height(), 0);
+  for (int v = 0; v < points.height(); ++v) {
+    for (int u = 0; u < points.width(); ++u) {
+      const Point4f& p = points(u, v);
+      if (is_valid(p))
+        depth(u, v) = static_cast<std::uint16_t>(std::lround(p.z() * units_per_metre));
+    }
+  }
+  return depth;
+}
+
+}  // namespace kartograf::testing

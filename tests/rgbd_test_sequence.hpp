@@ -1,0 +1,54 @@
+#pragma once
+// Small RGB-D sequences rendered in memory from the synthetic world (synth/), for the odometry,
+// loop-closure and SLAM tests: exact ground truth, Kinect-like noise, 320x240 to stay fast.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/core/intrinsics.hpp"
+#include "kartograf/core/point_image.hpp"
+#include "kartograf/mapping/frame_source.hpp"
+#include "kartograf/registration/rgbd_frame.hpp"
+#include "kartograf/synth/world.hpp"
+
+namespace kartograf::testing {
+
+inline constexpr double kSynthUnitsPerMetre = 5000.0;
+
+// The default building (seed 1), built once.
+const synth::World& test_world();
+// 320x240, f = 262.5: the TUM Kinect at half resolution.
+PinholeIntrinsics qvga_kinect();
+
+struct RenderedSequence {
+  PinholeIntrinsics camera;
+  std::vector<Eigen::Isometry3d> truth;  // camera-to-world
+  std::vector<registration::RgbdImages> frames;
+};
+
+// One frame per pose, timestamps i / 30 s; noise: the Kinect model (seeded per frame) or none.
+RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera, bool noise = true);
+
+// The pipeline's view of a rendered sequence.
+class MemoryFrameSource final : public mapping::FrameSource {
+ public:
+  explicit MemoryFrameSource(const RenderedSequence& sequence) : sequence_(&sequence) {}
+  std::size_t size() const override { return sequence_->frames.size(); }
+  PinholeIntrinsics camera() const override { return sequence_->camera; }
+  double depth_units_per_metre() const override { return kSynthUnitsPerMetre; }
+  registration::RgbdImages frame(std::size_t i) const override { return sequence_->frames.at(i); }
+
+ private:
+  const RenderedSequence* sequence_;
+};
+
+// ATE RMSE (SE(3)-aligned, eval/trajectory_metrics.hpp) of an estimate against the truth.
+double ate_rmse(const std::vector<Eigen::Isometry3d>& estimate,
+                const std::vector<Eigen::Isometry3d>& truth);
+
+// A depth image (units_per_metre) of an organized point image: what a sensor would report.
+DepthImage depth_of(const PointImage& points, double units_per_metre);
+
+}  // namespace kartograf::testing

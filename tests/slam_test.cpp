@@ -1,0 +1,137 @@
+// The SLAM pipeline (mapping/slam.hpp) on a rendered sequence that comes back along its way, so
+// that loop closures are found, verified and kept, the pose graph lowers the
+// error, and the map has points, normals and colours; plus the frame loop's error propagation and
+// the odometry-only run.
+#include <gtest/gtest.h>
+
+#include <string>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/mapping/slam.hpp"
+#include "kartograf/synth/trajectory.hpp"
+#include "rgbd_test_sequence.hpp"
+#include "test_support.hpp"
+
+namespace kartograf {
+namespace {
+
+constexpr int kFrames = 60;
+
+// 30 frames (1.3 m) of the 500-frame robot tour along a furnished room, then back the same way
+// (as a robot reversing): the return trip sees again what the way out saw.
+const testing::RenderedSequence& out_and_back() {
+  static const testing::RenderedSequence sequence = [] {
+    const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
+    std::vector<Eigen::Isometry3d> poses;
+    for (int i = 400; i < 430; ++i) poses.push_back(tour[static_cast<std::size_t>(i)].pose);
+    for (int i = 429; i >= 400; --i) poses.push_back(tour[static_cast<std::size_t>(i)].pose);
+    return testing::render_sequence(poses, testing::qvga_kinect());
+  }();
+  return sequence;
+}
+
+mapping::SlamParams loop_params() {
+  mapping::SlamParams params;
+  params.loops.min_frame_gap = 20;
+  params.map.voxel_size = 0.05;
+  return params;
+}
+
+TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
+  const testing::MemoryFrameSource source(out_and_back());
+  const compute::Context context = compute::Context::cpu();
+  std::size_t tracked = 0, verified = 0, odometry_progress = 0, map_progress = 0;
+  mapping::SlamObserver observer;
+  observer.on_frame = [&](const registration::OdometryFrame&) { ++tracked; };
+  observer.on_loop_closure = [&](const mapping::LoopClosure&) { ++verified; };
+  observer.on_progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
+    EXPECT_EQ(total, static_cast<std::size_t>(kFrames));
+    (stage == "map" ? map_progress : odometry_progress) = done;
+  };
+  const mapping::SlamResult result = mapping::run_slam(context, source, loop_params(), observer);
+
+  ASSERT_EQ(result.poses.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(tracked, static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(odometry_progress, static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(map_progress, static_cast<std::size_t>(kFrames));
+  EXPECT_EQ(verified, result.loop_closures.size());
+  std::size_t kept = 0, pruned = 0;
+  for (const auto& record : result.loop_closures) {
+    pruned += record.pruned;
+    if (record.closure.report.accepted() && !record.pruned) {
+      ++kept;
+      EXPECT_GE(record.closure.candidate.query_frame - record.closure.candidate.match_frame, 20u);
+      EXPECT_LT(record.chi2, 25.0);
+    }
+  }
+  RecordProperty("loop_closures_kept", std::to_string(kept));
+  RecordProperty("loop_closures_verified", std::to_string(result.loop_closures.size()));
+  RecordProperty("loop_closures_pruned", std::to_string(pruned));
+  EXPECT_GE(kept, 1u);
+  EXPECT_GE(result.graph_edges, static_cast<std::size_t>(kFrames - 1) + kept);
+  EXPECT_TRUE(result.final_graph.converged);
+
+  const double odometry_ate = testing::ate_rmse(result.odometry.poses, out_and_back().truth);
+  const double slam_ate = testing::ate_rmse(result.poses, out_and_back().truth);
+  RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
+  RecordProperty("slam_ate_m", testing::scientific(slam_ate));
+  EXPECT_LT(slam_ate, 0.01);
+  EXPECT_LE(slam_ate, odometry_ate * 1.05);
+
+  ASSERT_GT(result.map.size(), 1000u);
+  EXPECT_TRUE(result.map.has_normals());
+  EXPECT_TRUE(result.map.has_colors());
+  EXPECT_GE(result.map_voxels, result.map.size());
+  std::size_t with_normal = 0;
+  for (const Eigen::Vector3f& n : result.map.normals) with_normal += n.norm() > 0.99f;
+  EXPECT_GT(with_normal, result.map.size() * 8 / 10);  // edges and thin legs may have none
+  EXPECT_GT(result.timing.total_seconds, 0.0);
+}
+
+// A source whose frame 5 cannot be read: the error reaches the caller, nothing hangs.
+class BrokenSource final : public mapping::FrameSource {
+ public:
+  explicit BrokenSource(const testing::RenderedSequence& sequence) : inner_(sequence) {}
+  std::size_t size() const override { return 10; }
+  PinholeIntrinsics camera() const override { return inner_.camera(); }
+  double depth_units_per_metre() const override { return inner_.depth_units_per_metre(); }
+  registration::RgbdImages frame(std::size_t i) const override {
+    require(i != 5, "frame 5: corrupt file");
+    return inner_.frame(i);
+  }
+
+ private:
+  testing::MemoryFrameSource inner_;
+};
+
+TEST(Slam, PassesFrameErrorsToTheCaller) {
+  const BrokenSource source(out_and_back());
+  const compute::Context context = compute::Context::cpu();
+  try {
+    mapping::run_slam(context, source, loop_params());
+    FAIL() << "no error";
+  } catch (const Error& error) {
+    EXPECT_NE(std::string(error.what()).find("frame 5: corrupt file"), std::string::npos);
+  }
+  EXPECT_THROW(mapping::run_odometry(context, source, registration::OdometryParams{}), Error);
+}
+
+TEST(Slam, OdometryRunReportsTimingAndEveryFrame) {
+  testing::RenderedSequence sequence = out_and_back();
+  sequence.frames.resize(12);
+  const testing::MemoryFrameSource source(sequence);
+  const compute::Context context = compute::Context::cpu();
+  const mapping::OdometryRun run = mapping::run_odometry(context, source, {});
+  ASSERT_EQ(run.poses.size(), 12u);
+  EXPECT_EQ(run.frames.size(), 12u);
+  EXPECT_EQ(run.timestamps.size(), 12u);
+  EXPECT_DOUBLE_EQ(run.timestamps[3], 3 / 30.0);
+  EXPECT_GT(run.compute_seconds, 0.0);
+  EXPECT_GE(run.timing.wall_seconds, run.compute_seconds * 0.5);
+  EXPECT_GT(run.timing.load_seconds, 0.0);
+  EXPECT_EQ(run.keyframes.front(), 0u);
+  EXPECT_EQ(run.constraints.size(), 11u + 2u);  // 11 frame-to-frame, frames 5 and 10 k-back
+}
+
+}  // namespace
+}  // namespace kartograf
