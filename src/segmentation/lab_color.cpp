@@ -1,0 +1,88 @@
+#include "kartograf/segmentation/lab_color.hpp"
+
+#include <array>
+#include <cmath>
+
+namespace kartograf::segmentation {
+
+namespace {
+
+// sRGB -> XYZ (D65) and the D65 reference white, from IEC 61966-2-1.
+constexpr double kRgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
+                                    {0.2126729, 0.7151522, 0.0721750},
+                                    {0.0193339, 0.1191920, 0.9503041}};
+constexpr double kWhite[3] = {0.95047, 1.0, 1.08883};
+constexpr double kEpsilon = 216.0 / 24389.0;  // CIE's (6/29)^3
+constexpr double kKappa = 24389.0 / 27.0;
+
+double srgb_to_linear(std::uint8_t v) {
+  const double c = v / 255.0;
+  return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
+}
+
+double lab_f(double t) { return t > kEpsilon ? std::cbrt(t) : (kKappa * t + 16.0) / 116.0; }
+
+// The white-normalised XYZ rows, so that t = row . linear_rgb directly.
+double normalised_matrix(int row, int col) { return kRgbToXyz[row][col] / kWhite[row]; }
+
+// Tables for to_lab: the gamma decoding (exact per 8-bit value) and lab_f sampled on [0, kFMax]
+// with linear interpolation (error < 1e-5 in f, i.e. < 1e-3 in L*, a*, b*).
+struct LabTables {
+  static constexpr int kFSamples = 8192;
+  static constexpr float kFMax = 1.0001f;  // normalised X, Y, Z never exceed 1 for sRGB input
+  std::array<float, 256> linear{};
+  std::array<float, kFSamples + 2> f{};
+  float matrix[3][3]{};
+
+  LabTables() {
+    for (int v = 0; v < 256; ++v) linear[v] = static_cast<float>(srgb_to_linear(static_cast<std::uint8_t>(v)));
+    for (int i = 0; i < kFSamples + 2; ++i) f[i] = static_cast<float>(lab_f(i * double{kFMax} / kFSamples));
+    for (int r = 0; r < 3; ++r)
+      for (int c = 0; c < 3; ++c) matrix[r][c] = static_cast<float>(normalised_matrix(r, c));
+  }
+
+  float interpolated_f(float t) const {
+    const float x = std::fmin(std::fmax(t, 0.0f), kFMax) * (kFSamples / kFMax);
+    const int i = std::min(static_cast<int>(x), kFSamples);
+    const float w = x - static_cast<float>(i);
+    return f[i] + w * (f[i + 1] - f[i]);
+  }
+};
+
+const LabTables& lab_tables() {
+  static const LabTables tables;
+  return tables;
+}
+
+}  // namespace
+
+Eigen::Vector3f rgb_to_lab(const Rgb8& rgb) {
+  const double linear[3] = {srgb_to_linear(rgb[0]), srgb_to_linear(rgb[1]), srgb_to_linear(rgb[2])};
+  double f[3];
+  for (int r = 0; r < 3; ++r) {
+    double t = 0.0;
+    for (int c = 0; c < 3; ++c) t += normalised_matrix(r, c) * linear[c];
+    f[r] = lab_f(t);
+  }
+  return {static_cast<float>(116.0 * f[1] - 16.0), static_cast<float>(500.0 * (f[0] - f[1])),
+          static_cast<float>(200.0 * (f[1] - f[2]))};
+}
+
+LabImage to_lab(const RgbImage& rgb) {
+  const LabTables& tables = lab_tables();
+  LabImage lab(rgb.width(), rgb.height());
+  const Rgb8* in = rgb.data();
+  Eigen::Vector4f* out = lab.data();
+  for (std::size_t i = 0; i < rgb.size(); ++i) {
+    const float r = tables.linear[in[i][0]], g = tables.linear[in[i][1]], b = tables.linear[in[i][2]];
+    float f[3];
+    for (int row = 0; row < 3; ++row) {
+      const float* m = tables.matrix[row];
+      f[row] = tables.interpolated_f(m[0] * r + m[1] * g + m[2] * b);
+    }
+    out[i] = Eigen::Vector4f(116.0f * f[1] - 16.0f, 500.0f * (f[0] - f[1]), 200.0f * (f[1] - f[2]), 0.0f);
+  }
+  return lab;
+}
+
+}  // namespace kartograf::segmentation
