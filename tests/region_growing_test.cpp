@@ -19,9 +19,12 @@ using segmentation::SegmentLabelImage;
 
 void expect_lab(const Rgb8& rgb, const Eigen::Vector3f& expected) {
   const Eigen::Vector3f lab = segmentation::rgb_to_lab(rgb);
-  EXPECT_NEAR(lab.x(), expected.x(), 0.01) << int{rgb[0]} << "," << int{rgb[1]} << "," << int{rgb[2]};
-  EXPECT_NEAR(lab.y(), expected.y(), 0.01) << int{rgb[0]} << "," << int{rgb[1]} << "," << int{rgb[2]};
-  EXPECT_NEAR(lab.z(), expected.z(), 0.01) << int{rgb[0]} << "," << int{rgb[1]} << "," << int{rgb[2]};
+  EXPECT_NEAR(lab.x(), expected.x(), 0.01)
+      << int{rgb[0]} << "," << int{rgb[1]} << "," << int{rgb[2]};
+  EXPECT_NEAR(lab.y(), expected.y(), 0.01)
+      << int{rgb[0]} << "," << int{rgb[1]} << "," << int{rgb[2]};
+  EXPECT_NEAR(lab.z(), expected.z(), 0.01)
+      << int{rgb[0]} << "," << int{rgb[1]} << "," << int{rgb[2]};
 }
 
 TEST(LabColor, KnownAnswers) {
@@ -49,7 +52,10 @@ TEST(LabColor, ImageConversionMatchesPerPixelConversion) {
   double worst = 0;
   for (int y = 0; y < 32; ++y) {
     for (int x = 0; x < 32; ++x) {
-      worst = std::max(worst, double((lab(x, y).head<3>() - segmentation::rgb_to_lab(rgb(x, y))).cwiseAbs().maxCoeff()));
+      worst = std::max(
+          worst,
+          double(
+              (lab(x, y).head<3>() - segmentation::rgb_to_lab(rgb(x, y))).cwiseAbs().maxCoeff()));
       EXPECT_EQ(lab(x, y).w(), 0.0f);
     }
   }
@@ -64,14 +70,17 @@ PointImage flat_points(int width, int height, float depth = 1.0f) {
   return points;
 }
 
-LabImage uniform_lab(int width, int height, const Eigen::Vector4f& colour) { return LabImage(width, height, colour); }
+LabImage uniform_lab(int width, int height, const Eigen::Vector4f& colour) {
+  return LabImage(width, height, colour);
+}
 
 TEST(RegionGrowing, TwoColourBlocksGiveTwoSegmentsInScanOrder) {
   RgbImage rgb(8, 6);
   for (int y = 0; y < 6; ++y) {
     for (int x = 0; x < 8; ++x) rgb(x, y) = x < 3 ? Rgb8{200, 30, 30} : Rgb8{30, 30, 200};
   }
-  const SegmentLabelImage labels = segmentation::grow_regions_lab(segmentation::to_lab(rgb), flat_points(8, 6), {});
+  const SegmentLabelImage labels =
+      segmentation::grow_regions_lab(segmentation::to_lab(rgb), flat_points(8, 6), {});
   EXPECT_EQ(segmentation::segment_count(labels), 2u);
   for (int y = 0; y < 6; ++y) {
     for (int x = 0; x < 8; ++x) EXPECT_EQ(labels(x, y), x < 3 ? 0u : 1u) << x << "," << y;
@@ -123,8 +132,8 @@ TEST(RegionGrowing, DepthJumpOptionSplitsSameColourBlocksAtDifferentDepths) {
 TEST(RegionGrowing, TilesBoundSegments) {
   RegionGrowingParams tiled;
   tiled.tile_size = 16;
-  const SegmentLabelImage labels =
-      segmentation::grow_regions_lab(uniform_lab(40, 20, {50, 0, 0, 0}), flat_points(40, 20), tiled);
+  const SegmentLabelImage labels = segmentation::grow_regions_lab(
+      uniform_lab(40, 20, {50, 0, 0, 0}), flat_points(40, 20), tiled);
   EXPECT_EQ(segmentation::segment_count(labels), 6u);  // 3 x 2 tiles, the last ones partial
   EXPECT_EQ(labels(15, 15), 0u);
   EXPECT_EQ(labels(16, 0), 1u);
@@ -134,15 +143,19 @@ TEST(RegionGrowing, TilesBoundSegments) {
 }
 
 TEST(RegionGrowing, RejectsBadInput) {
-  EXPECT_ERROR_MENTIONS(segmentation::grow_regions_lab(uniform_lab(4, 4, Eigen::Vector4f::Zero()), flat_points(5, 4), {}),
+  EXPECT_ERROR_MENTIONS(segmentation::grow_regions_lab(uniform_lab(4, 4, Eigen::Vector4f::Zero()),
+                                                       flat_points(5, 4), {}),
                         "grow_regions_lab", "4x4", "5x4");
   RegionGrowingParams bad;
   bad.lab_threshold = 0.0f;
-  EXPECT_ERROR_MENTIONS(segmentation::grow_regions_lab(uniform_lab(4, 4, Eigen::Vector4f::Zero()), flat_points(4, 4), bad),
+  EXPECT_ERROR_MENTIONS(segmentation::grow_regions_lab(uniform_lab(4, 4, Eigen::Vector4f::Zero()),
+                                                       flat_points(4, 4), bad),
                         "lab_threshold");
   bad = {};
   bad.tile_size = -1;
-  EXPECT_ERROR_MENTIONS(segmentation::grow_regions_lab(uniform_lab(4, 4, Eigen::Vector4f::Zero()), flat_points(4, 4), bad), "tile_size");
+  EXPECT_ERROR_MENTIONS(segmentation::grow_regions_lab(uniform_lab(4, 4, Eigen::Vector4f::Zero()),
+                                                       flat_points(4, 4), bad),
+                        "tile_size");
   EXPECT_EQ(segmentation::grow_regions_lab({}, {}, {}).size(), 0u);
 }
 

@@ -20,10 +20,14 @@ double srgb_to_linear(std::uint8_t v) {
   return c <= 0.04045 ? c / 12.92 : std::pow((c + 0.055) / 1.055, 2.4);
 }
 
-double lab_f(double t) { return t > kEpsilon ? std::cbrt(t) : (kKappa * t + 16.0) / 116.0; }
+double lab_f(double t) {
+  return t > kEpsilon ? std::cbrt(t) : (kKappa * t + 16.0) / 116.0;
+}
 
 // The white-normalised XYZ rows, so that t = row . linear_rgb directly.
-double normalised_matrix(int row, int col) { return kRgbToXyz[row][col] / kWhite[row]; }
+double normalised_matrix(int row, int col) {
+  return kRgbToXyz[row][col] / kWhite[row];
+}
 
 // Tables for to_lab: the gamma decoding (exact per 8-bit value) and lab_f sampled on [0, kFMax]
 // with linear interpolation (error < 1e-5 in f, i.e. < 1e-3 in L*, a*, b*).
@@ -35,8 +39,10 @@ struct LabTables {
   float matrix[3][3]{};
 
   LabTables() {
-    for (int v = 0; v < 256; ++v) linear[v] = static_cast<float>(srgb_to_linear(static_cast<std::uint8_t>(v)));
-    for (int i = 0; i < kFSamples + 2; ++i) f[i] = static_cast<float>(lab_f(i * double{kFMax} / kFSamples));
+    for (int v = 0; v < 256; ++v)
+      linear[v] = static_cast<float>(srgb_to_linear(static_cast<std::uint8_t>(v)));
+    for (int i = 0; i < kFSamples + 2; ++i)
+      f[i] = static_cast<float>(lab_f(i * double{kFMax} / kFSamples));
     for (int r = 0; r < 3; ++r)
       for (int c = 0; c < 3; ++c) matrix[r][c] = static_cast<float>(normalised_matrix(r, c));
   }
@@ -74,13 +80,15 @@ LabImage to_lab(const RgbImage& rgb) {
   const Rgb8* in = rgb.data();
   Eigen::Vector4f* out = lab.data();
   for (std::size_t i = 0; i < rgb.size(); ++i) {
-    const float r = tables.linear[in[i][0]], g = tables.linear[in[i][1]], b = tables.linear[in[i][2]];
+    const float r = tables.linear[in[i][0]], g = tables.linear[in[i][1]],
+                b = tables.linear[in[i][2]];
     float f[3];
     for (int row = 0; row < 3; ++row) {
       const float* m = tables.matrix[row];
       f[row] = tables.interpolated_f(m[0] * r + m[1] * g + m[2] * b);
     }
-    out[i] = Eigen::Vector4f(116.0f * f[1] - 16.0f, 500.0f * (f[0] - f[1]), 200.0f * (f[1] - f[2]), 0.0f);
+    out[i] = Eigen::Vector4f(116.0f * f[1] - 16.0f, 500.0f * (f[0] - f[1]), 200.0f * (f[1] - f[2]),
+                             0.0f);
   }
   return lab;
 }

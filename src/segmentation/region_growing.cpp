@@ -18,16 +18,17 @@ SegmentLabelImage grow_regions_lab(const LabImage& lab, const PointImage& points
                                    const RegionGrowingParams& params) {
   require(lab.width() == points.width() && lab.height() == points.height(),
           "grow_regions_lab: Lab image is " + std::to_string(lab.width()) + "x" +
-              std::to_string(lab.height()) + " but the point image is " + std::to_string(points.width()) +
-              "x" + std::to_string(points.height()));
+              std::to_string(lab.height()) + " but the point image is " +
+              std::to_string(points.width()) + "x" + std::to_string(points.height()));
   require(std::isfinite(params.lab_threshold) && params.lab_threshold > 0,
-          "grow_regions_lab: lab_threshold must be positive, got " + std::to_string(params.lab_threshold));
+          "grow_regions_lab: lab_threshold must be positive, got " +
+              std::to_string(params.lab_threshold));
   require(std::isfinite(params.max_depth_jump) && params.max_depth_jump >= 0,
           "grow_regions_lab: max_depth_jump must be >= 0 (0 = off), got " +
               std::to_string(params.max_depth_jump));
 
   require(params.tile_size >= 0, "grow_regions_lab: tile_size must be >= 0 (0 = off), got " +
-                                      std::to_string(params.tile_size));
+                                     std::to_string(params.tile_size));
 
   const int width = lab.width(), height = lab.height();
   SegmentLabelImage labels(width, height, geometry::kNoLabel);

@@ -1,0 +1,88 @@
+#pragma once
+// Plane extraction from one organized RGB-D frame, methods.md M1 steps 2-4: Lab region growing
+// (over-segmentation), per-segment moments on the context's backend and plane fits, merging of
+// neighbouring segments, and the output planes with a per-pixel plane id image.
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/compute/buffer.hpp"
+#include "kartograf/core/color.hpp"
+#include "kartograf/core/intrinsics.hpp"
+#include "kartograf/core/label_image.hpp"
+#include "kartograf/core/point_image.hpp"
+#include "kartograf/segmentation/plane_merge.hpp"
+#include "kartograf/segmentation/region_growing.hpp"
+
+namespace kartograf::segmentation {
+
+struct PlaneExtractionParams {
+  // The paper's Lab growing (threshold 15) with two variants on, tuned on synthetic Kinect frames:
+  // 16 px tiles (a segment cannot span a crease between two planes of one colour) and a 5 %
+  // depth-jump test (nor an occlusion edge).
+  RegionGrowingParams growing{.lab_threshold = 15.0f, .max_depth_jump = 0.05f, .tile_size = 16};
+  PlaneMergeParams merge;
+  std::uint64_t min_plane_pixels = 300;  // smaller merged planes are dropped (their pixels: 0)
+  // Pixels along plane borders (in segments left out of every plane, or touching another plane's
+  // segments) go to the nearest plane among their own and the neighbouring segments', within the
+  // merge distance allowance: mixed segments along edges and creases are split between planes.
+  bool refine_pixels = true;
+
+  void validate() const;  // throws Error naming the first bad field
+};
+
+// A plane n . p + offset = 0 in the camera frame, n of unit length towards the camera (offset > 0
+// for planes not through the camera centre).
+struct Plane {
+  Label id = 0;  // 1..n, by decreasing pixel count
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  double offset = 0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  // Extent: the bounding box of the plane's points in the in-plane frame (centroid; major_axis,
+  // minor_axis), i.e. coordinates (p - centroid) . axis between extent_min and extent_max.
+  Eigen::Vector3d major_axis = Eigen::Vector3d::Zero();
+  Eigen::Vector3d minor_axis = Eigen::Vector3d::Zero();
+  Eigen::Vector2d extent_min = Eigen::Vector2d::Zero();
+  Eigen::Vector2d extent_max = Eigen::Vector2d::Zero();
+  std::uint64_t inlier_count = 0;  // pixels labelled with this plane
+  double rms_error = 0;            // RMS point-plane distance of those pixels [m]
+  // (The plane is fitted to its merged segments; refined pixels count in inlier_count, rms_error
+  // and the extent but not in the fit.)
+};
+
+struct PlaneExtractionTimings {  // milliseconds, host wall clock
+  double lab = 0, growing = 0, moments = 0, merging = 0, output = 0;
+  double total() const { return lab + growing + moments + merging + output; }
+};
+
+struct PlaneSet {
+  std::vector<Plane> planes;        // planes[i].id == i + 1
+  LabelImage labels;                // plane id per pixel, 0 = none
+  std::uint32_t segment_count = 0;  // segments of the over-segmentation
+  std::uint32_t merged_count = 0;   // merged planes before the size filter
+  PlaneExtractionTimings timings;
+};
+
+class PlaneExtractor {
+ public:
+  // Throws Error on invalid intrinsics or parameters.
+  PlaneExtractor(const compute::Context& context, const PinholeIntrinsics& intrinsics,
+                 const PlaneExtractionParams& params = {});
+
+  // points (camera frame, NaN where invalid) and rgb have the intrinsics' size. Deterministic.
+  // Throws Error on a size mismatch or an empty image.
+  PlaneSet extract(const PointImage& points, const RgbImage& rgb);
+
+  const PlaneExtractionParams& params() const { return params_; }
+
+ private:
+  const compute::Context* context_;
+  PinholeIntrinsics intrinsics_;
+  PlaneExtractionParams params_;
+  SegmentPlaneFitter fitter_;
+  compute::Buffer<Point4f> points_;
+  std::vector<std::uint32_t> pixel_plane_;  // scratch: merged plane per pixel
+};
+
+}  // namespace kartograf::segmentation
