@@ -1,18 +1,23 @@
-// Over-segmentation in Lab (methods.md M1 step 2) at 640x480:
-//   region_grow_parallel/<backend>/640x480/t<threshold>[/depth]: ParallelRegionGrowing::segment on
-//       inputs resident on the device, plus finish(), after a warm-up call (the per-frame cost);
-//   region_grow_sequential/cpu/640x480/t<threshold>: the paper's stack-based grow_regions_lab.
-// Input: frame 100 of the synthetic robot tour (synth/, seed 1, Kinect noise), colour -> Lab and
-// depth -> points once before the cases run. Reports the segment count.
-// KARTOGRAF_BENCH_BACKENDS restricts the backends; KARTOGRAF_CPU_THREADS the CPU backend's threads.
+// Plane extraction (methods.md M1 steps 2-4) at 640x480:
+//   plane_extraction/<backend>/640x480: PlaneExtractor::extract with its defaults (Lab codes,
+//       tiled growing, moments, merging, pixel refinement, output), cycling through 8 frames of
+//       the synthetic robot tour; counters: the median stage times of the last run [ms], planes;
+//   region_grow/<backend>/640x480/t<threshold>: RegionGrower::grow (16 px tiles, 2 % depth jump:
+//       the extraction's growing) on points resident on the device;
+//   region_grow_sequential/cpu/640x480/t<threshold>: the paper's untiled growing (grow_regions).
+// Input: synthetic world seed 1 with the Kinect noise model, colour -> Lab codes and depth ->
+// points once before the cases run. KARTOGRAF_BENCH_BACKENDS restricts the backends;
+// KARTOGRAF_CPU_THREADS sets the CPU backend's threads (default 1).
 #include <benchmark/benchmark.h>
 
+#include <algorithm>
 #include <string>
+#include <vector>
 
 #include "bench_support.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
-#include "kartograf/segmentation/parallel_region_growing.hpp"
+#include "kartograf/segmentation/plane_extraction.hpp"
 #include "kartograf/segmentation/region_growing.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
@@ -22,82 +27,117 @@ namespace {
 
 using compute::BackendKind;
 
+const PinholeIntrinsics kCamera{640, 480, 525.0, 525.0, 319.5, 239.5};
+
 struct HostFrame {
-  segmentation::LabImage lab;
+  RgbImage color;
+  segmentation::LabCodeImage lab;
   PointImage points;
 };
 
-const HostFrame& host_frame() {
-  static const HostFrame frame = [] {
-    const PinholeIntrinsics camera{640, 480, 525.0, 525.0, 319.5, 239.5};
+const std::vector<HostFrame>& host_frames() {
+  static const std::vector<HostFrame> frames = [] {
     const synth::World world = synth::make_building(1);
-    const synth::SyntheticFrame rendered = synth::render(
-        world, camera, synth::robot_tour(world, 500)[100].pose, synth::NoiseModel::kinect(), 100);
+    const Trajectory tour = synth::robot_tour(world, 300);
     const compute::Context cpu = compute::Context::cpu();
-    return HostFrame{segmentation::to_lab(rendered.color),
-                     geometry::backproject(cpu, rendered.depth, camera, {5000.0})};
+    std::vector<HostFrame> result;
+    for (int f = 0; f < 8; ++f) {
+      const int index = 7 + f * 37;
+      const synth::SyntheticFrame rendered =
+          synth::render(world, kCamera, tour[index].pose, synth::NoiseModel::kinect(), index);
+      result.push_back({rendered.color, segmentation::to_lab_codes(rendered.color),
+                        geometry::backproject(cpu, rendered.depth, kCamera, {5000.0})});
+    }
+    return result;
   }();
-  return frame;
+  return frames;
 }
 
-segmentation::RegionGrowingParams params_for(float threshold, float depth_jump) {
-  segmentation::RegionGrowingParams params;
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  return values.empty() ? 0.0 : values[values.size() / 2];
+}
+
+void plane_extraction(benchmark::State& state, BackendKind backend) {
+  const compute::Context context(bench::context_options(backend));
+  const std::vector<HostFrame>& frames = host_frames();
+  segmentation::PlaneExtractor extractor(context, kCamera);
+  for (const HostFrame& frame : frames) extractor.extract(frame.points, frame.color);  // warm-up
+  std::vector<double> lab, growing, moments, merging, output, planes;
+  std::size_t next = 0;
+  for (auto _ : state) {
+    const HostFrame& frame = frames[next++ % frames.size()];
+    const segmentation::PlaneSet set = extractor.extract(frame.points, frame.color);
+    lab.push_back(set.timings.lab);
+    growing.push_back(set.timings.growing);
+    moments.push_back(set.timings.moments);
+    merging.push_back(set.timings.merging);
+    output.push_back(set.timings.output);
+    planes.push_back(static_cast<double>(set.planes.size()));
+  }
+  state.counters["lab_ms"] = median(lab);
+  state.counters["grow_ms"] = median(growing);
+  state.counters["moments_ms"] = median(moments);
+  state.counters["merge_ms"] = median(merging);
+  state.counters["output_ms"] = median(output);
+  state.counters["planes"] = median(planes);
+  state.SetItemsProcessed(state.iterations());
+  state.SetLabel(context.device_info().name);
+}
+
+// The extraction's growing (tiles, depth jump) at another threshold.
+segmentation::RegionGrowingParams tiled(float threshold) {
+  segmentation::RegionGrowingParams params = segmentation::PlaneExtractionParams{}.growing;
   params.lab_threshold = threshold;
-  params.max_depth_jump = depth_jump;
   return params;
 }
 
-void parallel_steady(benchmark::State& state, BackendKind backend, float threshold,
-                     float depth_jump) {
+void region_grow(benchmark::State& state, BackendKind backend, float threshold) {
   const compute::Context context(bench::context_options(backend));
-  const HostFrame& host = host_frame();
-  const auto lab = compute::Buffer<Eigen::Vector4f>::from_host(context, host.lab.pixels());
+  const HostFrame& host = host_frames().front();
   const auto points = compute::Buffer<Point4f>::from_host(context, host.points.pixels());
-  segmentation::ParallelRegionGrowing growing(context, host.lab.width(), host.lab.height());
-  const auto params = params_for(threshold, depth_jump);
-  growing.segment(lab, points, params);  // warm-up: pipelines built, driver JIT done
-  context.finish();
+  segmentation::RegionGrower grower(context);
+  const segmentation::RegionGrowingParams params = tiled(threshold);
+  grower.grow(host.lab, points, params);  // warm-up: pipelines built, driver JIT done
   std::uint32_t segments = 0;
-  for (auto _ : state) {
-    segments = growing.segment(lab, points, params);
-    context.finish();
-  }
+  for (auto _ : state) segments = grower.grow(host.lab, points, params);
   state.counters["segments"] = segments;
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(host.lab.size()));
   state.SetLabel(context.device_info().name);
 }
 
-void sequential(benchmark::State& state, float threshold, float depth_jump) {
-  const HostFrame& host = host_frame();
-  const auto params = params_for(threshold, depth_jump);
+void region_grow_sequential(benchmark::State& state, float threshold) {
+  const HostFrame& host = host_frames().front();
+  segmentation::RegionGrowingParams params;
+  params.lab_threshold = threshold;
+  segmentation::SegmentLabelImage labels;
   std::uint32_t segments = 0;
-  for (auto _ : state) {
-    const segmentation::SegmentLabelImage labels =
-        segmentation::grow_regions_lab(host.lab, host.points, params);
-    segments = segmentation::segment_count(labels);
-  }
+  for (auto _ : state) segments = segmentation::grow_regions(host.lab, host.points, params, labels);
   state.counters["segments"] = segments;
   state.SetItemsProcessed(state.iterations() * static_cast<std::int64_t>(host.lab.size()));
 }
 
 void register_benchmarks() {
   const std::string size = "640x480";
-  for (const float threshold : {10.0f, 20.0f}) {
+  for (const BackendKind backend : bench::backends_to_run()) {
+    bench::repeated(benchmark::RegisterBenchmark(
+                        bench::case_name("plane_extraction", backend, size).c_str(),
+                        plane_extraction, backend),
+                    5)
+        ->MinTime(0.5);
+  }
+  for (const float threshold : {15.0f, 25.0f}) {
     const std::string variant = "/t" + std::to_string(static_cast<int>(threshold));
     for (const BackendKind backend : bench::backends_to_run()) {
-      const std::string name = bench::case_name("region_grow_parallel", backend, size);
-      bench::repeated(benchmark::RegisterBenchmark((name + variant).c_str(), parallel_steady,
-                                                   backend, threshold, 0.0f),
-                      5)
-          ->MinTime(0.2);
-      bench::repeated(benchmark::RegisterBenchmark((name + variant + "/depth").c_str(),
-                                                   parallel_steady, backend, threshold, 0.05f),
-                      5)
+      const std::string name = bench::case_name("region_grow", backend, size) + variant;
+      bench::repeated(
+          benchmark::RegisterBenchmark(name.c_str(), region_grow, backend, threshold), 5)
           ->MinTime(0.2);
     }
-    const std::string name = bench::case_name("region_grow_sequential", BackendKind::cpu, size);
+    const std::string name =
+        bench::case_name("region_grow_sequential", BackendKind::cpu, size) + variant;
     bench::repeated(
-        benchmark::RegisterBenchmark((name + variant).c_str(), sequential, threshold, 0.0f), 5)
+        benchmark::RegisterBenchmark(name.c_str(), region_grow_sequential, threshold), 5)
         ->MinTime(0.2);
   }
 }

@@ -1,133 +1,107 @@
-// Parallel Lab region growing in 6 passes (rows, then upper neighbours, then numbering); see shaders/region_grow*.{glsl,comp} (the same rules,
-// kernel names, buffers and parameter layout) and
-// include/kartograf/segmentation/parallel_region_growing.hpp for the contract.
+// Tiled Lab region growing in 3 passes (grow each tile, scan the tile counts, add the offsets);
+// see shaders/region_grow*.{glsl,comp} (the same rules, kernel names, buffers and parameter
+// layout) and include/kartograf/segmentation/region_growing.hpp for the contract.
 typedef struct {
   uint width;
   uint height;
-  uint pixel_count;
-  uint block_count;  // padded to a multiple of 64
-  uint limit;        // connect when the quantised squared Lab distance < limit
-  float depth_ratio;  // 0: no depth test
+  uint tile_size;
+  uint tiles_x;
+  uint tile_count;
+  uint padded_tile_count;  // a multiple of 64 (the scan's lanes)
+  uint stack_stride;       // stack entries per tile: 8 tile_size^2 + 1
+  uint threshold_code;     // the threshold in 1/64 Lab units
+  float depth_ratio;       // 0: no depth test
 } RegionGrowParams;
 
 #define KG_NO_LABEL 0xffffffffu
-#define KG_PIXELS_PER_BLOCK 256u
 
-inline int3 kg_quantised_lab(float4 lab) {
-  return convert_int3_rte(clamp(lab.xyz, -255.0f, 255.0f) * 64.0f);
+__constant int kg_dx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
+__constant int kg_dy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
+
+inline bool kg_is_valid_pixel(__global const short4* lab, __global const float4* points, uint i) {
+  return lab[i].w != 0 && kg_is_valid_point(points[i]);
 }
 
-inline bool kg_is_valid_pixel(float4 lab, float4 point) {
-  return kg_is_valid_point(point) && isfinite(lab.x) && isfinite(lab.y) && isfinite(lab.z);
-}
-
-inline bool kg_connected(float4 lab_a, float4 point_a, float4 lab_b, float4 point_b,
-                         const RegionGrowParams* params) {
-  const int3 d = kg_quantised_lab(lab_a) - kg_quantised_lab(lab_b);
-  const uint distance_sq = (uint)(d.x * d.x) + (uint)(d.y * d.y) + (uint)(d.z * d.z);
-  if (distance_sq >= params->limit) return false;
-  if (params->depth_ratio == 0.0f) return true;
-  const double za = (double)point_a.z, zb = (double)point_b.z;
-  return fabs(za - zb) <= (double)params->depth_ratio * fmin(za, zb);
-}
-
-// One work-item per row: each valid pixel's parent is the first pixel of its run of left-joined
-// pixels (see region_grow_init.comp).
-__kernel void region_grow_init(__global const float4* lab, __global const float4* points,
-                               __global uint* parent, const RegionGrowParams params) {
-  const uint y = get_global_id(0);
-  if (y >= params.height) return;
-  uint run_start = KG_NO_LABEL;
-  bool previous_valid = false;
-  float4 previous_lab = (float4)(0.0f), previous_point = (float4)(0.0f);
-  for (uint i = y * params.width; i < (y + 1u) * params.width; ++i) {
-    const float4 lab_i = lab[i], point_i = points[i];
-    const bool valid = kg_is_valid_pixel(lab_i, point_i);
-    if (!valid) {
-      parent[i] = KG_NO_LABEL;
-    } else {
-      if (!previous_valid ||
-          !kg_connected(lab_i, point_i, previous_lab, previous_point, &params)) {
-        run_start = i;
-      }
-      parent[i] = run_start;
-    }
-    previous_valid = valid;
-    previous_lab = lab_i;
-    previous_point = point_i;
-  }
-}
-
-// Follows parents to the root, then points `start` straight at it (atomic_min: see
-// region_grow_union.comp).
-inline uint kg_find_root(volatile __global uint* parent, uint start) {
-  uint i = start;
-  uint p = parent[i];
-  while (p != i) {
-    i = p;
-    p = parent[i];
-  }
-  if (i != start) atomic_min(&parent[start], i);
-  return i;
-}
-
-// Playne & Hawick's atomic union with min-linking (see region_grow_union.comp).
-inline void kg_unite(volatile __global uint* parent, uint a, uint b) {
-  for (;;) {
-    a = kg_find_root(parent, a);
-    b = kg_find_root(parent, b);
-    if (a == b) return;
-    if (a > b) {
-      const uint t = a;
-      a = b;
-      b = t;
-    }
-    const uint old = atomic_min(&parent[b], a);
-    if (old == b) return;
-    b = old;
-  }
-}
-
-__kernel void region_grow_union(__global const float4* lab, __global const float4* points,
-                                volatile __global uint* parent, const RegionGrowParams params) {
-  const uint i = get_global_id(0);
-  if (i >= params.pixel_count || parent[i] == KG_NO_LABEL) return;
-  const int x = (int)(i % params.width), y = (int)(i / params.width);
-  const float4 lab_i = lab[i], point_i = points[i];
-  if (y == 0) return;
-  for (int dx = -1; dx <= 1; ++dx) {
-    const int nx = x + dx;
-    if (nx < 0 || nx >= (int)params.width) continue;
-    const uint j = (uint)(y - 1) * params.width + (uint)nx;
-    if (parent[j] == KG_NO_LABEL) continue;  // invalid pixels never change
-    if (kg_connected(lab_i, point_i, lab[j], points[j], &params)) kg_unite(parent, i, j);
-  }
-}
-
-__kernel void region_grow_count(__global const uint* parent, __global uint* block_counts,
+// One work-item grows every segment of one tile (see region_grow_tiles.comp).
+__kernel void region_grow_tiles(__global const short4* lab, __global const float4* points,
+                                __global uint* labels, __global uint* tile_counts,
+                                __global uint* stacks, __global uint* status,
                                 const RegionGrowParams params) {
-  const uint block = get_global_id(0);
-  if (block >= params.block_count) return;
-  const uint begin = min(block * KG_PIXELS_PER_BLOCK, params.pixel_count);
-  const uint end = min(begin + KG_PIXELS_PER_BLOCK, params.pixel_count);
-  uint roots = 0u;
-  for (uint i = begin; i < end; ++i) roots += parent[i] == i ? 1u : 0u;
-  block_counts[block] = roots;
+  const uint t = get_global_id(0);
+  if (t >= params.tile_count) return;
+  const uint x0 = (t % params.tiles_x) * params.tile_size;
+  const uint y0 = (t / params.tiles_x) * params.tile_size;
+  const uint x1 = min(params.width, x0 + params.tile_size);
+  const uint y1 = min(params.height, y0 + params.tile_size);
+  for (uint y = y0; y < y1; ++y) {
+    for (uint x = x0; x < x1; ++x) labels[y * params.width + x] = KG_NO_LABEL;
+  }
+  const uint base = t * params.stack_stride;
+  const long threshold = (long)params.threshold_code;
+  const long threshold_sq = threshold * threshold;
+  const double depth_ratio = (double)params.depth_ratio;
+  uint next = 0;
+  for (uint seed_y = y0; seed_y < y1; ++seed_y) {
+    for (uint seed_x = x0; seed_x < x1; ++seed_x) {
+      const uint seed = seed_y * params.width + seed_x;
+      if (labels[seed] != KG_NO_LABEL || !kg_is_valid_pixel(lab, points, seed)) continue;
+      const uint id = next++;
+      long sum_l = 0, sum_a = 0, sum_b = 0, count = 0;
+      uint top = 0;
+      stacks[base + top++] = seed;
+      while (top > 0) {
+        const uint pixel = stacks[base + --top];
+        if (labels[pixel] != KG_NO_LABEL) continue;
+        const short4 c = lab[pixel];
+        if (count > 0) {
+          const long dl = count * c.x - sum_l, da = count * c.y - sum_a, db = count * c.z - sum_b;
+          if (dl * dl + da * da + db * db >= threshold_sq * count * count) continue;
+        }
+        labels[pixel] = id;
+        ++count;
+        sum_l += c.x;
+        sum_a += c.y;
+        sum_b += c.z;
+        const int x = (int)(pixel % params.width), y = (int)(pixel / params.width);
+        const double depth = (double)points[pixel].z;
+        for (int k = 0; k < 8; ++k) {
+          const int nx = x + kg_dx[k], ny = y + kg_dy[k];
+          if (nx < (int)x0 || ny < (int)y0 || nx >= (int)x1 || ny >= (int)y1) continue;
+          const uint neighbour = (uint)ny * params.width + (uint)nx;
+          if (labels[neighbour] != KG_NO_LABEL || !kg_is_valid_pixel(lab, points, neighbour)) {
+            continue;
+          }
+          if (depth_ratio > 0.0 &&
+              fabs((double)points[neighbour].z - depth) > depth_ratio * depth) {
+            continue;
+          }
+          if (top >= params.stack_stride) {
+            atomic_inc(&status[1]);
+            continue;
+          }
+          stacks[base + top++] = neighbour;
+        }
+      }
+    }
+  }
+  tile_counts[t] = next;
 }
 
-__kernel void region_grow_scan(__global uint* block_counts, __global uint* status,
+// One work-group of 64: exclusive prefix sums of the tile counts, the total to status[0] (see
+// region_grow_scan.comp).
+__kernel void region_grow_scan(__global uint* tile_counts, __global uint* status,
                                const RegionGrowParams params) {
   __local uint part_offsets[64];
   const uint lane = get_local_id(0);
-  const uint part = params.block_count / 64u;
+  const uint part = params.padded_tile_count / 64u;
   const uint base = lane * part;
-  uint sum = 0u;
-  for (uint j = 0u; j < part; ++j) sum += block_counts[base + j];
+  uint sum = 0;
+  for (uint j = 0; j < part; ++j) sum += tile_counts[base + j];
   part_offsets[lane] = sum;
   barrier(CLK_LOCAL_MEM_FENCE);
-  if (lane == 0u) {
-    uint running = 0u;
-    for (uint l = 0u; l < 64u; ++l) {
+  if (lane == 0) {
+    uint running = 0;
+    for (uint l = 0; l < 64u; ++l) {
       const uint value = part_offsets[l];
       part_offsets[l] = running;
       running += value;
@@ -136,40 +110,18 @@ __kernel void region_grow_scan(__global uint* block_counts, __global uint* statu
   }
   barrier(CLK_LOCAL_MEM_FENCE);
   uint offset = part_offsets[lane];
-  for (uint j = 0u; j < part; ++j) {
-    const uint value = block_counts[base + j];
-    block_counts[base + j] = offset;
+  for (uint j = 0; j < part; ++j) {
+    const uint value = tile_counts[base + j];
+    tile_counts[base + j] = offset;
     offset += value;
   }
 }
 
-__kernel void region_grow_number_roots(__global const uint* parent,
-                                       __global const uint* block_offsets, __global uint* labels,
-                                       const RegionGrowParams params) {
-  const uint block = get_global_id(0);
-  if (block >= params.block_count) return;
-  const uint begin = min(block * KG_PIXELS_PER_BLOCK, params.pixel_count);
-  const uint end = min(begin + KG_PIXELS_PER_BLOCK, params.pixel_count);
-  uint next = block_offsets[block];
-  for (uint i = begin; i < end; ++i) {
-    if (parent[i] == i) labels[i] = next++;
-  }
-}
-
-__kernel void region_grow_assign(__global const uint* parent, __global uint* labels,
-                                 const RegionGrowParams params) {
+// Tile-local segment numbers plus the tile's offset (see region_grow_offsets.comp).
+__kernel void region_grow_offsets(__global uint* labels, __global const uint* tile_offsets,
+                                  const RegionGrowParams params) {
   const uint i = get_global_id(0);
-  if (i >= params.pixel_count) return;
-  uint p = parent[i];
-  if (p == KG_NO_LABEL) {
-    labels[i] = KG_NO_LABEL;
-    return;
-  }
-  if (p == i) return;  // a root: numbered by region_grow_number_roots
-  uint root = i;
-  while (p != root) {
-    root = p;
-    p = parent[root];
-  }
-  labels[i] = labels[root];
+  if (i >= params.width * params.height || labels[i] == KG_NO_LABEL) return;
+  const uint x = i % params.width, y = i / params.width;
+  labels[i] += tile_offsets[(y / params.tile_size) * params.tiles_x + x / params.tile_size];
 }

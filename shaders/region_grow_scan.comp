@@ -1,23 +1,23 @@
 #version 450
-// Parallel Lab region growing, pass 4 of 6: one work-group turns the block counts into exclusive
-// prefix sums in place (each lane a contiguous part, lane 0 the 64 part sums) and writes the
-// segment count to status[0].
+// Tiled Lab region growing, pass 2 of 3: one work-group turns the segment counts per tile into
+// exclusive prefix sums in place (each lane a contiguous part, lane 0 the 64 part sums) and
+// writes the segment count to status[0].
 #extension GL_GOOGLE_include_directive : require
 #include "region_grow.glsl"
 
 layout(local_size_x = 64) in;
 
-layout(std430, binding = 0) buffer BlockCounts { uint block_counts[]; };
-layout(std430, binding = 1) writeonly buffer Status { uint status[]; };
+layout(std430, binding = 0) buffer TileCounts { uint tile_counts[]; };
+layout(std430, binding = 1) buffer Status { uint status[]; };
 
 shared uint part_offsets[64];
 
 void main() {
   const uint lane = gl_LocalInvocationID.x;
-  const uint part = params.block_count / 64u;
+  const uint part = params.padded_tile_count / 64u;
   const uint base = lane * part;
   uint sum = 0u;
-  for (uint j = 0u; j < part; ++j) sum += block_counts[base + j];
+  for (uint j = 0u; j < part; ++j) sum += tile_counts[base + j];
   part_offsets[lane] = sum;
   barrier();
   if (lane == 0u) {
@@ -32,8 +32,8 @@ void main() {
   barrier();
   uint offset = part_offsets[lane];
   for (uint j = 0u; j < part; ++j) {
-    const uint value = block_counts[base + j];
-    block_counts[base + j] = offset;
+    const uint value = tile_counts[base + j];
+    tile_counts[base + j] = offset;
     offset += value;
   }
 }

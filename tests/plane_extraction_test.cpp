@@ -353,9 +353,11 @@ TEST_P(PlaneExtractionBackendTest, IsDeterministicAndAgreesWithTheCpuBackend) {
       EXPECT_LE(plane.inlier_count, (&plane - 1)->inlier_count);
     }
   }
-  // Moments are bit-identical on every backend, so everything downstream is too.
+  // Run to run on one backend: identical. Against the CPU backend: the same labels (the growing
+  // is exact on every backend), plane parameters within rounding (the CPU sums moments in double
+  // as segments grow, devices reduce them in fixed point).
   expect_same_planes(first, extract_synthetic(context(), camera, 40), 0.0);
-  expect_same_planes(first, extract_synthetic(compute::Context::cpu(), camera, 40), 0.0);
+  expect_same_planes(first, extract_synthetic(compute::Context::cpu(), camera, 40), 1e-9);
 }
 
 KARTOGRAF_INSTANTIATE_BACKEND_TESTS(PlaneExtractionBackendTest);

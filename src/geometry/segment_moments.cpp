@@ -1,6 +1,8 @@
 #include "kartograf/geometry/segment_moments.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
@@ -30,46 +32,24 @@ float fixed_point_scale(double count, double per_term) {
   return static_cast<float>(std::exp2(std::floor(62.0 - std::log2(max_total))));
 }
 
-std::int64_t to_fixed(double value, double scale) {
-  return static_cast<std::int64_t>(std::nearbyint(value * scale));
-}
-
 struct Accumulation {
-  std::vector<std::int64_t> moments;
+  std::vector<FixedPointMoments::Sums> moments;  // per label
   std::uint32_t points_too_far = 0;
   std::uint32_t bad_labels = 0;
 };
 
 void accumulate_cpu(std::span<const Point4f> points, std::span<const std::uint32_t> labels,
-                    const SegmentMomentKernelParams& params, Accumulation& out) {
-  const double s1 = params.first_scale, s2 = params.second_scale;
-  const double bound = params.max_offset;
+                    const FixedPointMoments& fixed, std::uint32_t label_count,
+                    Accumulation& out) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::uint32_t label = labels[i];
     const Point4f& p = points[i];
     if (label == kNoLabel || !is_valid(p)) continue;
-    if (label >= params.label_count) {
+    if (label >= label_count) {
       ++out.bad_labels;
       continue;
     }
-    const double dx = static_cast<double>(p.x()) - static_cast<double>(params.origin_x);
-    const double dy = static_cast<double>(p.y()) - static_cast<double>(params.origin_y);
-    const double dz = static_cast<double>(p.z()) - static_cast<double>(params.origin_z);
-    if (std::fabs(dx) > bound || std::fabs(dy) > bound || std::fabs(dz) > bound) {
-      ++out.points_too_far;
-      continue;
-    }
-    std::int64_t* m = &out.moments[std::size_t{label} * kValuesPerLabel];
-    m[0] += 1;
-    m[1] += to_fixed(dx, s1);
-    m[2] += to_fixed(dy, s1);
-    m[3] += to_fixed(dz, s1);
-    m[4] += to_fixed(dx * dx, s2);
-    m[5] += to_fixed(dx * dy, s2);
-    m[6] += to_fixed(dx * dz, s2);
-    m[7] += to_fixed(dy * dy, s2);
-    m[8] += to_fixed(dy * dz, s2);
-    m[9] += to_fixed(dz * dz, s2);
+    if (!fixed.add(p, out.moments[label])) ++out.points_too_far;
   }
 }
 
@@ -99,46 +79,38 @@ SegmentMomentSet segment_moments(const compute::Context& context,
   return SegmentMomentReducer(context).run(points, labels, params);
 }
 
-SegmentMomentSet SegmentMomentReducer::run(const compute::Buffer<Point4f>& points,
-                                           const compute::Buffer<std::uint32_t>& labels,
-                                           const SegmentMomentParams& params) {
-  const compute::Context& context = *context_;
-  require(params.label_count >= 1 && params.label_count <= kMaxSegmentLabels,
-          "segment moments: label_count must be 1.." + std::to_string(kMaxSegmentLabels) + ", got " +
+namespace {
+
+void check_params(std::size_t point_count, std::size_t label_length,
+                  const SegmentMomentParams& params, std::uint32_t max_labels) {
+  require(params.label_count >= 1 && params.label_count <= max_labels,
+          "segment moments: label_count must be 1.." + std::to_string(max_labels) + ", got " +
               std::to_string(params.label_count));
-  require(points.size() == labels.size(), "segment moments: " + std::to_string(points.size()) +
-                                              " points but " + std::to_string(labels.size()) +
-                                              " labels");
-  require(points.size() < (std::size_t{1} << 31), "segment moments: more than 2^31 points");
+  require(point_count == label_length, "segment moments: " + std::to_string(point_count) +
+                                           " points but " + std::to_string(label_length) +
+                                           " labels");
+  require(point_count < (std::size_t{1} << 31), "segment moments: more than 2^31 points");
   require(params.origin.allFinite(), "segment moments: origin has NaN/Inf");
   require(std::isfinite(params.max_offset) && params.max_offset > 0,
           "segment moments: max_offset must be positive");
+}
 
-  const double count = static_cast<double>(points.size());
-  const double bound = params.max_offset;
-  const SegmentMomentKernelParams kernel_params{
-      static_cast<std::uint32_t>(points.size()), params.label_count, params.origin.x(),
-      params.origin.y(),  params.origin.z(),     params.max_offset,
-      fixed_point_scale(count, bound), fixed_point_scale(count, bound * bound)};
+SegmentMomentKernelParams kernel_params_for(std::size_t point_count,
+                                            const SegmentMomentParams& params,
+                                            const FixedPointMoments& fixed) {
+  return {static_cast<std::uint32_t>(point_count),
+          params.label_count,
+          params.origin.x(),
+          params.origin.y(),
+          params.origin.z(),
+          params.max_offset,
+          fixed.first_scale(),
+          fixed.second_scale()};
+}
 
-  Accumulation accumulation;
-  accumulation.moments.assign(std::size_t{params.label_count} * kValuesPerLabel, 0);
-  if (context.is_cpu()) {
-    accumulate_cpu(points.host_span(), labels.host_span(), kernel_params, accumulation);
-  } else {
-    if (moments_.size() < accumulation.moments.size()) {
-      moments_ = compute::Buffer<std::int64_t>(context, accumulation.moments.size());
-    }
-    moments_.fill_zero();
-    status_.fill_zero();
-    compute::dispatch(context, kSegmentMomentsKernel, {points, labels, moments_, status_}, kernel_params,
-                      {compute::groups_for(points.size(), kSegmentMomentsKernel.local_x), 1});
-    moments_.download(std::span<std::int64_t>(accumulation.moments));
-    std::uint32_t counters[2] = {};
-    status_.download(counters);
-    accumulation.points_too_far = counters[0];
-    accumulation.bad_labels = counters[1];
-  }
+// Checks the counters and turns the fixed-point sums into moments.
+SegmentMomentSet finish(const Accumulation& accumulation, const SegmentMomentParams& params,
+                        const FixedPointMoments& fixed) {
   require(accumulation.bad_labels == 0,
           "segment moments: " + std::to_string(accumulation.bad_labels) + " pixels carry a label >= " +
               std::to_string(params.label_count) + " (and not kNoLabel)");
@@ -146,21 +118,72 @@ SegmentMomentSet SegmentMomentReducer::run(const compute::Buffer<Point4f>& point
           "segment moments: " + std::to_string(accumulation.points_too_far) +
               " points lie farther than max_offset = " + std::to_string(params.max_offset) +
               " m from the origin");
-
   SegmentMomentSet result;
   result.origin = params.origin.cast<double>();
-  result.segments.resize(params.label_count);
-  const double s1 = kernel_params.first_scale, s2 = kernel_params.second_scale;
-  for (std::size_t label = 0; label < params.label_count; ++label) {
-    const std::int64_t* m = &accumulation.moments[label * kValuesPerLabel];
-    SegmentMoments& out = result.segments[label];
-    out.count = static_cast<std::uint64_t>(m[0]);
-    out.sum = Eigen::Vector3d(m[1] / s1, m[2] / s1, m[3] / s1);
-    out.sum_outer << m[4] / s2, m[5] / s2, m[6] / s2,  //
-        m[5] / s2, m[7] / s2, m[8] / s2,               //
-        m[6] / s2, m[8] / s2, m[9] / s2;
-  }
+  result.segments.reserve(accumulation.moments.size());
+  for (const FixedPointMoments::Sums& sums : accumulation.moments)
+    result.segments.push_back(fixed.moments(sums));
   return result;
+}
+
+}  // namespace
+
+FixedPointMoments::FixedPointMoments(std::size_t point_count, const SegmentMomentParams& params)
+    : origin_(params.origin.cast<double>()),
+      bound_(params.max_offset),
+      first_scale_(fixed_point_scale(static_cast<double>(point_count), params.max_offset)),
+      second_scale_(fixed_point_scale(static_cast<double>(point_count),
+                                      double{params.max_offset} * params.max_offset)) {}
+
+SegmentMoments FixedPointMoments::moments(const Sums& m) const {
+  const double s1 = first_scale_, s2 = second_scale_;
+  SegmentMoments out;
+  out.count = static_cast<std::uint64_t>(m[0]);
+  out.sum = Eigen::Vector3d(m[1] / s1, m[2] / s1, m[3] / s1);
+  out.sum_outer << m[4] / s2, m[5] / s2, m[6] / s2,  //
+      m[5] / s2, m[7] / s2, m[8] / s2,               //
+      m[6] / s2, m[8] / s2, m[9] / s2;
+  return out;
+}
+
+SegmentMomentSet segment_moments(std::span<const Point4f> points,
+                                 std::span<const std::uint32_t> labels,
+                                 const SegmentMomentParams& params) {
+  check_params(points.size(), labels.size(), params, std::numeric_limits<std::uint32_t>::max() - 1);
+  const FixedPointMoments fixed(points.size(), params);
+  Accumulation accumulation;
+  accumulation.moments.assign(params.label_count, FixedPointMoments::Sums{});
+  accumulate_cpu(points, labels, fixed, params.label_count, accumulation);
+  return finish(accumulation, params, fixed);
+}
+
+SegmentMomentSet SegmentMomentReducer::run(const compute::Buffer<Point4f>& points,
+                                           const compute::Buffer<std::uint32_t>& labels,
+                                           const SegmentMomentParams& params) {
+  const compute::Context& context = *context_;
+  check_params(points.size(), labels.size(), params, kMaxSegmentLabels);
+  if (context.is_cpu()) return segment_moments(points.host_span(), labels.host_span(), params);
+  const FixedPointMoments fixed(points.size(), params);
+  const std::size_t values = std::size_t{params.label_count} * kValuesPerLabel;
+  if (moments_.size() < values) moments_ = compute::Buffer<std::int64_t>(context, values);
+  moments_.fill_zero();
+  status_.fill_zero();
+  compute::dispatch(context, kSegmentMomentsKernel, {points, labels, moments_, status_},
+                    kernel_params_for(points.size(), params, fixed),
+                    {compute::groups_for(points.size(), kSegmentMomentsKernel.local_x), 1});
+  std::vector<std::int64_t> sums(values);
+  moments_.download(std::span<std::int64_t>(sums));
+  Accumulation accumulation;
+  accumulation.moments.resize(params.label_count);
+  for (std::size_t label = 0; label < params.label_count; ++label) {
+    std::copy_n(&sums[label * kValuesPerLabel], kValuesPerLabel,
+                accumulation.moments[label].begin());
+  }
+  std::uint32_t counters[2] = {};
+  status_.download(counters);
+  accumulation.points_too_far = counters[0];
+  accumulation.bad_labels = counters[1];
+  return finish(accumulation, params, fixed);
 }
 
 }  // namespace kartograf::geometry

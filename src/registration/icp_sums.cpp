@@ -5,7 +5,7 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
-#include "registration/cpu_parallel.hpp"
+#include "compute/cpu_parallel.hpp"
 
 namespace kartograf::registration {
 
@@ -120,7 +120,7 @@ std::uint64_t for_each_pair_cpu(const Correspondences& pairs,
   return considered;
 }
 
-// Sums add_pair(sums, pair...) over all pairs: per-chunk rows (detail::for_each_chunk, on up to
+// Sums add_pair(sums, pair...) over all pairs: per-chunk rows (compute::detail::for_each_chunk, on up to
 // two threads on this machine), added in chunk order as the device adds its work-group rows.
 // The considered count goes to sums[considered_slot].
 template <class AddPair>
@@ -129,9 +129,9 @@ Sums reduce_cpu(const Correspondences& pairs, const std::array<double, kFrameVal
   struct alignas(64) Row {
     Sums sums{};
   };
-  std::array<Row, detail::kCpuChunks> rows{};
+  std::array<Row, compute::detail::kCpuChunks> rows{};
   const std::size_t count = pairs.source->size();
-  detail::for_each_chunk(count, count, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+  compute::detail::for_each_chunk(count, count, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
     Sums& sums = rows[chunk].sums;
     sums[considered_slot] = static_cast<double>(for_each_pair_cpu(
         pairs, frame, begin, end, [&](auto&&... pair) { add_pair(sums, pair...); }));

@@ -8,7 +8,7 @@
 
 #include "kartograf/compute/kernel.hpp"
 #include "registration/association_checks.hpp"
-#include "registration/cpu_parallel.hpp"
+#include "compute/cpu_parallel.hpp"
 
 namespace kartograf::registration {
 
@@ -119,7 +119,7 @@ void associate_cpu(const Frame& frame, const CloudView& source, const CloudView&
   const std::size_t row_length =
       source.camera ? static_cast<std::size_t>(source.camera->width) : count;
   const std::size_t rows = (count + row_length - 1) / row_length;
-  detail::for_each_chunk(rows, count, [&](std::size_t first_row, std::size_t end_row, std::size_t) {
+  compute::detail::for_each_chunk(rows, count, [&](std::size_t first_row, std::size_t end_row, std::size_t) {
     for (std::size_t row = first_row; row < end_row; ++row) {
       const std::size_t start = row * row_length;
       const std::size_t end = std::min(count, start + row_length);

@@ -5,14 +5,14 @@
 #include <limits>
 #include <string>
 
+#include "compute/cpu_parallel.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/segment_moments.hpp"
-#include "registration/cpu_parallel.hpp"
 
 namespace kartograf::segmentation {
 namespace {
 
-static_assert(detail::kChunks == registration::detail::kCpuChunks);
+static_assert(detail::kChunks == compute::detail::kCpuChunks);
 
 // Rows per distance block: the block's k distances per row stay in cache (256 x 90 doubles).
 constexpr Eigen::Index kBlockRows = 256;
@@ -192,7 +192,7 @@ void for_each_distance_block(const FeatureMatrix& features, const CentreMatrix& 
   const Eigen::MatrixXd centres_t = centres.transpose();
   const Eigen::RowVectorXd centre_norms = centres.rowwise().squaredNorm().transpose();
   const auto rows = static_cast<std::size_t>(features.rows());
-  registration::detail::for_each_chunk(
+  compute::detail::for_each_chunk(
       rows, rows * static_cast<std::size_t>(centres.rows()),
       [&](std::size_t begin, std::size_t end, std::size_t chunk) {
         Eigen::MatrixXd block, distances;

@@ -6,9 +6,9 @@
 #include <random>
 #include <vector>
 
+#include "compute/cpu_parallel.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/segment_moments.hpp"
-#include "registration/cpu_parallel.hpp"
 
 namespace kartograf::segmentation {
 namespace {
@@ -46,7 +46,7 @@ CentreMatrix kmeans_plus_plus_seeds(const ClusteringFeatures& features, std::uin
     // Squared distance of every feature to its nearest centre so far, summed per chunk.
     std::array<double, detail::kChunks> chunk_totals{};
     const Eigen::RowVectorXd centre = centres.row(c);
-    registration::detail::for_each_chunk(
+    compute::detail::for_each_chunk(
         n, n, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
           double total = 0;
           for (std::size_t i = begin; i < end; ++i) {

@@ -1,7 +1,10 @@
 #include "kartograf/segmentation/lab_color.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
+
+#include "compute/cpu_parallel.hpp"
 
 namespace kartograf::segmentation {
 
@@ -48,7 +51,7 @@ struct LabTables {
   }
 
   float interpolated_f(float t) const {
-    const float x = std::fmin(std::fmax(t, 0.0f), kFMax) * (kFSamples / kFMax);
+    const float x = std::min(std::max(t, 0.0f), kFMax) * (kFSamples / kFMax);
     const int i = std::min(static_cast<int>(x), kFSamples);
     const float w = x - static_cast<float>(i);
     return f[i] + w * (f[i + 1] - f[i]);
@@ -74,23 +77,73 @@ Eigen::Vector3f rgb_to_lab(const Rgb8& rgb) {
           static_cast<float>(200.0 * (f[1] - f[2]))};
 }
 
-LabImage to_lab(const RgbImage& rgb) {
+namespace {
+
+// Round half to even of |v| <= 2^22 without a libm call: adding 1.5 * 2^23 leaves no fraction
+// bits, so the float addition rounds (as roundEven / convert_int_rte do).
+std::int16_t to_code(float value) {
+  constexpr float kShift = 12582912.0f;  // 1.5 * 2^23
+  constexpr float kClamp = 255.0f;
+  const float scaled = std::min(std::max(value, -kClamp), kClamp) * kLabCodeScale;
+  return static_cast<std::int16_t>((scaled + kShift) - kShift);
+}
+
+// Converts every pixel with the tables (on the CPU backend's threads); `store` receives the index
+// and (L*, a*, b*).
+template <class Store>
+void convert_pixels(const RgbImage& rgb, Store&& store) {
   const LabTables& tables = lab_tables();
-  LabImage lab(rgb.width(), rgb.height());
   const Rgb8* in = rgb.data();
+  compute::detail::for_each_chunk(
+      rgb.size(), rgb.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const float r = tables.linear[in[i][0]], g = tables.linear[in[i][1]],
+                      b = tables.linear[in[i][2]];
+          float f[3];
+          for (int row = 0; row < 3; ++row) {
+            const float* m = tables.matrix[row];
+            f[row] = tables.interpolated_f(m[0] * r + m[1] * g + m[2] * b);
+          }
+          store(i, 116.0f * f[1] - 16.0f, 500.0f * (f[0] - f[1]), 200.0f * (f[1] - f[2]));
+        }
+      });
+}
+
+}  // namespace
+
+LabImage to_lab(const RgbImage& rgb) {
+  LabImage lab(rgb.width(), rgb.height());
   Eigen::Vector4f* out = lab.data();
-  for (std::size_t i = 0; i < rgb.size(); ++i) {
-    const float r = tables.linear[in[i][0]], g = tables.linear[in[i][1]],
-                b = tables.linear[in[i][2]];
-    float f[3];
-    for (int row = 0; row < 3; ++row) {
-      const float* m = tables.matrix[row];
-      f[row] = tables.interpolated_f(m[0] * r + m[1] * g + m[2] * b);
-    }
-    out[i] = Eigen::Vector4f(116.0f * f[1] - 16.0f, 500.0f * (f[0] - f[1]), 200.0f * (f[1] - f[2]),
-                             0.0f);
-  }
+  convert_pixels(rgb, [out](std::size_t i, float l, float a, float b) {
+    out[i] = Eigen::Vector4f(l, a, b, 0.0f);
+  });
   return lab;
+}
+
+LabCodeImage to_lab_codes(const RgbImage& rgb) {
+  LabCodeImage codes;
+  to_lab_codes(rgb, codes);
+  return codes;
+}
+
+void to_lab_codes(const RgbImage& rgb, LabCodeImage& codes) {
+  if (codes.width() != rgb.width() || codes.height() != rgb.height())
+    codes = LabCodeImage(rgb.width(), rgb.height());
+  LabCode* out = codes.data();
+  convert_pixels(rgb, [out](std::size_t i, float l, float a, float b) {
+    out[i] = {to_code(l), to_code(a), to_code(b), 1};
+  });
+}
+
+LabCodeImage to_lab_codes(const LabImage& lab) {
+  LabCodeImage codes(lab.width(), lab.height());
+  for (std::size_t i = 0; i < lab.size(); ++i) {
+    const Eigen::Vector4f& v = lab.data()[i];
+    const bool valid = v.head<3>().allFinite();
+    codes.data()[i] =
+        valid ? LabCode{to_code(v.x()), to_code(v.y()), to_code(v.z()), 1} : LabCode{0, 0, 0, 0};
+  }
+  return codes;
 }
 
 }  // namespace kartograf::segmentation

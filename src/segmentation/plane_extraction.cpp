@@ -1,12 +1,14 @@
 #include "kartograf/segmentation/plane_extraction.hpp"
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <limits>
 #include <numeric>
 #include <string>
 
+#include "compute/cpu_parallel.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
 
 namespace kartograf::segmentation {
@@ -29,13 +31,24 @@ std::string size_text(int width, int height) {
 // The centre of the valid points' bounding box and the half extent (plus a margin), for the
 // fixed-point moments. False when no point is valid.
 bool moment_frame(const PointImage& points, Eigen::Vector3f& origin, float& max_offset) {
-  Eigen::Array3f lo = Eigen::Array3f::Constant(std::numeric_limits<float>::infinity());
-  Eigen::Array3f hi = -lo;
-  for (const Point4f& p : points.pixels()) {
-    if (!is_valid(p)) continue;
-    lo = lo.min(p.head<3>().array());
-    hi = hi.max(p.head<3>().array());
-  }
+  constexpr float kInfinity = std::numeric_limits<float>::infinity();
+  std::array<Eigen::Array3f, compute::detail::kCpuChunks> chunk_lo, chunk_hi;
+  chunk_lo.fill(Eigen::Array3f::Constant(kInfinity));
+  chunk_hi.fill(Eigen::Array3f::Constant(-kInfinity));
+  compute::detail::for_each_chunk(points.size(), points.size(),
+                                  [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+                                    Eigen::Array3f lo = chunk_lo[chunk], hi = chunk_hi[chunk];
+                                    for (std::size_t i = begin; i < end; ++i) {
+                                      const Point4f& p = points.data()[i];
+                                      if (!is_valid(p)) continue;
+                                      lo = lo.min(p.head<3>().array());
+                                      hi = hi.max(p.head<3>().array());
+                                    }
+                                    chunk_lo[chunk] = lo, chunk_hi[chunk] = hi;
+                                  });
+  Eigen::Array3f lo = chunk_lo[0], hi = chunk_hi[0];
+  for (std::size_t c = 1; c < chunk_lo.size(); ++c)
+    lo = lo.min(chunk_lo[c]), hi = hi.max(chunk_hi[c]);
   if (!(lo <= hi).all()) return false;
   require(lo.isFinite().all() && hi.isFinite().all(),
           "plane extraction: a point has an infinite coordinate");
@@ -44,19 +57,203 @@ bool moment_frame(const PointImage& points, Eigen::Vector3f& origin, float& max_
   return true;
 }
 
+// A pixel's point with what every plane's distance allowance there needs.
+struct PixelPoint {
+  Eigen::Vector3d p;
+  double inverse_range;  // 1 / |p|
+  double base;           // distance_base + distance_per_z2 z^2
+
+  PixelPoint(const Point4f& point, const PlaneMergeParams& params)
+      : p(point.head<3>().cast<double>()),
+        inverse_range(1.0 / p.norm()),
+        base(params.distance_base + params.distance_per_z2 * p.z() * p.z()) {}
+};
+
+// Distance of the pixel's point to the plane over the merge's distance allowance there (< 1:
+// within it); distance_allowance without its square root per plane.
+double plane_score(const SegmentPlane& plane, const PixelPoint& pixel,
+                   const PlaneMergeParams& params) {
+  const double along = plane.normal.dot(pixel.p);
+  const double facing = std::max(std::fabs(along) * pixel.inverse_range, params.min_facing_factor);
+  return std::fabs(along + plane.offset) / (pixel.base * facing);
+}
+
+// Pixels of segments along plane borders (left out of every plane, or touching another plane's
+// segments: mixed pieces along edges and creases) go to the plane, among their own and those of
+// the neighbouring segments, with the lowest score below 1; a plane's own pixels otherwise stay.
+// Plane fits are unchanged.
+void refine_border_pixels(const SegmentLabelImage& segments, const PointImage& points,
+                          const MergedPlanes& merged, const PlaneMergeParams& params,
+                          std::vector<std::uint32_t>& pixel_plane) {
+  const SegmentGraph& graph = merged.graph;
+  const auto segment_count = static_cast<std::uint32_t>(merged.segment_plane.size());
+  // Per segment, the other planes among its neighbours' (distinct, in graph order): segments
+  // with none are not on a border.
+  std::vector<std::uint32_t> candidate_start(std::size_t{segment_count} + 1, 0);
+  std::vector<std::uint32_t> candidates;
+  for (std::uint32_t s = 0; s < segment_count; ++s) {
+    const std::uint32_t own = merged.segment_plane[s];
+    const std::size_t first = candidates.size();
+    for (std::uint32_t k = graph.offsets[s]; k < graph.offsets[s + 1]; ++k) {
+      const std::uint32_t other = merged.segment_plane[graph.neighbours[k]];
+      if (other == geometry::kNoLabel || other == own ||
+          std::find(candidates.begin() + static_cast<std::ptrdiff_t>(first), candidates.end(),
+                    other) != candidates.end()) {
+        continue;
+      }
+      candidates.push_back(other);
+    }
+    candidate_start[s + 1] = static_cast<std::uint32_t>(candidates.size());
+  }
+  const std::uint32_t* segment = segments.data();
+  compute::detail::for_each_chunk(
+      segments.size(), segments.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (std::size_t i = begin; i < end; ++i) {
+          const std::uint32_t s = segment[i];
+          if (s == geometry::kNoLabel || candidate_start[s] == candidate_start[s + 1]) continue;
+          const PixelPoint p(points.data()[i], params);
+          const std::uint32_t own = pixel_plane[i];
+          double best = own == geometry::kNoLabel
+                            ? 1.0
+                            : std::min(1.0, plane_score(merged.planes[own], p, params));
+          for (std::uint32_t k = candidate_start[s]; k < candidate_start[s + 1]; ++k) {
+            const double score = plane_score(merged.planes[candidates[k]], p, params);
+            if (score < best) best = score, pixel_plane[i] = candidates[k];
+          }
+        }
+      });
+}
+
+// Planes grow pixel by pixel (breadth first) into valid pixels that no plane took, while a pixel
+// lies within the distance allowance of the plane it is reached from and its depth continues that
+// pixel's (|dz| <= max_depth_jump z; 0: no test). Dark or finely textured surfaces fall apart into
+// colour segments too small to merge, and on dark ones most pixels have no depth: the growth
+// reaches up to kFloodRadius pixels, across the gaps.
+void flood_unassigned_pixels(const PointImage& points, const std::vector<SegmentPlane>& planes,
+                             const PlaneMergeParams& params, float max_depth_jump,
+                             std::vector<std::uint32_t>& pixel_plane,
+                             std::vector<std::uint32_t>& queue,
+                             std::vector<std::uint8_t>& source_mask) {
+  constexpr int kFloodRadius = 2;
+  const int width = points.width(), height = points.height();
+  const Point4f* point = points.data();
+  const auto open = [&](std::size_t j) {
+    return pixel_plane[j] == geometry::kNoLabel && is_valid(point[j]);
+  };
+  // Sources: plane pixels within the radius of an unassigned valid pixel, in pixel order.
+  std::vector<std::uint8_t>& source = source_mask;
+  source.assign(pixel_plane.size(), 0);
+  for (std::size_t i = 0; i < pixel_plane.size(); ++i) {
+    if (!open(i)) continue;
+    const int x = static_cast<int>(i % static_cast<std::size_t>(width));
+    const int y = static_cast<int>(i / static_cast<std::size_t>(width));
+    for (int ny = std::max(0, y - kFloodRadius); ny <= std::min(height - 1, y + kFloodRadius);
+         ++ny) {
+      for (int nx = std::max(0, x - kFloodRadius); nx <= std::min(width - 1, x + kFloodRadius);
+           ++nx) {
+        const std::size_t j = static_cast<std::size_t>(ny) * width + nx;
+        if (pixel_plane[j] != geometry::kNoLabel) source[j] = 1;
+      }
+    }
+  }
+  queue.clear();
+  for (std::size_t i = 0; i < pixel_plane.size(); ++i) {
+    if (source[i]) queue.push_back(static_cast<std::uint32_t>(i));
+  }
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const std::uint32_t i = queue[head];
+    const SegmentPlane& plane = planes[pixel_plane[i]];
+    const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
+    const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
+    const float depth = point[i].z();
+    for (int ny = std::max(0, y - kFloodRadius); ny <= std::min(height - 1, y + kFloodRadius);
+         ++ny) {
+      for (int nx = std::max(0, x - kFloodRadius); nx <= std::min(width - 1, x + kFloodRadius);
+           ++nx) {
+        const std::uint32_t j = static_cast<std::uint32_t>(ny * width + nx);
+        if (!open(j)) continue;
+        if (max_depth_jump > 0.0f && std::fabs(point[j].z() - depth) > max_depth_jump * depth)
+          continue;
+        if (plane_score(plane, PixelPoint(point[j], params), params) >= 1.0) continue;
+        pixel_plane[j] = pixel_plane[i];
+        queue.push_back(j);
+      }
+    }
+  }
+}
+
+// Connected regions of valid pixels that no plane took (up to kFloodRadius pixels apart, with
+// continuous depth) that are planar become planes of their own: on dark surfaces most pixels have
+// no depth, so colour growing over 8-neighbours leaves only crumbs that never seed a plane.
+void plane_leftover_regions(const PointImage& points, const PlaneExtractionParams& params,
+                            std::vector<std::uint32_t>& pixel_plane,
+                            std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region) {
+  constexpr int kFloodRadius = 2;
+  const int width = points.width(), height = points.height();
+  const Point4f* point = points.data();
+  const float jump = params.growing.max_depth_jump;
+  const double min_facing = std::cos(params.merge.max_incidence_deg * M_PI / 180.0);
+  constexpr std::uint32_t kVisited = geometry::kNoLabel - 1;  // in no plane, checked
+  for (std::size_t seed = 0; seed < pixel_plane.size(); ++seed) {
+    if (pixel_plane[seed] != geometry::kNoLabel || !is_valid(point[seed])) continue;
+    region.assign(1, static_cast<std::uint32_t>(seed));
+    pixel_plane[seed] = kVisited;
+    geometry::SegmentMoments moments;
+    const Eigen::Vector3d origin = point[seed].head<3>().cast<double>();
+    for (std::size_t head = 0; head < region.size(); ++head) {
+      const std::uint32_t i = region[head];
+      const Eigen::Vector3d d = point[i].head<3>().cast<double>() - origin;
+      ++moments.count;
+      moments.sum += d;
+      moments.sum_outer += d * d.transpose();
+      const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
+      const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
+      const float depth = point[i].z();
+      for (int ny = std::max(0, y - kFloodRadius); ny <= std::min(height - 1, y + kFloodRadius);
+           ++ny) {
+        for (int nx = std::max(0, x - kFloodRadius); nx <= std::min(width - 1, x + kFloodRadius);
+             ++nx) {
+          const std::uint32_t j = static_cast<std::uint32_t>(ny * width + nx);
+          if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) continue;
+          if (jump > 0.0f && std::fabs(point[j].z() - depth) > jump * depth) continue;
+          pixel_plane[j] = kVisited;
+          region.push_back(j);
+        }
+      }
+    }
+    if (moments.count < params.min_plane_pixels) continue;
+    const SegmentPlane plane = fit_plane(moments, origin, params.merge.fit);
+    if (!plane.valid ||
+        plane.rms_error > distance_allowance(params.merge, plane.centroid, plane.normal) ||
+        std::fabs(plane.normal.dot(plane.centroid)) < min_facing * plane.centroid.norm()) {
+      continue;
+    }
+    const auto index = static_cast<std::uint32_t>(planes.size());
+    planes.push_back(plane);
+    for (const std::uint32_t i : region) {
+      if (plane_score(plane, PixelPoint(point[i], params.merge), params.merge) < 1.0)
+        pixel_plane[i] = index;
+    }
+  }
+  for (std::uint32_t& p : pixel_plane) {
+    if (p == kVisited) p = geometry::kNoLabel;
+  }
+}
+
 }  // namespace
 
 void PlaneExtractionParams::validate() const {
-  require(std::isfinite(growing.lab_threshold) && growing.lab_threshold > 0,
-          "plane extraction: growing.lab_threshold must be positive");
-  require(std::isfinite(growing.max_depth_jump) && growing.max_depth_jump >= 0,
-          "plane extraction: growing.max_depth_jump must be >= 0");
+  growing.validate();
   merge.validate();
 }
 
 PlaneExtractor::PlaneExtractor(const compute::Context& context, const PinholeIntrinsics& intrinsics,
                                const PlaneExtractionParams& params)
-    : context_(&context), intrinsics_(intrinsics), params_(params), fitter_(context) {
+    : context_(&context),
+      intrinsics_(intrinsics),
+      params_(params),
+      grower_(context),
+      fitter_(context) {
   intrinsics.validate("plane extraction");
   params.validate();
 }
@@ -76,65 +273,57 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
   PlaneSet result;
   result.labels = LabelImage(width, height, kUnlabeled);
   Clock::time_point clock = Clock::now();
-  const LabImage lab = to_lab(rgb);
+  to_lab_codes(rgb, lab_);
+  const LabCodeImage& lab = lab_;
   result.timings.lab = elapsed_ms(clock);
-  const SegmentLabelImage segments = grow_regions_lab(lab, points, params_.growing);
-  result.segment_count = segment_count(segments);
-  result.timings.growing = elapsed_ms(clock);
 
+  // Segments and their moments: on the CPU backend summed as the segments grow, on a device
+  // with the labels left there for the moments and downloaded once.
   Eigen::Vector3f origin;
   float max_offset = 0;
-  if (result.segment_count == 0 || !moment_frame(points, origin, max_offset)) return result;
-  if (points_.size() != points.size()) points_ = compute::Buffer<Point4f>(*context_, points.size());
-  points_.upload(points.pixels());
-  const geometry::SegmentMomentSet moments =
-      fitter_.moments(points_, segments.pixels(), result.segment_count, origin, max_offset);
-  result.timings.moments = elapsed_ms(clock);
+  if (!moment_frame(points, origin, max_offset)) return result;  // no valid point
+  const bool on_host = context_->is_cpu();
+  geometry::SegmentMomentSet moments;
+  if (on_host) {
+    moments.origin = origin.cast<double>();
+    result.segment_count =
+        grow_regions(lab, points, params_.growing, segments_, &statistics_, &moments.origin);
+    moments.segments = std::move(statistics_.moments);
+  } else {
+    if (points_.size() != points.size())
+      points_ = compute::Buffer<Point4f>(*context_, points.size());
+    points_.upload(points.pixels());
+    result.segment_count = grower_.grow(lab, points_, params_.growing, &statistics_.colours);
+  }
+  const SegmentLabelImage& segments = on_host ? segments_ : grower_.host_labels();
+  result.timings.growing = elapsed_ms(clock);
+  if (result.segment_count == 0) return result;
+  if (!on_host) {
+    moments = fitter_.moments(points_, grower_.labels(), segments.pixels(), result.segment_count,
+                              origin, max_offset);
+    result.timings.moments = elapsed_ms(clock);
+  }
 
-  const MergedPlanes merged = merge_segments(segments, moments, params_.merge);
+  MergedPlanes merged =
+      merge_segments(segments, moments, params_.merge, {statistics_.colours, &points});
   result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
   result.timings.merging = elapsed_ms(clock);
 
-  // Pixel refinement along plane borders: a pixel of a segment that no plane took (mixed pieces
-  // along edges and creases) or that touches a segment of another plane goes to the plane, among
-  // its own and those of the neighbouring segments, nearest in distance over allowance (< 1; a
-  // plane's own pixels otherwise stay). Plane fits are unchanged.
-  const std::size_t pixel_count = segments.size();
-  const std::uint32_t* segment = segments.data();
-  const Point4f* point = points.data();
   std::vector<std::uint32_t>& pixel_plane = pixel_plane_;
-  pixel_plane.assign(pixel_count, geometry::kNoLabel);
-  for (std::size_t i = 0; i < pixel_count; ++i) {
-    if (segment[i] != geometry::kNoLabel) pixel_plane[i] = merged.segment_plane[segment[i]];
+  pixel_plane.assign(segments.size(), geometry::kNoLabel);
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const std::uint32_t s = segments.data()[i];
+    if (s != geometry::kNoLabel) pixel_plane[i] = merged.segment_plane[s];
   }
   if (params_.refine_pixels) {
-    const SegmentGraph& graph = merged.graph;
-    std::vector<std::uint8_t> on_border(result.segment_count, 0);
-    for (std::uint32_t s = 0; s < result.segment_count; ++s) {
-      const std::uint32_t own = merged.segment_plane[s];
-      for (std::uint32_t k = graph.offsets[s]; k < graph.offsets[s + 1] && !on_border[s]; ++k) {
-        const std::uint32_t other = merged.segment_plane[graph.neighbours[k]];
-        on_border[s] = other != geometry::kNoLabel && other != own;
-      }
-    }
-    for (std::size_t i = 0; i < pixel_count; ++i) {
-      if (segment[i] == geometry::kNoLabel || !on_border[segment[i]]) continue;
-      const Eigen::Vector3d p = point[i].head<3>().cast<double>();
-      const auto score = [&](std::uint32_t candidate) {
-        const SegmentPlane& plane = merged.planes[candidate];
-        return std::fabs(plane.normal.dot(p) + plane.offset) /
-               distance_allowance(params_.merge, p, plane.normal);
-      };
-      const std::uint32_t own = pixel_plane[i];
-      double best = own == geometry::kNoLabel ? 1.0 : std::min(1.0, score(own));
-      for (std::uint32_t k = graph.offsets[segment[i]]; k < graph.offsets[segment[i] + 1]; ++k) {
-        const std::uint32_t candidate = merged.segment_plane[graph.neighbours[k]];
-        if (candidate == geometry::kNoLabel || candidate == own) continue;
-        const double candidate_score = score(candidate);
-        if (candidate_score < best) best = candidate_score, pixel_plane[i] = candidate;
-      }
-    }
+    refine_border_pixels(segments, points, merged, params_.merge, pixel_plane);
+    flood_unassigned_pixels(points, merged.planes, params_.merge, params_.growing.max_depth_jump,
+                            pixel_plane, flood_queue_, flood_sources_);
+    plane_leftover_regions(points, params_, pixel_plane, merged.planes, flood_queue_);
   }
+  result.timings.refinement = elapsed_ms(clock);
+  const std::size_t pixel_count = segments.size();
+  const Point4f* point = points.data();
 
   // Output planes: valid, large enough, by decreasing size (then merge order), ids 1..n.
   std::vector<std::uint64_t> pixels_of(merged.planes.size(), 0);
@@ -163,24 +352,46 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
     result.planes.push_back(plane);
     plane_label[kept[k]] = plane.id;
   }
-  std::vector<double> squared_error(kept.size(), 0.0);
+  // Labels, extents, inlier counts and errors: per chunk, combined in chunk order (the same
+  // sums for any thread count).
+  struct PlaneSums {
+    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+    Eigen::Vector2d hi = -lo;
+    double squared_error = 0;
+    std::uint64_t count = 0;
+  };
+  std::array<std::vector<PlaneSums>, compute::detail::kCpuChunks> chunk_sums;
   Label* out = result.labels.data();
-  for (std::size_t i = 0; i < pixel_count; ++i) {
-    if (pixel_plane[i] == geometry::kNoLabel || plane_label[pixel_plane[i]] == kUnlabeled) continue;
-    const Label id = plane_label[pixel_plane[i]];
-    out[i] = id;
-    Plane& plane = result.planes[id - 1];
-    const Eigen::Vector3d d = point[i].head<3>().cast<double>() - plane.centroid;
-    const Eigen::Vector2d uv(d.dot(plane.major_axis), d.dot(plane.minor_axis));
-    plane.extent_min = plane.extent_min.cwiseMin(uv);
-    plane.extent_max = plane.extent_max.cwiseMax(uv);
-    const double distance = d.dot(plane.normal);
-    squared_error[id - 1] += distance * distance;
-    ++plane.inlier_count;
-  }
+  compute::detail::for_each_chunk(
+      pixel_count, pixel_count, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+        std::vector<PlaneSums>& sums = chunk_sums[chunk];
+        sums.assign(kept.size(), PlaneSums{});
+        for (std::size_t i = begin; i < end; ++i) {
+          if (pixel_plane[i] == geometry::kNoLabel) continue;
+          const Label id = plane_label[pixel_plane[i]];
+          if (id == kUnlabeled) continue;
+          out[i] = id;
+          const Plane& plane = result.planes[id - 1];
+          PlaneSums& sum = sums[id - 1];
+          const Eigen::Vector3d d = point[i].head<3>().cast<double>() - plane.centroid;
+          const Eigen::Vector2d uv(d.dot(plane.major_axis), d.dot(plane.minor_axis));
+          sum.lo = sum.lo.cwiseMin(uv);
+          sum.hi = sum.hi.cwiseMax(uv);
+          const double distance = d.dot(plane.normal);
+          sum.squared_error += distance * distance;
+          ++sum.count;
+        }
+      });
   for (Plane& plane : result.planes) {
-    plane.rms_error =
-        std::sqrt(squared_error[plane.id - 1] / static_cast<double>(plane.inlier_count));
+    double squared_error = 0;
+    for (const std::vector<PlaneSums>& sums : chunk_sums) {
+      const PlaneSums& sum = sums[plane.id - 1];
+      plane.extent_min = plane.extent_min.cwiseMin(sum.lo);
+      plane.extent_max = plane.extent_max.cwiseMax(sum.hi);
+      squared_error += sum.squared_error;
+      plane.inlier_count += sum.count;
+    }
+    plane.rms_error = std::sqrt(squared_error / static_cast<double>(plane.inlier_count));
   }
   result.timings.output = elapsed_ms(clock);
   return result;

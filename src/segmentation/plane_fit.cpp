@@ -30,6 +30,8 @@ void orient_and_finish(const Eigen::Vector3d& normal, const Eigen::Vector3d& maj
   if (u.squaredNorm() < 1e-24) u = plane.normal.unitOrthogonal();
   plane.major_axis = u.normalized();
   plane.minor_axis = plane.normal.cross(plane.major_axis);
+  plane.major_sigma = std::sqrt(std::max(0.0, plane.major_axis.dot(covariance * plane.major_axis)));
+  plane.minor_sigma = std::sqrt(std::max(0.0, plane.minor_axis.dot(covariance * plane.minor_axis)));
   plane.valid = true;
 }
 
@@ -44,7 +46,10 @@ SegmentPlane fit_plane(const geometry::SegmentMoments& moments, const Eigen::Vec
   const Eigen::Matrix3d covariance = covariance_of(moments);
   const Eigen::Vector3d centroid = origin + moments.sum / n;
 
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver(covariance);
+  // The closed-form 3x3 solver: several times faster than the iterative one, and accurate here
+  // (the plane's normal is the eigenvector of the smallest eigenvalue of a well-separated trio).
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> solver;
+  solver.computeDirect(covariance);
   const Eigen::Vector3d eigenvalues = solver.eigenvalues();  // ascending
   if (!(eigenvalues(2) > 0.0) || eigenvalues(1) <= params.degenerate_ratio * eigenvalues(2)) {
     return plane;  // coincident or collinear points: no unique plane
@@ -85,6 +90,23 @@ std::vector<SegmentPlane> fit_planes(const geometry::SegmentMomentSet& moments,
 
 SegmentPlaneFitter::SegmentPlaneFitter(const compute::Context& context)
     : context_(&context), reducer_(context) {}
+
+geometry::SegmentMomentSet SegmentPlaneFitter::moments(
+    const compute::Buffer<Point4f>& points, const compute::Buffer<std::uint32_t>& device_labels,
+    std::span<const std::uint32_t> host_labels, std::uint32_t segment_count,
+    const Eigen::Vector3f& origin, float max_offset) {
+  require(device_labels.size() == host_labels.size() && points.size() == host_labels.size(),
+          "segment plane fit: " + std::to_string(points.size()) + " points but " +
+              std::to_string(device_labels.size()) + " device and " +
+              std::to_string(host_labels.size()) + " host labels");
+  if (segment_count == 0 || segment_count > geometry::kMaxSegmentLabels || points.empty())
+    return moments(points, host_labels, segment_count, origin, max_offset);
+  geometry::SegmentMomentParams params;
+  params.origin = origin;
+  params.max_offset = max_offset;
+  params.label_count = segment_count;
+  return reducer_.run(points, device_labels, params);
+}
 
 geometry::SegmentMomentSet SegmentPlaneFitter::moments(const compute::Buffer<Point4f>& points,
                                                        std::span<const std::uint32_t> labels,

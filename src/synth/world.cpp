@@ -19,6 +19,9 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numeric>
+#include <cmath>
+#include <numeric>
 #include <string>
 
 #include <Eigen/Geometry>
@@ -544,6 +547,50 @@ std::string to_string(FurnitureKind kind) {
       return "crate";
   }
   return "cabinet";
+}
+
+std::vector<Label> continuous_surface_ids(const World& world) {
+  constexpr double kTolerance = 1e-6;  // metres: layout coordinates are exact multiples of 5 mm
+  std::vector<Label> root(world.planes.size() + 1);
+  std::iota(root.begin(), root.end(), Label{0});
+  const auto find = [&](Label id) {
+    while (root[id] != id) id = root[id] = root[root[id]];
+    return id;
+  };
+  // Axis-aligned bounds of every polygon (the world's faces are axis-aligned rectangles, so two
+  // coplanar ones touch exactly when their bounds do).
+  std::vector<std::vector<Box3>> bounds(world.planes.size());
+  for (std::size_t i = 0; i < world.planes.size(); ++i) {
+    for (const auto& polygon : world.planes[i].polygons) {
+      Box3 box{polygon.front(), polygon.front()};
+      for (const Eigen::Vector3d& v : polygon) {
+        box.min = box.min.cwiseMin(v);
+        box.max = box.max.cwiseMax(v);
+      }
+      bounds[i].push_back(box);
+    }
+  }
+  const auto touch = [&](const Box3& a, const Box3& b) {
+    return ((a.min.array() - kTolerance) <= b.max.array()).all() &&
+           ((b.min.array() - kTolerance) <= a.max.array()).all();
+  };
+  for (std::size_t i = 0; i < world.planes.size(); ++i) {
+    for (std::size_t j = i + 1; j < world.planes.size(); ++j) {
+      const Plane& a = world.planes[i];
+      const Plane& b = world.planes[j];
+      if (a.normal.dot(b.normal) < 1.0 - 1e-9 || std::fabs(a.offset - b.offset) > kTolerance)
+        continue;
+      bool touching = false;
+      for (const Box3& box_a : bounds[i]) {
+        for (const Box3& box_b : bounds[j]) touching = touching || touch(box_a, box_b);
+      }
+      if (!touching) continue;
+      const Label ra = find(a.id), rb = find(b.id);
+      root[std::max(ra, rb)] = std::min(ra, rb);
+    }
+  }
+  for (Label id = 1; id < root.size(); ++id) root[id] = find(id);
+  return root;
 }
 
 double Plane::area() const {

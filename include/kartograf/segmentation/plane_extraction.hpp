@@ -19,14 +19,17 @@ namespace kartograf::segmentation {
 
 struct PlaneExtractionParams {
   // The paper's Lab growing (threshold 15) with two variants on, tuned on synthetic Kinect frames:
-  // 16 px tiles (a segment cannot span a crease between two planes of one colour) and a 5 %
-  // depth-jump test (nor an occlusion edge).
-  RegionGrowingParams growing{.lab_threshold = 15.0f, .max_depth_jump = 0.05f, .tile_size = 16};
+  // 16 px tiles (a segment cannot span a crease between two planes of one colour) and a 2 %
+  // depth-jump test (nor an occlusion edge or a step: a table leg set 4 cm back from the top's
+  // edge at 1.5 m).
+  RegionGrowingParams growing{.lab_threshold = 15.0f, .max_depth_jump = 0.02f, .tile_size = 16};
   PlaneMergeParams merge;
   std::uint64_t min_plane_pixels = 300;  // smaller merged planes are dropped (their pixels: 0)
   // Pixels along plane borders (in segments left out of every plane, or touching another plane's
   // segments) go to the nearest plane among their own and the neighbouring segments', within the
   // merge distance allowance: mixed segments along edges and creases are split between planes.
+  // Then planes grow pixel by pixel into the valid pixels no plane took, within the allowance
+  // and without crossing a depth jump (growing.max_depth_jump).
   bool refine_pixels = true;
 
   void validate() const;  // throws Error naming the first bad field
@@ -52,8 +55,13 @@ struct Plane {
 };
 
 struct PlaneExtractionTimings {  // milliseconds, host wall clock
-  double lab = 0, growing = 0, moments = 0, merging = 0, output = 0;
-  double total() const { return lab + growing + moments + merging + output; }
+  double lab = 0;
+  double growing = 0;  // CPU backend: with the moments, summed as the segments grow
+  double moments = 0;  // device backends: the moment reduction
+  double merging = 0;
+  double refinement = 0;  // border pixels, growth into left-over pixels, left-over planes
+  double output = 0;      // plane records and the label image
+  double total() const { return lab + growing + moments + merging + refinement + output; }
 };
 
 struct PlaneSet {
@@ -80,9 +88,15 @@ class PlaneExtractor {
   const compute::Context* context_;
   PinholeIntrinsics intrinsics_;
   PlaneExtractionParams params_;
+  RegionGrower grower_;
   SegmentPlaneFitter fitter_;
-  compute::Buffer<Point4f> points_;
-  std::vector<std::uint32_t> pixel_plane_;  // scratch: merged plane per pixel
+  compute::Buffer<Point4f> points_;          // device backends: the frame's points
+  LabCodeImage lab_;                         // the frame's colours (host)
+  SegmentLabelImage segments_;               // the frame's segments (host)
+  std::vector<std::uint32_t> pixel_plane_;   // scratch: merged plane per pixel
+  std::vector<std::uint32_t> flood_queue_;   // scratch: pixels to grow planes from
+  std::vector<std::uint8_t> flood_sources_;  // scratch: which pixels start the growth
+  SegmentStatistics statistics_;             // scratch: colours (and CPU: moments) per segment
 };
 
 }  // namespace kartograf::segmentation

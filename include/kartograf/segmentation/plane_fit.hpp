@@ -40,6 +40,10 @@ struct SegmentPlane {
   // In-plane axes (unit; major spread first): with normal they form a right-handed basis.
   Eigen::Vector3d major_axis = Eigen::Vector3d::Zero();
   Eigen::Vector3d minor_axis = Eigen::Vector3d::Zero();
+  // Standard deviation of the points along each in-plane axis [m] (a uniform strip of width w
+  // has w / sqrt(12)).
+  double major_sigma = 0;
+  double minor_sigma = 0;
 };
 
 // Moments relative to `origin` (a geometry::SegmentMomentSet's origin).
@@ -63,6 +67,13 @@ class SegmentPlaneFitter {
   // per coordinate. Throws Error on bad input.
   geometry::SegmentMomentSet moments(const compute::Buffer<Point4f>& points,
                                      std::span<const std::uint32_t> labels,
+                                     std::uint32_t segment_count, const Eigen::Vector3f& origin,
+                                     float max_offset);
+  // The same with the labels already on this context (device_labels; host_labels holds the same
+  // values, read only when there are more labels than one device pass takes).
+  geometry::SegmentMomentSet moments(const compute::Buffer<Point4f>& points,
+                                     const compute::Buffer<std::uint32_t>& device_labels,
+                                     std::span<const std::uint32_t> host_labels,
                                      std::uint32_t segment_count, const Eigen::Vector3f& origin,
                                      float max_offset);
 

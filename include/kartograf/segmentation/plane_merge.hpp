@@ -3,27 +3,35 @@
 // over segments with a stack: the largest unmerged segment that may seed a plane starts one, and
 // its neighbours join while they pass the tests against the plane merged so far, which is re-fitted
 // from the summed moments (moments are additive) as it grows. The tests:
-//  - normal angle (the paper's): for segments large enough to have a reliable normal, the angle to
-//    the merged plane's normal is below max_normal_angle_deg;
+//  - normal angle (the paper's): for segments large enough to have a normal, the angle to the
+//    merged plane's normal is below max_normal_angle_deg, widened by the normal's uncertainty
+//    (normal_uncertainty_deg: a narrow strip, or a slanted far surface that the sensor's depth
+//    quantization turns into bands of constant depth, has a normal that noise can tilt far);
 //  - distance (ours; the paper's fit-error test in a form that also rejects parallel but offset
 //    planes): the RMS distance of the segment's points to the merged plane, exact from the
 //    moments, is below the allowance (a + b z^2) max(cos t, f) at the segment's centroid (depth
-//    z, incidence t on the plane: depth noise is along the viewing ray), and its centroid within
-//    offset_base + a fraction of that allowance of the plane;
+//    z, incidence t on the plane: depth noise is along the viewing ray) and below
+//    max_joint_rms_growth times its own fit error (or the noise there), and its centroid lies
+//    within offset_allowance of the plane;
 //  - pixel count and fit error (the paper's): only a segment with at least min_seed_pixels points
 //    and its own fit error within the allowance starts a plane.
-// A second pass joins neighbouring merged planes, best pair first, while the plane fitted to both
-// stays within the allowance (and so does each part) and within the angle of both parts: it repairs
-// planes that the first pass split because a noisy seed or a far, noisy surface stopped the growth.
+// A second pass joins merged planes, best pair first, while the plane fitted to both stays within
+// the allowance and the RMS growth (and so does each part) and within the widened angle of both
+// parts: it repairs planes that the first pass split because a noisy seed or a far, noisy surface
+// stopped the growth. Planes that do not touch (a wall cut in two by an occluder) also join when
+// nearly parallel, alike in colour, and not seen through (see the join_apart fields).
 // Planes seen at more than max_incidence_deg from face-on (the surfaces of flying pixels along
 // depth edges contain the camera centre) never seed. Neighbours are segments with 8-adjacent pixels
 // (default) or, as in the paper, overlapping bounding rectangles. Deterministic: the order is fixed
 // by size, then label.
 #include <cstdint>
+#include <span>
 #include <vector>
 
+#include "kartograf/core/point_image.hpp"
 #include "kartograf/segmentation/plane_fit.hpp"
 #include "kartograf/segmentation/region_growing.hpp"
+#include "kartograf/segmentation/segment_graph.hpp"
 
 namespace kartograf::segmentation {
 
@@ -50,12 +58,36 @@ struct PlaneMergeParams {
   double max_offset_fraction = 0.2;
   // [m] added to that between touching segments: real sensors bend planes by a few mm.
   double offset_base = 0.005;
+  // Depth quantization step [m] at depth z: depth_step_per_z2 * z^2 (a structured-light sensor
+  // quantizes disparity: z^2 / (f b s) for focal length f [px], baseline b [m] and 1/s pixel
+  // disparity steps; Kinect: 1 / (525 * 0.075 * 8)). Half a step adds to the offset allowance:
+  // a small piece of a slanted far surface can lie on one quantization level.
+  double depth_step_per_z2 = 0.0032;
   double max_incidence_deg = 80.0;  // angle between the normal and the ray to the centroid
   bool join_planes = true;          // the second pass
+  // The RMS distance of a joining piece to the plane (first pass: a segment with a fit; second
+  // pass: the joint fit of two planes) stays within this multiple of the pieces' own RMS errors,
+  // or within depth_noise there: a step or a crease shows here even when it hides within the
+  // allowance.
+  double max_joint_rms_growth = 2.0;
   // Also join planes that do not touch (a wall cut in two by a doorway or an occluder) when their
   // normals are within max_apart_angle_deg.
   bool join_apart = true;
   double max_apart_angle_deg = 10.0;
+  std::uint64_t min_apart_pixels = 100;  // smaller planes only join planes they touch
+  // ... and, when segment colours are given, when their mean CIE-Lab colours are within this
+  // distance: two pieces of one surface look alike, while a door leaf flat on a wall or the walls
+  // of two rooms in one plane seen through a doorway do not (measured: the two halves of the
+  // table in PCL's mOSD test55 differ by 13 under uneven light; differently painted coplanar
+  // walls of the synthetic world by 20 to 23).
+  double max_apart_colour_distance = 18.0;
+  // ... and, when the points are given and the camera sees through the joint plane (a point
+  // behind it) at more than max_see_through_fraction of the valid pixels on the image line
+  // between the two pieces, only when their colours are within max_see_through_colour_distance
+  // (without colours: never). Behind an occluder a wall goes on; through a gap one sees either a
+  // doorway in one wall, whose two sides keep the wall's exact colour, or two coplanar objects.
+  double max_see_through_fraction = 0.25;
+  double max_see_through_colour_distance = 6.0;
   PlaneFitParams fit;
 
   void validate() const;  // throws Error naming the first bad field
@@ -65,26 +97,40 @@ struct PlaneMergeParams {
 double distance_allowance(const PlaneMergeParams& params, const Eigen::Vector3d& point,
                           const Eigen::Vector3d& normal);
 
-// Segment adjacency as compressed rows: the neighbours of segment s are
-// neighbours[offsets[s] .. offsets[s + 1]), ascending.
-struct SegmentGraph {
-  std::vector<std::uint32_t> offsets;
-  std::vector<std::uint32_t> neighbours;
-};
+// How far [m] the centroid of a piece at `point` may lie from a plane with unit `normal` it joins:
+// offset_base (between touching pieces) + max_offset_fraction of the distance allowance + half a
+// depth quantization step (along the ray, so scaled like the allowance).
+double offset_allowance(const PlaneMergeParams& params, const Eigen::Vector3d& point,
+                        const Eigen::Vector3d& normal, bool touching);
 
-SegmentGraph pixel_adjacency_graph(const SegmentLabelImage& labels, std::uint32_t segment_count);
-SegmentGraph bounding_box_graph(const SegmentLabelImage& labels, std::uint32_t segment_count);
+// The depth-dependent part of the distance allowance at `point` for a plane with unit `normal`:
+// distance_per_z2 z^2, scaled by the incidence like the allowance [m].
+double depth_noise(const PlaneMergeParams& params, const Eigen::Vector3d& point,
+                   const Eigen::Vector3d& normal);
+
+// The angle [deg] by which depth noise at the plane's centroid can tilt its fitted normal:
+// atan(depth_noise / half-width along the minor axis).
+double normal_uncertainty_deg(const PlaneMergeParams& params, const SegmentPlane& plane);
 
 struct MergedPlanes {
   std::vector<std::uint32_t> segment_plane;       // per segment: merged plane index or kNoLabel
   std::vector<geometry::SegmentMoments> moments;  // per merged plane: summed moments
-  std::vector<SegmentPlane> planes;               // per merged plane: the re-fit
-  SegmentGraph graph;                             // the segments' neighbours
+  // Per merged plane: the sum of its segments' mean colours times their pixel counts (empty when
+  // merge_segments was given no colours).
+  std::vector<Eigen::Vector3d> colour_sums;
+  std::vector<SegmentPlane> planes;  // per merged plane: the re-fit
+  SegmentGraph graph;                // the segments' neighbours
+};
+
+// What merging may use besides the labels and moments (all optional).
+struct MergeInputs {
+  std::span<const Eigen::Vector3f> colours;  // each segment's mean CIE-Lab (planes apart)
+  const PointImage* points = nullptr;        // the organized cloud of the labels (see-through)
 };
 
 // moments.segments and the label image cover the same segment_count segments.
 MergedPlanes merge_segments(const SegmentLabelImage& labels,
                             const geometry::SegmentMomentSet& moments,
-                            const PlaneMergeParams& params);
+                            const PlaneMergeParams& params, const MergeInputs& inputs = {});
 
 }  // namespace kartograf::segmentation

@@ -153,6 +153,12 @@ struct World {
   std::vector<Rect2> obstacle_footprints() const;
 };
 
+// Continuous planar surfaces: for every plane id (index = id, entry 0 unused), the smallest id of
+// the planes that form one surface with it: coplanar planes whose polygons touch or overlap, such
+// as a table leg flush with the edge of the top. Solids model such faces apart, yet they are one
+// plane to any sensor; plane-segmentation scores count them as one.
+std::vector<Label> continuous_surface_ids(const World& world);
+
 // The building for `seed`. Throws Error when the options are inconsistent.
 World make_building(std::uint64_t seed, const BuildingOptions& options = {});
 

@@ -1,6 +1,6 @@
 #pragma once
-// The CPU backend's data parallelism for the ICP hot loops: a fixed number of contiguous chunks,
-// run on KARTOGRAF_CPU_THREADS threads (default 1). Per-chunk results combined in chunk order do
+// The CPU backend's data parallelism for the hot loops of the operations: a fixed number of
+// contiguous chunks, run on KARTOGRAF_CPU_THREADS threads (default 1). Per-chunk results combined in chunk order do
 // not depend on the thread count or on scheduling, so sums are identical for any setting.
 //
 // Why one thread by default: on a machine shared with other work (this project's 2-core build
@@ -17,7 +17,7 @@
 
 #include "kartograf/core/error.hpp"
 
-namespace kartograf::registration::detail {
+namespace kartograf::compute::detail {
 
 inline constexpr std::size_t kCpuChunks = 8;
 
@@ -54,4 +54,4 @@ void for_each_chunk(std::size_t count, std::size_t work, Body&& body) {
   worker();
 }
 
-}  // namespace kartograf::registration::detail
+}  // namespace kartograf::compute::detail
