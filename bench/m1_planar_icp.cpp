@@ -11,11 +11,20 @@
 // the planar poses and by the all-point poses, over every frame) and both ATEs against the
 // ground truth.
 //
+// The planar method's segments come from the Lab region growing and merging (default) or, for
+// the paper's baselines (Tables 3-9), from K-Means, SOM or Fuzzy C-Means clustering of the 6-D
+// features with one plane fitted per cluster; the clustering time is reported per frame.
+// --tables prints the paper's Tables 1-2 instead: segments per Lab threshold (the paper's untiled
+// growing and the tiled one) and planes per Lab threshold and normal angle, means over the frames.
+//
 //   kartograf_m1_planar_icp [--sequence DIR] [--frames 25] [--gaps 1] [--points-per-plane 200]
+//                           [--segmentation lab|kmeans|som|fcm --k 30 --feature-stride 2]
 //   e.g. the paper's second experiment: --frames 61 --gaps 1,2,3,4,5
+//        Tables 1-2 on 10 frames: --tables --frames 10
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -33,8 +42,12 @@
 #include "kartograf/io/sequence_detect.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
+#include "kartograf/segmentation/clustering_features.hpp"
+#include "kartograf/segmentation/fuzzy_cmeans.hpp"
+#include "kartograf/segmentation/kmeans.hpp"
 #include "kartograf/segmentation/plane_extraction.hpp"
 #include "kartograf/segmentation/plane_sampling.hpp"
+#include "kartograf/segmentation/som.hpp"
 
 namespace kartograf {
 namespace {
@@ -60,7 +73,36 @@ struct Options {
   bool point_to_point = false;
   double max_distance = 0.1;
   int iterations = 30;
+  double max_normal_angle_deg =
+      30;  // pairs whose normals differ more are rejected (the ICP default)
+  std::string segmentation = "lab";  // lab | kmeans | som | fcm
+  std::uint32_t k = 30;              // clusters of the baselines
+  int feature_stride = 2;            // baselines: cluster 1 pixel in stride^2, label all
+  bool tables = false;
 };
+
+// The frame's planes by the clustering baseline named in the options: one plane per cluster.
+segmentation::PlaneSet clustered_planes(const PointImage& points, const RgbImage& color,
+                                        const Options& options) {
+  segmentation::FeatureParams feature_params;
+  feature_params.stride = options.feature_stride;
+  const segmentation::ClusteringFeatures features =
+      segmentation::make_clustering_features(points, color, feature_params);
+  segmentation::ClusteringResult result;
+  if (options.segmentation == "kmeans") {
+    result = segmentation::kmeans(features, {options.k});
+  } else if (options.segmentation == "som") {
+    segmentation::SomParams params;
+    params.k = options.k;
+    result = segmentation::som(features, params);
+  } else {
+    segmentation::FuzzyCMeansParams params;
+    params.k = options.k;
+    result = segmentation::fuzzy_cmeans(features, params);
+  }
+  return segmentation::fit_segment_planes(
+      points, segmentation::label_all_pixels(points, color, features, result), options.k, 100);
+}
 
 // A frame as both methods need it: its points, the planar sample and the full cloud.
 struct PreparedFrame {
@@ -104,7 +146,9 @@ class Experiment {
         geometry::backproject(*context_, frame.depth, sequence_->intrinsics(), range_);
 
     Clock::time_point start = Clock::now();
-    const segmentation::PlaneSet planes = extractor_.extract(prepared.points, frame.color);
+    const segmentation::PlaneSet planes =
+        options_.segmentation == "lab" ? extractor_.extract(prepared.points, frame.color)
+                                       : clustered_planes(prepared.points, frame.color, options_);
     const PointCloud sample = segmentation::sample_plane_points(
         prepared.points, nullptr, planes, {options_.points_per_plane, index + 1});
     prepared.planar = geometry::DeviceCloud::from_host(*context_, sample);
@@ -137,7 +181,7 @@ class Experiment {
     registration::IcpParams params;
     params.metric = options.point_to_point ? registration::ErrorMetric::point_to_point
                                            : registration::ErrorMetric::point_to_plane;
-    params.max_normal_angle_deg = 180;  // sampled plane points carry the plane's normal
+    params.max_normal_angle_deg = options.max_normal_angle_deg;
     params.levels = {{options.iterations, 1, options.max_distance, options.max_distance, 0}};
     return params;
   }
@@ -212,6 +256,81 @@ void run_gap(Experiment& experiment, const Options& options, int gap) {
   std::fflush(stdout);
 }
 
+double mean(const std::vector<double>& values) {
+  double sum = 0;
+  for (const double v : values) sum += v;
+  return values.empty() ? 0.0 : sum / static_cast<double>(values.size());
+}
+
+// The paper's Tables 1-2 on frames first .. first + frames - 1.
+void print_tables(const compute::Context& context, const io::Sequence& sequence,
+                  const Options& options) {
+  geometry::DepthRange range;
+  range.units_per_metre = sequence.depth_units_per_metre();
+  const std::vector<float> thresholds{10, 15, 20, 25, 30};
+  const std::vector<double> angles{15, 30, 45, 60};
+  // [threshold] -> per frame: untiled segments, ms; tiled segments, ms.
+  std::vector<std::array<std::vector<double>, 4>> growing(thresholds.size());
+  // [threshold][angle] -> per frame: merged planes, planes >= min_plane_pixels, ms.
+  std::vector<std::vector<std::array<std::vector<double>, 3>>> merging(
+      thresholds.size(), std::vector<std::array<std::vector<double>, 3>>(angles.size()));
+  for (std::size_t f = options.first; f < options.first + options.frames; ++f) {
+    const io::RgbdFrame frame = sequence.frame(f);
+    const PointImage points =
+        geometry::backproject(context, frame.depth, sequence.intrinsics(), range);
+    const segmentation::LabCodeImage lab = segmentation::to_lab_codes(frame.color);
+    for (std::size_t t = 0; t < thresholds.size(); ++t) {
+      segmentation::RegionGrowingParams paper;
+      paper.lab_threshold = thresholds[t];
+      segmentation::RegionGrowingParams tiled = segmentation::PlaneExtractionParams{}.growing;
+      tiled.lab_threshold = thresholds[t];
+      segmentation::SegmentLabelImage labels;
+      for (const auto& [params, column] : {std::pair{paper, 0}, std::pair{tiled, 2}}) {
+        const Clock::time_point start = Clock::now();
+        const std::uint32_t count = segmentation::grow_regions(lab, points, params, labels);
+        growing[t][column + 1].push_back(1000 * seconds_since(start));
+        growing[t][column].push_back(count);
+      }
+      for (std::size_t a = 0; a < angles.size() && t > 0; ++a) {
+        segmentation::PlaneExtractionParams params;
+        params.growing.lab_threshold = thresholds[t];
+        params.merge.max_normal_angle_deg = angles[a];
+        segmentation::PlaneExtractor extractor(context, sequence.intrinsics(), params);
+        const segmentation::PlaneSet set = extractor.extract(points, frame.color);
+        merging[t][a][0].push_back(set.merged_count);
+        merging[t][a][1].push_back(static_cast<double>(set.planes.size()));
+        merging[t][a][2].push_back(set.timings.total());
+      }
+    }
+    std::cerr << "  frame " << f - options.first + 1 << "/" << options.frames << "\r" << std::flush;
+  }
+  std::cerr << "\n";
+  const int paper_segments[] = {8115, 5130, 3520, 2719, 2071};
+  std::printf(
+      "Table 1: segments per Lab threshold (means over %zu frames; the paper: NYU-Depth v2, "
+      "561x427, MATLAB)\n\n| Lab threshold | paper: segments | untiled (the paper's growing) "
+      "| ms | tiled 16 px, 2 %% depth jump | ms |\n|---:|---:|---:|---:|---:|---:|\n",
+      options.frames);
+  for (std::size_t t = 0; t < thresholds.size(); ++t) {
+    std::printf("| %.0f | %d | %.0f | %.1f | %.0f | %.1f |\n", thresholds[t], paper_segments[t],
+                mean(growing[t][0]), mean(growing[t][1]), mean(growing[t][2]), mean(growing[t][3]));
+  }
+  std::printf(
+      "\nTable 2: planes per Lab threshold and normal angle (merged planes / planes of at least "
+      "300 pixels; the paper: ~417, 282, 214, 172 planes for thresholds 15-30)\n\n| Lab "
+      "threshold |");
+  for (const double a : angles) std::printf(" %.0f deg |", a);
+  std::printf(" ms (30 deg) |\n|---:|");
+  for (std::size_t a = 0; a < angles.size(); ++a) std::printf("---:|");
+  std::printf("---:|\n");
+  for (std::size_t t = 1; t < thresholds.size(); ++t) {
+    std::printf("| %.0f |", thresholds[t]);
+    for (std::size_t a = 0; a < angles.size(); ++a)
+      std::printf(" %.0f / %.0f |", mean(merging[t][a][0]), mean(merging[t][a][1]));
+    std::printf(" %.1f |\n", mean(merging[t][1][2]));
+  }
+}
+
 int run(int argc, char** argv) {
   Options options;
   CLI::App app{"The M1 paper's planar-ICP vs all-point-ICP experiment"};
@@ -224,16 +343,35 @@ int run(int argc, char** argv) {
   app.add_flag("--point-to-point", options.point_to_point, "Point-to-point ICP (default: plane)");
   app.add_option("--max-distance", options.max_distance, "ICP pair gate [m]");
   app.add_option("--iterations", options.iterations, "ICP iterations");
+  app.add_option("--max-normal-angle", options.max_normal_angle_deg,
+                 "Normal gate of the pairs [deg] (>= 180: off)");
+  app.add_option("--segmentation", options.segmentation, "Planes from: lab | kmeans | som | fcm")
+      ->check(CLI::IsMember({"lab", "kmeans", "som", "fcm"}));
+  app.add_option("--k", options.k, "Clusters of the baselines")->check(CLI::Range(1, 100000));
+  app.add_option("--feature-stride", options.feature_stride,
+                 "Baselines: cluster the pixels on a stride grid, then label every pixel")
+      ->check(CLI::Range(1, 64));
+  app.add_flag("--tables", options.tables, "Print the paper's Tables 1-2 instead");
   CLI11_PARSE(app, argc, argv);
 
   const compute::Context context = compute::Context::from_environment();
   const std::unique_ptr<io::Sequence> sequence = io::open_sequence(options.sequence).sequence;
+  if (options.tables) {
+    print_tables(context, *sequence, options);
+    return 0;
+  }
   Experiment experiment(context, *sequence, options);
-  std::printf("%s, frames %zu..%zu, N = %zu, %s ICP (k-d tree, %d iterations, %.2f m gate), %s\n\n",
-              options.sequence.c_str(), options.first, options.first + options.frames - 1,
-              options.points_per_plane,
-              options.point_to_point ? "point-to-point" : "point-to-plane", options.iterations,
-              options.max_distance, context.device_info().name.c_str());
+  const std::string planes = options.segmentation == "lab"
+                                 ? std::string("Lab region growing + merging")
+                                 : options.segmentation + " k = " + std::to_string(options.k) +
+                                       ", features 1 in " + std::to_string(options.feature_stride) +
+                                       "^2";
+  std::printf(
+      "%s, frames %zu..%zu, planes: %s, N = %zu, %s ICP (k-d tree, %d iterations, %.2f m "
+      "gate), %s\n\n",
+      options.sequence.c_str(), options.first, options.first + options.frames - 1, planes.c_str(),
+      options.points_per_plane, options.point_to_point ? "point-to-point" : "point-to-plane",
+      options.iterations, options.max_distance, context.device_info().name.c_str());
   std::printf(
       "| gap | frames | planes/frame | planar ms/pair | all-point ms/pair | speed-up | model error "
       "(cm) | planar ATE (cm) | all-point ATE (cm) "

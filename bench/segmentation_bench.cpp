@@ -120,24 +120,24 @@ void region_grow_sequential(benchmark::State& state, float threshold) {
 void register_benchmarks() {
   const std::string size = "640x480";
   for (const BackendKind backend : bench::backends_to_run()) {
-    bench::repeated(benchmark::RegisterBenchmark(
-                        bench::case_name("plane_extraction", backend, size).c_str(),
-                        plane_extraction, backend),
-                    5)
+    bench::repeated(
+        benchmark::RegisterBenchmark(bench::case_name("plane_extraction", backend, size).c_str(),
+                                     plane_extraction, backend),
+        5)
         ->MinTime(0.5);
   }
   for (const float threshold : {15.0f, 25.0f}) {
     const std::string variant = "/t" + std::to_string(static_cast<int>(threshold));
     for (const BackendKind backend : bench::backends_to_run()) {
       const std::string name = bench::case_name("region_grow", backend, size) + variant;
-      bench::repeated(
-          benchmark::RegisterBenchmark(name.c_str(), region_grow, backend, threshold), 5)
+      bench::repeated(benchmark::RegisterBenchmark(name.c_str(), region_grow, backend, threshold),
+                      5)
           ->MinTime(0.2);
     }
     const std::string name =
         bench::case_name("region_grow_sequential", BackendKind::cpu, size) + variant;
-    bench::repeated(
-        benchmark::RegisterBenchmark(name.c_str(), region_grow_sequential, threshold), 5)
+    bench::repeated(benchmark::RegisterBenchmark(name.c_str(), region_grow_sequential, threshold),
+                    5)
         ->MinTime(0.2);
   }
 }

@@ -105,23 +105,6 @@ void expect_non_increasing(const std::vector<double>& history, double final_obje
   EXPECT_LE(final_objective, history.back() * (1 + 1e-12));
 }
 
-class ScopedCpuThreads {
- public:
-  explicit ScopedCpuThreads(const char* value) {
-    if (const char* old = std::getenv("KARTOGRAF_CPU_THREADS")) old_ = old;
-    setenv("KARTOGRAF_CPU_THREADS", value, 1);
-  }
-  ~ScopedCpuThreads() {
-    if (old_.empty())
-      unsetenv("KARTOGRAF_CPU_THREADS");
-    else
-      setenv("KARTOGRAF_CPU_THREADS", old_.c_str(), 1);
-  }
-
- private:
-  std::string old_;
-};
-
 TEST(ClusteringFeaturesTest, NormalisesColumnsAndWeightsGeometry) {
   PointImage points(3, 2, invalid_point());
   RgbImage rgb(3, 2, Rgb8{0, 0, 0});
@@ -285,7 +268,7 @@ TEST(ClusteringTest, KMeansObjectiveNeverIncreasesAndSeedMakesItDeterministic) {
   EXPECT_EQ(a.centres, b.centres);
   EXPECT_EQ(a.objective_history, b.objective_history);
   {
-    const ScopedCpuThreads threads("4");  // chunked sums: the thread count changes nothing
+    const testing::ScopedCpuThreads threads("4");  // chunked sums: the thread count changes nothing
     const ClusteringResult c = segmentation::kmeans(f, params);
     EXPECT_EQ(a.labels, c.labels);
     EXPECT_EQ(a.centres, c.centres);

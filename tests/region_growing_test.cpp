@@ -251,9 +251,9 @@ SegmentLabelImage paper_growing(const LabCodeImage& codes, const PointImage& poi
             for (int dy = -1; dy <= 1; ++dy) {
               for (int dx = -1; dx <= 1; ++dx) {
                 const int nx = x + dx, ny = y + dy;
-                if ((dx == 0 && dy == 0) || nx < tx || ny < ty || nx >= std::min(width, tx + tile) ||
-                    ny >= std::min(height, ty + tile) || labels(nx, ny) != geometry::kNoLabel ||
-                    !valid(nx, ny)) {
+                if ((dx == 0 && dy == 0) || nx < tx || ny < ty ||
+                    nx >= std::min(width, tx + tile) || ny >= std::min(height, ty + tile) ||
+                    labels(nx, ny) != geometry::kNoLabel || !valid(nx, ny)) {
                   continue;
                 }
                 const double z = points(x, y).z(), nz = points(nx, ny).z();
@@ -291,9 +291,9 @@ RandomFrame random_frame(std::mt19937_64& rng, int width, int height) {
       const Eigen::Vector3f base = colours[((y / block_h) * 64 + x / block_w) % 4096];
       lab(x, y) = Eigen::Vector4f(base.x() + jitter(rng) + 0.3f * x, base.y() + jitter(rng),
                                   base.z() + jitter(rng), 0.0f);
-      frame.points(x, y) = percent(rng) < 3 ? invalid_point()
-                                             : Point4f(0.0f, 0.0f, (x / 23) % 2 ? depth(rng) : 1.0f,
-                                                       1.0f);
+      frame.points(x, y) = percent(rng) < 3
+                               ? invalid_point()
+                               : Point4f(0.0f, 0.0f, (x / 23) % 2 ? depth(rng) : 1.0f, 1.0f);
     }
   }
   frame.codes = segmentation::to_lab_codes(lab);
@@ -314,35 +314,17 @@ TEST(RegionGrowing, EqualsAnIndependentImplementationOfThePaperOnRandomImages) {
          {RegionGrowingParams{}, RegionGrowingParams{10.0f, 0.05f, 0},
           RegionGrowingParams{20.0f, 0.0f, 16}, RegionGrowingParams{15.0f, 0.02f, 7}}) {
       SegmentLabelImage labels;
-      const std::uint32_t count = segmentation::grow_regions(frame.codes, frame.points, params, labels);
+      const std::uint32_t count =
+          segmentation::grow_regions(frame.codes, frame.points, params, labels);
       const SegmentLabelImage expected = paper_growing(frame.codes, frame.points, params);
-      EXPECT_EQ(mismatches(labels, expected), 0u) << "round " << round << " threshold "
-                                                  << params.lab_threshold << " tile "
-                                                  << params.tile_size;
+      EXPECT_EQ(mismatches(labels, expected), 0u)
+          << "round " << round << " threshold " << params.lab_threshold << " tile "
+          << params.tile_size;
       EXPECT_EQ(count, segmentation::segment_count(expected));
       EXPECT_GT(count, 20u);
     }
   }
 }
-
-// Sets KARTOGRAF_CPU_THREADS for one scope.
-class ScopedCpuThreads {
- public:
-  explicit ScopedCpuThreads(const char* value) {
-    if (const char* old = std::getenv("KARTOGRAF_CPU_THREADS")) old_ = old;
-    setenv("KARTOGRAF_CPU_THREADS", value, 1);
-  }
-  ~ScopedCpuThreads() {
-    if (old_) {
-      setenv("KARTOGRAF_CPU_THREADS", old_->c_str(), 1);
-    } else {
-      unsetenv("KARTOGRAF_CPU_THREADS");
-    }
-  }
-
- private:
-  std::optional<std::string> old_;
-};
 
 TEST(RegionGrowing, LabelsAndStatisticsDoNotDependOnTheThreadCount) {
   std::mt19937_64 rng(9);
@@ -352,11 +334,11 @@ TEST(RegionGrowing, LabelsAndStatisticsDoNotDependOnTheThreadCount) {
   SegmentLabelImage one, two;
   segmentation::SegmentStatistics stats_one, stats_two;
   {
-    const ScopedCpuThreads threads("1");
+    const testing::ScopedCpuThreads threads("1");
     segmentation::grow_regions(frame.codes, frame.points, params, one, &stats_one, &origin);
   }
   {
-    const ScopedCpuThreads threads("3");
+    const testing::ScopedCpuThreads threads("3");
     segmentation::grow_regions(frame.codes, frame.points, params, two, &stats_two, &origin);
   }
   EXPECT_EQ(mismatches(one, two), 0u);
@@ -441,10 +423,10 @@ TEST_P(RegionGrowerTest, SameAsTheReferenceOnSyntheticAndRealFrames) {
   const synth::World& world = testing::test_world();
   const synth::SyntheticFrame frame = synth::render(
       world, camera, synth::robot_tour(world, 60)[30].pose, synth::NoiseModel::kinect(), 7);
-  expect_same_as_reference(segmentation::to_lab_codes(frame.color),
-                           geometry::backproject(cpu, frame.depth, camera,
-                                                 {testing::kSynthUnitsPerMetre}),
-                           {15.0f, 0.02f, 16}, "synthetic frame");
+  expect_same_as_reference(
+      segmentation::to_lab_codes(frame.color),
+      geometry::backproject(cpu, frame.depth, camera, {testing::kSynthUnitsPerMetre}),
+      {15.0f, 0.02f, 16}, "synthetic frame");
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   expect_same_as_reference(
       segmentation::to_lab_codes(io::read_color_image(frames / "frame-000100.color.jpg")),
@@ -455,8 +437,8 @@ TEST_P(RegionGrowerTest, SameAsTheReferenceOnSyntheticAndRealFrames) {
 
 TEST_P(RegionGrowerTest, WorstCaseStacksAndTinyImages) {
   // One colour, one depth: every pixel pushes all its neighbours, the deepest stacks possible.
-  for (const auto& [width, height] : {std::pair{64, 64}, std::pair{1, 1}, std::pair{1, 9},
-                                      std::pair{9, 1}, std::pair{70, 3}}) {
+  for (const auto& [width, height] :
+       {std::pair{64, 64}, std::pair{1, 1}, std::pair{1, 9}, std::pair{9, 1}, std::pair{70, 3}}) {
     const LabCodeImage codes(width, height, LabCode{50 * 64, 0, 0, 1});
     expect_same_as_reference(codes, flat_points(width, height), {15.0f, 0.0f, 64},
                              std::to_string(width) + "x" + std::to_string(height));

@@ -97,12 +97,15 @@ void expect_mentions(const std::string& message, std::initializer_list<std::stri
 
 void TempDirTest::SetUp() {
   const auto* test = ::testing::UnitTest::GetInstance()->current_test_info();
-  dir_ = std::filesystem::temp_directory_path() /
-         ("kartograf-test-" + std::to_string(::getpid()) + "-" + test->test_suite_name() + "-" + test->name());
+  dir_ =
+      std::filesystem::temp_directory_path() / ("kartograf-test-" + std::to_string(::getpid()) +
+                                                "-" + test->test_suite_name() + "-" + test->name());
   std::filesystem::create_directories(dir_);
 }
 
-void TempDirTest::TearDown() { std::filesystem::remove_all(dir_); }
+void TempDirTest::TearDown() {
+  std::filesystem::remove_all(dir_);
+}
 
 void BackendTest::SetUp() {
   try {
@@ -122,6 +125,19 @@ void BackendTest::TearDown() {
   if (!context_) return;
   context_->finish();
   EXPECT_EQ(context_->validation_errors(), 0u) << "the Vulkan validation layer reported errors";
+}
+
+ScopedCpuThreads::ScopedCpuThreads(const char* value) {
+  if (const char* old = std::getenv("KARTOGRAF_CPU_THREADS")) old_ = old;
+  setenv("KARTOGRAF_CPU_THREADS", value, 1);
+}
+
+ScopedCpuThreads::~ScopedCpuThreads() {
+  if (old_) {
+    setenv("KARTOGRAF_CPU_THREADS", old_->c_str(), 1);
+  } else {
+    unsetenv("KARTOGRAF_CPU_THREADS");
+  }
 }
 
 }  // namespace kartograf::testing

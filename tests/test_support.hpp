@@ -8,6 +8,7 @@
 #include <functional>
 #include <initializer_list>
 #include <memory>
+#include <optional>
 #include <ostream>
 #include <random>
 #include <string>
@@ -18,7 +19,9 @@
 
 namespace kartograf::compute {
 // So that test names and ctest show "vulkan", not a byte dump.
-inline void PrintTo(BackendKind kind, std::ostream* out) { *out << to_string(kind); }
+inline void PrintTo(BackendKind kind, std::ostream* out) {
+  *out << to_string(kind);
+}
 }  // namespace kartograf::compute
 
 namespace kartograf::testing {
@@ -75,6 +78,18 @@ class BackendTest : public ::testing::TestWithParam<compute::BackendKind> {
   std::unique_ptr<compute::Context> context_;
 };
 
+// Sets KARTOGRAF_CPU_THREADS (the CPU backend's threads) for one scope, restoring it after.
+class ScopedCpuThreads {
+ public:
+  explicit ScopedCpuThreads(const char* value);
+  ~ScopedCpuThreads();
+  ScopedCpuThreads(const ScopedCpuThreads&) = delete;
+  ScopedCpuThreads& operator=(const ScopedCpuThreads&) = delete;
+
+ private:
+  std::optional<std::string> old_;
+};
+
 // Fixture: a fresh temporary directory per test, removed afterwards.
 class TempDirTest : public ::testing::Test {
  protected:
@@ -86,8 +101,8 @@ class TempDirTest : public ::testing::Test {
   std::filesystem::path dir_;
 };
 
-#define KARTOGRAF_INSTANTIATE_BACKEND_TESTS(fixture)                                     \
-  INSTANTIATE_TEST_SUITE_P(Backends, fixture,                                           \
+#define KARTOGRAF_INSTANTIATE_BACKEND_TESTS(fixture)                                         \
+  INSTANTIATE_TEST_SUITE_P(Backends, fixture,                                                \
                            ::testing::ValuesIn(::kartograf::testing::backends_under_test()), \
                            ::kartograf::testing::backend_test_name)
 

@@ -65,7 +65,7 @@ int run_synth_command(const SynthOptions& options, std::ostream& out, std::ostre
 // Options shared by `odometry` and `slam` (sequence_run.hpp).
 struct SequenceRunOptions {
   std::filesystem::path sequence;  // a folder in any supported layout (io/sequence_detect.hpp)
-  std::string method = "p2plane";  // p2p | p2plane | color
+  std::string method = "p2plane";  // p2p | p2plane | color | planar
   std::string backend = "auto";
   std::string backend_source = "--backend";  // names the setting in errors
   int reestimate_interval = 5;
@@ -93,5 +93,25 @@ struct SlamOptions {
 };
 CLI::App* add_slam_command(CLI::App& app, SlamOptions& options);
 int run_slam_command(const SlamOptions& options, std::ostream& out, std::ostream& err);
+
+// `planes INPUT --out DIR`: planes of an organized PCD, an RGB-D frame or a sequence's frames.
+struct PlanesOptions {
+  std::filesystem::path input, out_dir;
+  std::filesystem::path color, intrinsics;  // depth PNG input
+  double fx = 0, fy = 0, cx = -1, cy = -1;  // depth PNG input; 0 / -1: Kinect-like defaults
+  double depth_scale = 1000;                // depth PNG input: units per metre
+  std::size_t first = 0, frames = 0, step = 1;  // sequences
+  double lab_threshold = 15;
+  double normal_angle_deg = 30;
+  std::uint64_t min_plane_pixels = 300;
+  std::string neighbours = "pixel";  // pixel | bbox
+  std::string fit = "tls";           // tls | eq6
+  std::string backend = "auto";
+  std::string backend_source = "--backend";
+  bool force = false;
+  bool progress = true;
+};
+CLI::App* add_planes_command(CLI::App& app, PlanesOptions& options);
+int run_planes_command(const PlanesOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace kartograf::cli

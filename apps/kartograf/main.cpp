@@ -35,6 +35,12 @@ int main(int argc, char** argv) {
   CLI::App* odometry = kartograf::cli::add_odometry_command(app, odometry_options);
   kartograf::cli::SlamOptions slam_options;
   CLI::App* slam = kartograf::cli::add_slam_command(app, slam_options);
+  kartograf::cli::PlanesOptions planes_options;
+  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
+    planes_options.backend = env_backend;
+    planes_options.backend_source = "KARTOGRAF_BACKEND";
+  }
+  CLI::App* planes = kartograf::cli::add_planes_command(app, planes_options);
 
   try {
     app.parse(argc, argv);
@@ -52,6 +58,7 @@ int main(int argc, char** argv) {
       return kartograf::cli::run_odometry_command(odometry_options, std::cout, std::cerr);
     }
     if (*slam) return kartograf::cli::run_slam_command(slam_options, std::cout, std::cerr);
+    if (*planes) return kartograf::cli::run_planes_command(planes_options, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

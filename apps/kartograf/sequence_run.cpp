@@ -20,7 +20,7 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
                   "RGB-D sequence folder: TUM (rgb.txt, depth.txt), kartograf synth, or 7-Scenes")
       ->required();
   command.add_option("--method", o.method, "ICP error metric and pair rejection")
-      ->check(CLI::IsMember({"p2p", "p2plane", "color"}))
+      ->check(CLI::IsMember({"p2p", "p2plane", "color", "planar"}))
       ->capture_default_str();
   command
       .add_option("--backend", o.backend,
@@ -40,6 +40,7 @@ registration::OdometryParams odometry_params(const SequenceRunOptions& options) 
   registration::OdometryParams params;
   params.method = options.method == "p2p"     ? registration::OdometryMethod::point_to_point
                   : options.method == "color" ? registration::OdometryMethod::color
+                  : options.method == "planar" ? registration::OdometryMethod::planar
                                               : registration::OdometryMethod::point_to_plane;
   params.icp = registration::odometry_icp_params(params.method);
   params.reestimate_interval = options.reestimate_interval;

@@ -39,8 +39,7 @@ struct Accumulation {
 };
 
 void accumulate_cpu(std::span<const Point4f> points, std::span<const std::uint32_t> labels,
-                    const FixedPointMoments& fixed, std::uint32_t label_count,
-                    Accumulation& out) {
+                    const FixedPointMoments& fixed, std::uint32_t label_count, Accumulation& out) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     const std::uint32_t label = labels[i];
     const Point4f& p = points[i];
@@ -112,8 +111,9 @@ SegmentMomentKernelParams kernel_params_for(std::size_t point_count,
 SegmentMomentSet finish(const Accumulation& accumulation, const SegmentMomentParams& params,
                         const FixedPointMoments& fixed) {
   require(accumulation.bad_labels == 0,
-          "segment moments: " + std::to_string(accumulation.bad_labels) + " pixels carry a label >= " +
-              std::to_string(params.label_count) + " (and not kNoLabel)");
+          "segment moments: " + std::to_string(accumulation.bad_labels) +
+              " pixels carry a label >= " + std::to_string(params.label_count) +
+              " (and not kNoLabel)");
   require(accumulation.points_too_far == 0,
           "segment moments: " + std::to_string(accumulation.points_too_far) +
               " points lie farther than max_offset = " + std::to_string(params.max_offset) +

@@ -8,8 +8,12 @@
 #include <span>
 #include <string>
 
+#include "kartograf/geometry/subsample.hpp"
 #include "kartograf/registration/depth_weighted_finder.hpp"
+#include "kartograf/registration/kdtree_correspondences.hpp"
 #include "kartograf/registration/projective_association.hpp"
+#include "kartograf/segmentation/plane_extraction.hpp"
+#include "kartograf/segmentation/plane_sampling.hpp"
 
 namespace kartograf::registration {
 
@@ -80,6 +84,13 @@ IcpParams odometry_icp_params(OdometryMethod method) {
     case OdometryMethod::color:
       params.metric = ErrorMetric::point_to_plane;
       break;
+    case OdometryMethod::planar:
+      // One level on the plane samples (a few thousand points with exact plane normals, ~5 cm
+      // apart): k-d tree pairs within 10 cm whose normals agree within 30 degrees.
+      params.metric = ErrorMetric::point_to_plane;
+      params.max_normal_angle_deg = 30;
+      params.levels = {{30, 1, 0.10, 0.03}};
+      break;
     case OdometryMethod::point_to_point:
       // Point-to-point converges linearly and needs the closest point, not the projected one
       // (icp.hpp): more iterations and a search window.
@@ -89,6 +100,22 @@ IcpParams odometry_icp_params(OdometryMethod method) {
   }
   return params;
 }
+
+struct RgbdOdometry::PlanarFrames {
+  PlanarFrames(const compute::Context& context, const PinholeIntrinsics& camera,
+               const IcpParams& icp, std::size_t slots)
+      : extractor(context, camera),
+        engine(context, icp, std::make_unique<KdTreeCorrespondences>(context)),
+        samples(slots) {}
+
+  segmentation::PlaneExtractor extractor;
+  IcpEngine engine;
+  std::vector<geometry::DeviceCloud> samples;  // per ring slot
+};
+
+RgbdOdometry::~RgbdOdometry() = default;
+RgbdOdometry::RgbdOdometry(RgbdOdometry&&) noexcept = default;
+RgbdOdometry& RgbdOdometry::operator=(RgbdOdometry&&) noexcept = default;
 
 RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrinsics& camera,
                            OdometryParams params)
@@ -106,6 +133,10 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
   for (std::size_t i = 0; i < slots; ++i)
     ring_.emplace_back(context, camera, pyramid_params(params_, finest_level_, information_level_));
   colors_.resize(slots);
+  if (params_.method == OdometryMethod::planar) {
+    require(params_.points_per_plane > 0, "odometry: points_per_plane must be > 0");
+    planar_ = std::make_unique<PlanarFrames>(context, camera, params_.icp, slots);
+  }
 }
 
 FramePyramid& RgbdOdometry::pyramid_of(std::size_t frame) {
@@ -116,12 +147,22 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
                                                     const Eigen::Isometry3d& initial,
                                                     const RegistrationLimits& limits) {
   const std::size_t current = frames_.size();  // frames_ grows when track() ends
-  const auto first = static_cast<std::size_t>(finest_level_);
-  const std::size_t count = params_.icp.levels.size();
-  const std::vector<CloudView> source_views = pyramid_of(current).views();
-  const std::vector<CloudView> target_views = pyramid_of(target).views();
-  const IcpResult result = engine_.align(std::span(source_views).subspan(first, count),
-                                         std::span(target_views).subspan(first, count), initial);
+  IcpResult result;
+  if (planar_) {
+    const auto view = [](const geometry::DeviceCloud& cloud) {
+      return CloudView{&cloud.points, &cloud.normals, nullptr, std::nullopt};
+    };
+    const CloudView source = view(planar_->samples[slot_of(current)]);
+    const CloudView target_view = view(planar_->samples[slot_of(target)]);
+    result = planar_->engine.align(std::span(&source, 1), std::span(&target_view, 1), initial);
+  } else {
+    const auto first = static_cast<std::size_t>(finest_level_);
+    const std::size_t count = params_.icp.levels.size();
+    const std::vector<CloudView> source_views = pyramid_of(current).views();
+    const std::vector<CloudView> target_views = pyramid_of(target).views();
+    result = engine_.align(std::span(source_views).subspan(first, count),
+                           std::span(target_views).subspan(first, count), initial);
+  }
   Attempt attempt;
   attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
   attempt.inlier_rmse = result.inlier_rmse;
@@ -163,6 +204,16 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   frame.index = poses_.size();
   FramePyramid& pyramid = pyramid_of(frame.index);
   builder_.build(depth, color, pyramid);
+  if (planar_) {
+    require(color != nullptr && !color->empty(),
+            "odometry: the planar method needs the colour image of every frame");
+    const PointImage points =
+        geometry::backproject(*context_, depth, builder_.camera(), params_.depth_range);
+    const segmentation::PlaneSet planes = planar_->extractor.extract(points, *color);
+    planar_->samples[slot_of(frame.index)] = geometry::DeviceCloud::from_host(
+        *context_, segmentation::sample_plane_points(points, nullptr, planes,
+                                                     {params_.points_per_plane, frame.index + 1}));
+  }
   depth_ = &depth;
   color_ = color;
   RgbImage& kept_color = colors_[slot_of(frame.index)];

@@ -124,6 +124,33 @@ void refine_border_pixels(const SegmentLabelImage& segments, const PointImage& p
       });
 }
 
+// How far apart [pixels] the refinement's growth and left-over regions connect pixels: across a
+// one-pixel gap of missing depth.
+constexpr int kFloodRadius = 2;
+
+// Calls visit(j) for every pixel j within `radius` (Chebyshev) of pixel i, i itself included.
+template <class Visit>
+void for_each_pixel_near(std::uint32_t i, int width, int height, int radius, Visit&& visit) {
+  const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
+  const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
+  for (int ny = std::max(0, y - radius); ny <= std::min(height - 1, y + radius); ++ny) {
+    for (int nx = std::max(0, x - radius); nx <= std::min(width - 1, x + radius); ++nx)
+      visit(static_cast<std::uint32_t>(ny * width + nx));
+  }
+}
+
+// The output record of a fitted plane (extents and counts filled by the caller).
+Plane plane_record(Label id, const SegmentPlane& fit) {
+  Plane plane;
+  plane.id = id;
+  plane.normal = fit.normal;
+  plane.offset = fit.offset;
+  plane.centroid = fit.centroid;
+  plane.major_axis = fit.major_axis;
+  plane.minor_axis = fit.minor_axis;
+  return plane;
+}
+
 // Planes grow pixel by pixel (breadth first) into valid pixels that no plane took, while a pixel
 // lies within the distance allowance of the plane it is reached from and its depth continues that
 // pixel's (|dz| <= max_depth_jump z; 0: no test). Dark or finely textured surfaces fall apart into
@@ -134,7 +161,6 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
                              std::vector<std::uint32_t>& pixel_plane,
                              std::vector<std::uint32_t>& queue,
                              std::vector<std::uint8_t>& source_mask) {
-  constexpr int kFloodRadius = 2;
   const int width = points.width(), height = points.height();
   const Point4f* point = points.data();
   const auto open = [&](std::size_t j) {
@@ -145,16 +171,10 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
   source.assign(pixel_plane.size(), 0);
   for (std::size_t i = 0; i < pixel_plane.size(); ++i) {
     if (!open(i)) continue;
-    const int x = static_cast<int>(i % static_cast<std::size_t>(width));
-    const int y = static_cast<int>(i / static_cast<std::size_t>(width));
-    for (int ny = std::max(0, y - kFloodRadius); ny <= std::min(height - 1, y + kFloodRadius);
-         ++ny) {
-      for (int nx = std::max(0, x - kFloodRadius); nx <= std::min(width - 1, x + kFloodRadius);
-           ++nx) {
-        const std::size_t j = static_cast<std::size_t>(ny) * width + nx;
-        if (pixel_plane[j] != geometry::kNoLabel) source[j] = 1;
-      }
-    }
+    for_each_pixel_near(static_cast<std::uint32_t>(i), width, height, kFloodRadius,
+                        [&](std::uint32_t j) {
+                          if (pixel_plane[j] != geometry::kNoLabel) source[j] = 1;
+                        });
   }
   queue.clear();
   for (std::size_t i = 0; i < pixel_plane.size(); ++i) {
@@ -163,22 +183,14 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const std::uint32_t i = queue[head];
     const SegmentPlane& plane = planes[pixel_plane[i]];
-    const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
-    const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
     const float depth = point[i].z();
-    for (int ny = std::max(0, y - kFloodRadius); ny <= std::min(height - 1, y + kFloodRadius);
-         ++ny) {
-      for (int nx = std::max(0, x - kFloodRadius); nx <= std::min(width - 1, x + kFloodRadius);
-           ++nx) {
-        const std::uint32_t j = static_cast<std::uint32_t>(ny * width + nx);
-        if (!open(j)) continue;
-        if (max_depth_jump > 0.0f && std::fabs(point[j].z() - depth) > max_depth_jump * depth)
-          continue;
-        if (plane_score(plane, PixelPoint(point[j], params), params) >= 1.0) continue;
-        pixel_plane[j] = pixel_plane[i];
-        queue.push_back(j);
-      }
-    }
+    for_each_pixel_near(i, width, height, kFloodRadius, [&](std::uint32_t j) {
+      if (!open(j)) return;
+      if (max_depth_jump > 0.0f && std::fabs(point[j].z() - depth) > max_depth_jump * depth) return;
+      if (plane_score(plane, PixelPoint(point[j], params), params) >= 1.0) return;
+      pixel_plane[j] = pixel_plane[i];
+      queue.push_back(j);
+    });
   }
 }
 
@@ -188,7 +200,6 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
 void plane_leftover_regions(const PointImage& points, const PlaneExtractionParams& params,
                             std::vector<std::uint32_t>& pixel_plane,
                             std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region) {
-  constexpr int kFloodRadius = 2;
   const int width = points.width(), height = points.height();
   const Point4f* point = points.data();
   const float jump = params.growing.max_depth_jump;
@@ -206,20 +217,13 @@ void plane_leftover_regions(const PointImage& points, const PlaneExtractionParam
       ++moments.count;
       moments.sum += d;
       moments.sum_outer += d * d.transpose();
-      const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
-      const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
       const float depth = point[i].z();
-      for (int ny = std::max(0, y - kFloodRadius); ny <= std::min(height - 1, y + kFloodRadius);
-           ++ny) {
-        for (int nx = std::max(0, x - kFloodRadius); nx <= std::min(width - 1, x + kFloodRadius);
-             ++nx) {
-          const std::uint32_t j = static_cast<std::uint32_t>(ny * width + nx);
-          if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) continue;
-          if (jump > 0.0f && std::fabs(point[j].z() - depth) > jump * depth) continue;
-          pixel_plane[j] = kVisited;
-          region.push_back(j);
-        }
-      }
+      for_each_pixel_near(i, width, height, kFloodRadius, [&](std::uint32_t j) {
+        if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) return;
+        if (jump > 0.0f && std::fabs(point[j].z() - depth) > jump * depth) return;
+        pixel_plane[j] = kVisited;
+        region.push_back(j);
+      });
     }
     if (moments.count < params.min_plane_pixels) continue;
     const SegmentPlane plane = fit_plane(moments, origin, params.merge.fit);
@@ -339,14 +343,7 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
   kept.resize(std::min<std::size_t>(kept.size(), std::numeric_limits<Label>::max()));
   std::vector<Label> plane_label(merged.planes.size(), kUnlabeled);
   for (std::size_t k = 0; k < kept.size(); ++k) {
-    const SegmentPlane& fit = merged.planes[kept[k]];
-    Plane plane;
-    plane.id = static_cast<Label>(k + 1);
-    plane.normal = fit.normal;
-    plane.offset = fit.offset;
-    plane.centroid = fit.centroid;
-    plane.major_axis = fit.major_axis;
-    plane.minor_axis = fit.minor_axis;
+    Plane plane = plane_record(static_cast<Label>(k + 1), merged.planes[kept[k]]);
     plane.extent_min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
     plane.extent_max = -plane.extent_min;
     result.planes.push_back(plane);
@@ -394,6 +391,46 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
     plane.rms_error = std::sqrt(squared_error / static_cast<double>(plane.inlier_count));
   }
   result.timings.output = elapsed_ms(clock);
+  return result;
+}
+
+PlaneSet fit_segment_planes(const PointImage& points, const SegmentLabelImage& segments,
+                            std::uint32_t segment_count, std::uint64_t min_pixels) {
+  require(points.width() == segments.width() && points.height() == segments.height(),
+          "segment planes: point image is " + size_text(points.width(), points.height()) +
+              " but the segments are " + size_text(segments.width(), segments.height()));
+  PlaneSet result;
+  result.labels = LabelImage(points.width(), points.height(), kUnlabeled);
+  result.segment_count = segment_count;
+  result.merged_count = segment_count;
+  if (segment_count == 0) return result;
+  geometry::SegmentMomentParams params;
+  params.label_count = segment_count;
+  Eigen::Vector3f origin;
+  if (!moment_frame(points, origin, params.max_offset)) return result;
+  params.origin = origin;
+  const geometry::SegmentMomentSet moments =
+      geometry::segment_moments(points.pixels(), segments.pixels(), params);
+  std::vector<Label> plane_of(segment_count, kUnlabeled);
+  for (std::uint32_t s = 0; s < segment_count; ++s) {
+    const SegmentPlane fit = fit_plane(moments.segments[s], moments.origin);
+    if (!fit.valid || fit.count < min_pixels ||
+        result.planes.size() >= std::numeric_limits<Label>::max()) {
+      continue;
+    }
+    Plane plane = plane_record(static_cast<Label>(result.planes.size() + 1), fit);
+    plane.inlier_count = fit.count;
+    plane.rms_error = fit.rms_error;
+    const Eigen::Vector2d half(std::sqrt(3.0) * fit.major_sigma, std::sqrt(3.0) * fit.minor_sigma);
+    plane.extent_min = -half;  // of a uniform rectangle with the segment's spread
+    plane.extent_max = half;
+    plane_of[s] = plane.id;
+    result.planes.push_back(plane);
+  }
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const std::uint32_t s = segments.data()[i];
+    if (s != geometry::kNoLabel) result.labels.data()[i] = plane_of[s];
+  }
   return result;
 }
 

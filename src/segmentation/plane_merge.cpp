@@ -405,13 +405,17 @@ MergedPlanes merge_segments(const SegmentLabelImage& labels,
   // Fits, and the cosine of the widened angle test of segments with an angle test.
   std::vector<SegmentPlane> fits(segment_count);
   std::vector<double> min_cos(segment_count, -1.0);
-  for (std::uint32_t s = 0; s < segment_count; ++s) {
-    if (segments[s].count < min_fit_pixels) continue;
-    fits[s] = fit_plane(segments[s], origin, params.fit);
-    if (!fits[s].valid || segments[s].count < params.min_pixels_for_angle) continue;
-    const double max_deg = params.max_normal_angle_deg + normal_uncertainty_deg(params, fits[s]);
-    if (max_deg < 90.0) min_cos[s] = std::cos(max_deg * M_PI / 180.0);
-  }
+  compute::detail::for_each_chunk(
+      segment_count, segment_count * 64, [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (std::size_t s = begin; s < end; ++s) {
+          if (segments[s].count < min_fit_pixels) continue;
+          fits[s] = fit_plane(segments[s], origin, params.fit);
+          if (!fits[s].valid || segments[s].count < params.min_pixels_for_angle) continue;
+          const double max_deg =
+              params.max_normal_angle_deg + normal_uncertainty_deg(params, fits[s]);
+          if (max_deg < 90.0) min_cos[s] = std::cos(max_deg * M_PI / 180.0);
+        }
+      });
 
   std::vector<std::uint32_t> order;
   for (std::uint32_t s = 0; s < segment_count; ++s) {

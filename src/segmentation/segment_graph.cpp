@@ -58,15 +58,17 @@ SegmentGraph graph_from_edges(std::span<const std::uint64_t> edges, std::uint32_
 }
 
 SegmentGraph pixel_adjacency_graph(const SegmentLabelImage& labels, std::uint32_t segment_count) {
-  check_labels(labels, segment_count, "pixel adjacency graph");
   const int width = labels.width(), height = labels.height();
   // Rows in chunks on the CPU backend's threads; the edges are sorted and deduplicated after, so
   // the graph does not depend on the thread count.
   std::array<std::vector<std::uint64_t>, compute::detail::kCpuChunks> chunk_edges;
+  // The labels are checked as they are read: the largest label + 1 of each chunk (0 for none).
+  std::array<std::uint32_t, compute::detail::kCpuChunks> chunk_worst{};
   compute::detail::for_each_chunk(
       static_cast<std::size_t>(height), labels.size(),
       [&](std::size_t first_row, std::size_t end_row, std::size_t chunk) {
         std::vector<std::uint64_t>& edges = chunk_edges[chunk];
+        std::uint32_t worst = 0;
         // Runs along a boundary repeat the same pair: each segment remembers its last partner,
         // which drops most repeats before the sort.
         std::vector<std::uint32_t> last_partner(segment_count, kNoLabel);
@@ -83,7 +85,8 @@ SegmentGraph pixel_adjacency_graph(const SegmentLabelImage& labels, std::uint32_
           const std::uint32_t* below = y + 1 < height ? &labels(0, y + 1) : nullptr;
           for (int x = 0; x < width; ++x) {
             const std::uint32_t a = row[x];
-            if (a == kNoLabel) continue;
+            worst = std::max(worst, a + 1);  // kNoLabel + 1 wraps to 0
+            if (a == kNoLabel || a >= segment_count) continue;
             // Inside a segment all four are equal: one test for the common case.
             if (below != nullptr && x > 0 && x + 1 < width &&
                 ((a ^ row[x + 1]) | (a ^ below[x - 1]) | (a ^ below[x]) | (a ^ below[x + 1])) ==
@@ -97,7 +100,13 @@ SegmentGraph pixel_adjacency_graph(const SegmentLabelImage& labels, std::uint32_
             if (x + 1 < width) add(a, below[x + 1]);
           }
         }
+        chunk_worst[chunk] = worst;
       });
+  const std::uint32_t worst = *std::max_element(chunk_worst.begin(), chunk_worst.end());
+  if (worst > segment_count) {  // the message is built only on failure
+    throw Error("pixel adjacency graph: a pixel has label " + std::to_string(worst - 1) +
+                " >= segment count " + std::to_string(segment_count));
+  }
   std::vector<std::uint64_t> edges = std::move(chunk_edges[0]);
   for (std::size_t c = 1; c < chunk_edges.size(); ++c)
     edges.insert(edges.end(), chunk_edges[c].begin(), chunk_edges[c].end());

@@ -20,8 +20,6 @@
 #include <algorithm>
 #include <cmath>
 #include <numeric>
-#include <cmath>
-#include <numeric>
 #include <string>
 
 #include <Eigen/Geometry>

@@ -1,6 +1,6 @@
 #pragma once
-// Per-label moments of an organized or unorganized cloud (count, sum p, sum p p^T), the input of the
-// per-segment plane fits of methods.md M1 step 3, for up to 65,536 labels in one pass.
+// Per-label moments of an organized or unorganized cloud (count, sum p, sum p p^T), the input of
+// the per-segment plane fits of methods.md M1 step 3, for up to 65,536 labels in one pass.
 //
 // Every point adds its terms, relative to `origin`, as 64-bit fixed-point integers with atomic
 // adds: integer sums are exact and order-independent, so every backend returns bit-identical
@@ -33,8 +33,8 @@ struct SegmentMomentParams {
 
 struct SegmentMoments {
   std::uint64_t count = 0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();          // sum (p - origin)
-  Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();    // sum (p - origin)(p - origin)^T
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();        // sum (p - origin)
+  Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();  // sum (p - origin)(p - origin)^T
 };
 
 struct SegmentMomentSet {
@@ -104,7 +104,8 @@ class SegmentMomentReducer {
   // points and labels have the same length. Throws Error for a label >= label_count (other than
   // kNoLabel), a point beyond max_offset, or label_count outside 1..65536.
   SegmentMomentSet run(const compute::Buffer<Point4f>& points,
-                       const compute::Buffer<std::uint32_t>& labels, const SegmentMomentParams& params);
+                       const compute::Buffer<std::uint32_t>& labels,
+                       const SegmentMomentParams& params);
 
  private:
   const compute::Context* context_;

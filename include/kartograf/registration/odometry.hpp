@@ -31,6 +31,7 @@
 // the last keyframe, or is max_interval frames after it, or is a fallback. SLAM uses them as
 // loop-closure nodes.
 #include <cstddef>
+#include <memory>
 #include <optional>
 #include <vector>
 
@@ -53,6 +54,10 @@ enum class OdometryMethod {
   point_to_point,  // the M3 paper's metric (Arun's closed form), closest point in a 3x3 window
   point_to_plane,  // Gauss-Newton on plane distances
   color,           // point-to-plane on pairs that pass the M3 paper's HSI colour gate
+  // The M1 paper's planar ICP: the frame's planes (segmentation/plane_extraction.hpp), N points
+  // drawn on each (plane_sampling.hpp), point-to-plane ICP on those with k-d tree pairs and the
+  // planes' normals. Needs colour on the depth camera's pixel grid (the planes grow in Lab).
+  planar,
 };
 
 // The ICP parameters of each method; levels[0] runs on the pyramid level of
@@ -75,8 +80,9 @@ struct OdometryParams {
   // 320x240: 60 mm ATE over 60 frames starting at 320x240, 3 mm starting at 160x120).
   int icp_width = 320;
   int min_icp_level = 1;
-  int information_width = 80;  // the geometric information's level (80x60 of 640x480)
-  ColorGateParams color_gate;  // OdometryMethod::color
+  int information_width = 80;          // the geometric information's level (80x60 of 640x480)
+  ColorGateParams color_gate;          // OdometryMethod::color
+  std::size_t points_per_plane = 200;  // OdometryMethod::planar: the M1 paper's N
   // Degenerate frames with colour: measure the weak directions by image intensity
   // (photometric_refinement.hpp) instead of taking the prediction.
   bool photometric_refinement = true;
@@ -135,9 +141,13 @@ class RgbdOdometry {
   // Throws Error on invalid intrinsics, depth range or parameters.
   RgbdOdometry(const compute::Context& context, const PinholeIntrinsics& camera,
                OdometryParams params = {});
+  ~RgbdOdometry();
+  RgbdOdometry(RgbdOdometry&&) noexcept;
+  RgbdOdometry& operator=(RgbdOdometry&&) noexcept;
 
   // Registers the next frame (depth in params.depth_range's units; colour on the depth camera's
-  // pixel grid, required by OdometryMethod::color). Returns its report; poses() grows by one.
+  // pixel grid, required by OdometryMethod::color and ::planar). Returns its report; poses()
+  // grows by one. Throws Error when the method needs colour and there is none.
   const OdometryFrame& track(const DepthImage& depth, const RgbImage* color = nullptr);
 
   std::size_t frame_count() const { return poses_.size(); }
@@ -165,6 +175,8 @@ class RgbdOdometry {
   FramePyramid& pyramid_of(std::size_t frame);
   std::size_t slot_of(std::size_t frame) const { return frame % ring_.size(); }
 
+  struct PlanarFrames;  // OdometryMethod::planar: the plane samples of the frames in the ring
+
   const compute::Context* context_;
   OdometryParams params_;
   int finest_level_;       // pyramid level of icp.levels[0]
@@ -180,6 +192,7 @@ class RgbdOdometry {
   std::vector<OdometryFrame> frames_;
   std::vector<RelativePose> constraints_;
   std::vector<std::size_t> keyframes_;
+  std::unique_ptr<PlanarFrames> planar_;
   // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses.
   Eigen::Isometry3d predict() const;
 };

@@ -87,7 +87,7 @@ NearestCentres nearest_centres(const FeatureMatrix& features, const CentreMatrix
 namespace detail {
 
 // The shared hot loop: features are cut into kChunks contiguous chunks (run on
-// KARTOGRAF_CPU_THREADS threads, see src/registration/cpu_parallel.hpp) and each chunk into
+// KARTOGRAF_CPU_THREADS threads, see src/compute/cpu_parallel.hpp) and each chunk into
 // blocks of rows; visit(chunk, first_row, block, squared_distances) sees each block once, its
 // rows as doubles and the block x k matrix of squared distances to the centres. Accumulating per
 // chunk and combining in chunk order makes results independent of the thread count.

@@ -72,6 +72,14 @@ struct PlaneSet {
   PlaneExtractionTimings timings;
 };
 
+// One plane per segment of any segmentation (e.g. the clustering baselines of methods.md M1 step
+// 7): the total-least-squares fit of its points (fit_plane); segments without a valid fit or with
+// fewer than min_pixels points get no plane. Plane ids follow the segment order; the label image
+// gives each pixel its segment's plane (0: none). Throws Error on a size mismatch or a label >=
+// segment_count.
+PlaneSet fit_segment_planes(const PointImage& points, const SegmentLabelImage& segments,
+                            std::uint32_t segment_count, std::uint64_t min_pixels = 3);
+
 class PlaneExtractor {
  public:
   // Throws Error on invalid intrinsics or parameters.

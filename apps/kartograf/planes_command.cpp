@@ -1,0 +1,267 @@
+// `kartograf planes INPUT --out DIR`: plane extraction (segmentation::PlaneExtractor) of an
+// organized PCD with colour, an RGB-D frame (depth PNG + --color), or the frames of a sequence
+// folder. Per frame: labels.png (16-bit plane id, 0 = none), segmentation.png (planes over the
+// dimmed image, for people), planes.json and planes.ply (the plane points in their colours); one
+// summary line per frame on stdout. A sequence writes each frame to DIR/<frame number>/ and
+// DIR/summary.json. Wiring only.
+#include <algorithm>
+#include <cstdio>
+#include <filesystem>
+#include <memory>
+#include <ostream>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <nlohmann/json.hpp>
+
+#include "commands.hpp"
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/error.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/io/image_io.hpp"
+#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/io/pcd.hpp"
+#include "kartograf/io/plane_io.hpp"
+#include "kartograf/io/ply.hpp"
+#include "kartograf/io/sequence.hpp"
+#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/io/text_file.hpp"
+#include "sequence_run.hpp"
+
+namespace kartograf::cli {
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// One frame to extract planes from.
+struct PlaneInput {
+  std::string name;  // for messages and planes.json
+  PointImage points;
+  RgbImage color;
+  PinholeIntrinsics intrinsics;
+};
+
+segmentation::PlaneExtractionParams extraction_params(const PlanesOptions& o) {
+  segmentation::PlaneExtractionParams params;
+  params.growing.lab_threshold = static_cast<float>(o.lab_threshold);
+  params.merge.max_normal_angle_deg = o.normal_angle_deg;
+  params.min_plane_pixels = o.min_plane_pixels;
+  params.merge.neighbours = o.neighbours == "bbox"
+                                ? segmentation::NeighbourTest::bounding_box_overlap
+                                : segmentation::NeighbourTest::pixel_adjacency;
+  params.merge.fit.method = o.fit == "eq6" ? segmentation::PlaneFitMethod::paper_eq6
+                                           : segmentation::PlaneFitMethod::total_least_squares;
+  return params;
+}
+
+Json run_json(const PlanesOptions& o, const compute::Context& context) {
+  return {{"lab_threshold", o.lab_threshold},
+          {"normal_angle_deg", o.normal_angle_deg},
+          {"min_plane_pixels", o.min_plane_pixels},
+          {"neighbours", o.neighbours},
+          {"fit", o.fit},
+          {"backend", compute::to_string(context.backend())},
+          {"device", context.device_info().name}};
+}
+
+// An organized PCD with colour: its pixels are the camera's; intrinsics are not needed for the
+// extraction (only recorded), so they are estimated as a Kinect's at the cloud's size.
+PlaneInput pcd_input(const fs::path& path) {
+  const io::PcdCloud cloud = io::read_pcd(path);
+  const std::string name = "'" + path.string() + "'";
+  require(cloud.organized(), "planes: " + name + " is not organized (height " +
+                                 std::to_string(cloud.height) +
+                                 "): region growing needs the pixel grid of a depth camera");
+  require(!cloud.colors.empty(), "planes: " + name + " has no colour (rgb/rgba field)");
+  PlaneInput input{path.string(), cloud.to_point_image(), RgbImage(cloud.width, cloud.height),
+                   PinholeIntrinsics{}};
+  std::copy(cloud.colors.begin(), cloud.colors.end(), input.color.data());
+  const double f = 525.0 * cloud.width / 640.0;
+  input.intrinsics = {
+      cloud.width, cloud.height, f, f, (cloud.width - 1) / 2.0, (cloud.height - 1) / 2.0};
+  return input;
+}
+
+PinholeIntrinsics frame_intrinsics(const PlanesOptions& o, const DepthImage& depth) {
+  if (!o.intrinsics.empty()) {
+    const PinholeIntrinsics intrinsics = io::read_camera_intrinsics_json(o.intrinsics);
+    require(intrinsics.width == depth.width() && intrinsics.height == depth.height(),
+            "planes: " + o.intrinsics.string() + " is for " + std::to_string(intrinsics.width) +
+                "x" + std::to_string(intrinsics.height) + " images, the depth image is " +
+                std::to_string(depth.width()) + "x" + std::to_string(depth.height()));
+    return intrinsics;
+  }
+  const double scale = depth.width() / 640.0;
+  return {depth.width(),
+          depth.height(),
+          o.fx > 0 ? o.fx : 525.0 * scale,
+          o.fy > 0 ? o.fy : 525.0 * scale,
+          o.cx >= 0 ? o.cx : (depth.width() - 1) / 2.0,
+          o.cy >= 0 ? o.cy : (depth.height() - 1) / 2.0};
+}
+
+PlaneInput rgbd_input(const PlanesOptions& o, const compute::Context& context) {
+  require(!o.color.empty(),
+          "planes: " + o.input.string() + " is a depth image: give its colour image with --color");
+  const DepthImage depth = io::read_depth_png(o.input);
+  RgbImage color = io::read_color_image(o.color);
+  require(color.width() == depth.width() && color.height() == depth.height(),
+          "planes: the colour image " + o.color.string() + " is " + std::to_string(color.width()) +
+              "x" + std::to_string(color.height()) + ", the depth image " + o.input.string() +
+              " is " + std::to_string(depth.width()) + "x" + std::to_string(depth.height()));
+  PlaneInput input{o.input.string(), {}, std::move(color), frame_intrinsics(o, depth)};
+  input.intrinsics.validate("planes");
+  geometry::DepthRange range;
+  range.units_per_metre = o.depth_scale;
+  input.points = geometry::backproject(context, depth, input.intrinsics, range);
+  return input;
+}
+
+// Extracts and writes one frame's files into dir; returns its summary.
+Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& input,
+                   const fs::path& dir, const Json& run, std::ostream& out) {
+  const segmentation::PlaneSet set = extractor.extract(input.points, input.color);
+  std::size_t valid = 0, labelled = 0;
+  for (std::size_t i = 0; i < input.points.size(); ++i) {
+    if (!is_valid(input.points.data()[i])) continue;
+    ++valid;
+    labelled += set.labels.data()[i] != kUnlabeled;
+  }
+  require(valid > 0, "planes: " + input.name + " has no valid depth");
+  fs::create_directories(dir);
+  io::write_label_png(dir / "labels.png", set.labels);
+  io::write_png(dir / "segmentation.png", io::plane_overlay(input.color, set.labels));
+  io::write_ply(dir / "planes.ply", io::plane_points(input.points, set.labels));
+  io::write_planes_json(dir / "planes.json", set, {input.name, input.intrinsics, run.dump()});
+  const double coverage = 100.0 * static_cast<double>(labelled) / static_cast<double>(valid);
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "planes: %s: %zu planes (%u segments, %u merged), %.1f %% of valid pixels, %.1f ms"
+                " -> %s\n",
+                input.name.c_str(), set.planes.size(), set.segment_count, set.merged_count,
+                coverage, set.timings.total(), dir.string().c_str());
+  out << line;
+  return {{"source", input.name},
+          {"dir", dir.string()},
+          {"planes", set.planes.size()},
+          {"segments", set.segment_count},
+          {"valid_pixels", valid},
+          {"plane_pixels", labelled},
+          {"milliseconds", set.timings.total()}};
+}
+
+// Refuses to write into files left by an earlier run unless --force: a mix of two runs would
+// look like one.
+void check_output(const fs::path& dir, bool force) {
+  if (force || !fs::exists(dir)) return;
+  require(fs::is_directory(dir), "planes: --out " + dir.string() + " exists and is not a folder");
+  for (const char* file : {"planes.json", "labels.png", "summary.json"}) {
+    require(!fs::exists(dir / file), "planes: " + (dir / file).string() +
+                                         " exists (an earlier run?): use --force to overwrite");
+  }
+}
+
+}  // namespace
+
+CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
+  CLI::App* command = app.add_subcommand(
+      "planes",
+      "Planes of an organized PCD, an RGB-D frame (depth PNG + --color) or a sequence folder "
+      "(methods.md M1: Lab region growing, plane fits, merging)");
+  command->add_option("INPUT", o.input, "Organized PCD with colour, depth PNG, or sequence folder")
+      ->required();
+  command->add_option("--out", o.out_dir, "Output folder")->required();
+  command->add_option("--color", o.color, "Colour image of a depth PNG input");
+  command->add_option("--intrinsics", o.intrinsics,
+                      "Depth PNG input: camera_intrinsics.json (Open3D format)");
+  command->add_option("--fx", o.fx, "Depth PNG input: focal length [px] (default 525 at 640 wide)");
+  command->add_option("--fy", o.fy, "Depth PNG input: focal length [px]");
+  command->add_option("--cx", o.cx, "Depth PNG input: principal point [px] (default: centre)");
+  command->add_option("--cy", o.cy, "Depth PNG input: principal point [px]");
+  command->add_option("--depth-scale", o.depth_scale, "Depth PNG input: units per metre")
+      ->check(CLI::PositiveNumber)
+      ->capture_default_str();
+  command->add_option("--first", o.first, "Sequence: first frame")->capture_default_str();
+  command->add_option("--frames", o.frames, "Sequence: number of frames (0: to the end)")
+      ->capture_default_str();
+  command->add_option("--step", o.step, "Sequence: every step-th frame")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  command->add_option("--lab-threshold", o.lab_threshold, "Region growing: Lab distance")
+      ->check(CLI::Range(0.1, 1000.0))
+      ->capture_default_str();
+  command->add_option("--normal-angle", o.normal_angle_deg, "Merging: max normal angle [deg]")
+      ->check(CLI::Range(0.0, 180.0))
+      ->capture_default_str();
+  command->add_option("--min-plane-pixels", o.min_plane_pixels, "Smallest plane kept [pixels]")
+      ->capture_default_str();
+  command->add_option("--neighbours", o.neighbours, "Merging neighbours: pixel | bbox (the paper)")
+      ->check(CLI::IsMember({"pixel", "bbox"}))
+      ->capture_default_str();
+  command->add_option("--fit", o.fit, "Plane fit: tls | eq6 (the paper's z = Ax + By + C)")
+      ->check(CLI::IsMember({"tls", "eq6"}))
+      ->capture_default_str();
+  command
+      ->add_option("--backend", o.backend,
+                   "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)")
+      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
+  command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
+  command->add_flag("!--no-progress", o.progress, "No progress bar on stderr (sequences)");
+  return command;
+}
+
+int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& err) {
+  require(fs::exists(o.input), "planes: " + o.input.string() + ": no such file or folder");
+  compute::ContextOptions context_options;
+  context_options.backend = compute::parse_backend_choice(o.backend, o.backend_source);
+  const compute::Context context(context_options);
+  const segmentation::PlaneExtractionParams params = extraction_params(o);
+  params.validate();
+  const Json run = run_json(o, context);
+  check_output(o.out_dir, o.force);
+
+  if (!fs::is_directory(o.input)) {
+    std::string extension = o.input.extension().string();
+    std::transform(extension.begin(), extension.end(), extension.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    const PlaneInput input = extension == ".pcd" ? pcd_input(o.input) : rgbd_input(o, context);
+    segmentation::PlaneExtractor extractor(context, input.intrinsics, params);
+    extract_frame(extractor, input, o.out_dir, run, out);
+    return 0;
+  }
+
+  const io::OpenedSequence opened = io::open_sequence(o.input);
+  const io::Sequence& sequence = *opened.sequence;
+  const std::size_t end =
+      o.frames > 0 ? std::min(sequence.size(), o.first + o.frames * o.step) : sequence.size();
+  require(o.first < sequence.size(), "planes: --first " + std::to_string(o.first) + " but " +
+                                         o.input.string() + " has " +
+                                         std::to_string(sequence.size()) + " frames");
+  segmentation::PlaneExtractor extractor(context, sequence.intrinsics(), params);
+  geometry::DepthRange range;
+  range.units_per_metre = sequence.depth_units_per_metre();
+  ProgressBar bar(err, o.progress);
+  Json frames = Json::array();
+  const std::size_t total = (end - o.first + o.step - 1) / o.step;
+  for (std::size_t i = o.first; i < end; i += o.step) {
+    io::RgbdFrame frame = sequence.frame(i);
+    char number[32];
+    std::snprintf(number, sizeof(number), "%06zu", frame.index);
+    PlaneInput input{o.input.string() + " frame " + std::to_string(frame.index),
+                     geometry::backproject(context, frame.depth, sequence.intrinsics(), range),
+                     std::move(frame.color), sequence.intrinsics()};
+    frames.push_back(extract_frame(extractor, input, o.out_dir / number, run, out));
+    bar.update("planes", frames.size(), total);
+  }
+  bar.finish();
+  Json summary;
+  summary["sequence"] = o.input.string();
+  summary["layout"] = io::to_string(opened.detected.layout);
+  summary["run"] = run;
+  summary["frames"] = std::move(frames);
+  io::write_text_file(o.out_dir / "summary.json", summary.dump(1) + "\n");
+  return 0;
+}
+
+}  // namespace kartograf::cli
