@@ -97,9 +97,9 @@ int run_slam_command(const SlamOptions& options, std::ostream& out, std::ostream
 // `planes INPUT --out DIR`: planes of an organized PCD, an RGB-D frame or a sequence's frames.
 struct PlanesOptions {
   std::filesystem::path input, out_dir;
-  std::filesystem::path color, intrinsics;  // depth PNG input
-  double fx = 0, fy = 0, cx = -1, cy = -1;  // depth PNG input; 0 / -1: Kinect-like defaults
-  double depth_scale = 1000;                // depth PNG input: units per metre
+  std::filesystem::path color, intrinsics;      // depth PNG input
+  double fx = 0, fy = 0, cx = -1, cy = -1;      // depth PNG input; 0 / -1: Kinect-like defaults
+  double depth_scale = 1000;                    // depth PNG input: units per metre
   std::size_t first = 0, frames = 0, step = 1;  // sequences
   double lab_threshold = 15;
   double normal_angle_deg = 30;
@@ -113,5 +113,29 @@ struct PlanesOptions {
 };
 CLI::App* add_planes_command(CLI::App& app, PlanesOptions& options);
 int run_planes_command(const PlanesOptions& options, std::ostream& out, std::ostream& err);
+
+// `rooms MAP --method NAME --out DIR`: room segmentation of an occupancy map: DIR/rooms.png,
+// rooms_color.png, rooms.json. resolution_given: --resolution was set (it then overrides a YAML's).
+struct RoomsOptions {
+  std::filesystem::path map, out_dir;
+  std::string method = "morphological";
+  double resolution = 0.05;
+  int free_threshold = 250;
+  double min_area_m2 = -1, max_area_m2 = -1;  // < 0: the method's default
+  bool force = false;
+};
+CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& options);
+int run_rooms_command(const RoomsOptions& options, bool resolution_given, std::ostream& out);
+
+// `rooms-eval FOLDER`: every method on every map with a ground truth: tables on out, CSV.
+struct RoomsEvalOptions {
+  std::filesystem::path folder, csv;
+  std::vector<std::string> methods;  // empty: all
+  std::string only;                  // map name filter
+  RoomsOptions map;                  // resolution, free threshold, area limits
+  bool progress = true;
+};
+CLI::App* add_rooms_eval_command(CLI::App& app, RoomsEvalOptions& options);
+int run_rooms_eval_command(const RoomsEvalOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace kartograf::cli

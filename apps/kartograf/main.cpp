@@ -41,6 +41,10 @@ int main(int argc, char** argv) {
     planes_options.backend_source = "KARTOGRAF_BACKEND";
   }
   CLI::App* planes = kartograf::cli::add_planes_command(app, planes_options);
+  kartograf::cli::RoomsOptions rooms_options;
+  CLI::App* rooms = kartograf::cli::add_rooms_command(app, rooms_options);
+  kartograf::cli::RoomsEvalOptions rooms_eval_options;
+  CLI::App* rooms_eval = kartograf::cli::add_rooms_eval_command(app, rooms_eval_options);
 
   try {
     app.parse(argc, argv);
@@ -59,6 +63,13 @@ int main(int argc, char** argv) {
     }
     if (*slam) return kartograf::cli::run_slam_command(slam_options, std::cout, std::cerr);
     if (*planes) return kartograf::cli::run_planes_command(planes_options, std::cout, std::cerr);
+    if (*rooms) {
+      const bool resolution_given = rooms->get_option("--resolution")->count() > 0;
+      return kartograf::cli::run_rooms_command(rooms_options, resolution_given, std::cout);
+    }
+    if (*rooms_eval) {
+      return kartograf::cli::run_rooms_eval_command(rooms_eval_options, std::cout, std::cerr);
+    }
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

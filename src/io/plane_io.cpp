@@ -7,6 +7,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/input_file.hpp"
+#include "io/json_array.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/occupancy_map_io.hpp"
 
@@ -16,22 +17,17 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-template <class Vector>
-Json array_of(const Vector& v) {
-  Json json = Json::array();
-  for (int i = 0; i < v.size(); ++i) json.push_back(v[i]);
-  return json;
-}
+using detail::json_array;
 
 Json plane_json(const segmentation::Plane& plane) {
   return {{"id", plane.id},
-          {"normal", array_of(plane.normal)},
+          {"normal", json_array(plane.normal)},
           {"offset", plane.offset},
-          {"centroid", array_of(plane.centroid)},
-          {"major_axis", array_of(plane.major_axis)},
-          {"minor_axis", array_of(plane.minor_axis)},
-          {"extent_min", array_of(plane.extent_min)},
-          {"extent_max", array_of(plane.extent_max)},
+          {"centroid", json_array(plane.centroid)},
+          {"major_axis", json_array(plane.major_axis)},
+          {"minor_axis", json_array(plane.minor_axis)},
+          {"extent_min", json_array(plane.extent_min)},
+          {"extent_max", json_array(plane.extent_max)},
           {"inlier_count", plane.inlier_count},
           {"rms_error", plane.rms_error}};
 }

@@ -1,0 +1,61 @@
+#include "kartograf/rooms/room_methods.hpp"
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/rooms/threshold_methods.hpp"
+#include "kartograf/rooms/voronoi_segmentation.hpp"
+
+namespace kartograf::rooms {
+
+namespace {
+
+template <class Params>
+Params with_options(Params params, const RoomMethodOptions& options) {
+  if (options.room_area) params.room_area = *options.room_area;
+  params.furniture = options.furniture;
+  return params;
+}
+
+}  // namespace
+
+const std::vector<RoomMethod>& all_room_methods() {
+  static const std::vector<RoomMethod> methods{RoomMethod::morphological, RoomMethod::distance,
+                                               RoomMethod::voronoi};
+  return methods;
+}
+
+std::string to_string(RoomMethod method) {
+  switch (method) {
+    case RoomMethod::morphological:
+      return "morphological";
+    case RoomMethod::distance:
+      return "distance";
+    case RoomMethod::voronoi:
+      return "voronoi";
+  }
+  return "unknown";
+}
+
+RoomMethod parse_room_method(const std::string& name) {
+  std::string known;
+  for (const RoomMethod method : all_room_methods()) {
+    if (to_string(method) == name) return method;
+    if (!known.empty()) known += '|';
+    known += to_string(method);
+  }
+  throw Error("unknown room segmentation method '" + name + "' (known: " + known + ")");
+}
+
+RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
+                               const RoomMethodOptions& options) {
+  switch (method) {
+    case RoomMethod::morphological:
+      return segment_morphological(map, with_options(MorphologicalParams{}, options));
+    case RoomMethod::distance:
+      return segment_distance_transform(map, with_options(DistanceTransformParams{}, options));
+    case RoomMethod::voronoi:
+      return segment_voronoi(map, with_options(VoronoiParams{}, options));
+  }
+  throw Error("segment_rooms: unknown method");
+}
+
+}  // namespace kartograf::rooms

@@ -1,0 +1,66 @@
+#include "room_test_maps.hpp"
+
+namespace kartograf::testing {
+
+namespace {
+
+void fill(Image<CellState>& cells, const CellRect& r, CellState state) {
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x) cells(x, y) = state;
+}
+
+void fill(LabelImage& labels, const CellRect& r, Label label) {
+  for (int y = r.y0; y < r.y1; ++y)
+    for (int x = r.x0; x < r.x1; ++x) labels(x, y) = label;
+}
+
+constexpr int kRoom = 120, kWall = 2, kDoor = 18;
+
+}  // namespace
+
+OccupancyGrid carve_map(int width, int height, std::initializer_list<CellRect> free_cells,
+                        double resolution) {
+  OccupancyGrid map;
+  map.resolution = resolution;
+  map.cells = Image<CellState>(width, height, CellState::occupied);
+  for (const CellRect& r : free_cells) fill(map.cells, r, CellState::free);
+  return map;
+}
+
+OccupancyGrid rooms_in_a_row(int rooms, LabelImage* truth) {
+  const int width = kWall + rooms * (kRoom + kWall), height = kRoom + 2 * kWall;
+  OccupancyGrid map = carve_map(width, height, {});
+  if (truth) *truth = LabelImage(width, height, 0);
+  const int door_y0 = kWall + (kRoom - kDoor) / 2;
+  for (int k = 0; k < rooms; ++k) {
+    const CellRect room{kWall + k * (kRoom + kWall), kWall, (k + 1) * (kRoom + kWall),
+                        kWall + kRoom};
+    fill(map.cells, room, CellState::free);
+    if (truth) fill(*truth, room, static_cast<Label>(k + 1));
+    if (k > 0)
+      fill(map.cells, {room.x0 - kWall, door_y0, room.x0, door_y0 + kDoor}, CellState::free);
+  }
+  return map;
+}
+
+OccupancyGrid rooms_off_a_corridor(int rooms, LabelImage* truth) {
+  constexpr int kCorridor = 32;
+  const int width = kWall + rooms * (kRoom + kWall);
+  const int height = kWall + kRoom + kWall + kCorridor + kWall;
+  OccupancyGrid map = carve_map(width, height, {});
+  if (truth) *truth = LabelImage(width, height, 0);
+  const CellRect corridor{kWall, height - kWall - kCorridor, width - kWall, height - kWall};
+  fill(map.cells, corridor, CellState::free);
+  if (truth) fill(*truth, corridor, static_cast<Label>(rooms + 1));
+  for (int k = 0; k < rooms; ++k) {
+    const CellRect room{kWall + k * (kRoom + kWall), kWall, (k + 1) * (kRoom + kWall),
+                        kWall + kRoom};
+    fill(map.cells, room, CellState::free);
+    if (truth) fill(*truth, room, static_cast<Label>(k + 1));
+    const int door_x0 = room.x0 + (kRoom - kDoor) / 2;
+    fill(map.cells, {door_x0, room.y1, door_x0 + kDoor, room.y1 + kWall}, CellState::free);
+  }
+  return map;
+}
+
+}  // namespace kartograf::testing

@@ -1,0 +1,30 @@
+#pragma once
+// Hand-made occupancy maps with known rooms for the room segmentation tests: rectangles of free
+// space carved out of an occupied map, and the ground truth that goes with them.
+#include <initializer_list>
+
+#include "kartograf/core/label_image.hpp"
+#include "kartograf/core/occupancy_grid.hpp"
+
+namespace kartograf::testing {
+
+// Cells [x0, x1) x [y0, y1).
+struct CellRect {
+  int x0, y0, x1, y1;
+};
+
+// An occupied map of width x height cells at `resolution` with the rectangles set free.
+OccupancyGrid carve_map(int width, int height, std::initializer_list<CellRect> free_cells,
+                        double resolution = 0.05);
+
+// Rooms (6 x 6 m at 0.05 m/cell: 120 x 120 cells; two of them exceed the methods' largest room)
+// in a row, walls 2 cells thick, each pair joined by a doorway 18 cells (0.9 m) wide and a wall
+// thick, centred on the wall. Room k (1-based) is cells [2 + 122 (k - 1), 122 k) x [2, 122).
+// truth: rooms labelled 1..n, doorways 0.
+OccupancyGrid rooms_in_a_row(int rooms, LabelImage* truth = nullptr);
+
+// A corridor 1.6 m wide (32 cells) along the bottom with `rooms` 6 x 6 m rooms above it, each
+// opening onto it through a 0.9 m doorway. truth: the corridor is the last label.
+OccupancyGrid rooms_off_a_corridor(int rooms, LabelImage* truth = nullptr);
+
+}  // namespace kartograf::testing

@@ -1,0 +1,253 @@
+// Room segmentation by threshold sweeps (rooms/threshold_methods.hpp), the shared steps
+// (component tree, wavefront growing, room records) and the method registry: hand-made maps with
+// known rooms, errors, and the real ipa_room_segmentation maps.
+#include <algorithm>
+#include <set>
+
+#include "kartograf/eval/room_metrics.hpp"
+#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/io/room_io.hpp"
+#include "kartograf/rooms/component_tree.hpp"
+#include "kartograf/rooms/furniture.hpp"
+#include "kartograf/rooms/room_methods.hpp"
+#include "kartograf/rooms/threshold_methods.hpp"
+#include "room_test_maps.hpp"
+#include "test_support.hpp"
+
+namespace kartograf {
+namespace {
+
+using rooms::RoomMethod;
+
+// Every free cell has a room, no obstacle has one.
+void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& labels) {
+  int unlabelled_free = 0, labelled_walls = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const bool free = map.cells.data()[i] == CellState::free;
+    unlabelled_free += free && labels.data()[i] == 0;
+    labelled_walls += !free && labels.data()[i] != 0;
+  }
+  EXPECT_EQ(unlabelled_free, 0);
+  EXPECT_EQ(labelled_walls, 0);
+}
+
+class ThresholdMethods : public ::testing::TestWithParam<RoomMethod> {};
+
+TEST_P(ThresholdMethods, SplitRoomsInARowAtTheirDoorways) {
+  LabelImage truth;
+  const OccupancyGrid map = testing::rooms_in_a_row(3, &truth);
+  const rooms::RoomSegmentation result = rooms::segment_rooms(map, GetParam());
+  ASSERT_EQ(result.records.size(), 3u);
+  expect_free_space_covered(map, result.rooms);
+  const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
+  // Only the doorway cells (18 x 2 per doorway, in no true room) can go either way.
+  EXPECT_EQ(scores.recall_mean, 1.0);
+  EXPECT_GT(scores.precision_mean, 0.99);
+  // Rooms are 120 x 120 cells = 36 m^2 plus at most their doorways' cells.
+  for (const rooms::RoomRecord& r : result.records) {
+    EXPECT_GE(r.area_m2, 36.0);
+    EXPECT_LE(r.area_m2, 36.0 + 2 * 18 * 2 * 0.0025);
+  }
+  // The middle room touches both others, through one doorway each, 0.9 m wide (the border the
+  // split leaves may run a cell beyond it diagonally).
+  const rooms::RoomRecord& middle = result.records[1];
+  EXPECT_EQ(middle.neighbours, (std::vector<Label>{1, 3}));
+  for (const rooms::Doorway& d : middle.doorways) {
+    EXPECT_GE(d.width_m, 0.9 - 1e-9);
+    EXPECT_LE(d.width_m, 1.05 + 1e-9);
+  }
+}
+
+TEST_P(ThresholdMethods, FindRoomsOffACorridor) {
+  LabelImage truth;
+  const OccupancyGrid map = testing::rooms_off_a_corridor(4, &truth);
+  const rooms::RoomSegmentation result = rooms::segment_rooms(map, GetParam());
+  expect_free_space_covered(map, result.rooms);
+  const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
+  EXPECT_EQ(scores.segments, 5);
+  EXPECT_GT(scores.recall_mean, 0.97);
+  EXPECT_GT(scores.precision_mean, 0.97);
+}
+
+TEST_P(ThresholdMethods, RejectBadMaps) {
+  OccupancyGrid empty;
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(empty, GetParam()), "empty");
+  OccupancyGrid walls = testing::carve_map(10, 10, {});
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(walls, GetParam()), "no free cell");
+  OccupancyGrid bad_resolution = testing::rooms_in_a_row(1);
+  bad_resolution.resolution = 0;
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(bad_resolution, GetParam()), "resolution", "> 0");
+  EXPECT_ERROR_MENTIONS(
+      rooms::segment_rooms(testing::rooms_in_a_row(1), GetParam(), {rooms::AreaLimits{5, 2}}),
+      "area limits");
+}
+
+TEST_P(ThresholdMethods, AreaLimitsDecideWhatIsARoom) {
+  // Two 36 m^2 rooms: with rooms of 40-100 m^2 only both together are one; with the default
+  // limits (at most 47 m^2 morphological, 163 m^2 distance) the sweeps find each.
+  const OccupancyGrid map = testing::rooms_in_a_row(2);
+  EXPECT_EQ(rooms::segment_rooms(map, GetParam(), {rooms::AreaLimits{40, 100}}).records.size(), 1u);
+  EXPECT_EQ(rooms::segment_rooms(map, GetParam()).records.size(), 2u);
+}
+
+INSTANTIATE_TEST_SUITE_P(Rooms, ThresholdMethods,
+                         ::testing::Values(RoomMethod::morphological, RoomMethod::distance),
+                         [](const auto& info) { return rooms::to_string(info.param); });
+
+TEST(RoomMethods, ParseNamesAndRejectUnknownOnes) {
+  for (const RoomMethod m : rooms::all_room_methods())
+    EXPECT_EQ(rooms::parse_room_method(rooms::to_string(m)), m);
+  EXPECT_ERROR_MENTIONS(rooms::parse_room_method("watershed"), "watershed", "morphological");
+}
+
+TEST(ComponentTree, NestsTheComponentsOfEveryThreshold) {
+  // Two peaks (levels 3 and 2) on a plateau of level 1, joined at level 1 only.
+  Image<std::int32_t> levels(7, 1, 0);
+  const int row[7] = {1, 3, 3, 1, 2, 1, 0};
+  for (int x = 0; x < 7; ++x) levels(x, 0) = row[x];
+  const rooms::ComponentTree tree = rooms::build_component_tree(levels);
+  ASSERT_EQ(tree.nodes.size(), 3u);  // {3,3}, {2}, and the plateau {all but the last}
+  std::multiset<std::pair<int, std::uint32_t>> nodes;
+  for (const auto& n : tree.nodes) nodes.insert({n.level, n.cells});
+  EXPECT_EQ(nodes, (std::multiset<std::pair<int, std::uint32_t>>{{3, 2}, {2, 1}, {1, 6}}));
+  const int root = static_cast<int>(tree.nodes.size()) - 1;
+  EXPECT_EQ(tree.nodes[root].parent, -1);
+  EXPECT_EQ(tree.nodes[0].parent, root);
+  EXPECT_EQ(tree.nodes[1].parent, root);
+  EXPECT_EQ(tree.pixels_of(root).size(), 6u);
+  EXPECT_EQ(tree.node_of[6], -1);
+}
+
+TEST(GrowRooms, FillsFreeCellsFromTheNearestRoomOnly) {
+  OccupancyGrid map = testing::carve_map(10, 3, {{0, 0, 4, 3}, {5, 0, 10, 3}});  // wall at x = 4
+  LabelImage labels(10, 3, 0);
+  labels(0, 1) = 1;
+  labels(9, 1) = 2;
+  rooms::grow_rooms(labels, map);
+  for (int y = 0; y < 3; ++y) {
+    for (int x = 0; x < 10; ++x)
+      EXPECT_EQ(labels(x, y), x < 4 ? 1 : x == 4 ? 0 : 2) << x << "," << y;
+  }
+}
+
+TEST(GrowRooms, ByClearanceRoomsMeetAtTheDoorway) {
+  // A hall (100 x 60 cells) and a small room (30 x 30) beside it, joined by a 10-cell doorway in a
+  // one-cell wall; seeds in the middle of each, as the methods' room centres are.
+  const OccupancyGrid map =
+      testing::carve_map(132, 62, {{1, 1, 101, 61}, {102, 1, 131, 31}, {101, 16, 102, 26}});
+  LabelImage seeds(132, 62, 0);
+  for (int y = 25; y < 35; ++y)
+    for (int x = 45; x < 55; ++x) seeds(x, y) = 1;
+  seeds(116, 15) = 2;
+  LabelImage wavefront = seeds, by_clearance = seeds;
+  rooms::grow_rooms(wavefront, map);
+  rooms::grow_rooms_by_clearance(by_clearance, map, rooms::clearance(map));
+  int hall_cells_to_room = 0, hall_cells_to_room_wavefront = 0;
+  for (int y = 1; y < 61; ++y) {
+    for (int x = 1; x < 101; ++x) {
+      hall_cells_to_room += by_clearance(x, y) == 2;
+      hall_cells_to_room_wavefront += wavefront(x, y) == 2;
+    }
+  }
+  EXPECT_LE(hall_cells_to_room, 10);             // at most a few cells in the doorway's mouth
+  EXPECT_GT(hall_cells_to_room_wavefront, 500);  // the wavefront spills into the hall
+  for (int y = 1; y < 31; ++y)
+    for (int x = 102; x < 131; ++x) EXPECT_EQ(by_clearance(x, y), 2);
+}
+
+TEST(GrowRooms, ClearanceIsTheDistanceToTheNearestObstacle) {
+  const OccupancyGrid map = testing::carve_map(9, 5, {{1, 1, 8, 4}});
+  const Image<float> c = rooms::clearance(map);
+  EXPECT_FLOAT_EQ(c(0, 0), 0);
+  EXPECT_NEAR(c(1, 1), 1, 1e-3);
+  EXPECT_NEAR(c(4, 2), 2, 1e-3);
+}
+
+TEST(Furniture, FreeStandingObstaclesAreRemovedWallsStay) {
+  // A 6 x 4 m room (120 x 80 cells) with a table (0.5 x 0.5 m), a cupboard against the wall and
+  // a long partition wall (3 m) standing free.
+  OccupancyGrid map = testing::carve_map(124, 84, {{2, 2, 122, 82}});
+  const auto block = [&](int x0, int y0, int x1, int y1) {
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) map.cells(x, y) = CellState::occupied;
+  };
+  block(30, 30, 40, 40);  // table
+  block(2, 50, 12, 60);   // cupboard touching the left wall
+  block(60, 20, 62, 80);  // partition 3 m long
+  const OccupancyGrid cleaned = rooms::without_furniture(map);
+  EXPECT_EQ(cleaned.cells(35, 35), CellState::free);
+  EXPECT_EQ(cleaned.cells(5, 55), CellState::occupied);
+  EXPECT_EQ(cleaned.cells(61, 50), CellState::occupied);
+  EXPECT_EQ(cleaned.cells(0, 0), CellState::occupied);
+  EXPECT_ERROR_MENTIONS(rooms::without_furniture(map, {-1, 2}), "furniture limits");
+}
+
+TEST(Furniture, KeepsRoomsWholeWithTheFurnitureInThem) {
+  // Three 6 x 6 m rooms; in the first, a ring of chairs (0.3 m blocks 0.15 m apart) around a
+  // table (0.6 m): without the furniture step the inside of the ring becomes a room of its own.
+  OccupancyGrid map = testing::rooms_in_a_row(3);
+  const auto block = [&](int x0, int y0, int size) {
+    for (int y = y0; y < y0 + size; ++y)
+      for (int x = x0; x < x0 + size; ++x) map.cells(x, y) = CellState::occupied;
+  };
+  block(56, 56, 12);  // table
+  for (int k = 0; k < 6; ++k) {
+    block(38 + 9 * k, 38, 6), block(38 + 9 * k, 83, 6);
+    block(38, 38 + 9 * k, 6), block(83, 38 + 9 * k, 6);
+  }
+  rooms::MorphologicalParams as_reference;
+  as_reference.furniture.reset();
+  const auto reference = rooms::segment_morphological(map, as_reference);
+  const auto ours = rooms::segment_morphological(map);
+  EXPECT_EQ(reference.records.size(), 4u);
+  ASSERT_EQ(ours.records.size(), 3u);
+  EXPECT_NE(ours.rooms(50, 60), 0);  // the cells between chairs and table are in the room
+  EXPECT_EQ(ours.rooms(50, 60), ours.rooms(10, 10));
+  EXPECT_EQ(ours.rooms(60, 60), ours.rooms(10, 10));  // and so is the table
+  EXPECT_NE(reference.rooms(50, 60), reference.rooms(10, 10));
+  EXPECT_EQ(reference.rooms(60, 60), 0);
+  rooms::MorphologicalParams furniture_in_no_room;
+  furniture_in_no_room.furniture->in_rooms = false;
+  const auto apart = rooms::segment_morphological(map, furniture_in_no_room);
+  EXPECT_EQ(apart.records.size(), 3u);
+  EXPECT_EQ(apart.rooms(60, 60), 0);
+  EXPECT_EQ(apart.rooms(50, 60), apart.rooms(10, 10));
+}
+
+// The 10 real maps of the benchmark, plain and furnished, against the survey's reference
+// implementation's mean recall / precision (morphological 98.1 / 88.5 plain, 84.6 / 90.5
+// furnished; distance 96.9 / 88.4 and 76.1 / 88.4), which ours must match or beat.
+TEST(ThresholdMethodsOnRealMaps, MatchOrBeatTheReference) {
+  struct Reference {
+    RoomMethod method;
+    std::string variant;
+    double recall, precision;
+  };
+  const Reference references[] = {{RoomMethod::morphological, "plain", 0.981, 0.885},
+                                  {RoomMethod::morphological, "furnitures", 0.846, 0.905},
+                                  {RoomMethod::distance, "plain", 0.969, 0.884},
+                                  {RoomMethod::distance, "furnitures", 0.761, 0.884}};
+  const auto cases = io::find_room_maps(testing::data_dir() / "ipa_room_maps" / "test_maps");
+  for (const Reference& reference : references) {
+    double recall = 0, precision = 0;
+    int maps = 0;
+    for (const io::RoomMapCase& c : cases) {
+      if (c.variant != reference.variant) continue;
+      const auto result = rooms::segment_rooms(io::read_png_map(c.map), reference.method);
+      const auto scores = eval::evaluate_room_segmentation(
+          io::read_room_ground_truth_png(c.ground_truth), result.rooms);
+      recall += scores.recall_mean;
+      precision += scores.precision_mean;
+      ++maps;
+    }
+    ASSERT_EQ(maps, 10);
+    const std::string name = rooms::to_string(reference.method) + "_" + reference.variant;
+    RecordProperty(name + "_recall", std::to_string(recall / maps));
+    RecordProperty(name + "_precision", std::to_string(precision / maps));
+    EXPECT_GE(recall / maps, reference.recall) << name;
+    EXPECT_GE(precision / maps, reference.precision) << name;
+  }
+}
+
+}  // namespace
+}  // namespace kartograf
