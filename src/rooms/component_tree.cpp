@@ -5,6 +5,7 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
+#include "rooms/grid_neighbours.hpp"
 
 namespace kartograf::rooms {
 
@@ -78,28 +79,21 @@ ComponentTree build_component_tree(const Image<std::int32_t>& levels) {
     }
     for (std::size_t j = k; j < end; ++j) {
       const std::uint32_t p = order[j];
-      const int x = static_cast<int>(p % static_cast<std::uint32_t>(width));
-      const int y = static_cast<int>(p / static_cast<std::uint32_t>(width));
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if ((dx == 0 && dy == 0) || nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-          const std::uint32_t q = static_cast<std::uint32_t>(ny * width + nx);
-          if (!made[q]) continue;
-          std::uint32_t a = find(parent, p), b = find(parent, q);
-          if (a == b) continue;
-          touch(a);
-          touch(b);
-          if (size[a] < size[b]) std::swap(a, b);
-          parent[b] = a;
-          size[a] += size[b];
-          // b's absorbed nodes move to a.
-          auto& from = children[static_cast<std::size_t>(slot[b])];
-          auto& into = children[static_cast<std::size_t>(slot[a])];
-          into.insert(into.end(), from.begin(), from.end());
-          from.clear();
-        }
-      }
+      detail::for_each_neighbour8(p, width, height, [&](std::uint32_t q) {
+        if (!made[q]) return;
+        std::uint32_t a = find(parent, p), b = find(parent, q);
+        if (a == b) return;
+        touch(a);
+        touch(b);
+        if (size[a] < size[b]) std::swap(a, b);
+        parent[b] = a;
+        size[a] += size[b];
+        // b's absorbed nodes move to a.
+        auto& from = children[static_cast<std::size_t>(slot[b])];
+        auto& into = children[static_cast<std::size_t>(slot[a])];
+        into.insert(into.end(), from.begin(), from.end());
+        from.clear();
+      });
     }
     // One node per component touched at this level.
     for (const std::uint32_t r : touched) {

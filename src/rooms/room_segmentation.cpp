@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "kartograf/core/error.hpp"
+#include "rooms/grid_neighbours.hpp"
 
 namespace kartograf::rooms {
 
@@ -26,31 +27,41 @@ void check_map(const OccupancyGrid& map, const std::string& what) {
           what + ": the map has no free cell");
 }
 
-void grow_rooms(LabelImage& rooms, const OccupancyGrid& map) {
+namespace {
+
+// Priority flood of the unlabelled free cells from the labelled ones, level by level from the
+// highest (bucket_of: a cell's level, 0 .. top); within a level, breadth first. A cell takes the
+// label of the cell that reaches it first; one above the current level is flooded at it.
+template <class BucketOf>
+void flood_rooms(LabelImage& rooms, const OccupancyGrid& map, int top, BucketOf bucket_of) {
   const int width = map.width(), height = map.height();
-  require(rooms.width() == width && rooms.height() == height,
-          "grow_rooms: the label image differs from the map in size");
-  std::vector<std::uint32_t> queue;
-  for (std::size_t i = 0; i < rooms.size(); ++i) {
-    if (rooms.data()[i] != 0) queue.push_back(static_cast<std::uint32_t>(i));
-  }
+  std::vector<std::vector<std::uint32_t>> buckets(static_cast<std::size_t>(top) + 1);
   const CellState* cell = map.cells.data();
   Label* label = rooms.data();
-  for (std::size_t head = 0; head < queue.size(); ++head) {
-    const std::uint32_t i = queue[head];
-    const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
-    const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const int nx = x + dx, ny = y + dy;
-        if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-        const std::uint32_t j = static_cast<std::uint32_t>(ny * width + nx);
-        if (label[j] != 0 || cell[j] != CellState::free) continue;
-        label[j] = label[i];
-        queue.push_back(j);
-      }
-    }
+  for (std::size_t i = 0; i < rooms.size(); ++i) {
+    if (label[i] != 0)
+      buckets[static_cast<std::size_t>(bucket_of(i))].push_back(static_cast<std::uint32_t>(i));
   }
+  for (int b = top; b >= 0; --b) {
+    std::vector<std::uint32_t>& queue = buckets[static_cast<std::size_t>(b)];
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const std::uint32_t i = queue[head];
+      detail::for_each_neighbour8(i, width, height, [&](std::uint32_t j) {
+        if (label[j] != 0 || cell[j] != CellState::free) return;
+        label[j] = label[i];
+        buckets[static_cast<std::size_t>(std::min(b, bucket_of(j)))].push_back(j);
+      });
+    }
+    std::vector<std::uint32_t>().swap(queue);
+  }
+}
+
+}  // namespace
+
+void grow_rooms(LabelImage& rooms, const OccupancyGrid& map) {
+  require(rooms.width() == map.width() && rooms.height() == map.height(),
+          "grow_rooms: the label image differs from the map in size");
+  flood_rooms(rooms, map, 0, [](std::size_t) { return 0; });
 }
 
 Image<float> clearance(const OccupancyGrid& map) {
@@ -77,39 +88,13 @@ void grow_rooms_by_clearance(LabelImage& rooms, const OccupancyGrid& map,
   require(rooms.width() == width && rooms.height() == height && clearance.width() == width &&
               clearance.height() == height,
           "grow_rooms_by_clearance: the label and clearance images differ from the map in size");
-  // Priority flood with a bucket per quarter cell of clearance: O(cells).
+  // A bucket per quarter cell of clearance: O(cells).
   const auto bucket_of = [&](std::size_t i) {
     return static_cast<int>(std::max(0.0f, clearance.data()[i]) * 4.0f);
   };
   int top = 0;
   for (std::size_t i = 0; i < rooms.size(); ++i) top = std::max(top, bucket_of(i));
-  std::vector<std::vector<std::uint32_t>> buckets(static_cast<std::size_t>(top) + 1);
-  const CellState* cell = map.cells.data();
-  Label* label = rooms.data();
-  for (std::size_t i = 0; i < rooms.size(); ++i) {
-    if (label[i] != 0)
-      buckets[static_cast<std::size_t>(bucket_of(i))].push_back(static_cast<std::uint32_t>(i));
-  }
-  for (int b = top; b >= 0; --b) {
-    std::vector<std::uint32_t>& queue = buckets[static_cast<std::size_t>(b)];
-    for (std::size_t head = 0; head < queue.size(); ++head) {
-      const std::uint32_t i = queue[head];
-      const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
-      const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
-      for (int dy = -1; dy <= 1; ++dy) {
-        for (int dx = -1; dx <= 1; ++dx) {
-          const int nx = x + dx, ny = y + dy;
-          if (nx < 0 || ny < 0 || nx >= width || ny >= height) continue;
-          const std::uint32_t j = static_cast<std::uint32_t>(ny * width + nx);
-          if (label[j] != 0 || cell[j] != CellState::free) continue;
-          label[j] = label[i];
-          // A cell above the current level is flooded at the current level.
-          buckets[static_cast<std::size_t>(std::min(b, bucket_of(j)))].push_back(j);
-        }
-      }
-    }
-    std::vector<std::uint32_t>().swap(queue);
-  }
+  flood_rooms(rooms, map, top, bucket_of);
 }
 
 RoomSegmentation finish_segmentation(LabelImage rooms, const OccupancyGrid& map, std::string method,

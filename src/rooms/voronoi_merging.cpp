@@ -1,12 +1,14 @@
 #include "kartograf/rooms/voronoi_merging.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <functional>
 #include <map>
 #include <numeric>
 #include <vector>
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/rooms/room_segmentation.hpp"
 
 namespace kartograf::rooms {
 
@@ -17,6 +19,7 @@ constexpr int kWall = 0;
 struct Cell {
   int id = 0;
   long cells = 0;
+  float max_clearance = 0;    // cells: half the widest free space in the cell
   std::map<int, int> border;  // neighbour label (kWall: wall) -> touching cells outside
 
   double perimeter() const {
@@ -58,7 +61,7 @@ struct Cell {
   }
 };
 
-std::vector<Cell> measure_cells(const LabelImage& labels, int count) {
+std::vector<Cell> measure_cells(const LabelImage& labels, int count, const Image<float>& clearance) {
   std::vector<Cell> cells(static_cast<std::size_t>(count) + 1);
   for (int id = 0; id <= count; ++id) cells[static_cast<std::size_t>(id)].id = id;
   const int width = labels.width(), height = labels.height();
@@ -70,7 +73,11 @@ std::vector<Cell> measure_cells(const LabelImage& labels, int count) {
   for (int y = -1; y <= height; ++y) {
     for (int x = -1; x <= width; ++x) {
       const int own = label_at(x, y);
-      if (own) ++cells[static_cast<std::size_t>(own)].cells;
+      if (own) {
+        Cell& c = cells[static_cast<std::size_t>(own)];
+        ++c.cells;
+        c.max_clearance = std::max(c.max_clearance, clearance(x, y));
+      }
       int seen[8];
       int n_seen = 0;
       for (int dy = -1; dy <= 1; ++dy) {
@@ -145,6 +152,7 @@ class Merger {
     Cell& sink = alive_[into];
     const int gone = source.id, kept = sink.id;
     sink.cells += source.cells;
+    sink.max_clearance = std::max(sink.max_clearance, source.max_clearance);
     for (const auto& [id, n] : source.border) {
       if (id != kept) sink.border[id] += n;
     }
@@ -171,10 +179,12 @@ class Merger {
 void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const CellMergeParams& p) {
   require(cells.width() == map.width() && cells.height() == map.height(),
           "merge_voronoi_cells: the label image differs from the map in size");
+  require(std::isfinite(p.open_border_ratio) && p.open_border_ratio >= 0,
+          "merge_voronoi_cells: open_border_ratio must be >= 0");
   int count = 0;
   for (const Label l : cells.pixels()) count = std::max(count, static_cast<int>(l));
   if (count == 0) return;
-  Merger m(measure_cells(cells, count), map.resolution * map.resolution);
+  Merger m(measure_cells(cells, count, clearance(map)), map.resolution * map.resolution);
 
   m.run([&](const Cell& c) {  // 1. small, one neighbour, not closed off by walls
     return m.area_m2(c) < p.max_area_m2 && c.neighbours() == 1 && c.wall() <= p.one_neighbour_max_wall
@@ -196,6 +206,14 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
     if (!t || (t->neighbours() > p.part_target_max_neighbours && t->largest_shares(2) < p.part_target_two_largest))
       return kWall;
     return n;
+  });
+  m.run([&](const Cell& c) {  // 3b. pieces of one corridor or hall
+    if (p.open_border_ratio <= 0) return kWall;
+    for (const auto& [id, n] : c.border) {
+      const Cell* t = id == kWall ? nullptr : m.find(id);
+      if (t && n >= p.open_border_ratio * 2.0 * std::max(c.max_clearance, t->max_clearance)) return id;
+    }
+    return kWall;
   });
   m.run([&](const Cell& c) {  // 4. sharing most of the border
     std::vector<std::pair<int, int>> by_length;

@@ -14,6 +14,12 @@
 // 3. one neighbour (or one holding > 98 % of the perimeter with the wall), > 50 % wall and that
 //    neighbour > 15 % of the perimeter, the neighbour having <= 2 neighbours (or its two largest
 //    borders >= 95 % of its perimeter): merge (two parts of one room);
+// 3b. (not in the reference) a neighbour whose shared border is at least open_border_ratio x the
+//    widest free space (2 x the largest clearance) of either cell: merge. The border spans both
+//    cells, so no doorway lies between them: they are pieces of one corridor or hall, which the
+//    graph cuts wherever its clearance is least along a stretch, and which rules 4 and 5 leave
+//    apart once a piece's border is a small share of its long perimeter. A doorway off a corridor
+//    is narrower than the room behind it (the room's width counts), so rooms stay apart.
 // 4. a neighbour holding > 20 % of the perimeter (or > 10 % where the wall share lies within
 //    [1 - 2r - 0.05, 1 - r] for that share r) while the cell holds > 10 % of the neighbour's:
 //    merge (regions sharing most of their border);
@@ -38,6 +44,7 @@ struct CellMergeParams {
   double shared_min_low = 0.1;
   double shared_min_of_neighbour = 0.1;
   double dominant_neighbour = 0.4;  // rule 5
+  double open_border_ratio = 0.8;  // rule 3b; 0: off (the reference)
 };
 
 // Merges the labelled cells (labels 1..n, 0 = none) of `cells` in place. Throws Error if the
