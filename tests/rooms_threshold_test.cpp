@@ -31,6 +31,12 @@ void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& label
   EXPECT_EQ(labelled_walls, 0);
 }
 
+rooms::RoomMethodOptions area_limits(double min_m2, double max_m2) {
+  rooms::RoomMethodOptions options;
+  options.room_area = rooms::AreaLimits{min_m2, max_m2};
+  return options;
+}
+
 class ThresholdMethods : public ::testing::TestWithParam<RoomMethod> {};
 
 TEST_P(ThresholdMethods, SplitRoomsInARowAtTheirDoorways) {
@@ -78,7 +84,7 @@ TEST_P(ThresholdMethods, RejectBadMaps) {
   bad_resolution.resolution = 0;
   EXPECT_ERROR_MENTIONS(rooms::segment_rooms(bad_resolution, GetParam()), "resolution", "> 0");
   EXPECT_ERROR_MENTIONS(
-      rooms::segment_rooms(testing::rooms_in_a_row(1), GetParam(), {rooms::AreaLimits{5, 2}}),
+      rooms::segment_rooms(testing::rooms_in_a_row(1), GetParam(), area_limits(5, 2)),
       "area limits");
 }
 
@@ -86,7 +92,7 @@ TEST_P(ThresholdMethods, AreaLimitsDecideWhatIsARoom) {
   // Two 36 m^2 rooms: with rooms of 40-100 m^2 only both together are one; with the default
   // limits (at most 47 m^2 morphological, 163 m^2 distance) the sweeps find each.
   const OccupancyGrid map = testing::rooms_in_a_row(2);
-  EXPECT_EQ(rooms::segment_rooms(map, GetParam(), {rooms::AreaLimits{40, 100}}).records.size(), 1u);
+  EXPECT_EQ(rooms::segment_rooms(map, GetParam(), area_limits(40, 100)).records.size(), 1u);
   EXPECT_EQ(rooms::segment_rooms(map, GetParam()).records.size(), 2u);
 }
 

@@ -1,6 +1,7 @@
 #include "kartograf/rooms/room_methods.hpp"
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/rooms/feature_segmentation.hpp"
 #include "kartograf/rooms/threshold_methods.hpp"
 #include "kartograf/rooms/voronoi_segmentation.hpp"
 
@@ -19,7 +20,7 @@ Params with_options(Params params, const RoomMethodOptions& options) {
 
 const std::vector<RoomMethod>& all_room_methods() {
   static const std::vector<RoomMethod> methods{RoomMethod::morphological, RoomMethod::distance,
-                                               RoomMethod::voronoi};
+                                               RoomMethod::voronoi, RoomMethod::feature};
   return methods;
 }
 
@@ -31,6 +32,8 @@ std::string to_string(RoomMethod method) {
       return "distance";
     case RoomMethod::voronoi:
       return "voronoi";
+    case RoomMethod::feature:
+      return "feature";
   }
   return "unknown";
 }
@@ -54,6 +57,13 @@ RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
       return segment_distance_transform(map, with_options(DistanceTransformParams{}, options));
     case RoomMethod::voronoi:
       return segment_voronoi(map, with_options(VoronoiParams{}, options));
+    case RoomMethod::feature: {
+      FeatureSegmentationParams params;
+      if (options.room_area) params.region_area = *options.room_area;
+      const RoomClassifier classifier = RoomClassifier::load(
+          options.feature_model.empty() ? default_room_classifier_path() : options.feature_model);
+      return segment_feature_based(map, classifier, params);
+    }
   }
   throw Error("segment_rooms: unknown method");
 }

@@ -1,6 +1,7 @@
 #pragma once
 // The room segmentation methods by name, for the CLI, the benchmark and the pipeline: one call
 // that runs any of them with its reference parameters (or other room-area limits).
+#include <filesystem>
 #include <optional>
 #include <string>
 #include <vector>
@@ -11,7 +12,7 @@
 
 namespace kartograf::rooms {
 
-enum class RoomMethod { morphological, distance, voronoi };
+enum class RoomMethod { morphological, distance, voronoi, feature };
 
 std::string to_string(RoomMethod method);
 // Throws Error listing the known names.
@@ -24,6 +25,8 @@ struct RoomMethodOptions {
   // room: the rooms stay whole where tables and chairs stand. Empty: segment the map as it is
   // (the survey's reference behaviour).
   std::optional<FurnitureParams> furniture = FurnitureParams{};
+  // feature: the room/hallway classifier (default_room_classifier_path() when empty).
+  std::filesystem::path feature_model;
 };
 
 RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,

@@ -1,0 +1,306 @@
+#include "kartograf/rooms/laser_features.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+#include <opencv2/imgproc.hpp>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::rooms {
+
+namespace {
+
+// Feature indices, in the order of laser_feature_names().
+enum Feature : std::size_t {
+  mean_difference,
+  std_difference,
+  mean_clipped_difference,
+  std_clipped_difference,
+  mean_beam,
+  std_beam,
+  gaps,
+  minima_distance,
+  minima_angle,
+  mean_ratio,
+  std_ratio,
+  relative_gaps,
+  beam_kurtosis,
+  polygon_area,
+  polygon_perimeter,
+  area_per_perimeter,
+  mean_centroid_distance,
+  std_centroid_distance,
+  major_semi_axis,
+  minor_semi_axis,
+  axis_ratio,
+  mean_beam_per_max,
+  std_beam_per_max,
+  compactness,
+  shortest_beam,
+  longest_beam,
+  centroid_offset
+};
+
+struct MeanStd {
+  double mean = 0, std = 0;
+};
+
+// Population mean and standard deviation from the sum and the sum of squares of n values.
+MeanStd from_sums(double sum, double sum2, std::size_t n) {
+  const double mean = sum / static_cast<double>(n);
+  return {mean, std::sqrt(std::max(0.0, sum2 / static_cast<double>(n) - mean * mean))};
+}
+
+// Population mean and standard deviation of f(i), i in [0, n).
+template <class F>
+MeanStd mean_std(std::size_t n, F&& f) {
+  double sum = 0, sum2 = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double v = f(i);
+    sum += v;
+    sum2 += v * v;
+  }
+  return from_sums(sum, sum2, n);
+}
+
+double norm(double x, double y) {
+  return std::sqrt(x * x + y * y);
+}
+
+// Unit vectors of n beams at equal angles (cached: every scan of a map has the same n).
+void unit_directions(std::size_t n, std::vector<double>& xs, std::vector<double>& ys) {
+  thread_local std::vector<double> cos_table, sin_table;
+  if (cos_table.size() != n) {
+    cos_table.resize(n);
+    sin_table.resize(n);
+    for (std::size_t k = 0; k < n; ++k) {
+      const double angle = 2 * std::numbers::pi * static_cast<double>(k) / static_cast<double>(n);
+      cos_table[k] = std::cos(angle);
+      sin_table[k] = std::sin(angle);
+    }
+  }
+  xs = cos_table;
+  ys = sin_table;
+}
+
+}  // namespace
+
+LaserScanner::LaserScanner(const OccupancyGrid& map, const LaserScanParams& params)
+    : width_(map.width()), height_(map.height()), resolution_(map.resolution) {
+  require(width_ > 0 && height_ > 0, "laser scanner: the map has no cells");
+  require(resolution_ > 0 && std::isfinite(resolution_),
+          "laser scanner: the map resolution must be > 0, got " + std::to_string(resolution_));
+  require(params.beams >= 8,
+          "laser scanner: beams must be >= 8, got " + std::to_string(params.beams));
+  require(params.max_range_m > 0 && std::isfinite(params.max_range_m),
+          "laser scanner: max_range_m must be > 0, got " + std::to_string(params.max_range_m));
+  max_steps_ = std::max(1, static_cast<int>(std::ceil(params.max_range_m / resolution_)));
+  // Free space with a border of non-free cells, so that the grid's edge stops rays like a wall.
+  cv::Mat free(height_ + 2, width_ + 2, CV_8UC1, cv::Scalar(0));
+  for (int y = 0; y < height_; ++y) {
+    for (int x = 0; x < width_; ++x)
+      free.at<std::uint8_t>(y + 1, x + 1) = map.cells(x, y) == CellState::free ? 255 : 0;
+  }
+  cv::Mat distance;
+  cv::distanceTransform(free, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  clearance_ = Image<float>(width_ + 2, height_ + 2);
+  for (int y = 0; y < height_ + 2; ++y) {
+    const float* row = distance.ptr<float>(y);
+    std::copy(row, row + width_ + 2,
+              clearance_.data() + static_cast<std::size_t>(y) * (width_ + 2));
+  }
+  cos_.resize(static_cast<std::size_t>(params.beams));
+  sin_.resize(cos_.size());
+  for (std::size_t k = 0; k < cos_.size(); ++k) {
+    const double angle = 2 * std::numbers::pi * static_cast<double>(k) / params.beams;
+    cos_[k] = std::cos(angle);
+    sin_[k] = std::sin(angle);
+  }
+}
+
+void LaserScanner::scan(int col, int row, std::span<double> ranges) const {
+  if (ranges.size() != cos_.size()) {
+    throw Error("laser scanner: expected room for " + std::to_string(cos_.size()) + " beams, got " +
+                std::to_string(ranges.size()));
+  }
+  std::fill(ranges.begin(), ranges.end(), 0.0);
+  if (col < 0 || row < 0 || col >= width_ || row >= height_ || clearance_(col + 1, row + 1) <= 0)
+    return;
+  const int stride = width_ + 2;
+  const float* clearance = clearance_.data();
+  // Padded image coordinates of the cell centre; rows grow downwards, so +y is -row.
+  const double x0 = col + 1.5, y0 = row + 1.5;
+  for (std::size_t k = 0; k < cos_.size(); ++k) {
+    const double dx = cos_[k], dy = -sin_[k];
+    int step = 0;
+    while (step < max_steps_) {
+      // The border ring is non-free, so samples never leave the padded image before stopping.
+      const int cx = static_cast<int>(x0 + step * dx), cy = static_cast<int>(y0 + step * dy);
+      const float d = clearance[static_cast<std::size_t>(cy) * stride + cx];
+      if (d <= 0) break;
+      step += std::max(1, static_cast<int>(d - 1.5f));
+    }
+    ranges[k] = std::min(step, max_steps_) * resolution_;
+  }
+}
+
+const std::array<std::string_view, kLaserFeatureCount>& laser_feature_names() {
+  static const std::array<std::string_view, kLaserFeatureCount> names{"mean_difference",
+                                                                      "std_difference",
+                                                                      "mean_clipped_difference",
+                                                                      "std_clipped_difference",
+                                                                      "mean_beam",
+                                                                      "std_beam",
+                                                                      "gaps",
+                                                                      "minima_distance",
+                                                                      "minima_angle",
+                                                                      "mean_ratio",
+                                                                      "std_ratio",
+                                                                      "relative_gaps",
+                                                                      "beam_kurtosis",
+                                                                      "polygon_area",
+                                                                      "polygon_perimeter",
+                                                                      "area_per_perimeter",
+                                                                      "mean_centroid_distance",
+                                                                      "std_centroid_distance",
+                                                                      "major_semi_axis",
+                                                                      "minor_semi_axis",
+                                                                      "axis_ratio",
+                                                                      "mean_beam_per_max",
+                                                                      "std_beam_per_max",
+                                                                      "compactness",
+                                                                      "shortest_beam",
+                                                                      "longest_beam",
+                                                                      "centroid_offset"};
+  return names;
+}
+
+LaserFeatures laser_scan_features(std::span<const double> ranges,
+                                  const LaserFeatureParams& params) {
+  const std::size_t n = ranges.size();
+  require(n >= 8, "laser scan features: need at least 8 beams, got " + std::to_string(n));
+  for (const double b : ranges) {
+    if (!(b > 0 && std::isfinite(b)))
+      throw Error("laser scan features: beam lengths must be > 0 and finite, got " +
+                  std::to_string(b));
+  }
+  LaserFeatures f{};
+  const auto set = [&](Feature which, double value) { f[which] = static_cast<float>(value); };
+
+  // Differences and ratios of consecutive beams (cyclic: the last beam is followed by the first).
+  const auto next = [&](std::size_t i) { return i + 1 < n ? ranges[i + 1] : ranges[0]; };
+  double sum_difference = 0, sum2_difference = 0, sum_clipped = 0, sum2_clipped = 0;
+  double sum_ratio = 0, sum2_ratio = 0;
+  int gap_count = 0, relative_gap_count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = ranges[i], b = next(i);
+    const double difference = std::abs(a - b);
+    const double clipped = std::abs(std::min(a, params.clip_m) - std::min(b, params.clip_m));
+    const double ratio = std::min(a, b) / std::max(a, b);
+    sum_difference += difference;
+    sum2_difference += difference * difference;
+    sum_clipped += clipped;
+    sum2_clipped += clipped * clipped;
+    sum_ratio += ratio;
+    sum2_ratio += ratio * ratio;
+    gap_count += difference > params.gap_m;
+    relative_gap_count += ratio < params.relative_gap;
+  }
+  const MeanStd difference = from_sums(sum_difference, sum2_difference, n);
+  const MeanStd clipped = from_sums(sum_clipped, sum2_clipped, n);
+  const MeanStd ratio = from_sums(sum_ratio, sum2_ratio, n);
+  set(mean_difference, difference.mean);
+  set(std_difference, difference.std);
+  set(mean_clipped_difference, clipped.mean);
+  set(std_clipped_difference, clipped.std);
+  set(gaps, gap_count);
+  set(mean_ratio, ratio.mean);
+  set(std_ratio, ratio.std);
+  set(relative_gaps, relative_gap_count);
+
+  // Beam lengths.
+  const MeanStd length = mean_std(n, [&](std::size_t i) { return ranges[i]; });
+  const auto [shortest, longest] = std::minmax_element(ranges.begin(), ranges.end());
+  double m4 = 0;
+  for (const double b : ranges) {
+    const double d2 = (b - length.mean) * (b - length.mean);
+    m4 += d2 * d2;
+  }
+  m4 /= static_cast<double>(n);
+  const double variance = length.std * length.std;
+  set(mean_beam, length.mean);
+  set(std_beam, length.std);
+  set(beam_kurtosis, variance > 1e-12 ? m4 / (variance * variance) - 3 : 0.0);
+  set(mean_beam_per_max, length.mean / *longest);
+  set(std_beam_per_max, length.std / *longest);
+  set(shortest_beam, *shortest);
+  set(longest_beam, *longest);
+
+  // The shortest beam and the shortest one at least a quarter turn away from it: in a corridor,
+  // the two walls; their end points' distance is its width.
+  const double step = 2 * std::numbers::pi / static_cast<double>(n);
+  const std::size_t first = static_cast<std::size_t>(shortest - ranges.begin());
+  std::size_t second = first;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t apart = std::min((i + n - first) % n, (first + n - i) % n);
+    if (4 * apart >= n && (second == first || ranges[i] < ranges[second])) second = i;
+  }
+  const std::size_t apart = std::min((second + n - first) % n, (first + n - second) % n);
+  const double angle = static_cast<double>(apart) * step;
+  const double b1 = ranges[first], b2 = ranges[second];
+  set(minima_distance, std::sqrt(std::max(0.0, b1 * b1 + b2 * b2 - 2 * b1 * b2 * std::cos(angle))));
+  set(minima_angle, angle * 180 / std::numbers::pi);
+
+  // The polygon of the beams' end points: area, perimeter, centroid and second moments.
+  thread_local std::vector<double> xs, ys;
+  unit_directions(n, xs, ys);
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i] *= ranges[i];
+    ys[i] *= ranges[i];
+  }
+  double area2 = 0, perimeter = 0, cx6 = 0, cy6 = 0, ixx12 = 0, iyy12 = 0, ixy24 = 0;
+  double vx = 0, vy = 0;  // vertex mean
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    const double x0 = xs[i], y0 = ys[i], x1 = xs[j], y1 = ys[j];
+    const double cross = x0 * y1 - x1 * y0;
+    area2 += cross;
+    perimeter += norm(x1 - x0, y1 - y0);
+    cx6 += (x0 + x1) * cross;
+    cy6 += (y0 + y1) * cross;
+    ixx12 += (x0 * x0 + x0 * x1 + x1 * x1) * cross;
+    iyy12 += (y0 * y0 + y0 * y1 + y1 * y1) * cross;
+    ixy24 += (x0 * y1 + 2 * x0 * y0 + 2 * x1 * y1 + x1 * y0) * cross;
+    vx += x0;
+    vy += y0;
+  }
+  const double area = area2 / 2;  // > 0: the beams turn counter-clockwise
+  const double cx = cx6 / (6 * area), cy = cy6 / (6 * area);
+  const double sxx = ixx12 / (12 * area) - cx * cx, syy = iyy12 / (12 * area) - cy * cy;
+  const double sxy = ixy24 / (24 * area) - cx * cy;
+  // Eigenvalues of the area's covariance; a uniform ellipse with semi-axis a has variance a^2/4.
+  const double half_trace = (sxx + syy) / 2;
+  const double root = std::sqrt(std::max(0.0, (sxx - syy) * (sxx - syy) / 4 + sxy * sxy));
+  const double major = 2 * std::sqrt(std::max(0.0, half_trace + root));
+  const double minor = 2 * std::sqrt(std::max(0.0, half_trace - root));
+  vx /= static_cast<double>(n);
+  vy /= static_cast<double>(n);
+  const MeanStd centroid_distance =
+      mean_std(n, [&](std::size_t i) { return norm(xs[i] - vx, ys[i] - vy); });
+  set(polygon_area, area);
+  set(polygon_perimeter, perimeter);
+  set(area_per_perimeter, area / perimeter);
+  set(mean_centroid_distance, centroid_distance.mean);
+  set(std_centroid_distance, centroid_distance.std);
+  set(major_semi_axis, major);
+  set(minor_semi_axis, minor);
+  set(axis_ratio, major / std::max(minor, 1e-6));
+  set(compactness, 4 * std::numbers::pi * area / (perimeter * perimeter));
+  set(centroid_offset, norm(cx, cy));
+  return f;
+}
+
+}  // namespace kartograf::rooms
