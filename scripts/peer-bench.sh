@@ -1,9 +1,9 @@
 #!/usr/bin/env bash
-# Peer benchmark (docs/benchmarks.md): configures and builds kartograf_peer_bench and
-# kartograf_plane_peer_bench (-DKARTOGRAF_BUILD_PEER_BENCH=ON; needs Debian's libopen3d-dev and
-# libpcl-dev) and runs both once per thread count, OMP_NUM_THREADS (Open3D, PCL) and
-# KARTOGRAF_CPU_THREADS (Kartograf) pinned to the same n. The Markdown tables go to stdout,
-# progress to stderr. KARTOGRAF_PEER_ONLY=planes (or registration) runs one of the two.
+# Peer benchmark (docs/benchmarks.md): configures and builds kartograf_peer_bench
+# (-DKARTOGRAF_BUILD_PEER_BENCH=ON; needs Debian's libopen3d-dev and libpcl-dev) and runs it once
+# per thread count, OMP_NUM_THREADS (Open3D, PCL) and KARTOGRAF_CPU_THREADS (Kartograf) pinned to
+# the same n. The Markdown tables go to stdout, progress to stderr. KARTOGRAF_PEER_ONLY=planes (or
+# registration) runs one of its two parts (--suite).
 #
 #   scripts/peer-bench.sh [build-dir] [kartograf_peer_bench options...]
 #   KARTOGRAF_PEER_THREADS="1 2" (default) sets the thread counts to run.
@@ -22,17 +22,11 @@ for package in libopen3d-dev libpcl-dev; do
 done
 
 cmake -S "$repo" -B "$build" -G Ninja -DCMAKE_BUILD_TYPE=Release -DKARTOGRAF_BUILD_PEER_BENCH=ON >&2
-cmake --build "$build" --target kartograf_peer_bench kartograf_plane_peer_bench >&2
+cmake --build "$build" --target kartograf_peer_bench >&2
 
 for threads in ${KARTOGRAF_PEER_THREADS:-1 2}; do
   echo
   echo "<!-- OMP_NUM_THREADS=$threads KARTOGRAF_CPU_THREADS=$threads -->"
-  if [ "${KARTOGRAF_PEER_ONLY:-}" != planes ]; then
-    OMP_NUM_THREADS=$threads KARTOGRAF_CPU_THREADS=$threads \
-      "$build/bench/peer/kartograf_peer_bench" "$@"
-  fi
-  if [ "${KARTOGRAF_PEER_ONLY:-}" != registration ]; then
-    OMP_NUM_THREADS=$threads KARTOGRAF_CPU_THREADS=$threads \
-      "$build/bench/peer/kartograf_plane_peer_bench"
-  fi
+  OMP_NUM_THREADS=$threads KARTOGRAF_CPU_THREADS=$threads \
+    "$build/bench/peer/kartograf_peer_bench" --suite "${KARTOGRAF_PEER_ONLY:-all}" "$@"
 done

@@ -6,7 +6,6 @@
 #include <span>
 #include <utility>
 
-#include "kartograf/compute/backend.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/registration/color_gate.hpp"
@@ -14,18 +13,11 @@
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
 #include "kartograf/registration/odometry.hpp"
+#include "kartograf_contexts.hpp"
 #include "peer_methods.hpp"
 
 namespace kartograf::peer {
 namespace {
-
-using ContextPtr = std::shared_ptr<const compute::Context>;
-
-ContextPtr make_context(compute::BackendChoice backend) {
-  compute::ContextOptions options;
-  options.backend = backend;
-  return std::make_shared<const compute::Context>(options);
-}
 
 // One new frame per track(): depth upload, back-projection, the 3-level pyramid with normals, and
 // IcpEngine::align against the reference pyramid, which stays on the device.
@@ -171,16 +163,10 @@ std::vector<Method> kartograf_methods(const CloudIcpSettings& settings, bool dev
                                     kartograf_threads(), "", odometry_factory(cpu), true));
   if (device_backends) {
     // CPU-hosted drivers here (lavapipe, PoCL): for the record, not a speed claim.
-    for (const auto& status : compute::probe_backends()) {
-      if (status.backend == compute::BackendKind::cpu || !status.available) continue;
-      const auto choice = status.backend == compute::BackendKind::vulkan
-                              ? compute::BackendChoice::vulkan
-                              : compute::BackendChoice::opencl;
-      const ContextPtr context = make_context(choice);
-      methods.push_back(odometry_method(
-          "kartograf p2plane odometry (" + std::string(compute::to_string(status.backend)) + ": " +
-              context->device_info().name + ")",
-          "kartograf", "driver's own", kKartografOdometry, odometry_factory(context)));
+    for (const DeviceContext& device : device_contexts()) {
+      methods.push_back(odometry_method("kartograf p2plane odometry (" + device.label + ")",
+                                        "kartograf", "driver's own", kKartografOdometry,
+                                        odometry_factory(device.context)));
     }
   }
   methods.push_back(cloud_icp(kKartografCloudFull, InputKind::cloud_full, settings, false, cpu));

@@ -1,6 +1,8 @@
-// kartograf_peer_bench: Kartograf's registration against Open3D and PCL on the same frame pairs,
-// in one run (issue 4, part 6; docs/benchmarks.md holds the results).
+// kartograf_peer_bench: Kartograf against Open3D and PCL on the same inputs, in one run
+// (docs/benchmarks.md holds the results): registration (issue 4, part 6) and plane segmentation
+// (issue 5, part 8; plane_bench.hpp). --suite picks one of the two.
 //
+// Registration:
 //   pairs   7-Scenes RedKitchen frames (i + 1, i) and (i + 5, i) for several i, and the same on a
 //           synthetic hand-held sequence. Every method gets the same inputs: RGB-D frames for the
 //           odometry methods; clouds cut once by Kartograf (valid points with organized normals and
@@ -15,13 +17,10 @@
 //           (eval::evaluate_trajectory, SE(3) alignment).
 // Threads are whatever the environment pins: OMP_NUM_THREADS (Open3D's OpenMP loops) and
 // KARTOGRAF_CPU_THREADS (Kartograf's CPU loops; 1 when unset); both are printed.
-#include <chrono>
 #include <cmath>
 #include <cstdlib>
-#include <ctime>
 #include <exception>
 #include <filesystem>
-#include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <numbers>
@@ -37,11 +36,14 @@
 #include "kartograf/io/tum.hpp"
 #include "peer_methods.hpp"
 #include "peer_report.hpp"
+#include "peer_timing.hpp"
+#include "plane_bench.hpp"
 
 namespace kartograf::peer {
 namespace {
 
 struct Options {
+  std::string suite = "all";  // "registration", "planes" or "all"
   std::filesystem::path seven_scenes;
   std::filesystem::path synthetic;
   int synthetic_frames = 60;
@@ -49,27 +51,14 @@ struct Options {
   std::vector<std::size_t> synthetic_starts = {0, 15, 30};
   std::vector<int> gaps = {1, 5};
   std::size_t target_points = 20000;
-  double min_time = 0.3;
-  int max_calls = 9;
+  TimingOptions timing;
   bool chain = true;
   bool device_backends = true;
   bool details = false;                // every pair's errors and time on stderr
   std::string only;                    // run only methods whose name contains this
   std::filesystem::path trajectories;  // write the chained trajectories here (TUM format)
+  PlaneBenchOptions planes;            // its 7-Scenes folder, timing, only, ... come from above
 };
-
-using Clock = std::chrono::steady_clock;
-
-double seconds_since(Clock::time_point start) {
-  return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// CPU time of every thread of the process (Open3D's OpenMP workers, the drivers' threads).
-double process_cpu_seconds() {
-  timespec now{};
-  clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &now);
-  return static_cast<double>(now.tv_sec) + 1e-9 * static_cast<double>(now.tv_nsec);
-}
 
 std::vector<MethodOutcome> run_pairs(const std::vector<Method>& methods,
                                      const std::vector<FramePair>& pairs, const Options& options) {
@@ -79,19 +68,11 @@ std::vector<MethodOutcome> run_pairs(const std::vector<Method>& methods,
     MethodOutcome outcome{&method, {}};
     method.prepare(pairs.front())();  // warm-up: lazy initialisation, first allocations
     for (const FramePair& pair : pairs) {
-      const std::function<Estimate()> call = method.prepare(pair);
-      std::vector<double> seconds, cpu_seconds;
-      Estimate estimate;
-      const Clock::time_point first = Clock::now();
-      do {
-        const double cpu_start = process_cpu_seconds();
-        const Clock::time_point start = Clock::now();
-        estimate = call();
-        seconds.push_back(seconds_since(start));
-        cpu_seconds.push_back(process_cpu_seconds() - cpu_start);
-      } while (seconds_since(first) < options.min_time &&
-               static_cast<int>(seconds.size()) < options.max_calls);
-      outcome.pairs.push_back(score(pair, estimate, std::move(seconds), std::move(cpu_seconds)));
+      CallTimes times;
+      const std::vector<Estimate> estimates =
+          time_calls(method.prepare(pair), options.timing, times);
+      outcome.pairs.push_back(
+          score(pair, estimates.back(), std::move(times.seconds), std::move(times.cpu_seconds)));
     }
     std::cerr << ": " << 1000 * outcome.median_seconds() << " ms\n";
     outcomes.push_back(std::move(outcome));
@@ -165,21 +146,6 @@ std::vector<ChainOutcome> run_chain(const Dataset& dataset, const Options& optio
   return outcomes;
 }
 
-std::string cpu_model() {
-  std::ifstream cpuinfo("/proc/cpuinfo");
-  for (std::string line; std::getline(cpuinfo, line);) {
-    if (line.rfind("model name", 0) == 0) return line.substr(line.find(':') + 2);
-  }
-  return "unknown CPU";
-}
-
-std::string load_average() {
-  std::ifstream file("/proc/loadavg");
-  std::string one, five, fifteen;
-  file >> one >> five >> fifteen;
-  return one + " " + five + " " + fifteen;
-}
-
 std::size_t median_size(const std::vector<FramePair>& pairs, bool full) {
   std::vector<double> sizes;
   for (const FramePair& pair : pairs) {
@@ -204,22 +170,16 @@ std::vector<Method> all_methods(const Options& options, const CloudIcpSettings& 
   return methods;
 }
 
-int run(const Options& options) {
-  const Clock::time_point start = Clock::now();
+void run_registration(const Options& options) {
   const CloudIcpSettings settings;
-  std::cout << "# Kartograf peer benchmark\n\n"
-            << "- machine: " << cpu_model() << ", " << std::thread::hardware_concurrency()
-            << " cores; load average at start " << load_average() << "\n"
-            << "- Open3D " << open3d_version() << ", PCL " << pcl_version() << "\n"
-            << "- threads: " << kartograf_threads() << ", " << openmp_threads()
-            << ", PCL single-threaded\n"
+  std::cout << "\n# Registration\n\n"
             << "- cloud ICP (all libraries): max correspondence distance " << settings.max_distance
             << " m, at most " << settings.max_iterations
             << " iterations, identity start; odometry: each library's defaults, identity start, "
                "depth "
             << kMinDepthMetres << "-" << kMaxDepthMetres << " m\n"
-            << "- timing: per pair the median of 1-" << options.max_calls << " calls (until "
-            << options.min_time
+            << "- timing: per pair the median of 1-" << options.timing.max_calls << " calls (until "
+            << options.timing.min_time
             << " s have passed) after one warm-up call, per method the median over pairs; wall "
                "clock and process CPU time (all threads); ratio = method time / Kartograf time\n";
 
@@ -267,6 +227,28 @@ int run(const Options& options) {
     std::cout << "\n## Chained odometry (frame k to k - 1 from the identity, whole sequence)\n\n";
     print_chain_table(std::cout, chains);
   }
+}
+
+void run_planes(const Options& options) {
+  PlaneBenchOptions planes = options.planes;
+  planes.seven_scenes = options.seven_scenes;
+  planes.device_backends = options.device_backends;
+  planes.only = options.only;
+  planes.details = options.details;
+  planes.timing = options.timing;
+  run_plane_bench(planes, std::cout);
+}
+
+int run(const Options& options) {
+  const Clock::time_point start = Clock::now();
+  std::cout << "# Kartograf peer benchmark\n\n"
+            << "- machine: " << cpu_model() << ", " << std::thread::hardware_concurrency()
+            << " cores; load average at start " << load_average() << "\n"
+            << "- Open3D " << open3d_version() << ", PCL " << pcl_version() << "\n"
+            << "- threads: " << kartograf_threads() << ", " << openmp_threads()
+            << ", PCL single-threaded\n";
+  if (options.suite != "planes") run_registration(options);
+  if (options.suite != "registration") run_planes(options);
   std::cout << "\nload average at the end " << load_average() << "; run took "
             << std::lround(seconds_since(start)) << " s\n";
   return 0;
@@ -277,7 +259,9 @@ int run(const Options& options) {
 
 int main(int argc, char** argv) {
   kartograf::peer::Options options;
-  CLI::App app{"Kartograf against Open3D and PCL on the same frame pairs (docs/benchmarks.md)"};
+  CLI::App app{
+      "Kartograf against Open3D and PCL on the same frames: registration and plane "
+      "segmentation (docs/benchmarks.md)"};
   const char* data = std::getenv("KARTOGRAF_DATA_DIR");
   const std::filesystem::path data_dir = data && *data ? data : KARTOGRAF_DEFAULT_DATA_DIR;
   options.seven_scenes = data_dir / "7scenes_redkitchen";
@@ -290,15 +274,36 @@ int main(int argc, char** argv) {
       ->capture_default_str();
   app.add_option("--synthetic-frames", options.synthetic_frames, "Frames when writing it")
       ->capture_default_str();
-  app.add_option("--min-time", options.min_time, "Seconds of calls per method and pair")
+  app.add_option("--suite", options.suite, "What to compare")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"all", "registration", "planes"}));
+  app.add_option("--min-time", options.timing.min_time,
+                 "Seconds of calls per method and pair (or frame)")
       ->capture_default_str();
-  app.add_option("--max-calls", options.max_calls, "Most timed calls per method and pair")
+  app.add_option("--max-calls", options.timing.max_calls,
+                 "Most timed calls per method and pair (or frame)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 1000));
+  options.planes.mosd = data_dir / "pcl_mosd";
+  app.add_option("--mosd", options.planes.mosd, "Planes: PCL's mOSD folder ('' to skip)")
+      ->capture_default_str();
+  app.add_option("--plane-synthetic-frames", options.planes.synthetic_frames,
+                 "Planes: synthetic robot-tour frames with exact plane ids (0 to skip)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 290));
+  app.add_option("--plane-seven-scenes-frames", options.planes.seven_scenes_frames,
+                 "Planes: 7-Scenes frame indices")
+      ->capture_default_str();
+  app.add_option("--plane-overlays", options.planes.overlays,
+                 "Planes: write every method's planes over every frame here (PNG)");
+  app.add_option("--ransac-max-planes", options.planes.ransac_max_planes,
+                 "Planes: the most planes Open3D's SegmentPlane loop takes per frame")
       ->capture_default_str()
       ->check(CLI::Range(1, 1000));
   app.add_flag("!--no-chain", options.chain, "Skip the chained trajectories");
   app.add_flag("!--no-device-backends", options.device_backends,
-               "Kartograf odometry on the CPU backend only");
-  app.add_flag("--details", options.details, "Every pair's errors and time on stderr");
+               "Kartograf on the CPU backend only");
+  app.add_flag("--details", options.details, "Every pair's (frame's) errors and time on stderr");
   app.add_option("--only", options.only, "Only methods whose name contains this");
   app.add_option("--trajectories", options.trajectories,
                  "Write the chained trajectories here (TUM), for `kartograf eval traj`");

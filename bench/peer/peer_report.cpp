@@ -14,12 +14,6 @@
 namespace kartograf::peer {
 namespace {
 
-std::string fixed(double value, int digits) {
-  std::ostringstream text;
-  text << std::fixed << std::setprecision(digits) << value;
-  return text.str();
-}
-
 const char* input_name(InputKind input) {
   switch (input) {
     case InputKind::rgbd:
@@ -31,12 +25,18 @@ const char* input_name(InputKind input) {
   }
 }
 
+}  // namespace
+
+std::string fixed(double value, int digits) {
+  std::ostringstream text;
+  text << std::fixed << std::setprecision(digits) << value;
+  return text.str();
+}
+
 std::string ratio(double numerator, double denominator) {
   if (!(denominator > 0)) return "-";
   return fixed(numerator / denominator, numerator / denominator < 10 ? 2 : 0) + "x";
 }
-
-}  // namespace
 
 double median(std::vector<double> values) {
   if (values.empty()) return 0;

@@ -33,6 +33,9 @@ struct MethodOutcome {
 };
 
 double median(std::vector<double> values);
+// value with `digits` decimals; "a / b" as "1.23x" (no decimals from 10x on), "-" when b <= 0.
+std::string fixed(double value, int digits);
+std::string ratio(double numerator, double denominator);
 
 // Per method: median wall and CPU time, frames/s, the ratios (this time / the compared Kartograf
 // method's, and / Kartograf odometry's; wall and CPU), and the median rotation and translation
