@@ -1,5 +1,7 @@
 #include "room_test_maps.hpp"
 
+#include <gtest/gtest.h>
+
 namespace kartograf::testing {
 
 namespace {
@@ -61,6 +63,17 @@ OccupancyGrid rooms_off_a_corridor(int rooms, LabelImage* truth) {
     fill(map.cells, {door_x0, room.y1, door_x0 + kDoor, room.y1 + kWall}, CellState::free);
   }
   return map;
+}
+
+void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& labels) {
+  int unlabelled_free = 0, labelled_walls = 0;
+  for (std::size_t i = 0; i < labels.size(); ++i) {
+    const bool free = map.cells.data()[i] == CellState::free;
+    unlabelled_free += free && labels.data()[i] == 0;
+    labelled_walls += !free && labels.data()[i] != 0;
+  }
+  EXPECT_EQ(unlabelled_free, 0);
+  EXPECT_EQ(labelled_walls, 0);
 }
 
 }  // namespace kartograf::testing

@@ -27,4 +27,7 @@ OccupancyGrid rooms_in_a_row(int rooms, LabelImage* truth = nullptr);
 // opening onto it through a 0.9 m doorway. truth: the corridor is the last label.
 OccupancyGrid rooms_off_a_corridor(int rooms, LabelImage* truth = nullptr);
 
+// GoogleTest expectations: every free cell of the map has a room, no other cell has one.
+void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& labels);
+
 }  // namespace kartograf::testing

@@ -19,18 +19,6 @@ namespace {
 
 using rooms::RoomMethod;
 
-// Every free cell has a room, no obstacle has one.
-void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& labels) {
-  int unlabelled_free = 0, labelled_walls = 0;
-  for (std::size_t i = 0; i < labels.size(); ++i) {
-    const bool free = map.cells.data()[i] == CellState::free;
-    unlabelled_free += free && labels.data()[i] == 0;
-    labelled_walls += !free && labels.data()[i] != 0;
-  }
-  EXPECT_EQ(unlabelled_free, 0);
-  EXPECT_EQ(labelled_walls, 0);
-}
-
 rooms::RoomMethodOptions area_limits(double min_m2, double max_m2) {
   rooms::RoomMethodOptions options;
   options.room_area = rooms::AreaLimits{min_m2, max_m2};
@@ -44,7 +32,7 @@ TEST_P(ThresholdMethods, SplitRoomsInARowAtTheirDoorways) {
   const OccupancyGrid map = testing::rooms_in_a_row(3, &truth);
   const rooms::RoomSegmentation result = rooms::segment_rooms(map, GetParam());
   ASSERT_EQ(result.records.size(), 3u);
-  expect_free_space_covered(map, result.rooms);
+  testing::expect_free_space_covered(map, result.rooms);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
   // Only the doorway cells (18 x 2 per doorway, in no true room) can go either way.
   EXPECT_EQ(scores.recall_mean, 1.0);
@@ -68,7 +56,7 @@ TEST_P(ThresholdMethods, FindRoomsOffACorridor) {
   LabelImage truth;
   const OccupancyGrid map = testing::rooms_off_a_corridor(4, &truth);
   const rooms::RoomSegmentation result = rooms::segment_rooms(map, GetParam());
-  expect_free_space_covered(map, result.rooms);
+  testing::expect_free_space_covered(map, result.rooms);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
   EXPECT_EQ(scores.segments, 5);
   EXPECT_GT(scores.recall_mean, 0.97);

@@ -18,17 +18,6 @@ namespace {
 // [53, 71); the doorway between rooms k and k + 1 is columns [122 k, 122 k + 2).
 constexpr int kDoorRow0 = 53, kDoorRow1 = 71;
 
-void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& labels) {
-  int unlabelled_free = 0, labelled_walls = 0;
-  for (std::size_t i = 0; i < labels.size(); ++i) {
-    const bool free = map.cells.data()[i] == CellState::free;
-    unlabelled_free += free && labels.data()[i] == 0;
-    labelled_walls += !free && labels.data()[i] != 0;
-  }
-  EXPECT_EQ(unlabelled_free, 0);
-  EXPECT_EQ(labelled_walls, 0);
-}
-
 TEST(NearestObstacles, MatchesBruteForce) {
   std::mt19937 rng(7);
   Image<std::uint8_t> free_cells(23, 17, 1);
@@ -40,7 +29,8 @@ TEST(NearestObstacles, MatchesBruteForce) {
       double best = 1e18;
       for (int oy = -1; oy <= free_cells.height(); ++oy) {
         for (int ox = -1; ox <= free_cells.width(); ++ox) {
-          const bool inside = ox >= 0 && oy >= 0 && ox < free_cells.width() && oy < free_cells.height();
+          const bool inside =
+              ox >= 0 && oy >= 0 && ox < free_cells.width() && oy < free_cells.height();
           if (inside && free_cells(ox, oy)) continue;
           best = std::min(best, double(ox - x) * (ox - x) + double(oy - y) * (oy - y));
         }
@@ -60,7 +50,8 @@ TEST(VoronoiGraph, RunsThroughTheDoorAndCutsThere) {
   const rooms::VoronoiGraph graph = rooms::build_voronoi_graph(map);
   // The pruned graph crosses the doorway (columns 122-123) on its middle rows.
   int door_cells = 0;
-  for (int y = kDoorRow0; y < kDoorRow1; ++y) door_cells += graph.graph(122, y) + graph.graph(123, y);
+  for (int y = kDoorRow0; y < kDoorRow1; ++y)
+    door_cells += graph.graph(122, y) + graph.graph(123, y);
   EXPECT_GE(door_cells, 2);
   // Leaf branches are gone: no graph cell lies within 10 cells of a room corner.
   for (int y = 2; y < 12; ++y)
@@ -86,7 +77,7 @@ TEST(VoronoiSegmentation, SplitsTwoRoomsAtTheirDoor) {
   const rooms::RoomSegmentation result = rooms::segment_voronoi(map);
   EXPECT_EQ(result.method, "voronoi");
   ASSERT_EQ(result.records.size(), 2u);
-  expect_free_space_covered(map, result.rooms);
+  testing::expect_free_space_covered(map, result.rooms);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
   EXPECT_EQ(scores.recall_mean, 1.0);
   EXPECT_GT(scores.precision_mean, 0.99);
@@ -109,11 +100,12 @@ TEST(VoronoiSegmentation, FindsRoomsOffACorridor) {
   LabelImage truth;
   const OccupancyGrid map = testing::rooms_off_a_corridor(4, &truth);
   const rooms::RoomSegmentation result = rooms::segment_voronoi(map);
-  expect_free_space_covered(map, result.rooms);
+  testing::expect_free_space_covered(map, result.rooms);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
   // Every room comes out whole and nothing spills through a doorway...
   ASSERT_EQ(scores.room_recall.size(), 5u);
-  for (int room = 0; room < 4; ++room) EXPECT_GT(scores.room_recall[static_cast<std::size_t>(room)], 0.99) << room;
+  for (int room = 0; room < 4; ++room)
+    EXPECT_GT(scores.room_recall[static_cast<std::size_t>(room)], 0.99) << room;
   EXPECT_GT(scores.precision_mean, 0.99);
   // ...and the corridor, cut at every stretch of the graph, comes out whole again: its pieces share
   // borders as wide as the corridor (merging rule 3b).
@@ -123,7 +115,8 @@ TEST(VoronoiSegmentation, FindsRoomsOffACorridor) {
   // the next is < 20 % of its long perimeter.
   rooms::VoronoiParams reference;
   reference.merging.open_border_ratio = 0;
-  const auto pieces = eval::evaluate_room_segmentation(truth, rooms::segment_voronoi(map, reference).rooms);
+  const auto pieces =
+      eval::evaluate_room_segmentation(truth, rooms::segment_voronoi(map, reference).rooms);
   EXPECT_GE(pieces.segments, 6);
   EXPECT_LT(pieces.room_recall[4], 0.9);
 }
@@ -132,7 +125,7 @@ TEST(VoronoiCells, CutsMoreThanTheMergedResult) {
   const OccupancyGrid map = testing::rooms_off_a_corridor(4);
   const rooms::VoronoiGraph graph = rooms::build_voronoi_graph(map);
   LabelImage cells = rooms::voronoi_cells(map, graph, {0.1, 1e6});
-  expect_free_space_covered(map, cells);
+  testing::expect_free_space_covered(map, cells);
   const int before = *std::max_element(cells.pixels().begin(), cells.pixels().end());
   EXPECT_GT(before, 5);  // the corridor comes in pieces before merging
   rooms::merge_voronoi_cells(cells, map);
@@ -171,7 +164,8 @@ TEST(MergeVoronoiCells, KeepsARoomApartFromItsCorridor) {
   // A 6 x 6 m room above a 1.6 m corridor cut in two pieces, the room opening onto the first piece
   // through a 0.9 m doorway: the corridor pieces join (border = the corridor's width), the room,
   // whose doorway is far narrower than the room, stays apart.
-  const OccupancyGrid map = testing::carve_map(404, 160, {{2, 2, 122, 122}, {53, 122, 71, 124}, {2, 124, 402, 156}});
+  const OccupancyGrid map =
+      testing::carve_map(404, 160, {{2, 2, 122, 122}, {53, 122, 71, 124}, {2, 124, 402, 156}});
   LabelImage cells(404, 160, 0);
   for (int y = 2; y < 124; ++y)
     for (int x = 2; x < 122; ++x) cells(x, y) = map.cells(x, y) == CellState::free ? 1 : 0;
@@ -192,18 +186,22 @@ TEST(VoronoiSegmentation, RejectsBadInput) {
   EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(bad_resolution), "resolution", "> 0");
   rooms::VoronoiParams bad_limits;
   bad_limits.room_area = {5, 2};
-  EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(testing::rooms_in_a_row(1), bad_limits), "area limits");
+  EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(testing::rooms_in_a_row(1), bad_limits),
+                        "area limits");
   rooms::VoronoiParams bad_graph;
   bad_graph.graph.neighbourhood_index = 0;
-  EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(testing::rooms_in_a_row(1), bad_graph), "neighbourhood_index");
+  EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(testing::rooms_in_a_row(1), bad_graph),
+                        "neighbourhood_index");
   bad_graph = {};
   bad_graph.graph.min_angle_deg = 200;
-  EXPECT_ERROR_MENTIONS(rooms::build_voronoi_graph(testing::rooms_in_a_row(1), bad_graph.graph), "min_angle_deg");
+  EXPECT_ERROR_MENTIONS(rooms::build_voronoi_graph(testing::rooms_in_a_row(1), bad_graph.graph),
+                        "min_angle_deg");
   LabelImage wrong_size(3, 3, 0);
   EXPECT_ERROR_MENTIONS(rooms::merge_voronoi_cells(wrong_size, testing::rooms_in_a_row(1)), "size");
   rooms::VoronoiParams bad_merging;
   bad_merging.merging.open_border_ratio = -1;
-  EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(testing::rooms_in_a_row(1), bad_merging), "open_border_ratio");
+  EXPECT_ERROR_MENTIONS(rooms::segment_voronoi(testing::rooms_in_a_row(1), bad_merging),
+                        "open_border_ratio");
 }
 
 // The 10 real maps of the benchmark, plain and furnished. The survey's reference implementation
@@ -221,10 +219,13 @@ TEST(VoronoiSegmentationOnRealMaps, MatchesTheReference) {
     for (const auto& entry : std::filesystem::directory_iterator(folder)) {
       const std::string file = entry.path().filename().string();
       const std::string suffix = "_gt_segmentation.png";
-      if (file.size() <= suffix.size() || file.substr(file.size() - suffix.size()) != suffix) continue;
-      const auto map_path = folder / (file.substr(0, file.size() - suffix.size()) + v.suffix + ".png");
+      if (file.size() <= suffix.size() || file.substr(file.size() - suffix.size()) != suffix)
+        continue;
+      const auto map_path =
+          folder / (file.substr(0, file.size() - suffix.size()) + v.suffix + ".png");
       const auto result = rooms::segment_voronoi(io::read_png_map(map_path));
-      const auto scores = eval::evaluate_room_segmentation(io::read_room_ground_truth_png(entry.path()), result.rooms);
+      const auto scores = eval::evaluate_room_segmentation(
+          io::read_room_ground_truth_png(entry.path()), result.rooms);
       recall += scores.recall_mean;
       precision += scores.precision_mean;
       ++maps;

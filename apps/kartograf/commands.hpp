@@ -122,6 +122,8 @@ struct RoomsOptions {
   double resolution = 0.05;
   int free_threshold = 250;
   double min_area_m2 = -1, max_area_m2 = -1;  // < 0: the method's default
+  bool keep_furniture = false;                // segment the map as it is (the reference)
+  std::filesystem::path model;                // feature / vrf: trained model (empty: shipped)
   bool force = false;
 };
 CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& options);

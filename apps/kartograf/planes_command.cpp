@@ -26,6 +26,7 @@
 #include "kartograf/io/sequence.hpp"
 #include "kartograf/io/sequence_detect.hpp"
 #include "kartograf/io/text_file.hpp"
+#include "output_folder.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
@@ -151,17 +152,6 @@ Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& in
           {"milliseconds", set.timings.total()}};
 }
 
-// Refuses to write into files left by an earlier run unless --force: a mix of two runs would
-// look like one.
-void check_output(const fs::path& dir, bool force) {
-  if (force || !fs::exists(dir)) return;
-  require(fs::is_directory(dir), "planes: --out " + dir.string() + " exists and is not a folder");
-  for (const char* file : {"planes.json", "labels.png", "summary.json"}) {
-    require(!fs::exists(dir / file), "planes: " + (dir / file).string() +
-                                         " exists (an earlier run?): use --force to overwrite");
-  }
-}
-
 }  // namespace
 
 CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
@@ -219,7 +209,7 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
   const segmentation::PlaneExtractionParams params = extraction_params(o);
   params.validate();
   const Json run = run_json(o, context);
-  check_output(o.out_dir, o.force);
+  check_output_folder("planes", o.out_dir, {"planes.json", "labels.png", "summary.json"}, o.force);
 
   if (!fs::is_directory(o.input)) {
     std::string extension = o.input.extension().string();

@@ -25,6 +25,7 @@
 #include "kartograf/io/room_io.hpp"
 #include "kartograf/io/text_file.hpp"
 #include "kartograf/rooms/room_methods.hpp"
+#include "output_folder.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
@@ -66,16 +67,9 @@ rooms::RoomMethodOptions method_options(const RoomsOptions& o) {
             "rooms: --min-area and --max-area go together, with 0 <= min < max");
     options.room_area = rooms::AreaLimits{o.min_area_m2, o.max_area_m2};
   }
+  if (o.keep_furniture) options.furniture.reset();
+  options.feature_model = o.model;
   return options;
-}
-
-void check_output(const fs::path& dir, bool force) {
-  if (force || !fs::exists(dir)) return;
-  require(fs::is_directory(dir), "rooms: --out " + dir.string() + " exists and is not a folder");
-  for (const char* file : {"rooms.png", "rooms_color.png", "rooms.json"}) {
-    require(!fs::exists(dir / file), "rooms: " + (dir / file).string() +
-                                         " exists (an earlier run?): use --force to overwrite");
-  }
 }
 
 void add_map_options(CLI::App* command, RoomsOptions& o) {
@@ -86,6 +80,10 @@ void add_map_options(CLI::App* command, RoomsOptions& o) {
       ->capture_default_str();
   command->add_option("--min-area", o.min_area_m2, "Smallest room [m^2] (default: the method's)");
   command->add_option("--max-area", o.max_area_m2, "Largest room [m^2] (default: the method's)");
+  command->add_flag("--keep-furniture", o.keep_furniture,
+                    "Segment the map as it is, furniture included (the reference's behaviour)");
+  command->add_option("--model", o.model,
+                      "feature: the room/hallway classifier (default: the shipped model)");
 }
 
 // Mean and total recall/precision over a group of maps, as the survey reports them.
@@ -141,7 +139,7 @@ int run_rooms_command(const RoomsOptions& o, bool resolution_given, std::ostream
   const rooms::RoomMethod method = rooms::parse_room_method(o.method);
   const rooms::RoomMethodOptions options = method_options(o);
   const OccupancyGrid map = read_map(o.map, o.resolution, o.free_threshold, resolution_given);
-  check_output(o.out_dir, o.force);
+  check_output_folder("rooms", o.out_dir, {"rooms.png", "rooms_color.png", "rooms.json"}, o.force);
   const rooms::RoomSegmentation result = rooms::segment_rooms(map, method, options);
   fs::create_directories(o.out_dir);
   // Everything is computed before the first file is written; each write is atomic.

@@ -10,6 +10,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/rooms/room_segmentation.hpp"
+#include "rooms/grid_neighbours.hpp"
 
 namespace kartograf::rooms {
 
@@ -42,12 +43,15 @@ int neighbourhood(const Image<std::uint8_t>& mask, int x, int y) {
   int config = 0;
   for (int k = 0; k < 8; ++k) {
     const int nx = x + kDx[static_cast<std::size_t>(k)], ny = y + kDy[static_cast<std::size_t>(k)];
-    if (nx >= 0 && ny >= 0 && nx < mask.width() && ny < mask.height() && mask(nx, ny)) config |= 1 << k;
+    if (nx >= 0 && ny >= 0 && nx < mask.width() && ny < mask.height() && mask(nx, ny))
+      config |= 1 << k;
   }
   return config;
 }
 
-int count_bits(int config) { return __builtin_popcount(static_cast<unsigned>(config)); }
+int count_bits(int config) {
+  return __builtin_popcount(static_cast<unsigned>(config));
+}
 
 // The free space where the graph may run: opened by a 3x3 square, then eroded twice (reference).
 Image<std::uint8_t> graph_domain(const Image<std::uint8_t>& free_cells) {
@@ -60,7 +64,8 @@ Image<std::uint8_t> graph_domain(const Image<std::uint8_t>& free_cells) {
   cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), 2);
   Image<std::uint8_t> domain(width, height, 0);
   for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) domain(x, y) = (m.at<std::uint8_t>(y, x) && free_cells(x, y)) ? 1 : 0;
+    for (int x = 0; x < width; ++x)
+      domain(x, y) = (m.at<std::uint8_t>(y, x) && free_cells(x, y)) ? 1 : 0;
   return domain;
 }
 
@@ -80,7 +85,8 @@ Image<std::uint8_t> medial_anchors(const NearestObstacles& near, const Image<std
     if (sep2 <= need * need) return;
     const Eigen::Vector2d p(px, py), q(qx, qy);
     const auto bisector = [&](const Eigen::Vector2d& c) {
-      return std::abs((c - fp.cast<double>()).squaredNorm() - (c - fq.cast<double>()).squaredNorm());
+      return std::abs((c - fp.cast<double>()).squaredNorm() -
+                      (c - fq.cast<double>()).squaredNorm());
     };
     const double sp = bisector(p), sq = bisector(q);
     if (sp <= sq && domain(px, py)) anchors(px, py) = 1;
@@ -105,7 +111,8 @@ Image<std::uint8_t> thin(const Image<std::uint8_t>& domain, const Image<std::uin
   constexpr float kBucketsPerCell = 4.0f;
   float max_clearance = 0;
   for (const float c : clearance.pixels()) max_clearance = std::max(max_clearance, c);
-  std::vector<std::vector<std::uint32_t>> buckets(static_cast<std::size_t>(max_clearance * kBucketsPerCell) + 2);
+  std::vector<std::vector<std::uint32_t>> buckets(
+      static_cast<std::size_t>(max_clearance * kBucketsPerCell) + 2);
   const auto bucket_of = [&](std::uint32_t i) {
     return static_cast<std::size_t>(clearance.data()[i] * kBucketsPerCell);
   };
@@ -129,8 +136,10 @@ Image<std::uint8_t> thin(const Image<std::uint8_t>& domain, const Image<std::uin
       if (!simple[static_cast<std::size_t>(config)] || count_bits(config) <= 1) continue;
       fg(x, y) = 0;
       for (int k = 0; k < 8; ++k) {
-        const int nx = x + kDx[static_cast<std::size_t>(k)], ny = y + kDy[static_cast<std::size_t>(k)];
-        if (nx < 0 || ny < 0 || nx >= width || ny >= height || !fg(nx, ny) || anchors(nx, ny)) continue;
+        const int nx = x + kDx[static_cast<std::size_t>(k)],
+                  ny = y + kDy[static_cast<std::size_t>(k)];
+        if (nx < 0 || ny < 0 || nx >= width || ny >= height || !fg(nx, ny) || anchors(nx, ny))
+          continue;
         const auto j = static_cast<std::uint32_t>(ny * width + nx);
         buckets[std::max(b, bucket_of(j))].push_back(j);  // never behind the sweep
       }
@@ -159,8 +168,10 @@ void prune_leaves(Image<std::uint8_t>& graph) {
     for (int x = 0; x < width; ++x) {
       if (!graph(x, y)) continue;
       const int n = count_bits(neighbourhood(graph, x, y));
-      if (n > 2) branch(x, y) = 1;
-      else if (n <= 1) leaves.push_back(static_cast<std::uint32_t>(y * width + x));
+      if (n > 2)
+        branch(x, y) = 1;
+      else if (n <= 1)
+        leaves.push_back(static_cast<std::uint32_t>(y * width + x));
     }
   }
   for (std::size_t head = 0; head < leaves.size(); ++head) {
@@ -170,15 +181,19 @@ void prune_leaves(Image<std::uint8_t>& graph) {
     if (!graph(x, y)) continue;
     graph(x, y) = 0;
     for (int k = 0; k < 8; ++k) {
-      const int nx = x + kDx[static_cast<std::size_t>(k)], ny = y + kDy[static_cast<std::size_t>(k)];
-      if (nx < 0 || ny < 0 || nx >= width || ny >= height || !graph(nx, ny) || branch(nx, ny)) continue;
-      if (count_bits(neighbourhood(graph, nx, ny)) <= 1) leaves.push_back(static_cast<std::uint32_t>(ny * width + nx));
+      const int nx = x + kDx[static_cast<std::size_t>(k)],
+                ny = y + kDy[static_cast<std::size_t>(k)];
+      if (nx < 0 || ny < 0 || nx >= width || ny >= height || !graph(nx, ny) || branch(nx, ny))
+        continue;
+      if (count_bits(neighbourhood(graph, nx, ny)) <= 1)
+        leaves.push_back(static_cast<std::uint32_t>(ny * width + nx));
     }
   }
 }
 
 // Graph cells of >= 2 graph neighbours whose clearance is least in their graph neighbourhood.
-std::vector<Eigen::Vector2i> critical_points(const Image<std::uint8_t>& graph, const Image<float>& clearance,
+std::vector<Eigen::Vector2i> critical_points(const Image<std::uint8_t>& graph,
+                                             const Image<float>& clearance,
                                              const VoronoiGraphParams& params) {
   const int width = graph.width(), height = graph.height();
   std::vector<std::uint32_t> stamp(graph.size(), 0);
@@ -200,21 +215,18 @@ std::vector<Eigen::Vector2i> critical_points(const Image<std::uint8_t>& graph, c
       frontier.assign(1, p);
       int found = 0;
       bool minimum = true;
-      for (int step = 0; step < params.max_iterations && found <= wanted && !frontier.empty() && minimum; ++step) {
+      for (int step = 0;
+           step < params.max_iterations && found <= wanted && !frontier.empty() && minimum;
+           ++step) {
         next.clear();
         for (const std::uint32_t c : frontier) {
-          const int cx = static_cast<int>(c % static_cast<std::uint32_t>(width));
-          const int cy = static_cast<int>(c / static_cast<std::uint32_t>(width));
-          for (int k = 0; k < 8; ++k) {
-            const int nx = cx + kDx[static_cast<std::size_t>(k)], ny = cy + kDy[static_cast<std::size_t>(k)];
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height || !graph(nx, ny)) continue;
-            const auto n = static_cast<std::uint32_t>(ny * width + nx);
-            if (stamp[n] == visit) continue;
+          detail::for_each_neighbour8(c, width, height, [&](std::uint32_t n) {
+            if (!graph.data()[n] || stamp[n] == visit) return;
             stamp[n] = visit;
             next.push_back(n);
             ++found;
             if (before(n, p)) minimum = false;
-          }
+          });
         }
         frontier.swap(next);
       }
@@ -227,7 +239,8 @@ std::vector<Eigen::Vector2i> critical_points(const Image<std::uint8_t>& graph, c
 // The reference's variant: the graph is cut into stretches, each grown breadth first from the
 // first unvisited cell in raster order over unvisited cells (neighbourhood_index / clearance cells
 // or max_iterations steps); each stretch gives its cell of least clearance.
-std::vector<Eigen::Vector2i> stretch_minima(const Image<std::uint8_t>& graph, const Image<float>& clearance,
+std::vector<Eigen::Vector2i> stretch_minima(const Image<std::uint8_t>& graph,
+                                            const Image<float>& clearance,
                                             const VoronoiGraphParams& params) {
   const int width = graph.width(), height = graph.height();
   std::vector<std::uint8_t> used(graph.size(), 0);
@@ -243,23 +256,19 @@ std::vector<Eigen::Vector2i> stretch_minima(const Image<std::uint8_t>& graph, co
       frontier.assign(1, p);
       std::uint32_t best = p;
       int found = 0;
-      for (int step = 0; step < params.max_iterations && found <= wanted && !frontier.empty(); ++step) {
+      for (int step = 0; step < params.max_iterations && found <= wanted && !frontier.empty();
+           ++step) {
         next.clear();
         for (const std::uint32_t c : frontier) {
-          const int cx = static_cast<int>(c % static_cast<std::uint32_t>(width));
-          const int cy = static_cast<int>(c / static_cast<std::uint32_t>(width));
-          for (int k = 0; k < 8; ++k) {
-            const int nx = cx + kDx[static_cast<std::size_t>(k)], ny = cy + kDy[static_cast<std::size_t>(k)];
-            if (nx < 0 || ny < 0 || nx >= width || ny >= height || !graph(nx, ny)) continue;
-            const auto n = static_cast<std::uint32_t>(ny * width + nx);
-            if (used[n]) continue;
+          detail::for_each_neighbour8(c, width, height, [&](std::uint32_t n) {
+            if (!graph.data()[n] || used[n]) return;
             used[n] = 1;
             next.push_back(n);
             ++found;
             if (clearance.data()[n] < clearance.data()[best] ||
                 (clearance.data()[n] == clearance.data()[best] && n < best))
               best = n;
-          }
+          });
         }
         frontier.swap(next);
       }
@@ -278,7 +287,8 @@ Image<std::uint8_t> obstacle_border(const Image<std::uint8_t>& free_cells) {
     for (int x = 0; x < width; ++x) {
       if (free_cells(x, y)) continue;
       for (int k = 0; k < 8 && !border(x, y); ++k) {
-        const int nx = x + kDx[static_cast<std::size_t>(k)], ny = y + kDy[static_cast<std::size_t>(k)];
+        const int nx = x + kDx[static_cast<std::size_t>(k)],
+                  ny = y + kDy[static_cast<std::size_t>(k)];
         if (nx >= 0 && ny >= 0 && nx < width && ny < height && free_cells(nx, ny)) border(x, y) = 1;
       }
     }
@@ -297,8 +307,10 @@ CriticalLine critical_line(const Eigen::Vector2i& point, const NearestObstacles&
   const double d = line.clearance;
   const int radius = static_cast<int>(std::ceil(2.0 * d)) + 2;
   double best = std::numeric_limits<double>::infinity();
-  const int x0 = std::max(0, point.x() - radius), x1 = std::min(border.width() - 1, point.x() + radius);
-  const int y0 = std::max(0, point.y() - radius), y1 = std::min(border.height() - 1, point.y() + radius);
+  const int x0 = std::max(0, point.x() - radius),
+            x1 = std::min(border.width() - 1, point.x() + radius);
+  const int y0 = std::max(0, point.y() - radius),
+            y1 = std::min(border.height() - 1, point.y() + radius);
   for (int y = y0; y <= y1; ++y) {
     for (int x = x0; x <= x1; ++x) {
       if (!border(x, y)) continue;
@@ -309,7 +321,8 @@ CriticalLine critical_line(const Eigen::Vector2i& point, const NearestObstacles&
       line.basis_b = c;
     }
   }
-  const Eigen::Vector2d a = (line.basis_a - point).cast<double>(), b = (line.basis_b - point).cast<double>();
+  const Eigen::Vector2d a = (line.basis_a - point).cast<double>(),
+                        b = (line.basis_b - point).cast<double>();
   const double na = a.norm(), nb = b.norm();
   line.length = na + nb;
   line.angle_deg = (na > 0 && nb > 0 && line.basis_a != line.basis_b)
@@ -319,7 +332,8 @@ CriticalLine critical_line(const Eigen::Vector2i& point, const NearestObstacles&
 }
 
 // Drops corner lines and, of critical points too close together, all but the widest angle.
-std::vector<CriticalLine> filter_lines(const std::vector<CriticalLine>& lines, const VoronoiGraphParams& params) {
+std::vector<CriticalLine> filter_lines(const std::vector<CriticalLine>& lines,
+                                       const VoronoiGraphParams& params) {
   std::vector<CriticalLine> kept;
   for (std::size_t i = 0; i < lines.size(); ++i) {
     const CriticalLine& a = lines[i];
@@ -329,8 +343,11 @@ std::vector<CriticalLine> filter_lines(const std::vector<CriticalLine>& lines, c
     for (std::size_t j = 0; j < lines.size() && keep; ++j) {
       const CriticalLine& b = lines[j];
       if (j == i || (b.point - a.point).cast<double>().norm() >= radius) continue;
-      if (a.angle_deg < b.angle_deg) keep = false;
-      else if (a.angle_deg == b.angle_deg && (a.length > b.length || (a.length == b.length && j < i))) keep = false;
+      if (a.angle_deg < b.angle_deg)
+        keep = false;
+      else if (a.angle_deg == b.angle_deg &&
+               (a.length > b.length || (a.length == b.length && j < i)))
+        keep = false;
     }
     if (keep) kept.push_back(a);
   }
@@ -365,7 +382,9 @@ NearestObstacles nearest_obstacles(const Image<std::uint8_t>& free_cells) {
   for (int y = 0; y < height; ++y) {
     for (int s = 0; s < sites; ++s) {
       const int x = s - 1;
-      const double g = (x < 0 || x >= width) ? 0.0 : std::abs(row_of[static_cast<std::size_t>(y) * width + x] - y);
+      const double g = (x < 0 || x >= width)
+                           ? 0.0
+                           : std::abs(row_of[static_cast<std::size_t>(y) * width + x] - y);
       g2[static_cast<std::size_t>(s)] = g * g;
     }
     int k = 0;
@@ -373,7 +392,8 @@ NearestObstacles nearest_obstacles(const Image<std::uint8_t>& free_cells) {
     z[0] = -std::numeric_limits<double>::infinity();
     z[1] = std::numeric_limits<double>::infinity();
     const auto intersection = [&](int q, int r) {
-      return ((g2[static_cast<std::size_t>(q)] + double(q) * q) - (g2[static_cast<std::size_t>(r)] + double(r) * r)) /
+      return ((g2[static_cast<std::size_t>(q)] + double(q) * q) -
+              (g2[static_cast<std::size_t>(r)] + double(r) * r)) /
              (2.0 * (q - r));
     };
     for (int q = 1; q < sites; ++q) {
@@ -408,9 +428,11 @@ VoronoiGraph build_voronoi_graph(const OccupancyGrid& map, const VoronoiGraphPar
   check_map(map, what);
   require(params.neighbourhood_index >= 1 && params.max_iterations >= 1,
           what + ": neighbourhood_index and max_iterations must be >= 1");
-  require(std::isfinite(params.min_critical_point_distance_factor) && params.min_critical_point_distance_factor >= 0,
+  require(std::isfinite(params.min_critical_point_distance_factor) &&
+              params.min_critical_point_distance_factor >= 0,
           what + ": min_critical_point_distance_factor must be >= 0");
-  require(std::isfinite(params.min_angle_deg) && params.min_angle_deg >= 0 && params.min_angle_deg <= 180,
+  require(std::isfinite(params.min_angle_deg) && params.min_angle_deg >= 0 &&
+              params.min_angle_deg <= 180,
           what + ": min_angle_deg must lie in [0, 180]");
   require(std::isfinite(params.feature_separation) && params.feature_separation >= 0,
           what + ": feature_separation must be >= 0");
@@ -422,12 +444,13 @@ VoronoiGraph build_voronoi_graph(const OccupancyGrid& map, const VoronoiGraphPar
   NearestObstacles near = nearest_obstacles(free_cells);
   const Image<std::uint8_t> domain = graph_domain(free_cells);
   VoronoiGraph result;
-  result.graph = thin(domain, medial_anchors(near, domain, params.feature_separation), near.clearance);
+  result.graph =
+      thin(domain, medial_anchors(near, domain, params.feature_separation), near.clearance);
   prune_leaves(result.graph);
   const Image<std::uint8_t> border = obstacle_border(free_cells);
-  const std::vector<Eigen::Vector2i> points = params.stretch_minima
-                                                  ? stretch_minima(result.graph, near.clearance, params)
-                                                  : critical_points(result.graph, near.clearance, params);
+  const std::vector<Eigen::Vector2i> points =
+      params.stretch_minima ? stretch_minima(result.graph, near.clearance, params)
+                            : critical_points(result.graph, near.clearance, params);
   for (const Eigen::Vector2i& p : points)
     result.candidates.push_back(critical_line(p, near, border));
   result.critical_lines = filter_lines(result.candidates, params);

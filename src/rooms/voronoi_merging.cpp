@@ -61,7 +61,8 @@ struct Cell {
   }
 };
 
-std::vector<Cell> measure_cells(const LabelImage& labels, int count, const Image<float>& clearance) {
+std::vector<Cell> measure_cells(const LabelImage& labels, int count,
+                                const Image<float>& clearance) {
   std::vector<Cell> cells(static_cast<std::size_t>(count) + 1);
   for (int id = 0; id <= count; ++id) cells[static_cast<std::size_t>(id)].id = id;
   const int width = labels.width(), height = labels.height();
@@ -144,7 +145,8 @@ class Merger {
   }
 
   void sort() {
-    std::stable_sort(alive_.begin(), alive_.end(), [](const Cell& a, const Cell& b) { return a.cells < b.cells; });
+    std::stable_sort(alive_.begin(), alive_.end(),
+                     [](const Cell& a, const Cell& b) { return a.cells < b.cells; });
   }
 
   void merge(std::size_t from, std::size_t into) {
@@ -181,19 +183,27 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
           "merge_voronoi_cells: the label image differs from the map in size");
   require(std::isfinite(p.open_border_ratio) && p.open_border_ratio >= 0,
           "merge_voronoi_cells: open_border_ratio must be >= 0");
+  require(std::isfinite(p.doorway_ratio) && p.doorway_ratio >= 0,
+          "merge_voronoi_cells: doorway_ratio must be >= 0");
   int count = 0;
   for (const Label l : cells.pixels()) count = std::max(count, static_cast<int>(l));
   if (count == 0) return;
   Merger m(measure_cells(cells, count, clearance(map)), map.resolution * map.resolution);
+  // Cell c's border with neighbour t is narrower than the widest free space of both: a doorway.
+  const auto doorway_between = [&](const Cell& c, const Cell& t, int border) {
+    return border < p.doorway_ratio * 2.0 * std::min(c.max_clearance, t.max_clearance);
+  };
 
   m.run([&](const Cell& c) {  // 1. small, one neighbour, not closed off by walls
-    return m.area_m2(c) < p.max_area_m2 && c.neighbours() == 1 && c.wall() <= p.one_neighbour_max_wall
+    return m.area_m2(c) < p.max_area_m2 && c.neighbours() == 1 &&
+                   c.wall() <= p.one_neighbour_max_wall
                ? c.largest_neighbour()
                : kWall;
   });
   m.run([&](const Cell& c) {  // 2. very small
     const int n = c.largest_neighbour();
-    if (m.area_m2(c) >= p.small_area_m2 || n == kWall || c.share(n) <= p.small_min_shared) return kWall;
+    if (m.area_m2(c) >= p.small_area_m2 || n == kWall || c.share(n) <= p.small_min_shared)
+      return kWall;
     const Cell* t = m.find(n);
     return t && t->wall() <= p.small_target_max_wall ? n : kWall;
   });
@@ -203,7 +213,8 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
         c.wall() <= p.part_min_wall || c.share(n) <= p.part_min_shared)
       return kWall;
     const Cell* t = m.find(n);
-    if (!t || (t->neighbours() > p.part_target_max_neighbours && t->largest_shares(2) < p.part_target_two_largest))
+    if (!t || (t->neighbours() > p.part_target_max_neighbours &&
+               t->largest_shares(2) < p.part_target_two_largest))
       return kWall;
     return n;
   });
@@ -211,7 +222,8 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
     if (p.open_border_ratio <= 0) return kWall;
     for (const auto& [id, n] : c.border) {
       const Cell* t = id == kWall ? nullptr : m.find(id);
-      if (t && n >= p.open_border_ratio * 2.0 * std::max(c.max_clearance, t->max_clearance)) return id;
+      if (t && n >= p.open_border_ratio * 2.0 * std::max(c.max_clearance, t->max_clearance))
+        return id;
     }
     return kWall;
   });
@@ -224,9 +236,10 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
     const double wall = c.wall();
     for (const auto& [n, id] : by_length) {
       const double r = c.share(id);
-      if (!(r > p.shared_min || (r > p.shared_min_low && wall > 1 - 2 * r - 0.05 && wall < 1 - r))) continue;
+      if (!(r > p.shared_min || (r > p.shared_min_low && wall > 1 - 2 * r - 0.05 && wall < 1 - r)))
+        continue;
       const Cell* t = m.find(id);
-      if (t && t->share(c.id) > p.shared_min_of_neighbour) return id;
+      if (t && t->share(c.id) > p.shared_min_of_neighbour && !doorway_between(c, *t, n)) return id;
     }
     return kWall;
   });

@@ -22,7 +22,9 @@
 //    is narrower than the room behind it (the room's width counts), so rooms stay apart.
 // 4. a neighbour holding > 20 % of the perimeter (or > 10 % where the wall share lies within
 //    [1 - 2r - 0.05, 1 - r] for that share r) while the cell holds > 10 % of the neighbour's:
-//    merge (regions sharing most of their border);
+//    merge (regions sharing most of their border); not in the reference: unless their shared
+//    border is narrower than doorway_ratio x the widest free space of the narrower cell, a doorway
+//    (rows of cubicles opening onto a narrow aisle no longer join across it);
 // 5. the neighbour sharing the most border holds > 40 % of the perimeter: merge (clutter).
 #include "kartograf/core/label_image.hpp"
 #include "kartograf/core/occupancy_grid.hpp"
@@ -44,11 +46,13 @@ struct CellMergeParams {
   double shared_min_low = 0.1;
   double shared_min_of_neighbour = 0.1;
   double dominant_neighbour = 0.4;  // rule 5
-  double open_border_ratio = 0.8;  // rule 3b; 0: off (the reference)
+  double open_border_ratio = 0.88;  // rule 3b; 0: off (the reference)
+  double doorway_ratio = 0.95;      // rule 4's doorway test; 0: off (the reference)
 };
 
 // Merges the labelled cells (labels 1..n, 0 = none) of `cells` in place. Throws Error if the
 // image differs from the map in size.
-void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const CellMergeParams& params = {});
+void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map,
+                         const CellMergeParams& params = {});
 
 }  // namespace kartograf::rooms
