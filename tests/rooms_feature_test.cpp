@@ -91,7 +91,9 @@ TEST(LaserScanner, SkippingMatchesStepByStepMarchingInClutter) {
         const double t = 2 * std::numbers::pi * k / 360;
         int step = 0;
         for (;; ++step) {
-          const double px = x + 0.5 + step * std::cos(t), py = y + 0.5 - step * std::sin(t);
+          // The scanner's beam directions are fixed point, 1/65536 cell (laser_features.hpp).
+          const double px = x + 0.5 + step * (std::round(std::cos(t) * 65536) / 65536);
+          const double py = y + 0.5 + step * (std::round(-std::sin(t) * 65536) / 65536);
           const int cx = static_cast<int>(std::floor(px)), cy = static_cast<int>(std::floor(py));
           if (cx < 0 || cy < 0 || cx >= map.width() || cy >= map.height() ||
               map.cells(cx, cy) != CellState::free)

@@ -124,6 +124,7 @@ struct RoomsOptions {
   double min_area_m2 = -1, max_area_m2 = -1;  // < 0: the method's default
   bool keep_furniture = false;                // segment the map as it is (the reference)
   std::filesystem::path model;                // feature / vrf: trained model (empty: shipped)
+  std::string backend = "auto", backend_source = "default";  // feature: where the scans run
   bool force = false;
 };
 CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& options);

@@ -7,8 +7,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <ostream>
 #include <sstream>
 #include <string>
@@ -18,6 +20,7 @@
 #include <nlohmann/json.hpp>
 
 #include "commands.hpp"
+#include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/io/image_io.hpp"
@@ -72,6 +75,14 @@ rooms::RoomMethodOptions method_options(const RoomsOptions& o) {
   return options;
 }
 
+// The backend of the feature method's laser scans, made only when that method runs.
+std::optional<compute::Context> scan_context(const RoomsOptions& o, bool needed) {
+  if (!needed) return std::nullopt;
+  compute::ContextOptions context_options;
+  context_options.backend = compute::parse_backend_choice(o.backend, o.backend_source);
+  return std::optional<compute::Context>(std::in_place, context_options);
+}
+
 void add_map_options(CLI::App* command, RoomsOptions& o) {
   command->add_option("--resolution", o.resolution, "PNG maps: metres per cell")
       ->capture_default_str();
@@ -80,6 +91,15 @@ void add_map_options(CLI::App* command, RoomsOptions& o) {
       ->capture_default_str();
   command->add_option("--min-area", o.min_area_m2, "Smallest room [m^2] (default: the method's)");
   command->add_option("--max-area", o.max_area_m2, "Largest room [m^2] (default: the method's)");
+  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
+    o.backend = env_backend;
+    o.backend_source = "KARTOGRAF_BACKEND";
+  }
+  command
+      ->add_option("--backend", o.backend,
+                   "feature: where the laser scans run, auto|cpu|vulkan|opencl (default: "
+                   "$KARTOGRAF_BACKEND, else auto)")
+      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
   command->add_flag("--keep-furniture", o.keep_furniture,
                     "Segment the map as it is, furniture included (the reference's behaviour)");
   command->add_option("--model", o.model,
@@ -137,7 +157,10 @@ CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& o) {
 
 int run_rooms_command(const RoomsOptions& o, bool resolution_given, std::ostream& out) {
   const rooms::RoomMethod method = rooms::parse_room_method(o.method);
-  const rooms::RoomMethodOptions options = method_options(o);
+  rooms::RoomMethodOptions options = method_options(o);
+  const std::optional<compute::Context> context =
+      scan_context(o, method == rooms::RoomMethod::feature);
+  if (context) options.context = &*context;
   const OccupancyGrid map = read_map(o.map, o.resolution, o.free_threshold, resolution_given);
   check_output_folder("rooms", o.out_dir, {"rooms.png", "rooms_color.png", "rooms.json"}, o.force);
   const rooms::RoomSegmentation result = rooms::segment_rooms(map, method, options);
@@ -175,7 +198,11 @@ int run_rooms_eval_command(const RoomsEvalOptions& o, std::ostream& out, std::os
   std::vector<rooms::RoomMethod> methods;
   for (const std::string& name : o.methods) methods.push_back(rooms::parse_room_method(name));
   if (methods.empty()) methods = rooms::all_room_methods();
-  const rooms::RoomMethodOptions options = method_options(o.map);
+  rooms::RoomMethodOptions options = method_options(o.map);
+  const std::optional<compute::Context> context =
+      scan_context(o.map, std::find(methods.begin(), methods.end(), rooms::RoomMethod::feature) !=
+                              methods.end());
+  if (context) options.context = &*context;
   std::vector<io::RoomMapCase> cases = io::find_room_maps(o.folder);
   if (!o.only.empty()) {
     std::erase_if(

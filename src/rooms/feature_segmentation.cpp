@@ -13,8 +13,10 @@
 #include <opencv2/ml.hpp>
 
 #include "compute/cpu_parallel.hpp"
+#include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/connected_components.hpp"
+#include "kartograf/rooms/laser_scan_device.hpp"
 
 namespace kartograf::rooms {
 
@@ -27,27 +29,46 @@ namespace {
 using Clock = std::chrono::steady_clock;
 constexpr int kFeatureCount = static_cast<int>(kLaserFeatureCount);
 
-// A cell to scan.
-struct Cell {
-  int col = 0, row = 0;
-};
+using Cell = ScanCell;
 
-// The features of a scan at every cell, rows in the order of `cells`; threads over chunks of cells
-// (KARTOGRAF_CPU_THREADS, see src/compute/cpu_parallel.hpp).
+// Cells per device dispatch: the scans of a batch (360 beams: 23 MB of ranges) stay well within
+// what every driver binds.
+constexpr std::size_t kDeviceBatchCells = 16384;
+
+// The features of a scan at every cell, rows in the order of `cells`. The scans run on `context`
+// when it is a device backend (DeviceLaserScanner: the same scans, bit for bit), else with the
+// features on threads over chunks of cells (KARTOGRAF_CPU_THREADS, src/compute/cpu_parallel.hpp).
 std::vector<float> features_at(const LaserScanner& scanner, const std::vector<Cell>& cells,
-                               const LaserFeatureParams& params) {
+                               const LaserFeatureParams& params, const compute::Context* context) {
+  const auto beams = static_cast<std::size_t>(scanner.beams());
   std::vector<float> features(cells.size() * kLaserFeatureCount);
-  compute::detail::for_each_chunk(
-      cells.size(), cells.size() * static_cast<std::size_t>(scanner.beams()),
-      [&](std::size_t begin, std::size_t end, std::size_t) {
-        std::vector<double> ranges(static_cast<std::size_t>(scanner.beams()));
-        for (std::size_t i = begin; i < end; ++i) {
-          scanner.scan(cells[i].col, cells[i].row, ranges);
-          const LaserFeatures f = laser_scan_features(ranges, params);
-          std::copy(f.begin(), f.end(),
-                    features.begin() + static_cast<std::ptrdiff_t>(i * kLaserFeatureCount));
-        }
-      });
+  const auto store = [&](std::size_t i, std::span<const double> ranges) {
+    const LaserFeatures f = laser_scan_features(ranges, params);
+    std::copy(f.begin(), f.end(),
+              features.begin() + static_cast<std::ptrdiff_t>(i * kLaserFeatureCount));
+  };
+  if (context && !context->is_cpu()) {
+    DeviceLaserScanner device(*context, scanner);
+    for (std::size_t begin = 0; begin < cells.size(); begin += kDeviceBatchCells) {
+      const std::size_t count = std::min(kDeviceBatchCells, cells.size() - begin);
+      const std::vector<double> ranges =
+          device.scan_ranges(std::span(cells).subspan(begin, count), count);
+      compute::detail::for_each_chunk(
+          count, count * beams, [&](std::size_t first, std::size_t last, std::size_t) {
+            for (std::size_t i = first; i < last; ++i)
+              store(begin + i, std::span(ranges).subspan(i * beams, beams));
+          });
+    }
+    return features;
+  }
+  compute::detail::for_each_chunk(cells.size(), cells.size() * beams,
+                                  [&](std::size_t first, std::size_t last, std::size_t) {
+                                    std::vector<double> ranges(beams);
+                                    for (std::size_t i = first; i < last; ++i) {
+                                      scanner.scan(cells[i].col, cells[i].row, ranges);
+                                      store(i, ranges);
+                                    }
+                                  });
   return features;
 }
 
@@ -243,7 +264,7 @@ RoomClassifier train_room_classifier(const std::vector<RoomTrainingMap>& maps,
         labels.push_back(place == PlaceClass::room ? 1 : -1);
       }
     }
-    const std::vector<float> map_features = features_at(scanner, cells, params.features);
+    const std::vector<float> map_features = features_at(scanner, cells, params.features, nullptr);
     features.insert(features.end(), map_features.begin(), map_features.end());
   }
   return RoomClassifier::train(features, labels, params.weak_count, params.max_depth);
@@ -252,7 +273,8 @@ RoomClassifier train_room_classifier(const std::vector<RoomTrainingMap>& maps,
 // ---- Segmentation ------------------------------------------------------------------------------
 
 Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                  const FeatureSegmentationParams& params) {
+                                  const FeatureSegmentationParams& params,
+                                  const compute::Context* context) {
   check_map(map, "feature-based room segmentation");
   require(!classifier.empty(), "feature-based room segmentation: the room classifier is empty");
   require(params.sample_stride >= 1, "feature-based room segmentation: sample_stride must be >= 1");
@@ -266,7 +288,7 @@ Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier
   }
   const LaserScanner scanner(map, params.scan);
   const std::vector<float> scores =
-      smoothed(cells, classifier.scores(features_at(scanner, cells, params.features)),
+      smoothed(cells, classifier.scores(features_at(scanner, cells, params.features, context)),
                params.sample_stride, params.smoothing_radius);
   // Classes as labels 1 (room) and 2 (hallway), grown over the free cells between the lattice's.
   LabelImage classes(width, height, 0);
@@ -288,11 +310,12 @@ std::filesystem::path default_room_classifier_path() {
 }
 
 RoomSegmentation segment_feature_based(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                       const FeatureSegmentationParams& params) {
+                                       const FeatureSegmentationParams& params,
+                                       const compute::Context* context) {
   const Clock::time_point start = Clock::now();
   check_map(map, "feature-based room segmentation");
   params.region_area.check("feature-based room segmentation");
-  const Image<PlaceClass> places = classify_places(map, classifier, params);
+  const Image<PlaceClass> places = classify_places(map, classifier, params, context);
   const int width = map.width(), height = map.height();
   const double cell_area = map.resolution * map.resolution;
   LabelImage rooms(width, height, 0);

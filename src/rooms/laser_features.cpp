@@ -8,6 +8,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "kartograf/core/error.hpp"
+#include "rooms/laser_beam.hpp"
 
 namespace kartograf::rooms {
 
@@ -91,13 +92,19 @@ void unit_directions(std::size_t n, std::vector<double>& xs, std::vector<double>
 LaserScanner::LaserScanner(const OccupancyGrid& map, const LaserScanParams& params)
     : width_(map.width()), height_(map.height()), resolution_(map.resolution) {
   require(width_ > 0 && height_ > 0, "laser scanner: the map has no cells");
+  require(width_ <= kMaxLaserScanMapSide && height_ <= kMaxLaserScanMapSide,
+          "laser scanner: the map is " + std::to_string(width_) + " x " + std::to_string(height_) +
+              " cells; at most " + std::to_string(kMaxLaserScanMapSide) + " per side");
   require(resolution_ > 0 && std::isfinite(resolution_),
           "laser scanner: the map resolution must be > 0, got " + std::to_string(resolution_));
   require(params.beams >= 8,
           "laser scanner: beams must be >= 8, got " + std::to_string(params.beams));
   require(params.max_range_m > 0 && std::isfinite(params.max_range_m),
           "laser scanner: max_range_m must be > 0, got " + std::to_string(params.max_range_m));
-  max_steps_ = std::max(1, static_cast<int>(std::ceil(params.max_range_m / resolution_)));
+  // Every beam stops at the border ring within 2^16 steps, so a larger limit changes nothing; the
+  // cap keeps step + skip far from overflowing.
+  max_steps_ = static_cast<int>(
+      std::clamp(std::ceil(params.max_range_m / resolution_), 1.0, double{1 << 24}));
   // Free space with a border of non-free cells, so that the grid's edge stops rays like a wall.
   cv::Mat free(height_ + 2, width_ + 2, CV_8UC1, cv::Scalar(0));
   for (int y = 0; y < height_; ++y) {
@@ -106,45 +113,53 @@ LaserScanner::LaserScanner(const OccupancyGrid& map, const LaserScanParams& para
   }
   cv::Mat distance;
   cv::distanceTransform(free, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
-  clearance_ = Image<float>(width_ + 2, height_ + 2);
+  // A skip of s steps moves a sample by s |direction| <= s (1 + 1.1e-5) cells (rounded directions);
+  // from within 0.71 cells of a free cell centre at distance d >= s + 1.5 from every non-free
+  // centre, the sample's cell centre stays closer than d while s * 1.1e-5 < 0.085: s <= 4096.
+  constexpr int kMaxSkip = 4096;
+  skips_ = Image<std::int32_t>(width_ + 2, height_ + 2);
   for (int y = 0; y < height_ + 2; ++y) {
     const float* row = distance.ptr<float>(y);
-    std::copy(row, row + width_ + 2,
-              clearance_.data() + static_cast<std::size_t>(y) * (width_ + 2));
+    for (int x = 0; x < width_ + 2; ++x) {
+      const float d = row[x];
+      skips_(x, y) = d <= 0 ? 0 : std::clamp(static_cast<int>(d - 1.5f), 1, kMaxSkip);
+    }
   }
-  cos_.resize(static_cast<std::size_t>(params.beams));
-  sin_.resize(cos_.size());
-  for (std::size_t k = 0; k < cos_.size(); ++k) {
-    const double angle = 2 * std::numbers::pi * static_cast<double>(k) / params.beams;
-    cos_[k] = std::cos(angle);
-    sin_[k] = std::sin(angle);
+  directions_.resize(2 * static_cast<std::size_t>(params.beams));
+  for (int k = 0; k < params.beams; ++k) {
+    const double angle = 2 * std::numbers::pi * k / params.beams;
+    // Image rows grow downwards, so the map's +y is -row.
+    directions_[2 * static_cast<std::size_t>(k)] =
+        static_cast<std::int32_t>(std::llround(std::cos(angle) * 65536.0));
+    directions_[2 * static_cast<std::size_t>(k) + 1] =
+        static_cast<std::int32_t>(std::llround(-std::sin(angle) * 65536.0));
+  }
+}
+
+void LaserScanner::scan_steps(int col, int row, std::span<std::int32_t> steps) const {
+  if (steps.size() != static_cast<std::size_t>(beams())) {
+    throw Error("laser scanner: expected room for " + std::to_string(beams()) + " beams, got " +
+                std::to_string(steps.size()));
+  }
+  std::fill(steps.begin(), steps.end(), 0);
+  if (col < 0 || row < 0 || col >= width_ || row >= height_) return;
+  // The cell centre in the padded grid, 1/65536 cell units (a non-free cell stops at step 0).
+  const std::int32_t x0 = (col + 1) * 65536 + 32768, y0 = (row + 1) * 65536 + 32768;
+  for (std::size_t k = 0; k < steps.size(); ++k) {
+    steps[k] = detail::trace_beam(skips_.data(), width_ + 2, x0, y0, directions_[2 * k],
+                                  directions_[2 * k + 1], max_steps_);
   }
 }
 
 void LaserScanner::scan(int col, int row, std::span<double> ranges) const {
-  if (ranges.size() != cos_.size()) {
-    throw Error("laser scanner: expected room for " + std::to_string(cos_.size()) + " beams, got " +
+  if (ranges.size() != static_cast<std::size_t>(beams())) {
+    throw Error("laser scanner: expected room for " + std::to_string(beams()) + " beams, got " +
                 std::to_string(ranges.size()));
   }
-  std::fill(ranges.begin(), ranges.end(), 0.0);
-  if (col < 0 || row < 0 || col >= width_ || row >= height_ || clearance_(col + 1, row + 1) <= 0)
-    return;
-  const int stride = width_ + 2;
-  const float* clearance = clearance_.data();
-  // Padded image coordinates of the cell centre; rows grow downwards, so +y is -row.
-  const double x0 = col + 1.5, y0 = row + 1.5;
-  for (std::size_t k = 0; k < cos_.size(); ++k) {
-    const double dx = cos_[k], dy = -sin_[k];
-    int step = 0;
-    while (step < max_steps_) {
-      // The border ring is non-free, so samples never leave the padded image before stopping.
-      const int cx = static_cast<int>(x0 + step * dx), cy = static_cast<int>(y0 + step * dy);
-      const float d = clearance[static_cast<std::size_t>(cy) * stride + cx];
-      if (d <= 0) break;
-      step += std::max(1, static_cast<int>(d - 1.5f));
-    }
-    ranges[k] = std::min(step, max_steps_) * resolution_;
-  }
+  thread_local std::vector<std::int32_t> steps;
+  steps.resize(ranges.size());
+  scan_steps(col, row, steps);
+  for (std::size_t k = 0; k < ranges.size(); ++k) ranges[k] = steps[k] * resolution_;
 }
 
 const std::array<std::string_view, kLaserFeatureCount>& laser_feature_names() {

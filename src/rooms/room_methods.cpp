@@ -62,7 +62,7 @@ RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
       if (options.room_area) params.region_area = *options.room_area;
       const RoomClassifier classifier = RoomClassifier::load(
           options.feature_model.empty() ? default_room_classifier_path() : options.feature_model);
-      return segment_feature_based(map, classifier, params);
+      return segment_feature_based(map, classifier, params, options.context);
     }
   }
   throw Error("segment_rooms: unknown method");

@@ -28,6 +28,10 @@
 #include "kartograf/rooms/laser_features.hpp"
 #include "kartograf/rooms/room_segmentation.hpp"
 
+namespace kartograf::compute {
+class Context;
+}
+
 namespace kartograf::rooms {
 
 // What a free cell is, for training and for the classifier's output.
@@ -102,9 +106,12 @@ struct FeatureSegmentationParams {
   LaserFeatureParams features;
 };
 
-// The class of every free cell (none elsewhere), as the segmentation sees it.
+// The class of every free cell (none elsewhere), as the segmentation sees it. The laser scans run
+// on `context` when it is a device backend (laser_scan_device.hpp; identical scans), else (null
+// included) on the CPU's threads.
 Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                  const FeatureSegmentationParams& params = {});
+                                  const FeatureSegmentationParams& params = {},
+                                  const compute::Context* context = nullptr);
 
 // The classifier shipped with Kartograf (models/rooms/room_hallway_boost.yml.gz, trained by
 // tools/train_room_classifier on ipa_room_segmentation's training maps): $KARTOGRAF_ROOM_MODEL
@@ -114,6 +121,7 @@ std::filesystem::path default_room_classifier_path();
 // Throws Error for a map without free cells, a resolution <= 0, bad limits, a stride < 1 or an
 // empty classifier.
 RoomSegmentation segment_feature_based(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                       const FeatureSegmentationParams& params = {});
+                                       const FeatureSegmentationParams& params = {},
+                                       const compute::Context* context = nullptr);
 
 }  // namespace kartograf::rooms

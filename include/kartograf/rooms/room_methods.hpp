@@ -10,6 +10,10 @@
 #include "kartograf/rooms/furniture.hpp"
 #include "kartograf/rooms/room_segmentation.hpp"
 
+namespace kartograf::compute {
+class Context;
+}
+
 namespace kartograf::rooms {
 
 enum class RoomMethod { morphological, distance, voronoi, feature };
@@ -27,6 +31,8 @@ struct RoomMethodOptions {
   std::optional<FurnitureParams> furniture = FurnitureParams{};
   // feature: the room/hallway classifier (default_room_classifier_path() when empty).
   std::filesystem::path feature_model;
+  // feature: the backend its laser scans run on (null: the CPU's threads). Not owned.
+  const compute::Context* context = nullptr;
 };
 
 RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
