@@ -2,6 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/io/room_io.hpp"
+#include "test_support.hpp"
+
 namespace kartograf::testing {
 
 namespace {
@@ -74,6 +78,49 @@ void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& label
   }
   EXPECT_EQ(unlabelled_free, 0);
   EXPECT_EQ(labelled_walls, 0);
+}
+
+namespace {
+
+std::filesystem::path benchmark_folder() {
+  return data_dir() / "ipa_room_maps" / "test_maps";
+}
+
+}  // namespace
+
+BenchmarkMeans benchmark_means(const std::string& name, const std::string& variant,
+                               const SegmentRooms& segment) {
+  BenchmarkMeans means;
+  for (const io::RoomMapCase& c : io::find_room_maps(benchmark_folder())) {
+    if (c.variant != variant) continue;
+    const rooms::RoomSegmentation result = segment(io::read_png_map(c.map));
+    const eval::RoomSegmentationScores scores = eval::evaluate_room_segmentation(
+        io::read_room_ground_truth_png(c.ground_truth), result.rooms);
+    means.recall += scores.recall_mean;
+    means.precision += scores.precision_mean;
+    ++means.maps;
+  }
+  if (means.maps > 0) {
+    means.recall /= means.maps;
+    means.precision /= means.maps;
+  }
+  ::testing::Test::RecordProperty(name + "_" + variant + "_recall", std::to_string(means.recall));
+  ::testing::Test::RecordProperty(name + "_" + variant + "_precision",
+                                  std::to_string(means.precision));
+  return means;
+}
+
+eval::RoomSegmentationScores benchmark_map_scores(const std::string& map,
+                                                  const SegmentRooms& segment) {
+  const rooms::RoomSegmentation result =
+      segment(io::read_png_map(benchmark_folder() / (map + ".png")));
+  const eval::RoomSegmentationScores scores = eval::evaluate_room_segmentation(
+      io::read_room_ground_truth_png(benchmark_folder() / (map + "_gt_segmentation.png")),
+      result.rooms);
+  ::testing::Test::RecordProperty("recall", std::to_string(scores.recall_mean));
+  ::testing::Test::RecordProperty("precision", std::to_string(scores.precision_mean));
+  ::testing::Test::RecordProperty("seconds", std::to_string(result.seconds));
+  return scores;
 }
 
 }  // namespace kartograf::testing

@@ -1,10 +1,14 @@
 #pragma once
 // Hand-made occupancy maps with known rooms for the room segmentation tests: rectangles of free
 // space carved out of an occupied map, and the ground truth that goes with them.
+#include <functional>
 #include <initializer_list>
+#include <string>
 
 #include "kartograf/core/label_image.hpp"
 #include "kartograf/core/occupancy_grid.hpp"
+#include "kartograf/eval/room_metrics.hpp"
+#include "kartograf/rooms/room_segmentation.hpp"
 
 namespace kartograf::testing {
 
@@ -29,5 +33,22 @@ OccupancyGrid rooms_off_a_corridor(int rooms, LabelImage* truth = nullptr);
 
 // GoogleTest expectations: every free cell of the map has a room, no other cell has one.
 void expect_free_space_covered(const OccupancyGrid& map, const LabelImage& labels);
+
+// ---- The ipa benchmark maps (../shared/data/ipa_room_maps/test_maps) ----------------------------
+using SegmentRooms = std::function<rooms::RoomSegmentation(const OccupancyGrid&)>;
+
+// Mean recall and precision (the survey's numbers) of `segment` over every benchmark map of one
+// variant (plain, furnitures, ...), recorded as test properties NAME_recall and NAME_precision.
+struct BenchmarkMeans {
+  double recall = 0, precision = 0;
+  int maps = 0;
+};
+BenchmarkMeans benchmark_means(const std::string& name, const std::string& variant,
+                               const SegmentRooms& segment);
+
+// The scores of `segment` on one plain benchmark map (e.g. "office_c"), recorded as test
+// properties recall, precision and seconds.
+eval::RoomSegmentationScores benchmark_map_scores(const std::string& map,
+                                                  const SegmentRooms& segment);
 
 }  // namespace kartograf::testing

@@ -278,19 +278,14 @@ TEST(FeatureSegmentation, RejectsBadInput) {
 }
 
 // One real map with the shipped model (trained on the ipa training drawings), against its ground
-// truth (office_e, plain).
+// truth (office_c, plain).
 TEST(FeatureSegmentation, RealIpaMap) {
-  const std::filesystem::path maps = testing::data_dir() / "ipa_room_maps" / "test_maps";
-  const OccupancyGrid map = io::read_png_map(maps / "office_e.png");
-  const LabelImage truth = io::read_room_ground_truth_png(maps / "office_e_gt_segmentation.png");
   const rooms::RoomClassifier classifier = rooms::RoomClassifier::load(shipped_model());
-  const rooms::RoomSegmentation result = rooms::segment_feature_based(map, classifier);
-  const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
-  RecordProperty("recall", std::to_string(scores.recall_mean));
-  RecordProperty("precision", std::to_string(scores.precision_mean));
-  RecordProperty("seconds", std::to_string(result.seconds));
-  EXPECT_GT(scores.recall_mean, 0.90);     // measured 0.926
-  EXPECT_GT(scores.precision_mean, 0.89);  // measured 0.918
+  const auto scores = testing::benchmark_map_scores("office_c", [&](const OccupancyGrid& map) {
+    return rooms::segment_feature_based(map, classifier);
+  });
+  EXPECT_GT(scores.recall_mean, 0.96);     // measured 0.990
+  EXPECT_GT(scores.precision_mean, 0.95);  // measured 0.976
 }
 
 }  // namespace

@@ -221,25 +221,14 @@ TEST(ThresholdMethodsOnRealMaps, MatchOrBeatTheReference) {
                                   {RoomMethod::morphological, "furnitures", 0.846, 0.905},
                                   {RoomMethod::distance, "plain", 0.969, 0.884},
                                   {RoomMethod::distance, "furnitures", 0.761, 0.884}};
-  const auto cases = io::find_room_maps(testing::data_dir() / "ipa_room_maps" / "test_maps");
   for (const Reference& reference : references) {
-    double recall = 0, precision = 0;
-    int maps = 0;
-    for (const io::RoomMapCase& c : cases) {
-      if (c.variant != reference.variant) continue;
-      const auto result = rooms::segment_rooms(io::read_png_map(c.map), reference.method);
-      const auto scores = eval::evaluate_room_segmentation(
-          io::read_room_ground_truth_png(c.ground_truth), result.rooms);
-      recall += scores.recall_mean;
-      precision += scores.precision_mean;
-      ++maps;
-    }
-    ASSERT_EQ(maps, 10);
-    const std::string name = rooms::to_string(reference.method) + "_" + reference.variant;
-    RecordProperty(name + "_recall", std::to_string(recall / maps));
-    RecordProperty(name + "_precision", std::to_string(precision / maps));
-    EXPECT_GE(recall / maps, reference.recall) << name;
-    EXPECT_GE(precision / maps, reference.precision) << name;
+    const std::string name = rooms::to_string(reference.method);
+    const testing::BenchmarkMeans means = testing::benchmark_means(
+        name, reference.variant,
+        [&](const OccupancyGrid& map) { return rooms::segment_rooms(map, reference.method); });
+    ASSERT_EQ(means.maps, 10);
+    EXPECT_GE(means.recall, reference.recall) << name << " " << reference.variant;
+    EXPECT_GE(means.precision, reference.precision) << name << " " << reference.variant;
   }
 }
 

@@ -71,7 +71,7 @@ rooms::RoomMethodOptions method_options(const RoomsOptions& o) {
     options.room_area = rooms::AreaLimits{o.min_area_m2, o.max_area_m2};
   }
   if (o.keep_furniture) options.furniture.reset();
-  options.feature_model = o.model;
+  options.model = o.model;
   return options;
 }
 
@@ -103,7 +103,7 @@ void add_map_options(CLI::App* command, RoomsOptions& o) {
   command->add_flag("--keep-furniture", o.keep_furniture,
                     "Segment the map as it is, furniture included (the reference's behaviour)");
   command->add_option("--model", o.model,
-                      "feature: the room/hallway classifier (default: the shipped model)");
+                      "feature, vrf: the trained model (default: the shipped one)");
 }
 
 // Mean and total recall/precision over a group of maps, as the survey reports them.

@@ -346,15 +346,20 @@ void write_ros_map(const fs::path& yaml_path, const OccupancyGrid& grid) {
   staged_yaml.publish();
 }
 
+GrayImage read_map_gray(const fs::path& path) {
+  const std::string name = "map image " + quoted(path);
+  const cv::Mat image = decode_image(path, name);
+  require_8bit(image, name);
+  return to_gray(image);
+}
+
 OccupancyGrid read_png_map(const fs::path& path, double resolution, int free_threshold) {
   const std::string name = "map image " + quoted(path);
   require(std::isfinite(resolution) && resolution > 0,
           name + ": the resolution must be > 0, got " + std::to_string(resolution));
   require(free_threshold >= 0 && free_threshold <= 255,
           name + ": the free threshold must be in 0..255, got " + std::to_string(free_threshold));
-  const cv::Mat image = decode_image(path, name);
-  require_8bit(image, name);
-  const GrayImage gray = to_gray(image);
+  const GrayImage gray = read_map_gray(path);
   OccupancyGrid grid;
   grid.resolution = resolution;
   grid.cells = Image<CellState>(gray.width(), gray.height());

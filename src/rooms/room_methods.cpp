@@ -3,6 +3,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/rooms/feature_segmentation.hpp"
 #include "kartograf/rooms/threshold_methods.hpp"
+#include "kartograf/rooms/voronoi_random_field.hpp"
 #include "kartograf/rooms/voronoi_segmentation.hpp"
 
 namespace kartograf::rooms {
@@ -20,7 +21,8 @@ Params with_options(Params params, const RoomMethodOptions& options) {
 
 const std::vector<RoomMethod>& all_room_methods() {
   static const std::vector<RoomMethod> methods{RoomMethod::morphological, RoomMethod::distance,
-                                               RoomMethod::voronoi, RoomMethod::feature};
+                                               RoomMethod::voronoi, RoomMethod::feature,
+                                               RoomMethod::vrf};
   return methods;
 }
 
@@ -34,6 +36,8 @@ std::string to_string(RoomMethod method) {
       return "voronoi";
     case RoomMethod::feature:
       return "feature";
+    case RoomMethod::vrf:
+      return "vrf";
   }
   return "unknown";
 }
@@ -61,8 +65,13 @@ RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
       FeatureSegmentationParams params;
       if (options.room_area) params.region_area = *options.room_area;
       const RoomClassifier classifier = RoomClassifier::load(
-          options.feature_model.empty() ? default_room_classifier_path() : options.feature_model);
+          options.model.empty() ? default_room_classifier_path() : options.model);
       return segment_feature_based(map, classifier, params, options.context);
+    }
+    case RoomMethod::vrf: {
+      const VrfModel model =
+          VrfModel::load(options.model.empty() ? default_vrf_model_path() : options.model);
+      return segment_voronoi_random_field(map, model, with_options(VrfParams{}, options));
     }
   }
   throw Error("segment_rooms: unknown method");

@@ -183,6 +183,8 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
           "merge_voronoi_cells: the label image differs from the map in size");
   require(std::isfinite(p.open_border_ratio) && p.open_border_ratio >= 0,
           "merge_voronoi_cells: open_border_ratio must be >= 0");
+  require(std::isfinite(p.open_end_ratio) && p.open_end_ratio >= 0,
+          "merge_voronoi_cells: open_end_ratio must be >= 0");
   require(std::isfinite(p.doorway_ratio) && p.doorway_ratio >= 0,
           "merge_voronoi_cells: doorway_ratio must be >= 0");
   int count = 0;
@@ -222,7 +224,9 @@ void merge_voronoi_cells(LabelImage& cells, const OccupancyGrid& map, const Cell
     if (p.open_border_ratio <= 0) return kWall;
     for (const auto& [id, n] : c.border) {
       const Cell* t = id == kWall ? nullptr : m.find(id);
-      if (t && n >= p.open_border_ratio * 2.0 * std::max(c.max_clearance, t->max_clearance))
+      if (!t) continue;
+      if (n >= p.open_border_ratio * 2.0 * std::max(c.max_clearance, t->max_clearance) ||
+          n >= p.open_end_ratio * 2.0 * std::min(c.max_clearance, t->max_clearance))
         return id;
     }
     return kWall;

@@ -37,6 +37,9 @@ void write_ros_map(const std::filesystem::path& yaml_path, const OccupancyGrid& 
 // occupied (ipa maps draw unknown/outside space grey and treat it as not free). Origin (0, 0, 0).
 OccupancyGrid read_png_map(const std::filesystem::path& path, double resolution = 0.05,
                            int free_threshold = 250);
+// The grey values of such an image (colour read as luminance, as the reference reads its maps),
+// e.g. a training drawing whose grey levels are labels.
+GrayImage read_map_gray(const std::filesystem::path& path);
 // Free 255, occupied 0, unknown 205 (read back as occupied: the format has no unknown).
 void write_png_map(const std::filesystem::path& path, const OccupancyGrid& grid);
 

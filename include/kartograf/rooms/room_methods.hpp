@@ -16,7 +16,7 @@ class Context;
 
 namespace kartograf::rooms {
 
-enum class RoomMethod { morphological, distance, voronoi, feature };
+enum class RoomMethod { morphological, distance, voronoi, feature, vrf };
 
 std::string to_string(RoomMethod method);
 // Throws Error listing the known names.
@@ -29,8 +29,9 @@ struct RoomMethodOptions {
   // room: the rooms stay whole where tables and chairs stand. Empty: segment the map as it is
   // (the survey's reference behaviour).
   std::optional<FurnitureParams> furniture = FurnitureParams{};
-  // feature: the room/hallway classifier (default_room_classifier_path() when empty).
-  std::filesystem::path feature_model;
+  // feature, vrf: the trained model (default_room_classifier_path() or default_vrf_model_path()
+  // when empty).
+  std::filesystem::path model;
   // feature: the backend its laser scans run on (null: the CPU's threads). Not owned.
   const compute::Context* context = nullptr;
 };

@@ -19,7 +19,10 @@
 //    cells, so no doorway lies between them: they are pieces of one corridor or hall, which the
 //    graph cuts wherever its clearance is least along a stretch, and which rules 4 and 5 leave
 //    apart once a piece's border is a small share of its long perimeter. A doorway off a corridor
-//    is narrower than the room behind it (the room's width counts), so rooms stay apart.
+//    is narrower than the room behind it (the room's width counts), so rooms stay apart. Also
+//    merged: a neighbour whose shared border is at least open_end_ratio x the widest free space
+//    of the narrower of the two cells, which opens onto the other across its whole width (the
+//    piece of a corridor that meets a wider corner or hall).
 // 4. a neighbour holding > 20 % of the perimeter (or > 10 % where the wall share lies within
 //    [1 - 2r - 0.05, 1 - r] for that share r) while the cell holds > 10 % of the neighbour's:
 //    merge (regions sharing most of their border); not in the reference: unless their shared
@@ -47,6 +50,7 @@ struct CellMergeParams {
   double shared_min_of_neighbour = 0.1;
   double dominant_neighbour = 0.4;  // rule 5
   double open_border_ratio = 0.88;  // rule 3b; 0: off (the reference)
+  double open_end_ratio = 1.05;     // rule 3b, narrower cell; 0: off (the reference)
   double doorway_ratio = 0.95;      // rule 4's doorway test; 0: off (the reference)
 };
 
