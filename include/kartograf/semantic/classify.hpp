@@ -1,0 +1,86 @@
+#pragma once
+// Rule-based classification of regions into floor, wall, ceiling, door or unknown (methods.md M2
+// step 3), and the whole pipeline from an organized point image to a SemanticImage.
+//
+// Rules (defaults are the paper's values where it gives them):
+//  - floor: horizontal, facing up, within floor_tolerance of the floor height (the lowest large
+//    horizontal region, gravity.hpp); several regions may be floor (furniture splits it);
+//  - ceiling: horizontal, facing down, within ceiling_tolerance of the ceiling height;
+//  - door: vertical, width in [door_min_width, door_max_width], reaching the floor (or cut below by
+//    the view), its top at door_min_height..door_max_height above the floor (or cut above by the
+//    view and at most door_max_height), at least half door_min_height of it in view, and next to
+//    a wall region parallel to it that it stands door_min_wall_offset (more far away) to
+//    door_max_wall_offset in front of (a door leaf standing open against the wall). "Next to":
+//    adjacent, directly or through one region between (the leaf's edge face), or within
+//    door_max_wall_gap along the wall (the wall behind a leaf is hidden by it);
+//  - wall: vertical and, as in the paper, height >= wall_height_fraction x (ceiling - floor) and
+//    width >= wall_min_width. Frames see parts of walls, so each test also passes when the view
+//    explains its failure: the height test when the region reaches (or is cut by the view near)
+//    both the floor and the ceiling level, the width test when the region is cut sideways by the
+//    view or is adjacent to another wall. Without a ceiling in view the room height is
+//    assumed_room_height above the floor; without a floor, below the ceiling. A vertical region
+//    next to a wall and reaching above door_min_height is a wall too (door jambs, wall pieces
+//    between doors);
+//  - a horizontal region facing down below the ceiling and adjacent to a wall (a lintel's
+//    underside) is wall;
+//  - everything else, and pixels in no region, unknown (furniture included: M2 has no furniture
+//    rule).
+#include <span>
+#include <vector>
+
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/semantic_class.hpp"
+#include "kartograf/semantic/gravity.hpp"
+#include "kartograf/semantic/normals_image.hpp"
+#include "kartograf/semantic/regions.hpp"
+
+namespace kartograf::semantic {
+
+struct ClassificationParams {
+  double floor_tolerance = 0.10;    // m
+  double ceiling_tolerance = 0.10;  // m
+  double wall_height_fraction = 0.9;
+  double wall_min_width = 2.0;                          // m
+  double reach_tolerance = 0.25;                        // m: "reaches the floor/ceiling level"
+  double assumed_room_height = 2.5;                     // m
+  double door_min_height = 1.8, door_max_height = 2.3;  // m
+  double door_min_width = 0.6, door_max_width = 1.2;    // m
+  // A leaf stands door_min_wall_offset (or door_relative_wall_offset x its range, as depth noise
+  // grows) to door_max_wall_offset in front of its wall: not a piece of the wall itself.
+  double door_min_wall_offset = 0.03;  // m
+  double door_relative_wall_offset = 0.01;
+  double door_max_wall_gap = 0.5;  // m along the wall between a leaf and its wall's visible part
+  double door_max_wall_offset = 0.09;  // m: a leaf is ~5 cm out; a wall step (thickness) >= 10 cm
+  double parallel_tolerance_deg = 15.0;
+};
+
+// Classes per region (index = label - 1).
+std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> regions,
+                                            const GravityEstimate& gravity,
+                                            const ClassificationParams& params = {});
+
+struct LabellingParams {
+  NormalsImageParams normals;
+  RegionParams regions;
+  LayerSplitParams layers;
+  MeasureParams measure;
+  GravityParams gravity;
+  ClassificationParams classes;
+};
+
+struct SemanticLabelling {
+  NormalImage normals;
+  RegionSegmentation regions;
+  std::vector<RegionMeasurements> measurements;
+  GravityEstimate gravity;
+  std::vector<SemanticClass> region_classes;
+  SemanticImage semantic;
+};
+
+// The whole of M2 steps 1-3 on one organized point image (sensor at the origin): smoothing,
+// normals, region growing, layer splitting (on the smoothed points), gravity, measurements,
+// classification; a split-off layer the rules leave unknown takes the class of its parent.
+SemanticLabelling label_organized_points(const compute::Context& context, const PointImage& points,
+                                         const LabellingParams& params = {});
+
+}  // namespace kartograf::semantic

@@ -1,0 +1,50 @@
+#pragma once
+// The normals image of method M2 (methods.md M2 step 1): the normal of every pixel of an organized
+// point image (an RGB-D frame back-projected, or an organized laser scan) stored as an RGB raster,
+// one colour channel per normal component.
+//
+// Normals come from geometry::estimate_normals, so they run on every backend. Two things make the
+// same call work for laser scans, whose frame has z up rather than z along the view:
+//  - the points are first smoothed by a mean over an organized window that only takes neighbours
+//    whose range (distance to the sensor at the origin) is within max_relative_range_jump of the
+//    centre's: a plane stays the same plane under averaging, while Kinect disparity steps and
+//    laser range noise (centimetres over pixels of millimetres) no longer dominate 4-neighbour
+//    tangents;
+//  - estimate_normals' depth-jump test is relative to z, meaningless for z-up frames, so it is
+//    given the points shifted to z >= 1 (a translation: tangents and normals are unchanged) with
+//    the test switched off; depth edges were already respected by the smoothing, and the region
+//    growing (regions.hpp) tests range jumps itself. The normals are then turned to face the
+//    sensor at the origin (n . p <= 0).
+#include <cstdint>
+
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/color.hpp"
+#include "kartograf/core/point_image.hpp"
+
+namespace kartograf::semantic {
+
+struct NormalsImageParams {
+  int smoothing_radius = 5;               // window (2r + 1)^2; 0: no smoothing
+  float max_relative_range_jump = 0.04f;  // neighbours farther apart in range are another surface
+};
+
+// The organized mean filter described above; invalid pixels stay invalid.
+PointImage smooth_organized_points(const PointImage& points, const NormalsImageParams& params);
+
+// Smoothing, then geometry::estimate_normals on `context`, normals facing the sensor (origin).
+NormalImage estimate_organized_normals(const compute::Context& context, const PointImage& points,
+                                       const NormalsImageParams& params = {});
+
+enum class NormalEncoding : std::uint8_t {
+  absolute,  // the paper's variant: (|nx|, |ny|, |nz|) * 255, opposite faces share a colour
+  signed_,   // (n + 1) / 2 * 255: every direction its own colour
+};
+
+// Invalid normals become black. Components are rounded to the nearest level.
+RgbImage normals_to_rgb(const NormalImage& normals, NormalEncoding encoding);
+
+// Grey (ITU-R BT.601 luma, rounded) of an encoded normals image: the input of cascade detection
+// (methods.md M2 step 4).
+GrayImage normals_rgb_to_gray(const RgbImage& normals_rgb);
+
+}  // namespace kartograf::semantic

@@ -1,0 +1,208 @@
+#pragma once
+// The hybrid metric-semantic grid of method M2 (methods.md; Siemiatkowska et al.): a 2-D grid in
+// which every cell holds the objects over it (label, outline in metres, height range, area) and a
+// traversability weight in [0, 1] (floor 1, obstacles 0, doors 0.7: "slow near doors").
+//
+// Input: labelled 3-D points in a gravity-aligned world frame (metres, z up), e.g. frames
+// back-projected with their pose and per-pixel classes, plus optional object detections. A cell
+// sees floor evidence (floor points near the floor height) and obstacle evidence (any non-floor,
+// non-ceiling point in the robot's height band above the floor). Cell classes, by priority:
+//   obstacle evidence   -> the most frequent label of its band points (wall, door, furniture,
+//                          unknown = an unclassified obstacle)
+//   floor in a wall gap -> door: an open doorway, a gap of door width between two collinear
+//                          straight wall pieces (the paper's "door adjacent to a wall")
+//   floor               -> floor
+//   nothing             -> unobserved (class unknown, weight NaN)
+// Clean-up before objects: an obstacle cell that sees floor and only holds points spilled over
+// from a surface on its boundary is floor; isolated obstacle cells are specks; furniture outlines
+// are filled to their convex hull (table tops drop out of grazing views).
+// Objects: straight wall pieces (wall cells grouped by their local direction), doorways (with
+// centre and width), door leaves and furniture (connected components of their cells); detections
+// add their own objects on the cells their footprint covers.
+//
+// Grid layout as core/occupancy_grid.hpp (ROS map_server): row 0 is the largest y, origin the
+// lower-left corner of the lower-left cell, no rotation.
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <optional>
+#include <span>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/core/color.hpp"
+#include "kartograf/core/image.hpp"
+#include "kartograf/core/occupancy_grid.hpp"
+#include "kartograf/core/semantic_class.hpp"
+
+namespace kartograf::semantic {
+
+inline constexpr float kUnobserved = std::numeric_limits<float>::quiet_NaN();
+
+// Traversability per cell class; NaN = unknown (not observed). The unknown class also marks
+// unclassified obstacles, which take `unclassified_obstacle`.
+struct TraversabilityWeights {
+  std::array<float, kSemanticClassCount> by_class = {
+      kUnobserved,  // unknown
+      1.0f,         // floor
+      0.0f,         // wall
+      0.0f,         // ceiling (never a cell class: ceiling points are above the robot)
+      0.7f,         // door: slow near doors
+      0.0f,         // furniture
+  };
+  float unclassified_obstacle = 0.0f;
+
+  float of(SemanticClass c) const { return by_class[static_cast<std::size_t>(c)]; }
+  // Throws Error unless every weight is NaN or in [0, 1].
+  void validate() const;
+};
+
+struct SemanticGridOptions {
+  double resolution = 0.05;         // metres per cell
+  std::optional<double> floor_z;    // default: median z of the floor points (else 0)
+  std::optional<double> ceiling_z;  // default: median z of the ceiling points (else none)
+  double floor_tolerance = 0.08;    // floor points within this of floor_z are floor evidence
+  double band_min = 0.10;           // robot height band above the floor [m]: obstacles
+  double band_max = 1.50;
+  double ceiling_margin = 0.15;  // object heights count points below ceiling - this
+  int min_obstacle_points = 2;   // per cell, fewer band points are noise
+  // ... and at least this many band points per floor point: a free cell seen many times gathers
+  // a few stray (flying, mixed) points that must not make it an obstacle.
+  double min_obstacle_floor_ratio = 0.25;
+  // Spill: an obstacle cell that sees floor, with >= spill_fraction of its band points within
+  // spill_margin of its side facing an obstacle cell with less floor, is free (a surface on the
+  // cell boundary scatters noisy points into both cells). spill_margin 0: off.
+  double spill_margin = 0.02;
+  double spill_fraction = 0.8;
+  bool remove_isolated_obstacles = true;
+  // Furniture outlines (legs, edges: a table top drops out at grazing views) are closed and
+  // filled to their convex hull when that is at most this area [m^2]; 0: off.
+  double max_furniture_fill_area = 4.0;  // obstacle cells without an obstacle neighbour: specks
+  int min_floor_points = 1;
+  double margin = 0.25;          // metres of grid around the data
+  double min_wall_length = 0.5;  // shorter straight wall pieces are not objects
+  double min_door_width = 0.4, max_door_width = 1.6;  // openings outside this are not doors
+  // An open doorway is also found as a gap of door width between two collinear wall pieces
+  // (their lines at most this far apart), with mostly observed floor along the gap.
+  double max_wall_misalignment = 0.15;
+  double min_gap_floor_fraction = 0.6;
+  double door_passage_depth = 0.4;  // and no obstacle this far on either side of its middle
+  TraversabilityWeights weights;
+
+  void validate() const;  // throws Error naming the first bad field
+};
+
+// An object detected by other means (e.g. the Haar cascade): a footprint polygon in metres.
+struct ObjectDetection {
+  SemanticClass label = SemanticClass::unknown;
+  std::string name;                        // e.g. "washbasin"
+  std::vector<Eigen::Vector2d> footprint;  // polygon, >= 3 vertices
+  double z_min = 0, z_max = 0;             // height range [m, world z]
+  std::optional<float> weight;             // traversability of its cells; default: its label's
+};
+
+enum class ObjectKind : std::uint8_t { wall, doorway, door_leaf, furniture, detection };
+std::string_view to_string(ObjectKind kind);
+
+struct SemanticObject {
+  int id = 0;  // 1-based: objects[id - 1]
+  ObjectKind kind = ObjectKind::wall;
+  SemanticClass label = SemanticClass::unknown;
+  std::string name;                      // "wall 3", "doorway 1", "door 2", "furniture 4", ...
+  std::vector<Eigen::Vector2d> contour;  // outline through its boundary cells' centres [m]
+  double z_min = 0, z_max = 0;           // height range of its points (world z) [m]
+  double area = 0;                       // footprint [m^2]
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  // Its extent along its main direction: a wall's line, a door's opening. width = |end - start|.
+  Eigen::Vector2d axis_start = Eigen::Vector2d::Zero(), axis_end = Eigen::Vector2d::Zero();
+  double width = 0;
+  std::vector<Eigen::Vector2i> cells;  // (col, row)
+};
+
+struct SemanticGrid {
+  double resolution = 0.05;
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // lower-left corner [m]
+  double floor_z = 0;
+  std::optional<double> ceiling_z;
+  Image<SemanticClass> classes;
+  Image<float> weight;                   // [0, 1], NaN = unobserved
+  Image<std::vector<int>> cell_objects;  // object ids over each cell
+  std::vector<SemanticObject> objects;
+  TraversabilityWeights weights;  // the table the cells were weighted with
+
+  int width() const { return classes.width(); }
+  int height() const { return classes.height(); }
+  bool contains(const Eigen::Vector2i& cell) const {
+    return cell.x() >= 0 && cell.y() >= 0 && cell.x() < width() && cell.y() < height();
+  }
+  Eigen::Vector2d cell_center(const Eigen::Vector2i& cell) const {
+    return origin + resolution * Eigen::Vector2d(cell.x() + 0.5, height() - cell.y() - 0.5);
+  }
+  Eigen::Vector2i cell_of(const Eigen::Vector2d& p) const {
+    const Eigen::Vector2d local = (p - origin) / resolution;
+    return {static_cast<int>(std::floor(local.x())),
+            height() - 1 - static_cast<int>(std::floor(local.y()))};
+  }
+  const SemanticObject& object(int id) const;  // throws Error for an unknown id
+};
+
+// Builds the grid. points[i] has class labels[i]; non-finite points are skipped. Throws Error on
+// mismatched sizes, bad options, no finite point, or a bad detection.
+SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
+                                 std::span<const SemanticClass> labels,
+                                 const SemanticGridOptions& options = {},
+                                 std::span<const ObjectDetection> detections = {});
+
+// ---- Exports (data only; io/ writes the files) -----------------------------------------------
+
+// Everything but the images, in plain fields: what the JSON export holds.
+struct ObjectRecord {
+  int id = 0;
+  std::string kind;   // to_string(ObjectKind)
+  std::string label;  // to_string(SemanticClass)
+  std::string name;
+  std::vector<Eigen::Vector2d> contour;
+  double z_min = 0, z_max = 0, area = 0, width = 0;
+  Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+  Eigen::Vector2d axis_start = Eigen::Vector2d::Zero(), axis_end = Eigen::Vector2d::Zero();
+  int cell_count = 0;
+};
+struct MapDescription {
+  double resolution = 0;
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();
+  int width = 0, height = 0;
+  double floor_z = 0;
+  std::optional<double> ceiling_z;
+  std::vector<std::pair<std::string, float>> class_weights;  // class name -> weight (NaN: unknown)
+  std::array<int, kSemanticClassCount> cells_per_class{};
+  int unobserved_cells = 0;
+  std::vector<ObjectRecord> objects;
+};
+MapDescription describe(const SemanticGrid& grid);
+
+// Colour of each class in the picture; unobserved cells are drawn `unobserved_colour`.
+Rgb8 class_colour(SemanticClass c);
+inline constexpr Rgb8 kUnobservedColour{60, 60, 60};
+
+// The grid as a picture, `pixels_per_cell` pixels per cell (row 0 on top, as the grid), with a
+// legend strip below it (a swatch and the name of each class and its weight).
+struct MapPicture {
+  RgbImage image;
+  int pixels_per_cell = 1;
+  int map_width = 0, map_height = 0;  // cells
+};
+MapPicture render_map(const SemanticGrid& grid, int pixels_per_cell = 2);
+
+// Occupancy for io::write_ros_map: weight > 0 free, weight 0 occupied, unobserved unknown.
+OccupancyGrid to_occupancy_grid(const SemanticGrid& grid);
+
+// A graded costmap in the ROS costmap_2d convention: 0 = free (weight 1) .. 254 = lethal
+// (weight 0), 255 = no information; cost = round(254 (1 - weight)).
+Image<std::uint8_t> to_costmap(const SemanticGrid& grid);
+
+}  // namespace kartograf::semantic

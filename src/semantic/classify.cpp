@@ -1,0 +1,215 @@
+#include "kartograf/semantic/classify.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::semantic {
+namespace {
+
+double cos_deg(double degrees) {
+  return std::cos(degrees * std::numbers::pi / 180.0);
+}
+
+// The floor and ceiling levels the rules compare with, filled in from the assumed room height
+// when only one of them is in view.
+struct Levels {
+  std::optional<double> floor, ceiling;
+};
+
+Levels room_levels(const GravityEstimate& gravity, const ClassificationParams& params) {
+  Levels levels{gravity.floor_height, gravity.ceiling_height};
+  if (levels.floor && levels.ceiling && *levels.ceiling - *levels.floor < params.door_min_height) {
+    levels.ceiling.reset();  // a low "ceiling" (a table's underside seen from below) is no room
+  }
+  if (levels.floor && !levels.ceiling) levels.ceiling = *levels.floor + params.assumed_room_height;
+  if (levels.ceiling && !levels.floor) levels.floor = *levels.ceiling - params.assumed_room_height;
+  return levels;
+}
+
+class RegionRules {
+ public:
+  RegionRules(std::span<const RegionMeasurements> regions, const GravityEstimate& gravity,
+              const ClassificationParams& params)
+      : regions_(regions),
+        up_(gravity.up),
+        params_(params),
+        levels_(room_levels(gravity, params)) {}
+
+  bool reaches_floor(const RegionMeasurements& r) const {
+    return levels_.floor && r.min_height <= *levels_.floor + params_.reach_tolerance;
+  }
+  bool reaches_ceiling(const RegionMeasurements& r) const {
+    return levels_.ceiling && r.max_height >= *levels_.ceiling - params_.reach_tolerance;
+  }
+  double height_above_floor(double height) const {
+    return levels_.floor ? height - *levels_.floor : height;
+  }
+
+  bool is_floor(const RegionMeasurements& r) const {
+    return r.orientation == RegionOrientation::horizontal && r.mean_normal.dot(up_) > 0 &&
+           levels_.floor &&
+           std::fabs(r.centroid.dot(up_) - *levels_.floor) <= params_.floor_tolerance;
+  }
+  bool is_ceiling(const RegionMeasurements& r, const GravityEstimate& gravity) const {
+    return r.orientation == RegionOrientation::horizontal && r.mean_normal.dot(up_) < 0 &&
+           gravity.ceiling_height &&
+           std::fabs(r.centroid.dot(up_) - *gravity.ceiling_height) <= params_.ceiling_tolerance;
+  }
+
+  // The paper's height test, or the view explains why the visible part falls short.
+  bool wall_height(const RegionMeasurements& r) const {
+    if (levels_.floor && levels_.ceiling &&
+        r.height() >= params_.wall_height_fraction * (*levels_.ceiling - *levels_.floor)) {
+      return true;
+    }
+    return (reaches_floor(r) || r.cut_below) && (reaches_ceiling(r) || r.cut_above);
+  }
+
+  // Door-sized where seen; an end out of view (cut by the image or an occluder) is not held
+  // against it, as long as half a door's height is in view.
+  bool door_shaped(const RegionMeasurements& r) const {
+    if (r.orientation != RegionOrientation::vertical) return false;
+    if (r.width < params_.door_min_width || r.width > params_.door_max_width) return false;
+    if (!reaches_floor(r) && !r.cut_below) return false;
+    const double top = height_above_floor(r.max_height);
+    if (top > params_.door_max_height) return false;
+    if (r.height() < 0.5 * params_.door_min_height) return false;
+    return top >= params_.door_min_height || r.cut_above;
+  }
+
+  // A wall parallel to r, r standing door_min..max_wall_offset in front of it, and next to r:
+  // a neighbour, a neighbour's neighbour (the leaf's own edge face often lies between), or
+  // within door_max_wall_gap of r along the wall (the wall behind a leaf is hidden by it, and the
+  // visible pieces beside it may be parted from it by a jamb or by clutter).
+  bool beside_parallel_wall(const RegionMeasurements& r,
+                            const std::vector<SemanticClass>& classes) const {
+    auto parallel_wall = [&](Label id) {
+      const RegionMeasurements& o = regions_[id - 1u];
+      if (classes[id - 1u] != SemanticClass::wall || id == r.id) return false;
+      if (o.mean_normal.dot(r.mean_normal) < cos_deg(params_.parallel_tolerance_deg)) return false;
+      // Distance of r's centroid from the wall's plane, positive towards the sensor (normals face
+      // it).
+      const double in_front = o.plane_normal.dot(r.centroid - o.centroid);
+      const double min_offset = std::max(params_.door_min_wall_offset,
+                                         params_.door_relative_wall_offset * r.centroid.norm());
+      return in_front >= min_offset && in_front <= params_.door_max_wall_offset;
+    };
+    for (const Label id : r.neighbours) {
+      if (parallel_wall(id)) return true;
+      const auto& second = regions_[id - 1u].neighbours;
+      if (std::any_of(second.begin(), second.end(), parallel_wall)) return true;
+    }
+    for (const RegionMeasurements& o : regions_) {
+      if (!parallel_wall(o.id)) continue;
+      const Eigen::Vector3d along = up_.cross(o.plane_normal).normalized();
+      const double gap = std::fabs(along.dot(r.centroid - o.centroid)) - 0.5 * (r.width + o.width);
+      if (gap <= params_.door_max_wall_gap) return true;
+    }
+    return false;
+  }
+
+  bool beside(const RegionMeasurements& r, const std::vector<SemanticClass>& classes,
+              SemanticClass wanted) const {
+    return std::any_of(r.neighbours.begin(), r.neighbours.end(),
+                       [&](Label id) { return classes[id - 1u] == wanted; });
+  }
+
+ private:
+  std::span<const RegionMeasurements> regions_;
+  Eigen::Vector3d up_;
+  const ClassificationParams& params_;
+  Levels levels_;
+};
+
+}  // namespace
+
+std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> regions,
+                                            const GravityEstimate& gravity,
+                                            const ClassificationParams& params) {
+  const RegionRules rules(regions, gravity, params);
+  std::vector<SemanticClass> classes(regions.size(), SemanticClass::unknown);
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    if (rules.is_floor(regions[i])) classes[i] = SemanticClass::floor;
+    if (rules.is_ceiling(regions[i], gravity)) classes[i] = SemanticClass::ceiling;
+  }
+  // Walls: the full rule first, then tall regions joined to a wall (its width test passes through
+  // the neighbour), until nothing changes.
+  auto candidate = [&](std::size_t i) {
+    return classes[i] == SemanticClass::unknown &&
+           regions[i].orientation == RegionOrientation::vertical && rules.wall_height(regions[i]);
+  };
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    if (candidate(i) && (regions[i].width >= params.wall_min_width || regions[i].cut_sideways)) {
+      classes[i] = SemanticClass::wall;
+    }
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      if (candidate(i) && rules.beside(regions[i], classes, SemanticClass::wall)) {
+        classes[i] = SemanticClass::wall;
+        changed = true;
+      }
+    }
+  }
+  // Doors among the door-shaped regions, walls so far or not: a leaf in front of a wall (which
+  // is farther from the sensor, so two regions never make each other doors).
+  const std::vector<SemanticClass> walls = classes;
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    if ((classes[i] == SemanticClass::unknown || classes[i] == SemanticClass::wall) &&
+        rules.door_shaped(regions[i]) && rules.beside_parallel_wall(regions[i], walls)) {
+      classes[i] = SemanticClass::door;
+    }
+  }
+  // Door jambs and wall pieces reaching above door height next to a wall; lintel undersides.
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    const RegionMeasurements& r = regions[i];
+    if (classes[i] != SemanticClass::unknown || !rules.beside(r, classes, SemanticClass::wall))
+      continue;
+    const bool jamb = r.orientation == RegionOrientation::vertical &&
+                      rules.height_above_floor(r.max_height) >= params.door_min_height - 0.1;
+    const bool lintel =
+        r.orientation == RegionOrientation::horizontal && r.mean_normal.dot(gravity.up) < 0;
+    if (jamb || lintel) classes[i] = SemanticClass::wall;
+  }
+  return classes;
+}
+
+SemanticLabelling label_organized_points(const compute::Context& context, const PointImage& points,
+                                         const LabellingParams& params) {
+  SemanticLabelling out;
+  const PointImage smoothed = smooth_organized_points(points, params.normals);
+  NormalsImageParams presmoothed = params.normals;
+  presmoothed.smoothing_radius = 0;
+  out.normals = estimate_organized_normals(context, smoothed, presmoothed);
+  out.regions = segment_regions(points, out.normals, params.regions);
+  const int unsplit_count = out.regions.region_count;
+  const std::vector<Label> parents =
+      split_offset_layers(smoothed, out.normals, out.regions, params.layers);
+  const auto provisional =
+      measure_regions(points, out.normals, out.regions, Eigen::Vector3d::UnitZ(), params.measure);
+  out.gravity = estimate_gravity(provisional, params.gravity);
+  out.measurements =
+      measure_regions(points, out.normals, out.regions, out.gravity.up, params.measure);
+  find_floor_and_ceiling(out.measurements, params.gravity, out.gravity);
+  out.region_classes = classify_regions(out.measurements, out.gravity, params.classes);
+  // A layer that the rules do not recognise (no door leaf) is part of the surface it was split
+  // from: offsets that large also come from smoothing at creases and from long grazing views.
+  for (std::size_t k = 0; k < parents.size(); ++k) {
+    SemanticClass& c = out.region_classes[static_cast<std::size_t>(unsplit_count) + k];
+    if (c == SemanticClass::unknown) c = out.region_classes[parents[k] - 1u];
+  }
+  out.semantic = SemanticImage(points.width(), points.height(), SemanticClass::unknown);
+  for (std::size_t i = 0; i < out.semantic.size(); ++i) {
+    const Label l = out.regions.labels.pixels()[i];
+    if (l != kUnlabeled) out.semantic.pixels()[i] = out.region_classes[l - 1u];
+  }
+  return out;
+}
+
+}  // namespace kartograf::semantic

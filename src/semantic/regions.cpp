@@ -1,0 +1,383 @@
+#include "kartograf/semantic/regions.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <set>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::semantic {
+namespace {
+
+double cos_deg(double degrees) {
+  return std::cos(degrees * std::numbers::pi / 180.0);
+}
+
+Eigen::Vector3d vec3(const Point4f& p) {
+  return p.head<3>().cast<double>();
+}
+
+bool ranges_continuous(const Point4f& a, const Point4f& b, double max_relative_jump) {
+  const double ra = a.head<3>().norm(), rb = b.head<3>().norm();
+  return std::fabs(ra - rb) <= max_relative_jump * std::min(ra, rb);
+}
+
+// Value at `fraction` of the sorted values (nearest rank), for trimmed extremes.
+double quantile(std::vector<double>& values, double fraction) {
+  const auto k = static_cast<std::size_t>(
+      std::clamp(std::lround(fraction * static_cast<double>(values.size() - 1)), 0L,
+                 static_cast<long>(values.size() - 1)));
+  std::nth_element(values.begin(), values.begin() + static_cast<std::ptrdiff_t>(k), values.end());
+  return values[k];
+}
+
+double trimmed_extent(std::vector<double> values, double trim, double& low, double& high) {
+  low = quantile(values, trim);
+  high = quantile(values, 1.0 - trim);
+  return high - low;
+}
+
+// Whether each region's points span a plane (PCA: smallest spread well below the middle one) whose
+// normal agrees with the region's mean normal (see regions.hpp).
+std::vector<bool> consistent_planes(const PointImage& points, const NormalImage& normals,
+                                    const std::vector<int>& region_of,
+                                    const std::vector<int>& sizes, const RegionParams& params) {
+  const std::size_t n = sizes.size();
+  std::vector<Eigen::Vector3d> sum(n, Eigen::Vector3d::Zero()), normal(n, Eigen::Vector3d::Zero());
+  std::vector<Eigen::Matrix3d> outer(n, Eigen::Matrix3d::Zero());
+  std::vector<Eigen::Vector3d> origin(n, Eigen::Vector3d::Zero());
+  std::vector<bool> seen(n, false);
+  for (std::size_t i = 0; i < region_of.size(); ++i) {
+    const int r = region_of[i];
+    if (r < 0 || sizes[static_cast<std::size_t>(r)] < params.min_region_pixels) continue;
+    const auto k = static_cast<std::size_t>(r);
+    const Eigen::Vector3d p = vec3(points.pixels()[i]);
+    if (!seen[k])
+      origin[k] = p, seen[k] = true;  // offsets from a member keep sums well-conditioned
+    const Eigen::Vector3d d = p - origin[k];
+    sum[k] += d;
+    outer[k] += d * d.transpose();
+    normal[k] += vec3(normals.pixels()[i]);
+  }
+  std::vector<bool> planar(n, false);
+  const double region_cos = cos_deg(params.max_region_angle_deg);
+  for (std::size_t k = 0; k < n; ++k) {
+    if (!seen[k]) continue;
+    const Eigen::Vector3d mean = sum[k] / sizes[k];
+    const Eigen::Matrix3d covariance = outer[k] / sizes[k] - mean * mean.transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(covariance);
+    const Eigen::Vector3d spread = pca.eigenvalues();  // ascending
+    planar[k] = spread(0) * params.min_plane_spread_ratio <= spread(1) &&
+                std::fabs(pca.eigenvectors().col(0).dot(normal[k].normalized())) >= region_cos;
+  }
+  return planar;
+}
+
+// The fill described in regions.hpp.
+void fill_from_planes(const PointImage& points, const NormalImage& normals,
+                      const RegionParams& params, RegionSegmentation& out) {
+  const int w = points.width(), h = points.height();
+  const auto n = static_cast<std::size_t>(out.region_count);
+  std::vector<Eigen::Vector3d> centroid(n, Eigen::Vector3d::Zero()),
+      normal(n, Eigen::Vector3d::Zero());
+  std::vector<int> count(n, 0);
+  std::vector<int> queue;
+  for (int i = 0; i < w * h; ++i) {
+    const Label l = out.labels.pixels()[static_cast<std::size_t>(i)];
+    if (l == kUnlabeled) continue;
+    centroid[l - 1u] += vec3(points.pixels()[static_cast<std::size_t>(i)]);
+    normal[l - 1u] += vec3(normals.pixels()[static_cast<std::size_t>(i)]);
+    ++count[l - 1u];
+    queue.push_back(i);
+  }
+  for (std::size_t r = 0; r < n; ++r) {
+    centroid[r] /= count[r];
+    normal[r].normalize();
+  }
+  for (std::size_t head = 0; head < queue.size(); ++head) {
+    const int i = queue[head];
+    const Label l = out.labels.pixels()[static_cast<std::size_t>(i)];
+    const Point4f& p = points.pixels()[static_cast<std::size_t>(i)];
+    const int x = i % w, y = i / w;
+    const int candidates[4] = {x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1,
+                               y + 1 < h ? i + w : -1};
+    for (const int j : candidates) {
+      if (j < 0 || out.labels.pixels()[static_cast<std::size_t>(j)] != kUnlabeled) continue;
+      const Point4f& q = points.pixels()[static_cast<std::size_t>(j)];
+      if (!is_valid(q) || !ranges_continuous(p, q, params.max_relative_range_jump)) continue;
+      const double distance = std::fabs(normal[l - 1u].dot(vec3(q) - centroid[l - 1u]));
+      const double range = q.head<3>().norm();
+      if (distance >
+          params.fill_plane_distance +
+              range * (params.fill_relative_distance + params.fill_quadratic_distance * range)) {
+        continue;
+      }
+      out.labels.pixels()[static_cast<std::size_t>(j)] = l;
+      queue.push_back(j);
+    }
+  }
+}
+
+}  // namespace
+
+RegionSegmentation segment_regions(const PointImage& points, const NormalImage& normals,
+                                   const RegionParams& params) {
+  require(points.width() == normals.width() && points.height() == normals.height(),
+          "segment_regions: points are " + std::to_string(points.width()) + "x" +
+              std::to_string(points.height()) + " but normals " + std::to_string(normals.width()) +
+              "x" + std::to_string(normals.height()));
+  require(params.max_neighbour_angle_deg > 0 && params.max_neighbour_angle_deg < 180 &&
+              params.max_region_angle_deg > 0 && params.max_region_angle_deg < 180,
+          "segment_regions: angles must be in (0, 180) degrees");
+  require(params.max_relative_range_jump > 0,
+          "segment_regions: max_relative_range_jump must be > 0");
+  require(params.min_region_pixels >= 1, "segment_regions: min_region_pixels must be >= 1");
+
+  const int w = points.width(), h = points.height();
+  const double neighbour_cos = cos_deg(params.max_neighbour_angle_deg);
+  const double region_cos = cos_deg(params.max_region_angle_deg);
+  constexpr int kUnvisited = -1;
+  std::vector<int> region_of(points.size(), kUnvisited);
+  std::vector<int> sizes;
+  std::vector<int> queue;
+  auto usable = [&](int i) {
+    return is_valid(points.pixels()[static_cast<std::size_t>(i)]) &&
+           is_valid(normals.pixels()[static_cast<std::size_t>(i)]);
+  };
+  for (int seed = 0; seed < w * h; ++seed) {
+    if (region_of[static_cast<std::size_t>(seed)] != kUnvisited || !usable(seed)) continue;
+    const int region = static_cast<int>(sizes.size());
+    Eigen::Vector3d normal_sum = Eigen::Vector3d::Zero();
+    queue.assign(1, seed);
+    region_of[static_cast<std::size_t>(seed)] = region;
+    for (std::size_t head = 0; head < queue.size(); ++head) {
+      const int i = queue[head];
+      const Point4f& p = points.pixels()[static_cast<std::size_t>(i)];
+      const Eigen::Vector3d n = vec3(normals.pixels()[static_cast<std::size_t>(i)]);
+      normal_sum += n;
+      const Eigen::Vector3d mean = normal_sum.normalized();
+      const int x = i % w, y = i / w;
+      const int candidates[4] = {x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1,
+                                 y + 1 < h ? i + w : -1};
+      for (const int j : candidates) {
+        if (j < 0 || region_of[static_cast<std::size_t>(j)] != kUnvisited || !usable(j)) continue;
+        const Eigen::Vector3d m = vec3(normals.pixels()[static_cast<std::size_t>(j)]);
+        if (m.dot(n) < neighbour_cos || m.dot(mean) < region_cos ||
+            !ranges_continuous(p, points.pixels()[static_cast<std::size_t>(j)],
+                               params.max_relative_range_jump)) {
+          continue;
+        }
+        region_of[static_cast<std::size_t>(j)] = region;
+        queue.push_back(j);
+      }
+    }
+    sizes.push_back(static_cast<int>(queue.size()));
+    // Pixels refused here may seed or join other regions later: unmark nothing, they were never
+    // marked. Small regions are dropped after all are grown.
+  }
+  RegionSegmentation out;
+  out.labels = LabelImage(w, h, kUnlabeled);
+  std::vector<Label> relabel(sizes.size(), kUnlabeled);
+  const std::vector<bool> planar = consistent_planes(points, normals, region_of, sizes, params);
+  for (std::size_t r = 0; r < sizes.size(); ++r) {
+    if (sizes[r] < params.min_region_pixels || !planar[r]) continue;
+    require(out.region_count < 65535, "segment_regions: more than 65535 regions");
+    relabel[r] = static_cast<Label>(++out.region_count);
+  }
+  for (std::size_t i = 0; i < region_of.size(); ++i) {
+    if (region_of[i] >= 0) out.labels.pixels()[i] = relabel[static_cast<std::size_t>(region_of[i])];
+  }
+  fill_from_planes(points, normals, params, out);
+  return out;
+}
+
+std::vector<Label> split_offset_layers(const PointImage& smoothed_points,
+                                       const NormalImage& normals, RegionSegmentation& regions,
+                                       const LayerSplitParams& params) {
+  const int w = smoothed_points.width(), h = smoothed_points.height();
+  require(normals.width() == w && normals.height() == h && regions.labels.width() == w &&
+              regions.labels.height() == h,
+          "split_offset_layers: points, normals and labels must have one size");
+  require(params.min_offset > 0 && params.min_pixels >= 1,
+          "split_offset_layers: min_offset must be > 0 and min_pixels >= 1");
+  const auto n = static_cast<std::size_t>(regions.region_count);
+  std::vector<Eigen::Vector3d> normal(n, Eigen::Vector3d::Zero());
+  std::vector<std::vector<double>> offsets(n);
+  LabelImage& labels = regions.labels;
+  for (int i = 0; i < w * h; ++i) {
+    const Label l = labels.pixels()[static_cast<std::size_t>(i)];
+    const Point4f& m = normals.pixels()[static_cast<std::size_t>(i)];
+    if (l != kUnlabeled && is_valid(m)) normal[l - 1u] += vec3(m);
+  }
+  for (auto& v : normal) v.normalize();
+  for (int i = 0; i < w * h; ++i) {
+    const Label l = labels.pixels()[static_cast<std::size_t>(i)];
+    if (l != kUnlabeled) {
+      offsets[l - 1u].push_back(
+          normal[l - 1u].dot(vec3(smoothed_points.pixels()[static_cast<std::size_t>(i)])));
+    }
+  }
+  std::vector<double> plane(n, 0.0);
+  for (std::size_t r = 0; r < n; ++r) {
+    if (!offsets[r].empty()) plane[r] = quantile(offsets[r], 0.5);
+  }
+  // Side of each pixel: +1 in front of its region's plane, -1 behind, 0 on it.
+  std::vector<int> side(static_cast<std::size_t>(w * h), 0);
+  for (int i = 0; i < w * h; ++i) {
+    const Label l = labels.pixels()[static_cast<std::size_t>(i)];
+    if (l == kUnlabeled) continue;
+    const double s =
+        normal[l - 1u].dot(vec3(smoothed_points.pixels()[static_cast<std::size_t>(i)])) -
+        plane[l - 1u];
+    // Normals face the sensor, n . p = -distance to the plane: "in front" is positive.
+    side[static_cast<std::size_t>(i)] = s > params.min_offset ? 1 : s < -params.min_offset ? -1 : 0;
+  }
+  std::vector<bool> visited(side.size(), false);
+  std::vector<int> component;
+  std::vector<Label> parents;
+  for (int seed = 0; seed < w * h; ++seed) {
+    const auto s = static_cast<std::size_t>(seed);
+    if (side[s] == 0 || visited[s]) continue;
+    const Label l = labels.pixels()[s];
+    component.assign(1, seed);
+    visited[s] = true;
+    for (std::size_t head = 0; head < component.size(); ++head) {
+      const int i = component[head], x = i % w, y = i / w;
+      const int candidates[4] = {x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1,
+                                 y + 1 < h ? i + w : -1};
+      for (const int j : candidates) {
+        const auto u = static_cast<std::size_t>(j);
+        if (j < 0 || visited[u] || side[u] != side[s] || labels.pixels()[u] != l) continue;
+        visited[u] = true;
+        component.push_back(j);
+      }
+    }
+    if (static_cast<int>(component.size()) < params.min_pixels) continue;
+    require(regions.region_count < 65535, "split_offset_layers: more than 65535 regions");
+    const auto label = static_cast<Label>(++regions.region_count);
+    for (const int i : component) labels.pixels()[static_cast<std::size_t>(i)] = label;
+    parents.push_back(l);
+  }
+  return parents;
+}
+
+std::vector<RegionMeasurements> measure_regions(const PointImage& points,
+                                                const NormalImage& normals,
+                                                const RegionSegmentation& regions,
+                                                const Eigen::Vector3d& up,
+                                                const MeasureParams& params) {
+  const int w = points.width(), h = points.height();
+  require(normals.width() == w && normals.height() == h && regions.labels.width() == w &&
+              regions.labels.height() == h,
+          "measure_regions: points, normals and labels must have one size");
+  require(std::fabs(up.norm() - 1.0) < 1e-6, "measure_regions: up must be a unit vector");
+  require(params.trim_fraction >= 0 && params.trim_fraction < 0.5,
+          "measure_regions: trim_fraction must be in [0, 0.5)");
+  const auto n_regions = static_cast<std::size_t>(regions.region_count);
+  std::vector<RegionMeasurements> out(n_regions);
+  std::vector<std::vector<int>> members(n_regions);
+  std::vector<std::set<Label>> adjacent(n_regions);
+  const LabelImage& labels = regions.labels;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const Label l = labels(x, y);
+      if (l == kUnlabeled) continue;
+      RegionMeasurements& m = out[l - 1u];
+      members[l - 1u].push_back(y * w + x);
+      m.centroid += vec3(points(x, y));
+      if (is_valid(normals(x, y))) m.mean_normal += vec3(normals(x, y));  // filled pixels have none
+      for (int d = 1; d <= params.adjacency_radius; ++d) {
+        for (const auto& [qx, qy] : {std::pair{x + d, y}, std::pair{x, y + d}}) {
+          if (qx >= w || qy >= h) continue;
+          const Label o = labels(qx, qy);
+          if (o != kUnlabeled && o != l) {
+            adjacent[l - 1u].insert(o);
+            adjacent[o - 1u].insert(l);
+          }
+        }
+      }
+    }
+  }
+  const double horizontal_cos = cos_deg(params.horizontal_tolerance_deg);
+  const double vertical_sin = std::sin(params.vertical_tolerance_deg * std::numbers::pi / 180.0);
+  for (std::size_t r = 0; r < n_regions; ++r) {
+    RegionMeasurements& m = out[r];
+    m.id = static_cast<Label>(r + 1);
+    m.pixel_count = static_cast<int>(members[r].size());
+    m.centroid /= m.pixel_count;
+    m.mean_normal.normalize();
+    // Area: the parallelogram towards each pixel's right and lower neighbours of the region,
+    // projected on the mean normal (depth noise would inflate the raw parallelogram).
+    for (const int i : members[r]) {
+      const int x = i % w, y = i / w;
+      if (x + 1 < w && y + 1 < h && labels(x + 1, y) == m.id && labels(x, y + 1) == m.id) {
+        m.area += std::fabs((vec3(points(x + 1, y)) - vec3(points(x, y)))
+                                .cross(vec3(points(x, y + 1)) - vec3(points(x, y)))
+                                .dot(m.mean_normal));
+      }
+    }
+    m.neighbours.assign(adjacent[r].begin(), adjacent[r].end());
+    const double along_up = m.mean_normal.dot(up);
+    m.orientation = std::fabs(along_up) >= horizontal_cos ? RegionOrientation::horizontal
+                    : std::fabs(along_up) <= vertical_sin ? RegionOrientation::vertical
+                                                          : RegionOrientation::other;
+    {
+      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+      for (const int i : members[r]) {
+        const Eigen::Vector3d d = vec3(points.pixels()[static_cast<std::size_t>(i)]) - m.centroid;
+        scatter += d * d.transpose();
+      }
+      m.plane_normal =
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+      if (m.plane_normal.dot(m.mean_normal) < 0) m.plane_normal = -m.plane_normal;
+    }
+    // Horizontal axis: in the plane and horizontal for a vertical region; for others the major
+    // principal axis of the points projected onto the horizontal plane.
+    Eigen::Vector3d axis;
+    std::vector<double> heights, along;
+    heights.reserve(members[r].size());
+    along.reserve(members[r].size());
+    if (m.orientation == RegionOrientation::vertical) {
+      axis = up.cross(m.mean_normal).normalized();
+    } else {
+      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+      for (const int i : members[r]) {
+        Eigen::Vector3d d = vec3(points.pixels()[static_cast<std::size_t>(i)]) - m.centroid;
+        d -= d.dot(up) * up;
+        scatter += d * d.transpose();
+      }
+      axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
+    }
+    for (const int i : members[r]) {
+      const Eigen::Vector3d p = vec3(points.pixels()[static_cast<std::size_t>(i)]);
+      heights.push_back(p.dot(up));
+      along.push_back(p.dot(axis));
+    }
+    trimmed_extent(heights, params.trim_fraction, m.min_height, m.max_height);
+    double low = 0, high = 0;
+    m.width = trimmed_extent(along, params.trim_fraction, low, high);
+    // Where the region meets the image border or a pixel without a point, the surface may go on
+    // out of view: classify that spot by its height within the region.
+    const double band = std::max(0.1, 0.15 * m.height());
+    for (const int i : members[r]) {
+      const int x = i % w, y = i / w;
+      bool open = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      for (const auto& [qx, qy] :
+           {std::pair{x - 1, y}, std::pair{x + 1, y}, std::pair{x, y - 1}, std::pair{x, y + 1}}) {
+        open = open || (qx >= 0 && qy >= 0 && qx < w && qy < h && !is_valid(points(qx, qy)));
+      }
+      if (!open) continue;
+      const double height = vec3(points(x, y)).dot(up);
+      if (height >= m.max_height - band) m.cut_above = true;
+      if (height <= m.min_height + band) m.cut_below = true;
+      if (height > m.min_height + band && height < m.max_height - band) m.cut_sideways = true;
+    }
+  }
+  return out;
+}
+
+}  // namespace kartograf::semantic

@@ -1,0 +1,827 @@
+#include "kartograf/semantic/semantic_grid.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <deque>
+#include <numbers>
+#include <sstream>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+#include <opencv2/core.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/eval/connected_components.hpp"
+
+namespace kartograf::semantic {
+namespace {
+
+constexpr std::size_t index_of(SemanticClass c) {
+  return static_cast<std::size_t>(c);
+}
+
+// What the points say about one cell.
+struct CellEvidence {
+  int floor = 0;
+  std::array<int, kSemanticClassCount> band{};  // points in the robot's height band, per class
+  // Band points within the spill margin of each side: -x, +x, -y, +y.
+  std::array<int, 4> near_side{};
+  float z_min = std::numeric_limits<float>::infinity();
+  float z_max = -std::numeric_limits<float>::infinity();
+  int band_total() const {
+    int total = 0;
+    for (std::size_t c = 0; c < band.size(); ++c) {
+      if (c != index_of(SemanticClass::floor) && c != index_of(SemanticClass::ceiling))
+        total += band[c];
+    }
+    return total;
+  }
+};
+
+std::optional<double> median_z(std::span<const Eigen::Vector3d> points,
+                               std::span<const SemanticClass> labels, SemanticClass wanted) {
+  std::vector<double> z;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (labels[i] == wanted && points[i].allFinite()) z.push_back(points[i].z());
+  }
+  if (z.empty()) return std::nullopt;
+  std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
+  return z[z.size() / 2];
+}
+
+// Fills an object's metric description from its cells: centre, main axis and extent along it,
+// area, outline, height range.
+// A preferred axis (a wall's run direction) replaces the principal one when they differ by more
+// than 11.25 degrees: short thick blobs have no reliable principal axis.
+void describe_cells(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                    SemanticObject& object, bool keep_axis = false,
+                    const std::optional<Eigen::Vector2d>& preferred_axis = std::nullopt) {
+  const double res = grid.resolution;
+  Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+  for (const auto& c : object.cells) mean += grid.cell_center(c);
+  mean /= static_cast<double>(object.cells.size());
+  object.centre = mean;
+  object.area = static_cast<double>(object.cells.size()) * res * res;
+
+  if (!keep_axis) {
+    Eigen::Matrix2d cov = Eigen::Matrix2d::Zero();
+    for (const auto& c : object.cells) {
+      const Eigen::Vector2d d = grid.cell_center(c) - mean;
+      cov += d * d.transpose();
+    }
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(cov);
+    Eigen::Vector2d axis = eig.eigenvectors().col(1);
+    if (preferred_axis && std::fabs(axis.dot(*preferred_axis)) < std::cos(std::numbers::pi / 16))
+      axis = *preferred_axis;
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const auto& c : object.cells) {
+      const double t = axis.dot(grid.cell_center(c) - mean);
+      lo = std::min(lo, t), hi = std::max(hi, t);
+    }
+    object.axis_start = mean + (lo - 0.5 * res) * axis;
+    object.axis_end = mean + (hi + 0.5 * res) * axis;
+    object.width = (object.axis_end - object.axis_start).norm();
+  }
+
+  float z_min = std::numeric_limits<float>::infinity(), z_max = -z_min;
+  int col0 = grid.width(), row0 = grid.height(), col1 = -1, row1 = -1;
+  for (const auto& c : object.cells) {
+    z_min = std::min(z_min, evidence(c.x(), c.y()).z_min);
+    z_max = std::max(z_max, evidence(c.x(), c.y()).z_max);
+    col0 = std::min(col0, c.x()), col1 = std::max(col1, c.x());
+    row0 = std::min(row0, c.y()), row1 = std::max(row1, c.y());
+  }
+  if (std::isfinite(z_min)) object.z_min = z_min, object.z_max = z_max;
+
+  // Outline: the largest external contour of the cell mask (1-cell frame so it closes).
+  cv::Mat mask = cv::Mat::zeros(row1 - row0 + 3, col1 - col0 + 3, CV_8U);
+  for (const auto& c : object.cells)
+    mask.at<std::uint8_t>(c.y() - row0 + 1, c.x() - col0 + 1) = 255;
+  std::vector<std::vector<cv::Point>> contours;
+  cv::findContours(mask, contours, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  const auto largest = std::max_element(contours.begin(), contours.end(),
+                                        [](auto& a, auto& b) { return a.size() < b.size(); });
+  object.contour.clear();
+  if (largest != contours.end()) {
+    for (const cv::Point& p : *largest)
+      object.contour.push_back(grid.cell_center({p.x + col0 - 1, p.y + row0 - 1}));
+  }
+}
+
+// The cells of each connected component of `mask` (8-connected), in raster order.
+std::vector<std::vector<Eigen::Vector2i>> components(const Image<std::uint8_t>& mask) {
+  const LabelImage labels = eval::label_connected_components(mask, {eval::Connectivity::eight, 1});
+  std::vector<std::vector<Eigen::Vector2i>> out;
+  for (int row = 0; row < mask.height(); ++row) {
+    for (int col = 0; col < mask.width(); ++col) {
+      const Label l = labels(col, row);
+      if (!l) continue;
+      if (out.size() < l) out.resize(l);
+      out[l - 1].push_back({col, row});
+    }
+  }
+  return out;
+}
+
+// Direction bin (8 bins over 180 degrees) of each wall cell: the direction of the longest run of
+// wall cells through it, when that run is at least twice as long as the run across it; -1 where
+// no direction dominates (corners, specks). Runs, not a local covariance, so that thick and noisy
+// wall bands still read as lines.
+Image<int> wall_direction_bins(const Image<SemanticClass>& classes) {
+  constexpr int kBins = 8;
+  constexpr int kReach = 10;  // cells each way
+  constexpr int kMinRun = 7;  // cells
+  auto is_wall = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < classes.width() && y < classes.height() &&
+           classes(x, y) == SemanticClass::wall;
+  };
+  std::array<Eigen::Vector2d, kBins> directions;
+  for (int b = 0; b < kBins; ++b)
+    directions[b] = {std::cos(b * std::numbers::pi / kBins),
+                     -std::sin(b * std::numbers::pi / kBins)};
+  Image<int> bins(classes.width(), classes.height(), -1);
+  for (int row = 0; row < classes.height(); ++row) {
+    for (int col = 0; col < classes.width(); ++col) {
+      if (!is_wall(col, row)) continue;
+      std::array<int, kBins> runs{};
+      for (int b = 0; b < kBins; ++b) {
+        int run = 1;
+        for (const double sign : {-1.0, 1.0}) {
+          int misses = 0;
+          for (int t = 1; t <= kReach; ++t) {
+            const Eigen::Vector2d p = Eigen::Vector2d(col, row) + sign * t * directions[b];
+            if (is_wall(static_cast<int>(std::lround(p.x())),
+                        static_cast<int>(std::lround(p.y())))) {
+              ++run, misses = 0;
+            } else if (++misses > 1) {
+              break;  // one missing cell is noise, two end the run
+            }
+          }
+        }
+        runs[b] = run;
+      }
+      const int best = static_cast<int>(std::max_element(runs.begin(), runs.end()) - runs.begin());
+      if (runs[best] >= kMinRun && runs[best] >= 2 * runs[(best + kBins / 2) % kBins])
+        bins(col, row) = best;
+    }
+  }
+  return bins;
+}
+
+bool point_in_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon) {
+  bool inside = false;
+  for (std::size_t i = 0, j = polygon.size() - 1; i < polygon.size(); j = i++) {
+    const Eigen::Vector2d& a = polygon[i];
+    const Eigen::Vector2d& b = polygon[j];
+    if ((a.y() > p.y()) != (b.y() > p.y()) &&
+        p.x() < (b.x() - a.x()) * (p.y() - a.y()) / (b.y() - a.y()) + a.x())
+      inside = !inside;
+  }
+  return inside;
+}
+
+// An opening found between two collinear wall pieces: its two ends on the wall line.
+struct WallGap {
+  Eigen::Vector2d a, b;
+  int merged = 1;
+};
+
+// Doorways as gaps of door width in a wall line, with observed floor along the gap and no obstacle
+// across its middle. The two faces of a wall give one gap each; gaps whose centres are closer
+// than half the smallest door width merge.
+template <class AddObject>
+void add_gap_doorways(SemanticGrid& grid, const SemanticGridOptions& options,
+                      const std::vector<int>& wall_ids, int& doorway_count,
+                      AddObject&& add_object) {
+  const double res = grid.resolution;
+  auto floor_fraction = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+    const double length = (b - a).norm();
+    int passable = 0, total = 0;
+    for (double t = 2 * res; t <= length - 2 * res; t += 0.5 * res) {
+      const Eigen::Vector2i c = grid.cell_of(a + (b - a) * (t / length));
+      if (!grid.contains(c)) return 0.0;
+      ++total;
+      passable += grid.weight(c.x(), c.y()) > 0;
+    }
+    return total ? static_cast<double>(passable) / total : 0.0;
+  };
+  // From each end of each wall piece, walk on along its line: floor for a door's width, then wall
+  // again (any wall cell, within a cell of the line) is an opening.
+  auto is_wall = [&](const Eigen::Vector2d& p) {
+    const Eigen::Vector2i c = grid.cell_of(p);
+    return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::wall;
+  };
+  std::vector<WallGap> gaps;
+  for (const int id : wall_ids) {
+    const SemanticObject& wall = grid.objects[id - 1];
+    const Eigen::Vector2d u = (wall.axis_end - wall.axis_start).normalized();
+    const Eigen::Vector2d n(-u.y(), u.x());
+    const std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, 2> ends = {
+        std::pair{wall.axis_end, u}, std::pair{wall.axis_start, Eigen::Vector2d(-u)}};
+    for (const auto& [from, dir] : ends) {
+      // Leave this piece's own end (noisy, up to 0.3 m), cross the opening, meet wall again.
+      double open_from = -1, hit = -1;
+      for (double t = 0.5 * res; t <= 0.3 + options.max_door_width + res; t += 0.5 * res) {
+        const Eigen::Vector2d p = from + t * dir;
+        const Eigen::Vector2i c = grid.cell_of(p);
+        if (!grid.contains(c)) break;
+        const bool wall_here = is_wall(p) || is_wall(p + res * n) || is_wall(p - res * n);
+        if (open_from < 0) {
+          if (!wall_here)
+            open_from = t;
+          else if (t > 0.3)
+            break;
+          continue;
+        }
+        if (wall_here) {
+          if (t - open_from >= options.min_door_width && t - open_from <= options.max_door_width)
+            hit = t;
+          break;
+        }
+        if (grid.weight(c.x(), c.y()) == 0.0f) break;  // furniture or another obstacle
+      }
+      if (hit < 0) continue;
+      const WallGap gap{from + open_from * dir, from + hit * dir};
+      if (floor_fraction(gap.a, gap.b) < options.min_gap_floor_fraction) continue;
+      // One must be able to pass through: no obstacle across the gap's middle on either side.
+      bool passable = true;
+      const Eigen::Vector2d middle = 0.5 * (gap.a + gap.b);
+      for (double t = -options.door_passage_depth; t <= options.door_passage_depth; t += res) {
+        const Eigen::Vector2i c = grid.cell_of(middle + t * n);
+        passable &= grid.contains(c) && grid.weight(c.x(), c.y()) != 0.0f;
+      }
+      if (passable) gaps.push_back(gap);
+    }
+  }
+  // Merge the gaps of the two faces of one wall (orienting each like the first); merged gaps
+  // hold sums until divided below.
+  std::vector<WallGap> merged;
+  for (WallGap gap : gaps) {
+    auto same = std::find_if(merged.begin(), merged.end(), [&](const WallGap& m) {
+      const Eigen::Vector2d centre = 0.5 * (m.a + m.b) / m.merged;
+      return (centre - 0.5 * (gap.a + gap.b)).norm() < 0.5 * options.min_door_width;
+    });
+    if (same == merged.end()) {
+      merged.push_back(gap);
+      continue;
+    }
+    if ((same->a / same->merged - gap.a).norm() > (same->a / same->merged - gap.b).norm())
+      std::swap(gap.a, gap.b);
+    same->a += gap.a, same->b += gap.b, ++same->merged;
+  }
+  for (WallGap& gap : merged) {
+    gap.a /= gap.merged, gap.b /= gap.merged;
+    const Eigen::Vector2d centre = 0.5 * (gap.a + gap.b);
+    // Its cells: passable cells across the wall's thickness along the gap.
+    const double width = (gap.b - gap.a).norm();
+    const Eigen::Vector2d u = (gap.b - gap.a) / width, n(-u.y(), u.x());
+    const double across = 0.5 * options.max_wall_misalignment + res;
+    std::vector<Eigen::Vector2i> cells;
+    const Eigen::Vector2i c0 = grid.cell_of(centre);
+    const int reach = static_cast<int>(std::ceil((0.5 * width + across) / res)) + 1;
+    for (int dy = -reach; dy <= reach; ++dy) {
+      for (int dx = -reach; dx <= reach; ++dx) {
+        const Eigen::Vector2i c = c0 + Eigen::Vector2i(dx, dy);
+        if (!grid.contains(c) || !(grid.weight(c.x(), c.y()) > 0)) continue;
+        const Eigen::Vector2d d = grid.cell_center(c) - centre;
+        if (std::fabs(u.dot(d)) <= 0.5 * width && std::fabs(n.dot(d)) <= across) cells.push_back(c);
+      }
+    }
+    if (cells.empty()) continue;
+    for (const auto& c : cells) {
+      grid.classes(c.x(), c.y()) = SemanticClass::door;
+      grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::door);
+    }
+    SemanticObject& door =
+        add_object(ObjectKind::doorway, SemanticClass::door,
+                   "doorway " + std::to_string(++doorway_count), std::move(cells));
+    door.centre = centre, door.axis_start = gap.a, door.axis_end = gap.b, door.width = width;
+  }
+}
+
+// Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
+// piece, closed over gaps of a few cells, is filled to its convex hull when that is at most
+// max_area: the robot cannot drive under it within its height band.
+void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double max_area,
+                    float furniture_weight) {
+  const int w = grid.width(), h = grid.height();
+  cv::Mat mask(h, w, CV_8U);
+  for (int row = 0; row < h; ++row)
+    for (int col = 0; col < w; ++col)
+      mask.at<std::uint8_t>(row, col) = furniture(col, row) ? 255 : 0;
+  cv::Mat closed;
+  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  std::vector<std::vector<cv::Point>> pieces;
+  cv::findContours(closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  cv::Mat fill = cv::Mat::zeros(h, w, CV_8U);
+  const double cell_area = grid.resolution * grid.resolution;
+  for (const auto& piece : pieces) {
+    std::vector<cv::Point> hull;
+    cv::convexHull(piece, hull);
+    if (cv::contourArea(hull) * cell_area <= max_area) cv::fillConvexPoly(fill, hull, 255);
+  }
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      const SemanticClass c = grid.classes(col, row);
+      // Only floor and unobserved cells change: walls and doors keep their class.
+      if (!fill.at<std::uint8_t>(row, col) || furniture(col, row) ||
+          !(c == SemanticClass::floor || std::isnan(grid.weight(col, row))))
+        continue;
+      furniture(col, row) = 1;
+      grid.classes(col, row) = SemanticClass::furniture;
+      grid.weight(col, row) = furniture_weight;
+    }
+  }
+}
+
+// A surface on the boundary between two cells (the synthetic world's walls lie on the 5 cm
+// lattice) puts noisy points on both sides of it. The cell that sees floor and whose band points
+// hug the side facing an obstacle cell with less floor is free: the surface belongs to the other.
+void remove_spill(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                  const SemanticGridOptions& options, Image<std::uint8_t>& leaf,
+                  Image<std::uint8_t>& furniture) {
+  const std::array<Eigen::Vector2i, 4> sides = {Eigen::Vector2i(-1, 0), Eigen::Vector2i(1, 0),
+                                                Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)};
+  std::vector<Eigen::Vector2i> spilled;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const CellEvidence& e = evidence(col, row);
+      if (!(grid.weight(col, row) == 0.0f || leaf(col, row)) || e.floor < options.min_floor_points)
+        continue;
+      const int band = e.band_total();
+      for (int s = 0; s < 4; ++s) {
+        const Eigen::Vector2i n = Eigen::Vector2i(col, row) + sides[s];
+        if (!grid.contains(n) || evidence(n.x(), n.y()).floor >= e.floor) continue;
+        if (!(grid.weight(n.x(), n.y()) == 0.0f || leaf(n.x(), n.y()))) continue;
+        if (e.near_side[s] >= options.spill_fraction * band) {
+          spilled.push_back({col, row});
+          break;
+        }
+      }
+    }
+  }
+  for (const auto& c : spilled) {
+    grid.classes(c.x(), c.y()) = SemanticClass::floor;
+    grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::floor);
+    leaf(c.x(), c.y()) = 0, furniture(c.x(), c.y()) = 0;
+  }
+}
+
+bool is_obstacle(float weight_value) {
+  return weight_value == 0.0f;
+}
+
+// Obstacle cells with no obstacle among their 8 neighbours become what their floor evidence says.
+void remove_isolated_obstacles(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                               const SemanticGridOptions& options, Image<std::uint8_t>& leaf,
+                               Image<std::uint8_t>& furniture) {
+  std::vector<Eigen::Vector2i> specks;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      if (!is_obstacle(grid.weight(col, row)) && !leaf(col, row)) continue;
+      bool alone = true;
+      for (int dy = -1; dy <= 1 && alone; ++dy) {
+        for (int dx = -1; dx <= 1 && alone; ++dx) {
+          const Eigen::Vector2i n(col + dx, row + dy);
+          if ((dx || dy) && grid.contains(n) &&
+              (is_obstacle(grid.weight(n.x(), n.y())) || leaf(n.x(), n.y())))
+            alone = false;
+        }
+      }
+      if (alone) specks.push_back({col, row});
+    }
+  }
+  for (const auto& c : specks) {
+    const bool floor = evidence(c.x(), c.y()).floor >= options.min_floor_points;
+    grid.classes(c.x(), c.y()) = floor ? SemanticClass::floor : SemanticClass::unknown;
+    grid.weight(c.x(), c.y()) = floor ? options.weights.of(SemanticClass::floor) : kUnobserved;
+    leaf(c.x(), c.y()) = 0, furniture(c.x(), c.y()) = 0;
+  }
+}
+
+}  // namespace
+
+void TraversabilityWeights::validate() const {
+  for (std::size_t c = 0; c < by_class.size(); ++c) {
+    const float w = by_class[c];
+    require(std::isnan(w) || (w >= 0.0f && w <= 1.0f),
+            "TraversabilityWeights: weight of class " + std::string(kSemanticClassNames[c]) +
+                " must be in [0, 1] or NaN (unknown), got " + std::to_string(w));
+  }
+  require(unclassified_obstacle >= 0.0f && unclassified_obstacle <= 1.0f,
+          "TraversabilityWeights: unclassified_obstacle must be in [0, 1], got " +
+              std::to_string(unclassified_obstacle));
+}
+
+void SemanticGridOptions::validate() const {
+  auto positive = [](double v, const char* name) {
+    require(std::isfinite(v) && v > 0, std::string("SemanticGridOptions: ") + name +
+                                           " must be positive, got " + std::to_string(v));
+  };
+  positive(resolution, "resolution");
+  positive(floor_tolerance, "floor_tolerance");
+  positive(band_max, "band_max");
+  require(band_min >= 0 && band_min < band_max,
+          "SemanticGridOptions: need 0 <= band_min < band_max, got " + std::to_string(band_min) +
+              " and " + std::to_string(band_max));
+  require(min_obstacle_points >= 1 && min_floor_points >= 1,
+          "SemanticGridOptions: min_obstacle_points and min_floor_points must be >= 1");
+  require(margin >= 0, "SemanticGridOptions: margin must be >= 0");
+  require(min_door_width > 0 && min_door_width < max_door_width,
+          "SemanticGridOptions: need 0 < min_door_width < max_door_width");
+  weights.validate();
+}
+
+std::string_view to_string(ObjectKind kind) {
+  switch (kind) {
+    case ObjectKind::wall:
+      return "wall";
+    case ObjectKind::doorway:
+      return "doorway";
+    case ObjectKind::door_leaf:
+      return "door";
+    case ObjectKind::furniture:
+      return "furniture";
+    case ObjectKind::detection:
+      return "detection";
+  }
+  return "?";
+}
+
+const SemanticObject& SemanticGrid::object(int id) const {
+  require(id >= 1 && id <= static_cast<int>(objects.size()),
+          "SemanticGrid: no object " + std::to_string(id) + " (the map has " +
+              std::to_string(objects.size()) + ")");
+  return objects[static_cast<std::size_t>(id - 1)];
+}
+
+SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
+                                 std::span<const SemanticClass> labels,
+                                 const SemanticGridOptions& options,
+                                 std::span<const ObjectDetection> detections) {
+  options.validate();
+  require(points.size() == labels.size(), "build_semantic_grid: " + std::to_string(points.size()) +
+                                              " points but " + std::to_string(labels.size()) +
+                                              " labels");
+  for (const SemanticClass c : labels) {
+    require(static_cast<int>(c) < kSemanticClassCount, "build_semantic_grid: label value " +
+                                                           std::to_string(static_cast<int>(c)) +
+                                                           " is no SemanticClass");
+  }
+
+  SemanticGrid grid;
+  grid.resolution = options.resolution;
+  grid.weights = options.weights;
+  grid.floor_z =
+      options.floor_z.value_or(median_z(points, labels, SemanticClass::floor).value_or(0.0));
+  grid.ceiling_z =
+      options.ceiling_z ? options.ceiling_z : median_z(points, labels, SemanticClass::ceiling);
+
+  // Extent from the data, the origin on a multiple of the resolution (so grids of one world align).
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const auto& p : points) {
+    if (!p.allFinite()) continue;
+    lo = lo.cwiseMin(p.head<2>()), hi = hi.cwiseMax(p.head<2>());
+  }
+  require(std::isfinite(lo.x()),
+          "build_semantic_grid: no finite point among " + std::to_string(points.size()));
+  const double res = options.resolution;
+  grid.origin = ((lo.array() - options.margin) / res).floor() * res;
+  const Eigen::Vector2i size =
+      ((hi.array() + options.margin - grid.origin.array()) / res).ceil().cast<int>().max(1);
+  require(static_cast<double>(size.x()) * size.y() < 1e8,
+          "build_semantic_grid: the points span " + std::to_string(size.x()) + " x " +
+              std::to_string(size.y()) + " cells: too many (outliers far away?)");
+  grid.classes = Image<SemanticClass>(size.x(), size.y(), SemanticClass::unknown);
+  grid.weight = Image<float>(size.x(), size.y(), kUnobserved);
+  grid.cell_objects = Image<std::vector<int>>(size.x(), size.y());
+
+  // Evidence per cell.
+  Image<CellEvidence> evidence(size.x(), size.y());
+  const double below_ceiling = grid.ceiling_z
+                                   ? *grid.ceiling_z - grid.floor_z - options.ceiling_margin
+                                   : std::numeric_limits<double>::infinity();
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    if (!p.allFinite()) continue;
+    const Eigen::Vector2i cell = grid.cell_of(p.head<2>());
+    CellEvidence& e = evidence(cell.x(), cell.y());
+    const double h = p.z() - grid.floor_z;
+    const SemanticClass c = labels[i];
+    if (c == SemanticClass::floor) {
+      if (std::fabs(h) <= options.floor_tolerance) ++e.floor;
+      continue;  // a floor label far from the floor is a bad label, not an obstacle
+    }
+    if (c == SemanticClass::ceiling) continue;
+    if (h >= options.band_min && h <= options.band_max) {
+      ++e.band[index_of(c)];
+      const Eigen::Vector2d local =
+          p.head<2>() - grid.cell_center(cell) + Eigen::Vector2d::Constant(0.5 * res);
+      const double m = options.spill_margin;
+      e.near_side[0] += local.x()<m, e.near_side[1] += local.x()> res - m;
+      e.near_side[2] += local.y()<m, e.near_side[3] += local.y()> res - m;
+    }
+    if (h >= options.band_min && h < below_ceiling) {
+      e.z_min = std::min(e.z_min, static_cast<float>(p.z()));
+      e.z_max = std::max(e.z_max, static_cast<float>(p.z()));
+    }
+  }
+
+  // Cell classes.
+  Image<std::uint8_t> leaf(size.x(), size.y(), 0), furniture(size.x(), size.y(), 0);
+  for (int row = 0; row < size.y(); ++row) {
+    for (int col = 0; col < size.x(); ++col) {
+      const CellEvidence& e = evidence(col, row);
+      SemanticClass c = SemanticClass::unknown;
+      float w = kUnobserved;
+      const int band = e.band_total();
+      if (band >= options.min_obstacle_points &&
+          band >= options.min_obstacle_floor_ratio * e.floor) {
+        std::size_t best = 0;
+        for (std::size_t k = 0; k < e.band.size(); ++k) {
+          if (k == index_of(SemanticClass::floor) || k == index_of(SemanticClass::ceiling))
+            continue;
+          if (e.band[k] > e.band[best]) best = k;
+        }
+        c = static_cast<SemanticClass>(best);
+        w = c == SemanticClass::unknown ? options.weights.unclassified_obstacle
+                                        : options.weights.of(c);
+        leaf(col, row) = c == SemanticClass::door;
+        furniture(col, row) = c == SemanticClass::furniture;
+      } else if (e.floor >= options.min_floor_points) {
+        c = SemanticClass::floor;
+        w = options.weights.of(c);
+      }
+      grid.classes(col, row) = c;
+      grid.weight(col, row) = w;
+    }
+  }
+
+  if (options.spill_margin > 0) remove_spill(grid, evidence, options, leaf, furniture);
+  if (options.remove_isolated_obstacles)
+    remove_isolated_obstacles(grid, evidence, options, leaf, furniture);
+
+  auto add_object = [&](ObjectKind kind, SemanticClass label, const std::string& name,
+                        std::vector<Eigen::Vector2i> cells) -> SemanticObject& {
+    SemanticObject object;
+    object.id = static_cast<int>(grid.objects.size()) + 1;
+    object.kind = kind;
+    object.label = label;
+    object.name = name;
+    object.cells = std::move(cells);
+    describe_cells(grid, evidence, object);
+    grid.objects.push_back(std::move(object));
+    return grid.objects.back();
+  };
+
+  if (options.max_furniture_fill_area > 0)
+    fill_furniture(grid, furniture, options.max_furniture_fill_area,
+                   options.weights.of(SemanticClass::furniture));
+  int doorway_count = 0;
+  int leaf_count = 0;
+  for (auto& cells : components(leaf))
+    add_object(ObjectKind::door_leaf, SemanticClass::door, "door " + std::to_string(++leaf_count),
+               std::move(cells));
+  int furniture_count = 0;
+  for (auto& cells : components(furniture))
+    add_object(ObjectKind::furniture, SemanticClass::furniture,
+               "furniture " + std::to_string(++furniture_count), std::move(cells));
+
+  // Walls: straight pieces (cells of one direction, connected); corner cells join the nearest.
+  const Image<int> bins = wall_direction_bins(grid.classes);
+  Image<int> wall_id(size.x(), size.y(), 0);
+  int wall_count = 0;
+  std::vector<int> wall_ids;
+  for (int row = 0; row < size.y(); ++row) {
+    for (int col = 0; col < size.x(); ++col) {
+      const int bin = bins(col, row);
+      if (bin < 0 || wall_id(col, row)) continue;
+      std::vector<Eigen::Vector2i> cells{{col, row}};
+      wall_id(col, row) = -1;
+      for (std::size_t k = 0; k < cells.size(); ++k) {
+        for (int dy = -1; dy <= 1; ++dy) {
+          for (int dx = -1; dx <= 1; ++dx) {
+            const Eigen::Vector2i n = cells[k] + Eigen::Vector2i(dx, dy);
+            if (!grid.contains(n) || wall_id(n.x(), n.y()) || bins(n.x(), n.y()) != bin) continue;
+            wall_id(n.x(), n.y()) = -1;
+            cells.push_back(n);
+          }
+        }
+      }
+      const double angle = bin * std::numbers::pi / 8;
+      const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
+      SemanticObject candidate;
+      candidate.cells = cells;
+      describe_cells(grid, evidence, candidate, false, direction);
+      if (candidate.width < options.min_wall_length) {
+        for (const auto& c : cells) wall_id(c.x(), c.y()) = -2;  // a leftover
+        continue;
+      }
+      SemanticObject& wall = add_object(ObjectKind::wall, SemanticClass::wall,
+                                        "wall " + std::to_string(++wall_count), cells);
+      wall.centre = candidate.centre, wall.axis_start = candidate.axis_start;
+      wall.axis_end = candidate.axis_end, wall.width = candidate.width;
+      wall_ids.push_back(wall.id);
+      for (const auto& c : cells) wall_id(c.x(), c.y()) = wall.id;
+    }
+  }
+  // Leftover wall cells (corners, short pieces) join the wall with the most cells around them.
+  std::vector<std::vector<Eigen::Vector2i>> extra(grid.objects.size() + 1);
+  for (int row = 0; row < size.y(); ++row) {
+    for (int col = 0; col < size.x(); ++col) {
+      if (grid.classes(col, row) != SemanticClass::wall || wall_id(col, row) > 0) continue;
+      std::vector<int> votes(grid.objects.size() + 1, 0);
+      for (int dy = -4; dy <= 4; ++dy) {
+        for (int dx = -4; dx <= 4; ++dx) {
+          const Eigen::Vector2i n(col + dx, row + dy);
+          if (grid.contains(n) && wall_id(n.x(), n.y()) > 0) ++votes[wall_id(n.x(), n.y())];
+        }
+      }
+      const auto best = std::max_element(votes.begin(), votes.end());
+      if (*best > 0) extra[best - votes.begin()].push_back({col, row});
+    }
+  }
+  for (const int id : wall_ids) {
+    SemanticObject& wall = grid.objects[id - 1];
+    if (extra[id].empty()) continue;
+    wall.cells.insert(wall.cells.end(), extra[id].begin(), extra[id].end());
+    describe_cells(grid, evidence, wall, /*keep_axis=*/true);
+  }
+
+  add_gap_doorways(grid, options, wall_ids, doorway_count, add_object);
+
+  // Detections: their own objects on the cells whose centres their footprint covers.
+  for (std::size_t d = 0; d < detections.size(); ++d) {
+    const ObjectDetection& det = detections[d];
+    const std::string what = "build_semantic_grid: detection " + std::to_string(d) + " (" +
+                             (det.name.empty() ? std::string(to_string(det.label)) : det.name) +
+                             ")";
+    require(det.footprint.size() >= 3,
+            what + ": footprint needs >= 3 vertices, got " + std::to_string(det.footprint.size()));
+    require(!det.weight || (*det.weight >= 0.0f && *det.weight <= 1.0f),
+            what + ": weight must be in [0, 1]");
+    std::vector<Eigen::Vector2i> cells;
+    for (int row = 0; row < size.y(); ++row) {
+      for (int col = 0; col < size.x(); ++col) {
+        if (point_in_polygon(grid.cell_center({col, row}), det.footprint))
+          cells.push_back({col, row});
+      }
+    }
+    if (cells.empty()) continue;  // outside the map or smaller than a cell
+    const float w = det.weight.value_or(options.weights.of(det.label));
+    for (const auto& c : cells) {
+      if (det.label != SemanticClass::unknown) grid.classes(c.x(), c.y()) = det.label;
+      if (!std::isnan(w)) grid.weight(c.x(), c.y()) = w;
+    }
+    SemanticObject& object = add_object(
+        ObjectKind::detection, det.label,
+        det.name.empty() ? "detection " + std::to_string(d + 1) : det.name, std::move(cells));
+    object.z_min = det.z_min, object.z_max = det.z_max;
+    object.contour = det.footprint;
+  }
+
+  for (const SemanticObject& object : grid.objects) {
+    for (const auto& c : object.cells) grid.cell_objects(c.x(), c.y()).push_back(object.id);
+  }
+  return grid;
+}
+
+// ---- Exports ---------------------------------------------------------------------------------
+
+MapDescription describe(const SemanticGrid& grid) {
+  MapDescription d;
+  d.resolution = grid.resolution;
+  d.origin = grid.origin;
+  d.width = grid.width(), d.height = grid.height();
+  d.floor_z = grid.floor_z;
+  d.ceiling_z = grid.ceiling_z;
+  for (int c = 0; c < kSemanticClassCount; ++c)
+    d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
+  d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      if (std::isnan(grid.weight(col, row)))
+        ++d.unobserved_cells;
+      else
+        ++d.cells_per_class[index_of(grid.classes(col, row))];
+    }
+  }
+  for (const SemanticObject& o : grid.objects) {
+    d.objects.push_back({o.id, std::string(to_string(o.kind)), std::string(to_string(o.label)),
+                         o.name, o.contour, o.z_min, o.z_max, o.area, o.width, o.centre,
+                         o.axis_start, o.axis_end, static_cast<int>(o.cells.size())});
+  }
+  return d;
+}
+
+Rgb8 class_colour(SemanticClass c) {
+  switch (c) {
+    case SemanticClass::floor:
+      return {245, 245, 232};
+    case SemanticClass::wall:
+      return {25, 25, 25};
+    case SemanticClass::ceiling:
+      return {120, 180, 240};
+    case SemanticClass::door:
+      return {235, 140, 20};
+    case SemanticClass::furniture:
+      return {140, 70, 170};
+    case SemanticClass::unknown:
+      return {210, 40, 40};  // an unclassified obstacle
+  }
+  return {0, 0, 0};
+}
+
+MapPicture render_map(const SemanticGrid& grid, int pixels_per_cell) {
+  require(pixels_per_cell >= 1 && pixels_per_cell <= 32,
+          "render_map: pixels_per_cell must be in 1..32, got " + std::to_string(pixels_per_cell));
+  struct Entry {
+    Rgb8 colour;
+    std::string text;
+  };
+  auto weight_text = [](float w) {
+    if (std::isnan(w)) return std::string("unknown");
+    std::ostringstream s;
+    s.precision(2);
+    s << w;
+    return s.str();
+  };
+  const std::vector<SemanticClass> shown = {SemanticClass::floor, SemanticClass::door,
+                                            SemanticClass::wall, SemanticClass::furniture,
+                                            SemanticClass::unknown};
+  std::vector<Entry> legend;
+  for (const SemanticClass c : shown) {
+    const std::string name =
+        c == SemanticClass::unknown ? "other obstacle" : std::string(to_string(c));
+    const float w =
+        c == SemanticClass::unknown ? grid.weights.unclassified_obstacle : grid.weights.of(c);
+    legend.push_back({class_colour(c), name + "  w=" + weight_text(w)});
+  }
+  legend.push_back({kUnobservedColour, "unobserved"});
+
+  constexpr int kLine = 16;
+  const int map_w = grid.width() * pixels_per_cell, map_h = grid.height() * pixels_per_cell;
+  const int width = std::max(map_w, 190);
+  const int height = map_h + 6 + kLine * static_cast<int>(legend.size());
+  cv::Mat picture(height, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Rgb8 c = std::isnan(grid.weight(col, row)) ? kUnobservedColour
+                                                       : class_colour(grid.classes(col, row));
+      cv::rectangle(
+          picture,
+          cv::Rect(col * pixels_per_cell, row * pixels_per_cell, pixels_per_cell, pixels_per_cell),
+          cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+    }
+  }
+  for (std::size_t i = 0; i < legend.size(); ++i) {
+    const int y = map_h + 6 + kLine * static_cast<int>(i);
+    const Rgb8& c = legend[i].colour;
+    cv::rectangle(picture, cv::Rect(4, y, 12, 12), cv::Scalar(c[0], c[1], c[2]), cv::FILLED);
+    cv::rectangle(picture, cv::Rect(4, y, 12, 12), cv::Scalar(0, 0, 0), 1);
+    cv::putText(picture, legend[i].text, cv::Point(22, y + 11), cv::FONT_HERSHEY_SIMPLEX, 0.4,
+                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+
+  MapPicture out;
+  out.pixels_per_cell = pixels_per_cell;
+  out.map_width = grid.width(), out.map_height = grid.height();
+  out.image = RgbImage(width, height);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const cv::Vec3b& v = picture.at<cv::Vec3b>(y, x);
+      out.image(x, y) = {v[0], v[1], v[2]};  // the channels were drawn in RGB order
+    }
+  }
+  return out;
+}
+
+OccupancyGrid to_occupancy_grid(const SemanticGrid& grid) {
+  OccupancyGrid out;
+  out.resolution = grid.resolution;
+  out.origin = Eigen::Vector3d(grid.origin.x(), grid.origin.y(), 0.0);
+  out.cells = Image<CellState>(grid.width(), grid.height(), CellState::unknown);
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const float w = grid.weight(col, row);
+      if (!std::isnan(w)) out.cells(col, row) = w > 0 ? CellState::free : CellState::occupied;
+    }
+  }
+  return out;
+}
+
+Image<std::uint8_t> to_costmap(const SemanticGrid& grid) {
+  Image<std::uint8_t> out(grid.width(), grid.height(), 255);
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const float w = grid.weight(col, row);
+      if (!std::isnan(w)) out(col, row) = static_cast<std::uint8_t>(std::lround(254.0 * (1.0 - w)));
+    }
+  }
+  return out;
+}
+
+}  // namespace kartograf::semantic

@@ -1,0 +1,444 @@
+// The metric-semantic grid (method M2) and planning on it: a hand-made room with a door gives the
+// expected cells and objects; exports say what the cells hold; A* costs equal a brute-force
+// Dijkstra's; unreachable goals fail clearly; on the synthetic world (ground-truth labels, Kinect
+// noise) the traversable cells match the floor plan's free space and "go to the door" ends at a
+// true doorway without touching an obstacle.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <numbers>
+#include <queue>
+#include <random>
+#include <vector>
+
+#include "kartograf/semantic/planning.hpp"
+#include "kartograf/semantic/semantic_grid.hpp"
+#include "kartograf/synth/floor_plan.hpp"
+#include "kartograf/synth/render.hpp"
+#include "kartograf/synth/trajectory.hpp"
+#include "test_support.hpp"
+
+namespace kartograf::semantic {
+namespace {
+
+// ---- A hand-made room ------------------------------------------------------------------------
+// Room x in [0.012, 4.012], y in [0.012, 3.012] (off the 5 cm lattice, so no surface lies on a
+// cell boundary); a 0.9 m doorway in the north wall at x in [1.512, 2.412] opening onto a hall;
+// a cabinet 0.6 x 0.4 x 0.8 m.
+struct LabelledPoints {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<SemanticClass> labels;
+  void add(const Eigen::Vector3d& p, SemanticClass c) { points.push_back(p), labels.push_back(c); }
+  // Points every `step` on an axis-aligned rectangle of the plane (lo..hi, one coordinate fixed).
+  void box_face(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, SemanticClass c,
+                double step = 0.02) {
+    for (double x = lo.x(); x <= hi.x() + 1e-9; x += (hi.x() > lo.x() ? step : 1.0))
+      for (double y = lo.y(); y <= hi.y() + 1e-9; y += (hi.y() > lo.y() ? step : 1.0))
+        for (double z = lo.z(); z <= hi.z() + 1e-9; z += (hi.z() > lo.z() ? step : 1.0))
+          add({x, y, z}, c);
+  }
+};
+
+constexpr double kX0 = 0.012, kX1 = 4.012, kY0 = 0.012, kY1 = 3.012;
+constexpr double kDoorX0 = 1.512, kDoorX1 = 2.412, kHallY1 = 4.012, kHeight = 2.5;
+
+LabelledPoints room_with_door() {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({kX0, kY0, 0}, {kX1, kY1, 0}, C::floor);                // room floor
+  s.box_face({kX0, kY1 + 0.1, 0}, {kX1, kHallY1, 0}, C::floor);      // hall floor
+  s.box_face({kDoorX0, kY1, 0}, {kDoorX1, kY1 + 0.1, 0}, C::floor);  // doorway floor
+  s.box_face({kX0, kY0, kHeight}, {kX1, kY1, kHeight}, C::ceiling);
+  s.box_face({kX0, kY0, 0.02}, {kX0, kY1, kHeight}, C::wall);         // west
+  s.box_face({kX1, kY0, 0.02}, {kX1, kY1, kHeight}, C::wall);         // east
+  s.box_face({kX0, kY0, 0.02}, {kX1, kY0, kHeight}, C::wall);         // south
+  s.box_face({kX0, kY1, 0.02}, {kDoorX0, kY1, kHeight}, C::wall);     // north, left of the door
+  s.box_face({kDoorX1, kY1, 0.02}, {kX1, kY1, kHeight}, C::wall);     // north, right of the door
+  s.box_face({kDoorX0, kY1, 2.0}, {kDoorX1, kY1, kHeight}, C::wall);  // lintel
+  // Cabinet at x 0.512..1.112, y 0.512..0.912, 0.8 m high: top and sides.
+  s.box_face({0.512, 0.512, 0.8}, {1.112, 0.912, 0.8}, C::furniture);
+  s.box_face({0.512, 0.512, 0.02}, {1.112, 0.512, 0.8}, C::furniture);
+  s.box_face({0.512, 0.912, 0.02}, {1.112, 0.912, 0.8}, C::furniture);
+  s.box_face({0.512, 0.512, 0.02}, {0.512, 0.912, 0.8}, C::furniture);
+  s.box_face({1.112, 0.512, 0.02}, {1.112, 0.912, 0.8}, C::furniture);
+  return s;
+}
+
+class SemanticGridRoom : public ::testing::Test {
+ protected:
+  LabelledPoints scene = room_with_door();
+  SemanticGrid grid = build_semantic_grid(scene.points, scene.labels);
+
+  SemanticClass class_at(double x, double y) const {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return grid.classes(c.x(), c.y());
+  }
+  float weight_at(double x, double y) const {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return grid.weight(c.x(), c.y());
+  }
+  std::vector<const SemanticObject*> objects_of(ObjectKind kind) const {
+    std::vector<const SemanticObject*> out;
+    for (const auto& o : grid.objects)
+      if (o.kind == kind) out.push_back(&o);
+    return out;
+  }
+};
+
+TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
+  EXPECT_NEAR(grid.floor_z, 0.0, 1e-9);
+  ASSERT_TRUE(grid.ceiling_z.has_value());
+  EXPECT_NEAR(*grid.ceiling_z, kHeight, 1e-9);
+  EXPECT_EQ(grid.resolution, 0.05);
+  EXPECT_EQ(class_at(2.5, 1.5), SemanticClass::floor);
+  EXPECT_EQ(weight_at(2.5, 1.5), 1.0f);
+  EXPECT_EQ(class_at(kX0, 1.5), SemanticClass::wall);
+  EXPECT_EQ(weight_at(kX0, 1.5), 0.0f);
+  EXPECT_EQ(class_at(kX1, 1.5), SemanticClass::wall);
+  EXPECT_EQ(class_at(0.8, 0.7), SemanticClass::furniture);  // inside the cabinet, under its top
+  EXPECT_EQ(weight_at(0.8, 0.7), 0.0f);
+  EXPECT_EQ(class_at(1.962, kY1), SemanticClass::door);  // the doorway: slow, not blocked
+  EXPECT_FLOAT_EQ(weight_at(1.962, kY1), 0.7f);
+  EXPECT_TRUE(std::isnan(weight_at(kX1 + 0.2, 1.5)));  // outside: never observed
+  EXPECT_EQ(class_at(kX1 + 0.2, 1.5), SemanticClass::unknown);
+}
+
+TEST_F(SemanticGridRoom, DoorWallsAndFurnitureAreObjects) {
+  const auto doors = objects_of(ObjectKind::doorway);
+  ASSERT_EQ(doors.size(), 1u);
+  const SemanticObject& door = *doors[0];
+  EXPECT_EQ(door.label, SemanticClass::door);
+  EXPECT_NEAR(door.centre.x(), 0.5 * (kDoorX0 + kDoorX1), 0.06);
+  EXPECT_NEAR(door.centre.y(), kY1, 0.06);
+  EXPECT_NEAR(door.width, kDoorX1 - kDoorX0, 0.1);
+  // The cell at the door's centre lists the door.
+  const Eigen::Vector2i c = grid.cell_of(door.centre);
+  const auto& ids = grid.cell_objects(c.x(), c.y());
+  EXPECT_NE(std::find(ids.begin(), ids.end(), door.id), ids.end());
+
+  const auto walls = objects_of(ObjectKind::wall);
+  ASSERT_GE(walls.size(), 4u);
+  // The south wall: one straight piece of about the room's width along y = kY0.
+  const auto south = std::find_if(walls.begin(), walls.end(), [](const SemanticObject* w) {
+    return std::fabs(w->centre.y() - kY0) < 0.1 && w->width > 3.0;
+  });
+  ASSERT_NE(south, walls.end());
+  EXPECT_NEAR((*south)->width, kX1 - kX0, 0.2);
+  EXPECT_NEAR((*south)->z_min, 0.1, 0.03);  // the band starts 0.1 m above the floor
+  EXPECT_GT((*south)->z_max, 2.0);
+  EXPECT_FALSE((*south)->contour.empty());
+
+  const auto furniture = objects_of(ObjectKind::furniture);
+  ASSERT_EQ(furniture.size(), 1u);
+  EXPECT_NEAR(furniture[0]->area, 0.6 * 0.4, 0.12);
+  EXPECT_NEAR(furniture[0]->centre.x(), 0.812, 0.06);
+  EXPECT_NEAR(furniture[0]->centre.y(), 0.712, 0.06);
+  EXPECT_NEAR(furniture[0]->z_max, 0.8, 1e-6);
+}
+
+TEST_F(SemanticGridRoom, DetectionsAddObjectsAndWeights) {
+  ObjectDetection basin{SemanticClass::furniture,
+                        "washbasin",
+                        {{3.0, 1.0}, {3.5, 1.0}, {3.5, 1.4}, {3.0, 1.4}},
+                        0.6,
+                        0.9,
+                        0.0f};
+  const SemanticGrid with = build_semantic_grid(scene.points, scene.labels, {},
+                                                std::span<const ObjectDetection>(&basin, 1));
+  const SemanticObject& o = with.objects.back();
+  EXPECT_EQ(o.kind, ObjectKind::detection);
+  EXPECT_EQ(o.name, "washbasin");
+  EXPECT_EQ(o.cells.size(), 10u * 8u);
+  const Eigen::Vector2i c = with.cell_of({3.2, 1.2});
+  EXPECT_EQ(with.weight(c.x(), c.y()), 0.0f);
+  EXPECT_EQ(with.classes(c.x(), c.y()), SemanticClass::furniture);
+
+  ObjectDetection bad = basin;
+  bad.footprint.resize(2);
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(scene.points, scene.labels, {},
+                                            std::span<const ObjectDetection>(&bad, 1)),
+                        "washbasin", "footprint");
+}
+
+TEST_F(SemanticGridRoom, BadInputIsRejected) {
+  std::vector<SemanticClass> short_labels(scene.labels.begin(), scene.labels.end() - 1);
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(scene.points, short_labels), "points", "labels");
+  SemanticGridOptions options;
+  options.weights.by_class[static_cast<int>(SemanticClass::door)] = 1.5f;
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(scene.points, scene.labels, options), "door", "[0, 1]");
+  const std::vector<Eigen::Vector3d> none(3, Eigen::Vector3d::Constant(std::nan("")));
+  const std::vector<SemanticClass> none_labels(3, SemanticClass::floor);
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(none, none_labels), "no finite point");
+}
+
+TEST_F(SemanticGridRoom, ExportsDescribeTheCells) {
+  const MapDescription d = describe(grid);
+  EXPECT_EQ(d.width, grid.width());
+  EXPECT_EQ(d.objects.size(), grid.objects.size());
+  int cells = d.unobserved_cells;
+  for (const int n : d.cells_per_class) cells += n;
+  EXPECT_EQ(cells, grid.width() * grid.height());
+  EXPECT_EQ(d.objects[0].label, std::string(to_string(grid.objects[0].label)));
+
+  const OccupancyGrid occupancy = to_occupancy_grid(grid);
+  const Eigen::Vector2i floor = grid.cell_of({2.5, 1.5}), wall = grid.cell_of({kX0, 1.5}),
+                        outside = grid.cell_of({kX1 + 0.2, 1.5}), door = grid.cell_of({1.962, kY1});
+  EXPECT_EQ(occupancy.cells(floor.x(), floor.y()), CellState::free);
+  EXPECT_EQ(occupancy.cells(wall.x(), wall.y()), CellState::occupied);
+  EXPECT_EQ(occupancy.cells(outside.x(), outside.y()), CellState::unknown);
+  // Same cell geometry as the grid.
+  EXPECT_EQ(occupancy.cell_of({2.5, 1.5}), floor);
+
+  const Image<std::uint8_t> costs = to_costmap(grid);
+  EXPECT_EQ(costs(floor.x(), floor.y()), 0);
+  EXPECT_EQ(costs(wall.x(), wall.y()), 254);
+  EXPECT_EQ(costs(door.x(), door.y()), 76);  // round(254 * 0.3)
+  EXPECT_EQ(costs(outside.x(), outside.y()), 255);
+
+  MapPicture picture = render_map(grid, 2);
+  EXPECT_EQ(picture.map_width, grid.width());
+  EXPECT_GT(picture.image.height(), 2 * grid.height());  // the legend below the map
+  EXPECT_EQ(picture.image(2 * floor.x(), 2 * floor.y()), class_colour(SemanticClass::floor));
+  EXPECT_EQ(picture.image(2 * wall.x(), 2 * wall.y()), class_colour(SemanticClass::wall));
+  EXPECT_EQ(picture.image(2 * outside.x(), 2 * outside.y()), kUnobservedColour);
+
+  const PlannedPath path = plan_to_nearest_door(grid, {3.0, 1.5});
+  const Rgb8 blue{0, 110, 255};
+  draw_path(picture, path, blue);
+  const Eigen::Vector2i mid = path.cells[path.cells.size() / 2];
+  EXPECT_EQ(picture.image(2 * mid.x() + 1, 2 * mid.y() + 1), blue);
+}
+
+// ---- Planning --------------------------------------------------------------------------------
+
+// Reference: plain Dijkstra over the same graph (8 neighbours, entering a cell of weight w costs
+// step / w, weight 0 blocked, no diagonal step past a blocked cell).
+double dijkstra_cost(const Image<float>& weights, double resolution, Eigen::Vector2i start,
+                     Eigen::Vector2i goal) {
+  const int w = weights.width(), h = weights.height();
+  std::vector<double> dist(static_cast<std::size_t>(w * h),
+                           std::numeric_limits<double>::infinity());
+  using Entry = std::pair<double, int>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<>> queue;
+  dist[start.y() * w + start.x()] = 0;
+  queue.push({0.0, start.y() * w + start.x()});
+  auto open = [&](int x, int y) { return x >= 0 && y >= 0 && x < w && y < h && weights(x, y) > 0; };
+  while (!queue.empty()) {
+    const auto [d, i] = queue.top();
+    queue.pop();
+    if (d > dist[i]) continue;
+    const int x = i % w, y = i / w;
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        if ((!dx && !dy) || !open(x + dx, y + dy)) continue;
+        if (dx && dy && (!open(x + dx, y) || !open(x, y + dy))) continue;
+        const double step = std::hypot(dx, dy) * resolution / weights(x + dx, y + dy);
+        const int j = (y + dy) * w + x + dx;
+        if (d + step < dist[j]) dist[j] = d + step, queue.push({dist[j], j});
+      }
+    }
+  }
+  return dist[goal.y() * w + goal.x()];
+}
+
+TEST(SemanticPlanning, AStarCostsEqualBruteForceDijkstra) {
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> weight(0.2f, 1.0f);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  int reachable = 0, unreachable = 0;
+  for (int trial = 0; trial < 40; ++trial) {
+    Image<float> weights(31, 23);
+    for (float& v : weights.pixels()) v = unit(rng) < 0.3 ? 0.0f : weight(rng);
+    const Eigen::Vector2i start(static_cast<int>(rng() % 31), static_cast<int>(rng() % 23));
+    const Eigen::Vector2i goal(static_cast<int>(rng() % 31), static_cast<int>(rng() % 23));
+    weights(start.x(), start.y()) = 1.0f;
+    weights(goal.x(), goal.y()) = 1.0f;
+    const double expected = dijkstra_cost(weights, 0.05, start, goal);
+    auto run = [&] {
+      return plan_on_weights(
+          weights, 0.05, start, [&](const Eigen::Vector2i& c) { return c == goal; },
+          [&](const Eigen::Vector2i& c) { return (c - goal).cast<double>().norm() * 0.05; },
+          "trial " + std::to_string(trial));
+    };
+    if (std::isinf(expected)) {
+      ++unreachable;
+      EXPECT_ERROR_MENTIONS(run(), "goal unreachable", "trial " + std::to_string(trial));
+      continue;
+    }
+    ++reachable;
+    const PlannedPath path = run();
+    EXPECT_NEAR(path.cost, expected, 1e-9) << "trial " << trial;
+    ASSERT_FALSE(path.cells.empty());
+    EXPECT_EQ(path.cells.front(), start);
+    EXPECT_EQ(path.cells.back(), goal);
+    // The path's own cost, recomputed, is the reported one; every cell is passable.
+    double cost = 0;
+    for (std::size_t i = 1; i < path.cells.size(); ++i) {
+      const Eigen::Vector2i d = path.cells[i] - path.cells[i - 1];
+      ASSERT_LE(d.cwiseAbs().maxCoeff(), 1);
+      const float w = weights(path.cells[i].x(), path.cells[i].y());
+      ASSERT_GT(w, 0.0f);
+      cost += d.cast<double>().norm() * 0.05 / w;
+    }
+    EXPECT_NEAR(cost, path.cost, 1e-9);
+  }
+  EXPECT_GT(reachable, 10);  // both outcomes were exercised
+  EXPECT_GT(unreachable, 0);
+}
+
+TEST(SemanticPlanning, SlowCellsAreAvoidedWhenADetourIsCheaper) {
+  // A 0.3-weight band across the middle with a 1.0 gap at one end: crossing costs 1/0.3 per cell.
+  Image<float> weights(20, 9, 1.0f);
+  for (int y = 0; y < 9; ++y)
+    for (int x = 9; x <= 10; ++x) weights(x, y) = y == 0 ? 1.0f : 0.3f;
+  const Eigen::Vector2i start(0, 8), goal(19, 8);
+  const PlannedPath path = plan_on_weights(
+      weights, 1.0, start, [&](const Eigen::Vector2i& c) { return c == goal; },
+      [&](const Eigen::Vector2i& c) { return (c - goal).cast<double>().norm(); }, "band");
+  EXPECT_NEAR(path.cost, dijkstra_cost(weights, 1.0, start, goal), 1e-9);
+  EXPECT_LT(path.cost, 19 + 2 * (1 / 0.3 - 1));  // cheaper than straight through the band
+}
+
+TEST_F(SemanticGridRoom, UnreachableGoalsAndBlockedStartsFailClearly) {
+  // The hall beyond the door is reachable; a goal outside the building is not.
+  EXPECT_NO_THROW(plan_path(grid, {3.0, 1.5}, {2.0, 3.7}));
+  EXPECT_ERROR_MENTIONS(plan_path(grid, {3.0, 1.5}, {kX1 + 0.2, 1.5}), "goal unreachable",
+                        "(3.000, 1.500)");
+  EXPECT_ERROR_MENTIONS(plan_path(grid, {0.8, 0.7}, {3.0, 1.5}), "start", "obstacle");
+  EXPECT_ERROR_MENTIONS(plan_path(grid, {-5.0, 1.5}, {3.0, 1.5}), "start", "outside the map");
+  // A robot too wide for the 0.9 m door cannot reach the hall.
+  PlannerOptions wide;
+  wide.robot_radius = 0.5;
+  EXPECT_ERROR_MENTIONS(plan_path(grid, {2.0, 1.5}, {2.0, 3.75}, wide), "goal unreachable");
+  // ... nor come within 0.35 m of its centre once 0.6 m from the jambs.
+  wide.robot_radius = 0.6;
+  EXPECT_ERROR_MENTIONS(plan_to_nearest_door(grid, {2.0, 1.0}, {}, wide), "goal unreachable",
+                        "nearest door");
+}
+
+TEST_F(SemanticGridRoom, QueriesGoToTheDoorAndAlongTheWall) {
+  const PlannerOptions options;  // robot radius 0.2 m
+  const PlannedPath door_path = plan_to_nearest_door(grid, {3.0, 1.0}, {}, options);
+  const SemanticObject& door = grid.object(door_path.target_object);
+  EXPECT_EQ(door.kind, ObjectKind::doorway);
+  EXPECT_LE((door_path.points.back() - door.centre).norm(), 0.35 + 1e-9);
+  const Image<float> weights = planning_weights(grid, options);
+  for (const auto& c : door_path.cells) EXPECT_GT(weights(c.x(), c.y()), 0.0f);
+  EXPECT_NEAR(door_path.length, (door_path.points.back() - door_path.points.front()).norm(), 0.3);
+
+  // Along the south wall (the nearest), 0.5 m off it, to its far (east) end.
+  const PlannedPath wall_path = plan_along_nearest_wall(grid, {1.5, 0.8});
+  const SemanticObject& wall = grid.object(wall_path.target_object);
+  EXPECT_NEAR(wall.centre.y(), kY0, 0.1);
+  EXPECT_GT(wall_path.points.back().x(), kX1 - 1.0);
+  int on_line = 0;
+  for (const auto& p : wall_path.points) on_line += std::fabs(p.y() - (kY0 + 0.5)) <= 0.1;
+  EXPECT_GT(on_line, static_cast<int>(wall_path.points.size()) / 2);
+}
+
+// ---- The synthetic world ---------------------------------------------------------------------
+
+// 360-degree sweeps (12 headings, looking down at the floor and up at the lintels) at every
+// room's most open point and along the robot's tour, Kinect noise, ground-truth labels.
+class SemanticGridSynthetic : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    world_ = new synth::World(synth::make_building(5));
+    const Trajectory tour = synth::robot_tour(*world_, 300);
+    std::vector<Eigen::Vector3d> spots;
+    for (const auto& room : world_->rooms) {
+      const Eigen::Vector2d p = synth::most_open_point(*world_, room.id).first;
+      spots.emplace_back(p.x(), p.y(), 1.0);
+    }
+    for (int i = 0; i < 300; i += 25) spots.push_back(tour[i].pose.translation());
+    const PinholeIntrinsics k{160, 120, 131.25, 131.25, 79.5, 59.5};
+    std::vector<Eigen::Vector3d> points;
+    std::vector<SemanticClass> labels;
+    std::uint64_t frame_seed = 0;
+    for (const auto& spot : spots) {
+      for (int heading = 0; heading < 12; ++heading) {
+        for (const double pitch : {0.6, -0.2}) {
+          const Eigen::Isometry3d pose =
+              synth::camera_pose(spot, heading * std::numbers::pi / 6, pitch);
+          const synth::SyntheticFrame f =
+              synth::render(*world_, k, pose, synth::NoiseModel::kinect(), ++frame_seed);
+          for (int v = 0; v < k.height; ++v) {
+            for (int u = 0; u < k.width; ++u) {
+              if (!f.depth(u, v)) continue;
+              const double z = f.depth(u, v) / synth::kTumDepthUnitsPerMetre;
+              points.push_back(pose *
+                               Eigen::Vector3d((u - k.cx) / k.fx * z, (v - k.cy) / k.fy * z, z));
+              labels.push_back(f.semantic(u, v));
+            }
+          }
+        }
+      }
+    }
+    grid_ = new SemanticGrid(build_semantic_grid(points, labels));
+    starts_ = new std::vector<Eigen::Vector2d>;
+    for (int i = 0; i < 300; i += 50) starts_->push_back(tour[i].pose.translation().head<2>());
+  }
+  static void TearDownTestSuite() {
+    delete world_, delete grid_, delete starts_;
+    world_ = nullptr, grid_ = nullptr, starts_ = nullptr;
+  }
+  static synth::World* world_;
+  static SemanticGrid* grid_;
+  static std::vector<Eigen::Vector2d>* starts_;
+};
+synth::World* SemanticGridSynthetic::world_ = nullptr;
+SemanticGrid* SemanticGridSynthetic::grid_ = nullptr;
+std::vector<Eigen::Vector2d>* SemanticGridSynthetic::starts_ = nullptr;
+
+TEST_F(SemanticGridSynthetic, TraversableCellsMatchTheFloorPlansFreeSpace) {
+  const synth::FloorPlan plan = synth::make_floor_plan(*world_);
+  long both = 0, either = 0;
+  for (int row = 0; row < plan.grid.height(); ++row) {
+    for (int col = 0; col < plan.grid.width(); ++col) {
+      const bool truth = plan.grid.cells(col, row) == CellState::free;
+      const Eigen::Vector2i c = grid_->cell_of(plan.grid.cell_center(col, row));
+      const bool ours = grid_->contains(c) && grid_->weight(c.x(), c.y()) > 0;
+      both += truth && ours;
+      either += truth || ours;
+    }
+  }
+  const double iou = static_cast<double>(both) / static_cast<double>(either);
+  RecordProperty("free_space_iou", std::to_string(iou));
+  std::printf("free-space IoU vs the floor plan: %.4f\n", iou);
+  EXPECT_GE(iou, 0.9);  // the acceptance
+}
+
+TEST_F(SemanticGridSynthetic, EveryDoorwayIsFoundAndGoToTheDoorEndsAtOne) {
+  int doorways = 0;
+  for (const auto& o : grid_->objects) {
+    if (o.kind != ObjectKind::doorway) continue;
+    ++doorways;
+    double nearest = 1e9;
+    for (const auto& d : world_->doorways)
+      nearest = std::min(nearest, (d.opening.center() - o.centre).norm());
+    EXPECT_LT(nearest, 0.15) << o.name;  // no false doorway
+  }
+  EXPECT_EQ(doorways, static_cast<int>(world_->doorways.size()));
+
+  const synth::FloorPlan plan = synth::make_floor_plan(*world_);
+  for (const Eigen::Vector2d& start : *starts_) {
+    const PlannedPath path = plan_to_nearest_door(*grid_, start);
+    double end = 1e9;
+    for (const auto& d : world_->doorways)
+      end = std::min(end, (d.opening.center() - path.points.back()).norm());
+    EXPECT_LE(end, 0.5) << "from " << start.transpose();
+    std::printf("go to the door from (%.2f, %.2f): %.2f m, ends %.3f m from a true doorway\n",
+                start.x(), start.y(), path.length, end);
+    for (const auto& p : path.points) {  // collision-free in the true floor plan
+      const Eigen::Vector2i c = plan.grid.cell_of(p);
+      ASSERT_TRUE(plan.grid.contains(c));
+      EXPECT_EQ(plan.grid.cells(c.x(), c.y()), CellState::free) << "path point " << p.transpose();
+    }
+  }
+}
+
+}  // namespace
+}  // namespace kartograf::semantic

@@ -1,0 +1,241 @@
+// M2 labelling (kartograf::semantic): normals images, region growing, gravity from the data and
+// the rules, checked on hand-made inputs and on small synthetic frames and laser scans against the
+// world's exact labels (furniture and pixels without a point ignored).
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <numbers>
+
+#include "kartograf/eval/semantic_metrics.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/semantic/classify.hpp"
+#include "kartograf/synth/laser_scan.hpp"
+#include "kartograf/synth/ray_caster.hpp"
+#include "kartograf/synth/render.hpp"
+#include "kartograf/synth/trajectory.hpp"
+#include "test_support.hpp"
+
+namespace kartograf::semantic {
+namespace {
+
+constexpr double kDegree = std::numbers::pi / 180.0;
+
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) / kDegree;
+}
+
+// Ground truth as evaluated: furniture and pixels without a point are not scored.
+eval::SemanticScores score(const PointImage& points, SemanticImage truth,
+                           const SemanticImage& labels) {
+  for (std::size_t i = 0; i < truth.size(); ++i) {
+    if (!is_valid(points.pixels()[i]) || truth.pixels()[i] == SemanticClass::furniture) {
+      truth.pixels()[i] = SemanticClass::unknown;
+    }
+  }
+  return eval::evaluate_semantic_segmentation(truth, labels);
+}
+
+double iou(const eval::SemanticScores& s, SemanticClass c) {
+  return s.iou[static_cast<std::size_t>(c)].value_or(-1.0);
+}
+
+TEST(SemanticNormalsImage, EncodesAbsoluteSignedAndGrey) {
+  NormalImage normals(3, 1, invalid_point());
+  normals(0, 0) = Point4f(0, 0, -1, 0);
+  normals(1, 0) = Point4f(0.6f, -0.8f, 0, 0);
+  const RgbImage absolute = normals_to_rgb(normals, NormalEncoding::absolute);
+  const RgbImage signed_rgb = normals_to_rgb(normals, NormalEncoding::signed_);
+  EXPECT_EQ(absolute(0, 0), (Rgb8{0, 0, 255}));
+  EXPECT_EQ(absolute(1, 0), (Rgb8{153, 204, 0}));
+  EXPECT_EQ(absolute(2, 0), (Rgb8{0, 0, 0}));
+  EXPECT_EQ(signed_rgb(0, 0), (Rgb8{128, 128, 0}));   // (n + 1) / 2 * 255 = 127.5 rounds up
+  EXPECT_EQ(signed_rgb(1, 0), (Rgb8{204, 25, 128}));  // -0.8f is below -0.8: 25.49... rounds down
+  EXPECT_EQ(signed_rgb(2, 0), (Rgb8{0, 0, 0}));
+  const GrayImage grey = normals_rgb_to_gray(absolute);
+  EXPECT_EQ(grey(0, 0), 29);   // 0.114 * 255
+  EXPECT_EQ(grey(1, 0), 165);  // 0.299 * 153 + 0.587 * 204 = 165.495
+  EXPECT_EQ(grey(2, 0), 0);
+}
+
+TEST(SemanticRegions, SplitsAtCreasesAndRangeJumpsAndRejectsMismatchedSizes) {
+  // A floor (y = 1, camera y down) meeting a wall (z = 3), and a box face 0.5 m in front of it.
+  const PinholeIntrinsics k{80, 60, 60, 60, 39.5, 29.5};
+  PointImage points(k.width, k.height, invalid_point());
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const Eigen::Vector3d ray((u - k.cx) / k.fx, (v - k.cy) / k.fy, 1.0);
+      double t = 3.0;                                           // the wall
+      if (u >= 50 && u < 70 && v >= 10 && v < 30) t = 2.5;      // the box face
+      if (ray.y() > 0 && 1.0 / ray.y() < t) t = 1.0 / ray.y();  // the floor
+      const Eigen::Vector3f p = (t * ray).cast<float>();
+      points(u, v) = Point4f(p.x(), p.y(), p.z(), 1);
+    }
+  }
+  const compute::Context cpu = compute::Context::cpu();
+  NormalsImageParams normal_params;
+  normal_params.smoothing_radius = 1;
+  const NormalImage normals = estimate_organized_normals(cpu, points, normal_params);
+  RegionParams params;
+  params.min_region_pixels = 20;
+  const RegionSegmentation regions = segment_regions(points, normals, params);
+  const Label wall = regions.labels(10, 5), floor = regions.labels(40, 55),
+              box = regions.labels(60, 20);
+  EXPECT_NE(wall, kUnlabeled);
+  EXPECT_NE(floor, kUnlabeled);
+  EXPECT_NE(box, kUnlabeled);
+  EXPECT_NE(wall, floor);
+  EXPECT_NE(wall, box);
+  EXPECT_EQ(regions.labels(45, 5), wall);  // the wall on both sides of the box is one region
+  const auto measured = measure_regions(points, normals, regions, Eigen::Vector3d(0, -1, 0));
+  const RegionMeasurements& box_face = measured[box - 1u];
+  EXPECT_EQ(box_face.orientation, RegionOrientation::vertical);
+  EXPECT_NEAR(box_face.width, 20 * 2.5 / 60, 0.06);              // 20 pixels at 2.5 m
+  EXPECT_NEAR(box_face.area, std::pow(19 * 2.5 / 60, 2), 0.01);  // between the pixel centres
+  EXPECT_EQ(measured[floor - 1u].orientation, RegionOrientation::horizontal);
+  EXPECT_NEAR(measured[floor - 1u].centroid.y(), 1.0, 0.01);
+
+  EXPECT_ERROR_MENTIONS(segment_regions(points, NormalImage(3, 3), params), "segment_regions",
+                        "80x60", "3x3");
+}
+
+// Regions from hand-made measurements: a room rotated by `rotation`, the sensor 0.8 m above the
+// floor and 1.9 m below the ceiling.
+std::vector<RegionMeasurements> room_regions(const Eigen::Matrix3d& rotation) {
+  auto region = [&](Label id, Eigen::Vector3d normal, Eigen::Vector3d centroid, double area) {
+    RegionMeasurements r;
+    r.id = id;
+    r.mean_normal = r.plane_normal = rotation * normal;
+    r.centroid = rotation * centroid;
+    r.area = area;
+    return r;
+  };
+  return {region(1, {0, 0, 1}, {1, 0, -0.8}, 6.0), region(2, {0, 0, -1}, {1, 0, 1.9}, 5.0),
+          region(3, {-1, 0, 0}, {3, 0, 0.5}, 4.0), region(4, {0, -1, 0}, {1, 2, 0.5}, 3.0),
+          region(5, {0, 1, 0}, {1, -2, 0.5}, 3.0)};
+}
+
+TEST(SemanticGravity, FindsUpFloorAndCeilingInAnyFrame) {
+  for (int trial = 0; trial < 5; ++trial) {
+    const Eigen::Matrix3d rotation =
+        Eigen::AngleAxisd(0.9 * trial + 0.3, Eigen::Vector3d(1, -2, 0.5 + trial).normalized())
+            .toRotationMatrix();
+    const auto regions = room_regions(rotation);
+    const GravityEstimate g = estimate_gravity(regions);
+    EXPECT_LT(angle_deg(g.up, rotation * Eigen::Vector3d::UnitZ()), 1e-6) << "trial " << trial;
+    ASSERT_TRUE(g.floor_height && g.ceiling_height);
+    EXPECT_NEAR(*g.floor_height, -0.8, 1e-9);
+    EXPECT_NEAR(*g.ceiling_height, 1.9, 1e-9);
+    EXPECT_DOUBLE_EQ(g.support_area, 11.0);
+  }
+  // A corridor: the side walls outweigh floor and ceiling, so without a prior the wall axis wins;
+  // a camera prior (up within 45 degrees of -y) picks the floor's axis.
+  auto corridor = room_regions(Eigen::Matrix3d::Identity());
+  corridor[3].area = corridor[4].area = 8.0;
+  EXPECT_LT(angle_deg(estimate_gravity(corridor).up.cwiseAbs(), Eigen::Vector3d::UnitY()), 1e-6);
+  GravityParams prior;
+  prior.prior_up = Eigen::Vector3d(0.2, 0.1, 1.0);
+  EXPECT_LT(angle_deg(estimate_gravity(corridor, prior).up, Eigen::Vector3d::UnitZ()), 1e-6);
+  EXPECT_ERROR_MENTIONS(estimate_gravity(std::vector<RegionMeasurements>{}), "estimate_gravity",
+                        "no region");
+}
+
+TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
+  GravityEstimate gravity;
+  gravity.floor_height = -1.0;
+  gravity.ceiling_height = 1.6;
+  auto vertical = [](Label id, double x, double min_h, double max_h, double width) {
+    RegionMeasurements r;
+    r.id = id;
+    r.orientation = RegionOrientation::vertical;
+    r.mean_normal = r.plane_normal = Eigen::Vector3d(-1, 0, 0);
+    r.centroid = Eigen::Vector3d(x, 0, 0.5 * (min_h + max_h));
+    r.min_height = min_h;
+    r.max_height = max_h;
+    r.width = width;
+    return r;
+  };
+  std::vector<RegionMeasurements> regions = {
+      vertical(1, 3.0, -1.0, 1.6, 3.5),    // a whole wall
+      vertical(2, 2.95, -1.0, 1.0, 0.85),  // a leaf 5 cm in front of it, 2 m high
+      vertical(3, 3.0, -1.0, 1.0, 0.85),   // the same shape flush with the wall: no leaf
+      vertical(4, 1.5, -1.0, -0.2, 1.0),   // a cabinet front, 0.8 m high
+      vertical(5, 3.0, -0.4, 0.9, 0.7),    // a piece of wall seen through clutter, cut above/below
+  };
+  regions[0].neighbours = {2, 3, 5};
+  regions[1].neighbours = {1};
+  regions[2].neighbours = {1};
+  regions[4].neighbours = {1};
+  regions[4].cut_above = regions[4].cut_below = true;
+  const auto classes = classify_regions(regions, gravity);
+  EXPECT_EQ(classes[0], SemanticClass::wall);
+  EXPECT_EQ(classes[1], SemanticClass::door);
+  EXPECT_EQ(classes[2],
+            SemanticClass::wall);  // no leaf: a door-high piece next to a wall (jamb rule)
+  EXPECT_EQ(classes[3], SemanticClass::unknown);
+  EXPECT_EQ(classes[4], SemanticClass::wall);
+}
+
+class SemanticLabels : public testing::BackendTest {};
+
+// A synthetic frame from the robot tour (small image, no noise): floor and wall IoU >= 0.9,
+// gravity within 2 degrees; every backend gives the CPU's labels (normals agree to 1e-5).
+TEST_P(SemanticLabels, SyntheticFramesAndBackendsAgree) {
+  const synth::World world = synth::make_building(5);
+  const Trajectory tour = synth::robot_tour(world, 300);
+  const PinholeIntrinsics k{160, 120, 131.25, 131.25, 79.5, 59.5};
+  LabellingParams params;
+  params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);
+  params.normals.smoothing_radius = 2;
+  params.regions.min_region_pixels = 20;
+  const synth::SyntheticFrame frame =
+      synth::render(world, k, tour[69].pose, synth::NoiseModel::none(), 1);
+  const PointImage points = geometry::backproject(context(), frame.depth, k, {5000.0, 0.1, 10.0});
+  const SemanticLabelling on_device = label_organized_points(context(), points, params);
+  const SemanticLabelling on_cpu = label_organized_points(compute::Context::cpu(), points, params);
+  std::size_t differ = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    differ += on_device.semantic.pixels()[i] != on_cpu.semantic.pixels()[i];
+  }
+  EXPECT_LE(differ, points.size() / 200);
+  const auto s = score(points, frame.semantic, on_device.semantic);
+  EXPECT_GE(iou(s, SemanticClass::floor), 0.9);
+  EXPECT_GE(iou(s, SemanticClass::wall), 0.9);
+  EXPECT_LT(angle_deg(on_device.gravity.up,
+                      tour[69].pose.linear().transpose() * Eigen::Vector3d::UnitZ()),
+            2.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(Backends, SemanticLabels,
+                         ::testing::ValuesIn(::kartograf::testing::backends_under_test()),
+                         ::kartograf::testing::backend_test_name);
+
+// A laser scan with its points in an arbitrary frame: gravity recovered from the data, floor,
+// wall and ceiling labelled.
+TEST(SemanticLaserScan, ArbitraryFrame) {
+  const synth::World world = synth::make_building(5);
+  const synth::RayCaster caster(world);
+  synth::LaserScanOptions options;
+  options.columns = 181;  // 1 degree steps keep the test small
+  options.lines = 101;
+  options.threads = 2;
+  const synth::LaserScan scan =
+      synth::scan_laser(caster, synth::default_scan_pose(world), options, 3);
+  const Eigen::Matrix3f rotation =
+      Eigen::AngleAxisf(2.1f, Eigen::Vector3f(0.3f, -1.0f, 0.4f).normalized()).toRotationMatrix();
+  PointImage points = scan.points;
+  for (Point4f& p : points.pixels()) {
+    if (is_valid(p)) p.head<3>() = rotation * p.head<3>();
+  }
+  LabellingParams params;
+  params.normals.smoothing_radius = 2;
+  params.regions.min_region_pixels = 20;
+  const SemanticLabelling result = label_organized_points(compute::Context::cpu(), points, params);
+  EXPECT_LT(angle_deg(result.gravity.up, rotation.cast<double>() * Eigen::Vector3d::UnitZ()), 2.0);
+  const auto s = score(points, scan.semantic, result.semantic);
+  EXPECT_GE(iou(s, SemanticClass::floor), 0.9);
+  EXPECT_GE(iou(s, SemanticClass::ceiling), 0.9);
+  EXPECT_GE(iou(s, SemanticClass::wall), 0.8);
+}
+
+}  // namespace
+}  // namespace kartograf::semantic
