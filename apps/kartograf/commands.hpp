@@ -141,4 +141,15 @@ struct RoomsEvalOptions {
 CLI::App* add_rooms_eval_command(CLI::App& app, RoomsEvalOptions& options);
 int run_rooms_eval_command(const RoomsEvalOptions& options, std::ostream& out, std::ostream& err);
 
+// `semantic SCAN --out DIR [--goto door|wall]`: the metric-semantic grid map of an organized scan.
+struct SemanticOptions {
+  std::filesystem::path input, out_dir;
+  std::string goto_target;  // empty, "door" or "wall"
+  double resolution = 0.05;
+  std::string backend = "auto", backend_source = "default";
+  bool force = false;
+};
+CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& options);
+int run_semantic_command(const SemanticOptions& options, std::ostream& out);
+
 }  // namespace kartograf::cli

@@ -45,6 +45,8 @@ int main(int argc, char** argv) {
   CLI::App* rooms = kartograf::cli::add_rooms_command(app, rooms_options);
   kartograf::cli::RoomsEvalOptions rooms_eval_options;
   CLI::App* rooms_eval = kartograf::cli::add_rooms_eval_command(app, rooms_eval_options);
+  kartograf::cli::SemanticOptions semantic_options;
+  CLI::App* semantic = kartograf::cli::add_semantic_command(app, semantic_options);
 
   try {
     app.parse(argc, argv);
@@ -70,6 +72,7 @@ int main(int argc, char** argv) {
     if (*rooms_eval) {
       return kartograf::cli::run_rooms_eval_command(rooms_eval_options, std::cout, std::cerr);
     }
+    if (*semantic) return kartograf::cli::run_semantic_command(semantic_options, std::cout);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

@@ -150,6 +150,28 @@ PlannedPath plan_on_weights(const Image<float>& weights, double resolution,
               std::to_string(reached) + " cells reachable from it)");
 }
 
+std::optional<Eigen::Vector2d> nearest_passable_point(const SemanticGrid& grid,
+                                                      const Eigen::Vector2d& point,
+                                                      double max_distance,
+                                                      const PlannerOptions& options) {
+  require(std::isfinite(max_distance) && max_distance >= 0,
+          "nearest_passable_point: max_distance must be >= 0");
+  const Image<float> weights = planning_weights(grid, options);
+  const Eigen::Vector2i centre = grid.cell_of(point);
+  const int reach = static_cast<int>(std::ceil(max_distance / grid.resolution)) + 1;
+  std::optional<Eigen::Vector2d> best;
+  double best_distance = max_distance;
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const Eigen::Vector2i cell = centre + Eigen::Vector2i(dx, dy);
+      if (!grid.contains(cell) || !(weights(cell.x(), cell.y()) > 0)) continue;
+      const double distance = (grid.cell_center(cell) - point).norm();
+      if (distance <= best_distance) best_distance = distance, best = grid.cell_center(cell);
+    }
+  }
+  return best;
+}
+
 PlannedPath plan_path(const SemanticGrid& grid, const Eigen::Vector2d& start,
                       const Eigen::Vector2d& goal, const PlannerOptions& options) {
   const std::string what = "plan_path from " + format_xy(start) + " to " + format_xy(goal);

@@ -7,6 +7,7 @@
 // Failures throw kartograf::Error: a start outside the map or in a blocked cell, and
 // "goal unreachable: ..." when no passable path exists.
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -74,6 +75,14 @@ struct WallQueryOptions {
 PlannedPath plan_along_nearest_wall(const SemanticGrid& grid, const Eigen::Vector2d& start,
                                     const WallQueryOptions& query = {},
                                     const PlannerOptions& options = {});
+
+// The centre of the passable cell (after inflating by the robot radius) nearest to `point`
+// within `max_distance` [m]: where a robot standing on unobserved ground (a scanner cannot see the
+// floor beneath itself) starts planning. Empty when there is none.
+std::optional<Eigen::Vector2d> nearest_passable_point(const SemanticGrid& grid,
+                                                      const Eigen::Vector2d& point,
+                                                      double max_distance,
+                                                      const PlannerOptions& options = {});
 
 // Draws the path (cell centres joined by lines, a dot at each end) onto a picture made by
 // render_map.
