@@ -143,13 +143,15 @@ int run_rooms_eval_command(const RoomsEvalOptions& options, std::ostream& out, s
 
 // `semantic SCAN --out DIR [--goto door|wall]`: the metric-semantic grid map of an organized scan.
 struct SemanticOptions {
-  std::filesystem::path input, out_dir;
+  std::filesystem::path input, out_dir, trajectory;
+  std::size_t frames = 0;   // sequence: 0 = all
+  int step = 10;            // sequence: every k-th frame
   std::string goto_target;  // empty, "door" or "wall"
   double resolution = 0.05;
   std::string backend = "auto", backend_source = "default";
   bool force = false;
 };
 CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& options);
-int run_semantic_command(const SemanticOptions& options, std::ostream& out);
+int run_semantic_command(const SemanticOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace kartograf::cli

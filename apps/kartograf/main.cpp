@@ -72,7 +72,7 @@ int main(int argc, char** argv) {
     if (*rooms_eval) {
       return kartograf::cli::run_rooms_eval_command(rooms_eval_options, std::cout, std::cerr);
     }
-    if (*semantic) return kartograf::cli::run_semantic_command(semantic_options, std::cout);
+    if (*semantic) return kartograf::cli::run_semantic_command(semantic_options, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

@@ -1,8 +1,9 @@
-// `kartograf semantic SCAN --out DIR [--goto door|wall]`: the metric-semantic map of one organized
-// scan (methods.md M2): per-pixel labels (labels.png), the normals image (normals.png), the hybrid
-// grid (semantic.png with a legend, semantic.json), a ROS costmap and occupancy map, and a path to
-// the nearest door or along the nearest wall from the sensor. Wiring only: the method lives in
-// semantic/, the files in io/.
+// `kartograf semantic INPUT --out DIR [--goto door|wall]`: the metric-semantic map (methods.md M2)
+// of one organized scan (PCD) or of an RGB-D sequence folder with camera poses (its ground truth,
+// or --trajectory, e.g. a SLAM run's trajectory.txt): per-pixel labels and the normals image (of
+// the scan, or of a sequence's first labelled frame), the hybrid grid (semantic.png with a legend,
+// semantic.json), a ROS costmap and occupancy map, and a path to the nearest door or along the
+// nearest wall from the sensor. Wiring only: the method lives in semantic/, the files in io/.
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -17,10 +18,13 @@
 #include "commands.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/geometry/backproject.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/occupancy_map_io.hpp"
 #include "kartograf/io/pcd.hpp"
 #include "kartograf/io/semantic_map_io.hpp"
+#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/io/tum.hpp"
 #include "kartograf/semantic/classify.hpp"
 #include "kartograf/semantic/normals_image.hpp"
 #include "kartograf/semantic/planning.hpp"
@@ -39,26 +43,96 @@ constexpr std::initializer_list<const char*> kOutputs = {
     "labels.png",    "labels_color.png", "normals.png",   "semantic.png",
     "semantic.json", "costmap.yaml",     "occupancy.yaml"};
 
-// The labelled points turned so that the estimated gravity's up is +z (the grid's frame).
-struct GravityAlignedPoints {
+// Labelled points in a frame whose +z is up (the grid's), where the sensor stood, and the labels
+// and normals of one view for the pictures.
+struct LabelledPoints {
   std::vector<Eigen::Vector3d> points;
   std::vector<SemanticClass> labels;
-  Eigen::Matrix3d rotation = Eigen::Matrix3d::Identity();  // sensor frame -> grid frame
+  Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
+  semantic::SemanticLabelling view;
+  int views = 0, views_without_gravity = 0;
 };
 
-GravityAlignedPoints align_to_gravity(const PointImage& points,
-                                      const semantic::SemanticLabelling& labelling) {
-  GravityAlignedPoints aligned;
-  aligned.rotation =
-      Eigen::Quaterniond::FromTwoVectors(labelling.gravity.up, Eigen::Vector3d::UnitZ())
-          .toRotationMatrix();
+// Appends the valid points of a labelled view, moved by `to_world`.
+void append_view(const PointImage& points, const semantic::SemanticLabelling& labelling,
+                 const Eigen::Isometry3d& to_world, LabelledPoints& out) {
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Point4f& p = points.data()[i];
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
-    aligned.points.push_back(aligned.rotation * p.head<3>().cast<double>());
-    aligned.labels.push_back(labelling.semantic.data()[i]);
+    out.points.push_back(to_world * p.head<3>().cast<double>());
+    out.labels.push_back(labelling.semantic.data()[i]);
   }
-  return aligned;
+}
+
+// Turns every point (and the sensor) so that `up` becomes +z.
+void make_up_z(const Eigen::Vector3d& up, LabelledPoints& out) {
+  const Eigen::Matrix3d rotation =
+      Eigen::Quaterniond::FromTwoVectors(up.normalized(), Eigen::Vector3d::UnitZ())
+          .toRotationMatrix();
+  for (Eigen::Vector3d& p : out.points) p = rotation * p;
+  out.sensor = rotation * out.sensor;
+}
+
+LabelledPoints scan_points(const SemanticOptions& o, const compute::Context& context) {
+  const io::PcdCloud cloud = io::read_pcd(o.input);
+  require(cloud.organized(), "semantic: '" + o.input.string() +
+                                 "' is not organized (height 1): the labelling needs the "
+                                 "scan's pixel grid");
+  const PointImage points = cloud.to_point_image();
+  LabelledPoints out;
+  out.view = semantic::label_organized_points(context, points);
+  out.views = 1;
+  append_view(points, out.view, Eigen::Isometry3d::Identity(), out);
+  make_up_z(out.view.gravity.up, out);
+  return out;
+}
+
+// Every --step-th frame with a pose; up is the area-weighted mean of the views' estimated up
+// directions in the world frame (views that see no floor or ceiling cannot say and are left out).
+LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context& context,
+                               std::ostream& err) {
+  const io::OpenedSequence opened = io::open_sequence(o.input);
+  const io::Sequence& sequence = *opened.sequence;
+  std::optional<Trajectory> trajectory;
+  if (!o.trajectory.empty()) trajectory = io::read_tum_trajectory(o.trajectory);
+  const std::size_t count =
+      o.frames > 0 ? std::min<std::size_t>(o.frames, sequence.size()) : sequence.size();
+  semantic::LabellingParams params;
+  params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);  // a camera looking ahead: image up
+  geometry::DepthRange range;
+  range.units_per_metre = sequence.depth_units_per_metre();
+  LabelledPoints out;
+  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
+  bool first = true;
+  std::string first_failure;
+  for (std::size_t i = 0; i < count; i += static_cast<std::size_t>(o.step)) {
+    const io::RgbdFrame frame = sequence.frame(i);
+    std::optional<Eigen::Isometry3d> pose = frame.pose;
+    if (trajectory)
+      pose = i < trajectory->size() ? std::optional((*trajectory)[i].pose) : std::nullopt;
+    if (!pose) continue;
+    const PointImage points =
+        geometry::backproject(context, frame.depth, sequence.intrinsics(), range);
+    semantic::SemanticLabelling labelling;
+    try {
+      labelling = semantic::label_organized_points(context, points, params);
+    } catch (const Error& e) {
+      // e.g. a wall seen from close by: no floor or ceiling to find gravity
+      if (++out.views_without_gravity == 1) first_failure = e.what();
+      continue;
+    }
+    ++out.views;
+    up_sum += labelling.gravity.support_area * (pose->linear() * labelling.gravity.up);
+    append_view(points, labelling, *pose, out);
+    if (first) out.sensor = pose->translation(), out.view = std::move(labelling), first = false;
+  }
+  require(out.views > 0, "semantic: no frame of '" + o.input.string() + "' could be labelled" +
+                             (first_failure.empty() ? " (none has a pose)" : ": " + first_failure));
+  if (out.views_without_gravity > 0)
+    err << "semantic: " << out.views_without_gravity << " frames left out, e.g.: " << first_failure
+        << "\n";
+  make_up_z(up_sum, out);
+  return out;
 }
 
 // The class colours of the grid picture's legend, per pixel (black: no point).
@@ -74,10 +148,18 @@ RgbImage colour_labels(const SemanticImage& labels) {
 CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& o) {
   CLI::App* command = app.add_subcommand(
       "semantic",
-      "Metric-semantic grid map of an organized scan (PCD): floor, walls, ceiling, doors, "
-      "traversability, and a path (methods.md M2)");
-  command->add_option("SCAN", o.input, "Organized PCD: a 3-D laser scan or a depth camera frame")
+      "Metric-semantic grid map of an organized scan or an RGB-D sequence: floor, walls, "
+      "ceiling, doors, traversability, and a path (methods.md M2)");
+  command
+      ->add_option("INPUT", o.input,
+                   "Organized PCD (a 3-D laser scan or a depth frame), or an RGB-D sequence "
+                   "folder with poses (TUM, 7-Scenes, kartograf synth)")
       ->required();
+  command->add_option("--trajectory", o.trajectory,
+                      "Sequence: camera poses in TUM format, one per frame (e.g. a SLAM run's "
+                      "trajectory.txt; default: the ground truth)");
+  command->add_option("--frames", o.frames, "Sequence: only the first N frames (0: all)");
+  command->add_option("--step", o.step, "Sequence: every k-th frame")->capture_default_str();
   command->add_option("--out", o.out_dir, "Output folder")->required();
   command->add_option("--goto", o.goto_target, "Plan from the sensor: door | wall")
       ->check(CLI::IsMember({"door", "wall"}));
@@ -95,31 +177,28 @@ CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& o) {
   return command;
 }
 
-int run_semantic_command(const SemanticOptions& o, std::ostream& out) {
+int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostream& err) {
   require(std::isfinite(o.resolution) && o.resolution > 0,
           "semantic: --resolution must be > 0 m, got " + std::to_string(o.resolution));
+  require(o.step >= 1, "semantic: --step must be >= 1");
+  require(fs::exists(o.input), "semantic: " + o.input.string() + ": no such file or folder");
   check_output_folder("semantic", o.out_dir, kOutputs, o.force);
-  const io::PcdCloud cloud = io::read_pcd(o.input);
-  require(cloud.organized(), "semantic: '" + o.input.string() +
-                                 "' is not organized (height 1): the labelling needs the "
-                                 "scan's pixel grid");
-  const PointImage points = cloud.to_point_image();
-
   compute::ContextOptions context_options;
   context_options.backend = compute::parse_backend_choice(o.backend, o.backend_source);
   const compute::Context context(context_options);
-  const semantic::SemanticLabelling labelling = semantic::label_organized_points(context, points);
-  const GravityAlignedPoints aligned = align_to_gravity(points, labelling);
+  const LabelledPoints labelled =
+      fs::is_directory(o.input) ? sequence_points(o, context, err) : scan_points(o, context);
+  const semantic::SemanticLabelling& labelling = labelled.view;
   semantic::SemanticGridOptions grid_options;
   grid_options.resolution = o.resolution;
   const semantic::SemanticGrid grid =
-      semantic::build_semantic_grid(aligned.points, aligned.labels, grid_options);
+      semantic::build_semantic_grid(labelled.points, labelled.labels, grid_options);
 
   // Everything is computed (and the path planned) before the first file is written.
   semantic::MapPicture picture = semantic::render_map(grid);
   std::vector<io::NamedPath> paths;
   // A scanner does not see the floor beneath itself: plan from the nearest passable cell.
-  Eigen::Vector2d sensor = Eigen::Vector2d::Zero();
+  Eigen::Vector2d sensor = labelled.sensor.head<2>();
   if (!o.goto_target.empty()) {
     const std::optional<Eigen::Vector2d> start =
         semantic::nearest_passable_point(grid, sensor, kMaxStartDistance);
@@ -149,8 +228,8 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out) {
   std::map<std::string, int> kinds;
   for (const semantic::SemanticObject& object : grid.objects)
     ++kinds[std::string(semantic::to_string(object.kind))];
-  out << o.input.string() << ": " << grid.width() << "x" << grid.height() << " cells of "
-      << grid.resolution << " m;";
+  out << o.input.string() << ": " << labelled.views << " view(s), " << grid.width() << "x"
+      << grid.height() << " cells of " << grid.resolution << " m;";
   for (const auto& [kind, count] : kinds) out << " " << count << " " << kind;
   for (const io::NamedPath& p : paths)
     out << "; " << p.query << ": " << p.path.length << " m to object " << p.path.target_object;
