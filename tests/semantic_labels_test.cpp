@@ -139,6 +139,63 @@ TEST(SemanticGravity, FindsUpFloorAndCeilingInAnyFrame) {
                         "no region");
 }
 
+// A scanner that sees only upwards (the ceiling, no floor) or a camera that sees only the floor:
+// one side of the axis in view, its sign from the plane's distance (max_sensor_height).
+TEST(SemanticGravity, SignWithPlanesOnOneSideOnly) {
+  auto ceiling_only = room_regions(Eigen::Matrix3d::Identity());
+  ceiling_only.erase(ceiling_only.begin());  // no floor
+  ceiling_only[0].centroid.z() = 3.4;        // a high ceiling, 3.4 m above the sensor
+  ceiling_only[0].area = 8.0;                // larger than the walls facing one way
+  GravityEstimate g = estimate_gravity(ceiling_only);
+  EXPECT_LT(angle_deg(g.up, Eigen::Vector3d::UnitZ()), 1e-6);
+  EXPECT_FALSE(g.floor_height);
+  ASSERT_TRUE(g.ceiling_height);
+  EXPECT_NEAR(*g.ceiling_height, 3.4, 1e-9);
+  auto floor_only = room_regions(Eigen::Matrix3d::Identity());
+  floor_only.erase(floor_only.begin() + 1);  // no ceiling
+  g = estimate_gravity(floor_only);
+  EXPECT_LT(angle_deg(g.up, Eigen::Vector3d::UnitZ()), 1e-6);
+  EXPECT_TRUE(g.floor_height && !g.ceiling_height);
+}
+
+// Large walls far away outweigh a fragmented ceiling, but as "floor" or "ceiling" they would put
+// the sensor metres above a floor: the axis that makes a plausible room wins.
+TEST(SemanticGravity, PrefersAxisThatMakesAPlausibleRoom) {
+  auto hall = room_regions(Eigen::Matrix3d::Identity());
+  hall.erase(hall.begin());  // no floor in view; the ceiling 3 m up
+  hall[0].centroid.z() = 3.0;
+  hall[2].centroid.y() = 9.0;
+  hall[3].centroid.y() = -9.0;
+  hall[2].area = hall[3].area = 12.0;
+  const GravityEstimate g = estimate_gravity(hall);
+  EXPECT_LT(angle_deg(g.up, Eigen::Vector3d::UnitZ()), 1e-6);
+  GravityParams lenient;
+  lenient.max_sensor_height = lenient.max_ceiling_height = 20.0;
+  EXPECT_LT(angle_deg(estimate_gravity(hall, lenient).up.cwiseAbs(), Eigen::Vector3d::UnitY()),
+            1e-6);
+}
+
+// A pinhole frame (x/z, y/z linear in column and row) is a camera frame; a laser scan's equal
+// angle steps are not, nor are points behind the sensor.
+TEST(SemanticLabels, RecognisesCameraFrames) {
+  PointImage frame(40, 30), scan(40, 30);
+  for (int y = 0; y < 30; ++y) {
+    for (int x = 0; x < 40; ++x) {
+      const float z = 2.0f + 0.02f * static_cast<float>(x + y);  // a slanted plane
+      frame(x, y) = Point4f((x - 19.5f) / 50.0f * z, (y - 14.5f) / 50.0f * z, z, 0);
+      const double azimuth = (x - 19.5) * 2.0 * kDegree, elevation = (y - 14.5) * 2.0 * kDegree;
+      scan(x, y) = Point4f(static_cast<float>(3 * std::sin(azimuth) * std::cos(elevation)),
+                           static_cast<float>(3 * std::sin(elevation)),
+                           static_cast<float>(3 * std::cos(azimuth) * std::cos(elevation)), 0);
+    }
+  }
+  frame(3, 4) = invalid_point();
+  EXPECT_TRUE(is_camera_frame(frame));
+  EXPECT_FALSE(is_camera_frame(scan));
+  frame(5, 5).z() = -1.0f;
+  EXPECT_FALSE(is_camera_frame(frame));
+}
+
 TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
   GravityEstimate gravity;
   gravity.floor_height = -1.0;
@@ -173,6 +230,32 @@ TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
             SemanticClass::wall);  // no leaf: a door-high piece next to a wall (jamb rule)
   EXPECT_EQ(classes[3], SemanticClass::unknown);
   EXPECT_EQ(classes[4], SemanticClass::wall);
+
+  // Seen from the ceiling down to furniture that hides its foot: a wall; the same shape hidden
+  // below but ending at 1.2 m (a cabinet behind a chair) is not.
+  std::vector<RegionMeasurements> occluded = {vertical(1, 3.0, 0.2, 1.6, 1.5),
+                                              vertical(2, 2.0, 0.2, 1.2, 1.5)};
+  for (RegionMeasurements& r : occluded) r.occluded_below = r.occluded_sideways = true;
+  const auto occluded_classes = classify_regions(occluded, gravity);
+  EXPECT_EQ(occluded_classes[0], SemanticClass::wall);
+  EXPECT_EQ(occluded_classes[1], SemanticClass::unknown);
+  occluded[0].occluded_below = false;
+  EXPECT_EQ(classify_regions(occluded, gravity)[0], SemanticClass::unknown);
+
+  // Only a high ceiling in view (a scanner looking up): a wall from the sensor's height to it.
+  GravityEstimate high_ceiling;
+  high_ceiling.ceiling_height = 3.4;
+  std::vector<RegionMeasurements> scanner_wall = {vertical(1, 3.0, -0.05, 3.4, 3.0)};
+  EXPECT_EQ(classify_regions(scanner_wall, high_ceiling)[0], SemanticClass::wall);
+  // A lowered part of that high ceiling, 3.0 m up: above any lintel, so ceiling too.
+  RegionMeasurements lowered;
+  lowered.id = 1;
+  lowered.orientation = RegionOrientation::horizontal;
+  lowered.mean_normal = lowered.plane_normal = -Eigen::Vector3d::UnitZ();
+  lowered.centroid = Eigen::Vector3d(1, 0, 3.0);
+  EXPECT_EQ(classify_regions(std::vector{lowered}, high_ceiling)[0], SemanticClass::ceiling);
+  lowered.centroid.z() = 2.0;  // lintel height: not ceiling
+  EXPECT_EQ(classify_regions(std::vector{lowered}, high_ceiling)[0], SemanticClass::unknown);
 }
 
 class SemanticLabels : public testing::BackendTest {};

@@ -26,8 +26,13 @@ Levels room_levels(const GravityEstimate& gravity, const ClassificationParams& p
   if (levels.floor && levels.ceiling && *levels.ceiling - *levels.floor < params.door_min_height) {
     levels.ceiling.reset();  // a low "ceiling" (a table's underside seen from below) is no room
   }
-  if (levels.floor && !levels.ceiling) levels.ceiling = *levels.floor + params.assumed_room_height;
-  if (levels.ceiling && !levels.floor) levels.floor = *levels.ceiling - params.assumed_room_height;
+  // The sensor (height 0) stands between floor and ceiling, whatever the assumed room height.
+  if (levels.floor && !levels.ceiling) {
+    levels.ceiling = std::max(*levels.floor + params.assumed_room_height, 0.0);
+  }
+  if (levels.ceiling && !levels.floor) {
+    levels.floor = std::min(*levels.ceiling - params.assumed_room_height, 0.0);
+  }
   return levels;
 }
 
@@ -55,10 +60,15 @@ class RegionRules {
            levels_.floor &&
            std::fabs(r.centroid.dot(up_) - *levels_.floor) <= params_.floor_tolerance;
   }
+  // At the ceiling's height, or (a lowered part of a high ceiling) above any door's lintel.
   bool is_ceiling(const RegionMeasurements& r, const GravityEstimate& gravity) const {
-    return r.orientation == RegionOrientation::horizontal && r.mean_normal.dot(up_) < 0 &&
-           gravity.ceiling_height &&
-           std::fabs(r.centroid.dot(up_) - *gravity.ceiling_height) <= params_.ceiling_tolerance;
+    if (r.orientation != RegionOrientation::horizontal || r.mean_normal.dot(up_) >= 0 ||
+        !gravity.ceiling_height) {
+      return false;
+    }
+    const double height = r.centroid.dot(up_);
+    return std::fabs(height - *gravity.ceiling_height) <= params_.ceiling_tolerance ||
+           height_above_floor(height) >= params_.door_max_height + params_.reach_tolerance;
   }
 
   // The paper's height test, or the view explains why the visible part falls short.
@@ -68,6 +78,11 @@ class RegionRules {
       return true;
     }
     return (reaches_floor(r) || r.cut_below) && (reaches_ceiling(r) || r.cut_above);
+  }
+  // Seen from the ceiling down to where a nearer surface hides it (furniture in front of a wall,
+  // or a scanner whose view starts at its own height).
+  bool ceiling_high(const RegionMeasurements& r) const {
+    return reaches_ceiling(r) && (reaches_floor(r) || r.cut_below || r.occluded_below);
   }
 
   // Door-sized where seen; an end out of view (cut by the image or an occluder) is not held
@@ -126,7 +141,37 @@ class RegionRules {
   Levels levels_;
 };
 
+// Least-squares residual (rms) of t ~ a * index + b, relative to the spread of t.
+double relative_line_residual(const std::vector<double>& index, const std::vector<double>& t) {
+  const auto n = static_cast<double>(t.size());
+  double si = 0, st = 0, sii = 0, sit = 0, stt = 0;
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    si += index[k], st += t[k], sii += index[k] * index[k], sit += index[k] * t[k];
+    stt += t[k] * t[k];
+  }
+  const double var_i = sii / n - (si / n) * (si / n), var_t = stt / n - (st / n) * (st / n);
+  if (var_i <= 0 || var_t <= 0) return 1.0;
+  const double cov = sit / n - (si / n) * (st / n);
+  return std::sqrt(std::max(0.0, var_t - cov * cov / var_i) / var_t);
+}
+
 }  // namespace
+
+bool is_camera_frame(const PointImage& points) {
+  std::vector<double> columns, rows, u, v;
+  for (int y = 0; y < points.height(); ++y) {
+    for (int x = 0; x < points.width(); ++x) {
+      const Point4f& p = points(x, y);
+      if (!is_valid(p)) continue;
+      if (p.z() <= 0) return false;  // a camera sees only in front of it
+      columns.push_back(x), rows.push_back(y);
+      u.push_back(p.x() / p.z()), v.push_back(p.y() / p.z());
+    }
+  }
+  constexpr double kMaxResidual = 0.01;  // a scan's angles are far from linear in tan
+  return columns.size() >= 3 && relative_line_residual(columns, u) <= kMaxResidual &&
+         relative_line_residual(rows, v) <= kMaxResidual;
+}
 
 std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> regions,
                                             const GravityEstimate& gravity,
@@ -141,10 +186,15 @@ std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> 
   // the neighbour), until nothing changes.
   auto candidate = [&](std::size_t i) {
     return classes[i] == SemanticClass::unknown &&
-           regions[i].orientation == RegionOrientation::vertical && rules.wall_height(regions[i]);
+           regions[i].orientation == RegionOrientation::vertical &&
+           (rules.wall_height(regions[i]) || rules.ceiling_high(regions[i]));
+  };
+  auto wide = [&](const RegionMeasurements& r) {
+    return r.width >= params.wall_min_width || r.cut_sideways ||
+           (r.occluded_sideways && rules.ceiling_high(r));
   };
   for (std::size_t i = 0; i < regions.size(); ++i) {
-    if (candidate(i) && (regions[i].width >= params.wall_min_width || regions[i].cut_sideways)) {
+    if (candidate(i) && wide(regions[i])) {
       classes[i] = SemanticClass::wall;
     }
   }
@@ -193,10 +243,14 @@ SemanticLabelling label_organized_points(const compute::Context& context, const 
       split_offset_layers(smoothed, out.normals, out.regions, params.layers);
   const auto provisional =
       measure_regions(points, out.normals, out.regions, Eigen::Vector3d::UnitZ(), params.measure);
-  out.gravity = estimate_gravity(provisional, params.gravity);
+  GravityParams gravity_params = params.gravity;
+  if (!gravity_params.prior_up && is_camera_frame(points)) {
+    gravity_params.prior_up = Eigen::Vector3d(0, -1, 0);  // optical frame: y points down
+  }
+  out.gravity = estimate_gravity(provisional, gravity_params);
   out.measurements =
       measure_regions(points, out.normals, out.regions, out.gravity.up, params.measure);
-  find_floor_and_ceiling(out.measurements, params.gravity, out.gravity);
+  find_floor_and_ceiling(out.measurements, gravity_params, out.gravity);
   out.region_classes = classify_regions(out.measurements, out.gravity, params.classes);
   // A layer that the rules do not recognise (no door leaf) is part of the surface it was split
   // from: offsets that large also come from smoothing at creases and from long grazing views.

@@ -277,6 +277,8 @@ std::vector<RegionMeasurements> measure_regions(const PointImage& points,
   require(std::fabs(up.norm() - 1.0) < 1e-6, "measure_regions: up must be a unit vector");
   require(params.trim_fraction >= 0 && params.trim_fraction < 0.5,
           "measure_regions: trim_fraction must be in [0, 0.5)");
+  require(params.occluder_relative_range >= 0 && params.occluder_relative_range < 1,
+          "measure_regions: occluder_relative_range must be in [0, 1)");
   const auto n_regions = static_cast<std::size_t>(regions.region_count);
   std::vector<RegionMeasurements> out(n_regions);
   std::vector<std::vector<int>> members(n_regions);
@@ -365,16 +367,27 @@ std::vector<RegionMeasurements> measure_regions(const PointImage& points,
     const double band = std::max(0.1, 0.15 * m.height());
     for (const int i : members[r]) {
       const int x = i % w, y = i / w;
-      bool open = x == 0 || y == 0 || x == w - 1 || y == h - 1;
+      bool open = x == 0 || y == 0 || x == w - 1 || y == h - 1, occluded = false;
+      const double range = vec3(points(x, y)).norm();
       for (const auto& [qx, qy] :
            {std::pair{x - 1, y}, std::pair{x + 1, y}, std::pair{x, y - 1}, std::pair{x, y + 1}}) {
-        open = open || (qx >= 0 && qy >= 0 && qx < w && qy < h && !is_valid(points(qx, qy)));
+        if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+        const Point4f& q = points(qx, qy);
+        open = open || !is_valid(q);
+        const bool nearer = q.head<3>().norm() < (1.0 - params.occluder_relative_range) * range;
+        occluded = occluded || (is_valid(q) && labels(qx, qy) != m.id && nearer);
       }
-      if (!open) continue;
+      if (!open && !occluded) continue;
       const double height = vec3(points(x, y)).dot(up);
-      if (height >= m.max_height - band) m.cut_above = true;
-      if (height <= m.min_height + band) m.cut_below = true;
-      if (height > m.min_height + band && height < m.max_height - band) m.cut_sideways = true;
+      const bool top = height >= m.max_height - band, bottom = height <= m.min_height + band;
+      if (open) {
+        m.cut_above = m.cut_above || top;
+        m.cut_below = m.cut_below || bottom;
+        m.cut_sideways = m.cut_sideways || (!top && !bottom);
+      } else {
+        m.occluded_below = m.occluded_below || bottom;
+        m.occluded_sideways = m.occluded_sideways || (!top && !bottom);
+      }
     }
   }
   return out;

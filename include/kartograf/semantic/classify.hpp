@@ -5,7 +5,8 @@
 // Rules (defaults are the paper's values where it gives them):
 //  - floor: horizontal, facing up, within floor_tolerance of the floor height (the lowest large
 //    horizontal region, gravity.hpp); several regions may be floor (furniture splits it);
-//  - ceiling: horizontal, facing down, within ceiling_tolerance of the ceiling height;
+//  - ceiling: horizontal, facing down, within ceiling_tolerance of the ceiling height, or higher
+//    than door_max_height + reach_tolerance above the floor (a lowered part of a high ceiling);
 //  - door: vertical, width in [door_min_width, door_max_width], reaching the floor (or cut below by
 //    the view), its top at door_min_height..door_max_height above the floor (or cut above by the
 //    view and at most door_max_height), at least half door_min_height of it in view, and next to
@@ -16,9 +17,12 @@
 //  - wall: vertical and, as in the paper, height >= wall_height_fraction x (ceiling - floor) and
 //    width >= wall_min_width. Frames see parts of walls, so each test also passes when the view
 //    explains its failure: the height test when the region reaches (or is cut by the view near)
-//    both the floor and the ceiling level, the width test when the region is cut sideways by the
-//    view or is adjacent to another wall. Without a ceiling in view the room height is
-//    assumed_room_height above the floor; without a floor, below the ceiling. A vertical region
+//    both the floor and the ceiling level, or reaches the ceiling and is hidden below by a nearer
+//    surface (occluded_below: furniture, or a scanner whose view starts at its own height); the
+//    width test when the region is cut sideways by the view, is adjacent to another wall, or
+//    (reaching the ceiling) is hidden sideways by a nearer surface. Without a ceiling in view the
+//    room height is assumed_room_height above the floor; without a floor, below the ceiling - but
+//    the sensor (height 0) always lies between the two. A vertical region
 //    next to a wall and reaching above door_min_height is a wall too (door jambs, wall pieces
 //    between doors);
 //  - a horizontal region facing down below the ceiling and adjacent to a wall (a lintel's
@@ -77,9 +81,15 @@ struct SemanticLabelling {
   SemanticImage semantic;
 };
 
+// Whether the points are a camera frame in the optical convention (x right, y down, z ahead):
+// every point in front (z > 0) and x/z, y/z linear in column and row (a pinhole projection; a
+// laser scan's equal angle steps are not).
+bool is_camera_frame(const PointImage& points);
+
 // The whole of M2 steps 1-3 on one organized point image (sensor at the origin): smoothing,
 // normals, region growing, layer splitting (on the smoothed points), gravity, measurements,
 // classification; a split-off layer the rules leave unknown takes the class of its parent.
+// Without a gravity prior, a camera frame (is_camera_frame) gets up = -y: an upright camera.
 SemanticLabelling label_organized_points(const compute::Context& context, const PointImage& points,
                                          const LabellingParams& params = {});
 

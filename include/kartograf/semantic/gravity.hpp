@@ -11,12 +11,18 @@
 //     planes, while walls split over two or more directions). With a prior (an RGB-D camera: up is
 //     roughly -y), only axes within prior_tolerance_deg of the prior's line are candidates. The
 //     best axis is refined as the area-weighted mean of its supporting normals (signs aligned).
+//     Axes whose farthest planes (step 2) make no plausible room around the sensor (floor more
+//     than max_sensor_height below, ceiling more than max_ceiling_height above) rank after all
+//     plausible ones: large walls (a corridor, a scanner that sees little ceiling) then lose.
 //  2. Sign. Normals face the sensor, so the supporting regions facing +axis lie below the sensor
 //     and those facing -axis above it. With a prior its sign decides. Otherwise the floor is taken
-//     to be the nearer of the two extreme planes (a robot's or tripod's sensor sits below half the
-//     room height): up points away from the nearest large supporting region, i.e. along its normal.
+//     to be the nearer of the two extreme planes, the farthest on each side (a robot's or tripod's
+//     sensor sits below half the room height). When all face one way (a scanner that sees only
+//     the ceiling, a camera that sees only the floor), they are the floor if the farthest is within
+//     max_sensor_height of the sensor, else the ceiling.
 //  3. Floor = the lowest large horizontal region facing up, ceiling = the highest large horizontal
-//     region facing down (heights p . up, relative to the sensor); either may be absent from view.
+//     region facing down (heights p . up, relative to the sensor), the floor below the sensor
+//     (height < 0) and the ceiling above it; either may be absent from view.
 #include <optional>
 #include <span>
 
@@ -31,6 +37,12 @@ struct GravityParams {
   double axis_tolerance_deg = 10.0;
   std::optional<Eigen::Vector3d> prior_up;  // e.g. (0, -1, 0) for a camera looking ahead
   double prior_tolerance_deg = 45.0;
+  // Without a prior and with planes on one side only: farther than this from the sensor they are a
+  // ceiling, not a floor (sensors on robots and tripods sit lower).
+  double max_sensor_height = 2.0;  // m
+  // Axes that put the floor farther than max_sensor_height below the sensor or the ceiling
+  // farther than this above it lose to any axis that does not (a wall is no floor or ceiling).
+  double max_ceiling_height = 6.0;  // m
 };
 
 struct GravityEstimate {

@@ -88,6 +88,9 @@ struct RegionMeasurements {
   // The region touches the image border or a pixel without a point: part of the surface may be
   // out of view (above, below, or beside the visible part).
   bool cut_above = false, cut_below = false, cut_sideways = false;
+  // The region borders a nearer surface (occluder_relative_range x range nearer: furniture in
+  // front of a wall) at its bottom or side: it may go on behind it.
+  bool occluded_below = false, occluded_sideways = false;
   std::vector<Label> neighbours;  // regions within adjacency_radius pixels, ascending
 
   double height() const { return max_height - min_height; }
@@ -98,6 +101,7 @@ struct MeasureParams {
   double vertical_tolerance_deg = 15.0;    // normal within this of perpendicular to up: vertical
   double trim_fraction = 0.01;             // extremes ignore this fraction of points at each end
   int adjacency_radius = 4;                // pixels; bridges the unlabelled seam at creases
+  double occluder_relative_range = 0.04;   // a neighbour this much nearer (x range) hides a cut
 };
 
 // One entry per region, index = label - 1. `up` must be a unit vector.
