@@ -55,6 +55,7 @@ struct SynthOptions {
   std::string trajectory = "robot";  // robot | handheld
   int room = 0;                      // handheld: room id, 0 = the largest
   PinholeIntrinsics intrinsics{640, 480, 525.0, 525.0, 319.5, 239.5};
+  bool intrinsics_given = false;  // any of --fx --fy --cx --cy; else scaled to --width/--height
   bool no_noise = false;
   bool force = false;
   int threads = 0;

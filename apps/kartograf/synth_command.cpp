@@ -25,16 +25,27 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
       ->capture_default_str()
       ->check(CLI::IsMember({"robot", "handheld"}));
   synth->add_option("--room", o.room, "handheld: the room id (default: the largest room)");
-  synth->add_option("--width", o.intrinsics.width, "Image width")
+  synth
+      ->add_option(
+          "--width", o.intrinsics.width,
+          "Image width (without --fx/--fy/--cx/--cy the Kinect's intrinsics scale with it)")
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
   synth->add_option("--height", o.intrinsics.height, "Image height")
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
-  synth->add_option("--fx", o.intrinsics.fx, "Focal length x [px]")->capture_default_str();
-  synth->add_option("--fy", o.intrinsics.fy, "Focal length y [px]")->capture_default_str();
-  synth->add_option("--cx", o.intrinsics.cx, "Principal point x [px]")->capture_default_str();
-  synth->add_option("--cy", o.intrinsics.cy, "Principal point y [px]")->capture_default_str();
+  synth->add_option("--fx", o.intrinsics.fx, "Focal length x [px]")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.intrinsics_given = true; });
+  synth->add_option("--fy", o.intrinsics.fy, "Focal length y [px]")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.intrinsics_given = true; });
+  synth->add_option("--cx", o.intrinsics.cx, "Principal point x [px]")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.intrinsics_given = true; });
+  synth->add_option("--cy", o.intrinsics.cy, "Principal point y [px]")
+      ->capture_default_str()
+      ->each([&o](const std::string&) { o.intrinsics_given = true; });
   synth->add_flag("--no-noise", o.no_noise,
                   "Exact depth (to 0.2 mm) with every return, clean colour");
   synth->add_flag("--force", o.force, "Write into a folder that is not empty");
@@ -51,6 +62,12 @@ int run_synth_command(const SynthOptions& o, std::ostream& out, std::ostream& er
   options.handheld_room = static_cast<Label>(o.room);
   require(o.room >= 0 && o.room <= 65535, "--room must be a room id");
   options.intrinsics = o.intrinsics;
+  if (!o.intrinsics_given) {
+    // The Kinect's 525 px focal length at 640 wide, scaled to the image; principal point centred.
+    options.intrinsics.fx = options.intrinsics.fy = 525.0 * o.intrinsics.width / 640.0;
+    options.intrinsics.cx = (o.intrinsics.width - 1) / 2.0;
+    options.intrinsics.cy = (o.intrinsics.height - 1) / 2.0;
+  }
   options.noise = o.no_noise ? synth::NoiseModel::none() : synth::NoiseModel::kinect();
   options.force = o.force;
   options.threads = o.threads;
