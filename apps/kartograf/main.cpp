@@ -36,10 +36,6 @@ int main(int argc, char** argv) {
   kartograf::cli::SlamOptions slam_options;
   CLI::App* slam = kartograf::cli::add_slam_command(app, slam_options);
   kartograf::cli::PlanesOptions planes_options;
-  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
-    planes_options.backend = env_backend;
-    planes_options.backend_source = "KARTOGRAF_BACKEND";
-  }
   CLI::App* planes = kartograf::cli::add_planes_command(app, planes_options);
   kartograf::cli::RoomsOptions rooms_options;
   CLI::App* rooms = kartograf::cli::add_rooms_command(app, rooms_options);
@@ -72,7 +68,8 @@ int main(int argc, char** argv) {
     if (*rooms_eval) {
       return kartograf::cli::run_rooms_eval_command(rooms_eval_options, std::cout, std::cerr);
     }
-    if (*semantic) return kartograf::cli::run_semantic_command(semantic_options, std::cout, std::cerr);
+    if (*semantic)
+      return kartograf::cli::run_semantic_command(semantic_options, std::cout, std::cerr);
   } catch (const std::exception& e) {
     std::cout.flush();
     std::cerr << "kartograf: error: " << e.what() << "\n";

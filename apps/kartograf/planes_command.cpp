@@ -14,6 +14,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "backend_option.hpp"
 #include "commands.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
@@ -192,10 +193,7 @@ CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
   command->add_option("--fit", o.fit, "Plane fit: tls | eq6 (the paper's z = Ax + By + C)")
       ->check(CLI::IsMember({"tls", "eq6"}))
       ->capture_default_str();
-  command
-      ->add_option("--backend", o.backend,
-                   "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)")
-      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
+  add_backend_option(*command, o.backend, o.backend_source);
   command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
   command->add_flag("!--no-progress", o.progress, "No progress bar on stderr (sequences)");
   return command;
@@ -203,9 +201,7 @@ CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
 
 int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& err) {
   require(fs::exists(o.input), "planes: " + o.input.string() + ": no such file or folder");
-  compute::ContextOptions context_options;
-  context_options.backend = compute::parse_backend_choice(o.backend, o.backend_source);
-  const compute::Context context(context_options);
+  const compute::Context context = backend_context(o.backend, o.backend_source);
   const segmentation::PlaneExtractionParams params = extraction_params(o);
   params.validate();
   const Json run = run_json(o, context);

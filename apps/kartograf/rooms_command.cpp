@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 #include <nlohmann/json.hpp>
 
+#include "backend_option.hpp"
 #include "commands.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
@@ -78,9 +79,7 @@ rooms::RoomMethodOptions method_options(const RoomsOptions& o) {
 // The backend of the feature method's laser scans, made only when that method runs.
 std::optional<compute::Context> scan_context(const RoomsOptions& o, bool needed) {
   if (!needed) return std::nullopt;
-  compute::ContextOptions context_options;
-  context_options.backend = compute::parse_backend_choice(o.backend, o.backend_source);
-  return std::optional<compute::Context>(std::in_place, context_options);
+  return backend_context(o.backend, o.backend_source);
 }
 
 void add_map_options(CLI::App* command, RoomsOptions& o) {
@@ -91,15 +90,7 @@ void add_map_options(CLI::App* command, RoomsOptions& o) {
       ->capture_default_str();
   command->add_option("--min-area", o.min_area_m2, "Smallest room [m^2] (default: the method's)");
   command->add_option("--max-area", o.max_area_m2, "Largest room [m^2] (default: the method's)");
-  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
-    o.backend = env_backend;
-    o.backend_source = "KARTOGRAF_BACKEND";
-  }
-  command
-      ->add_option("--backend", o.backend,
-                   "feature: where the laser scans run, auto|cpu|vulkan|opencl (default: "
-                   "$KARTOGRAF_BACKEND, else auto)")
-      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
+  add_backend_option(*command, o.backend, o.backend_source, "feature: where the laser scans run, ");
   command->add_flag("--keep-furniture", o.keep_furniture,
                     "Segment the map as it is, furniture included (the reference's behaviour)");
   command->add_option("--model", o.model,

@@ -15,6 +15,7 @@
 #include <CLI/CLI.hpp>
 #include <Eigen/Geometry>
 
+#include "backend_option.hpp"
 #include "commands.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
@@ -164,15 +165,7 @@ CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& o) {
   command->add_option("--goto", o.goto_target, "Plan from the sensor: door | wall")
       ->check(CLI::IsMember({"door", "wall"}));
   command->add_option("--resolution", o.resolution, "Grid cell size [m]")->capture_default_str();
-  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
-    o.backend = env_backend;
-    o.backend_source = "KARTOGRAF_BACKEND";
-  }
-  command
-      ->add_option("--backend", o.backend,
-                   "Where the normals run: auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, "
-                   "else auto)")
-      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
+  add_backend_option(*command, o.backend, o.backend_source, "Where the normals run: ");
   command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
   return command;
 }
@@ -183,9 +176,7 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
   require(o.step >= 1, "semantic: --step must be >= 1");
   require(fs::exists(o.input), "semantic: " + o.input.string() + ": no such file or folder");
   check_output_folder("semantic", o.out_dir, kOutputs, o.force);
-  compute::ContextOptions context_options;
-  context_options.backend = compute::parse_backend_choice(o.backend, o.backend_source);
-  const compute::Context context(context_options);
+  const compute::Context context = backend_context(o.backend, o.backend_source);
   const LabelledPoints labelled =
       fs::is_directory(o.input) ? sequence_points(o, context, err) : scan_points(o, context);
   const semantic::SemanticLabelling& labelling = labelled.view;

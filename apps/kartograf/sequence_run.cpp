@@ -6,15 +6,12 @@
 #include <cstdlib>
 #include <iostream>
 
+#include "backend_option.hpp"
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::cli {
 
 void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
-  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
-    o.backend = env_backend;
-    o.backend_source = "KARTOGRAF_BACKEND";
-  }
   command
       .add_option("SEQUENCE", o.sequence,
                   "RGB-D sequence folder: TUM (rgb.txt, depth.txt), kartograf synth, or 7-Scenes")
@@ -22,10 +19,7 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   command.add_option("--method", o.method, "ICP error metric and pair rejection")
       ->check(CLI::IsMember({"p2p", "p2plane", "color", "planar"}))
       ->capture_default_str();
-  command
-      .add_option("--backend", o.backend,
-                  "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)")
-      ->each([&o](const std::string&) { o.backend_source = "--backend"; });
+  add_backend_option(command, o.backend, o.backend_source);
   command
       .add_option("--reestimate-every", o.reestimate_interval,
                   "Re-register every k-th frame against frame n-k (the M3 paper's drift "
@@ -38,19 +32,17 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
 
 registration::OdometryParams odometry_params(const SequenceRunOptions& options) {
   registration::OdometryParams params;
-  params.method = options.method == "p2p"     ? registration::OdometryMethod::point_to_point
-                  : options.method == "color" ? registration::OdometryMethod::color
+  params.method = options.method == "p2p"      ? registration::OdometryMethod::point_to_point
+                  : options.method == "color"  ? registration::OdometryMethod::color
                   : options.method == "planar" ? registration::OdometryMethod::planar
-                                              : registration::OdometryMethod::point_to_plane;
+                                               : registration::OdometryMethod::point_to_plane;
   params.icp = registration::odometry_icp_params(params.method);
   params.reestimate_interval = options.reestimate_interval;
   return params;
 }
 
 compute::Context make_run_context(const SequenceRunOptions& options) {
-  compute::ContextOptions context_options;
-  context_options.backend = compute::parse_backend_choice(options.backend, options.backend_source);
-  return compute::Context(context_options);
+  return backend_context(options.backend, options.backend_source);
 }
 
 OpenedRun open_run(const SequenceRunOptions& options) {
