@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <random>
 
 #include "kartograf/eval/semantic_metrics.hpp"
 #include "kartograf/geometry/backproject.hpp"
@@ -96,6 +97,98 @@ TEST(SemanticRegions, SplitsAtCreasesAndRangeJumpsAndRejectsMismatchedSizes) {
 
   EXPECT_ERROR_MENTIONS(segment_regions(points, NormalImage(3, 3), params), "segment_regions",
                         "80x60", "3x3");
+}
+
+// A fronto-parallel wall at `depth` seen by a small pinhole camera; `keep(u, v)` decides which
+// pixels return a point, `offset(u, v)` moves a pixel's surface towards the camera.
+template <typename Keep, typename Offset>
+PointImage wall_points(double depth, const Keep& keep, const Offset& offset) {
+  const PinholeIntrinsics k{80, 60, 60, 60, 39.5, 29.5};
+  PointImage points(k.width, k.height, invalid_point());
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      if (!keep(u, v)) continue;
+      const double z = depth - offset(u, v);
+      points(u, v) = Point4f(static_cast<float>((u - k.cx) / k.fx * z),
+                             static_cast<float>((v - k.cy) / k.fy * z), static_cast<float>(z), 1);
+    }
+  }
+  return points;
+}
+
+TEST(SemanticRegions, SparseReturnsFormOneRegionAcrossGaps) {
+  // A dark surface: 45 % of the pixels return (fewer than the 59 % a 4-neighbour flood fill needs
+  // to percolate), every normal exact.
+  std::mt19937 rng(7);
+  std::bernoulli_distribution returns(0.45);
+  std::vector<bool> kept(80 * 60);
+  for (auto&& k : kept) k = returns(rng);
+  const PointImage points = wall_points(
+      2.0, [&](int u, int v) { return kept[v * 80 + u]; }, [](int, int) { return 0.0; });
+  NormalImage normals(points.width(), points.height(), invalid_point());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (is_valid(points.pixels()[i])) normals.pixels()[i] = Point4f(0, 0, -1, 0);
+  }
+  RegionParams params;
+  params.max_gap_pixels = 0;
+  const RegionSegmentation without = segment_regions(points, normals, params);
+  params.max_gap_pixels = 2;
+  const RegionSegmentation with = segment_regions(points, normals, params);
+  EXPECT_EQ(with.region_count, 1);
+  std::size_t labelled = 0, returned = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    returned += is_valid(points.pixels()[i]);
+    labelled += with.labels.pixels()[i] != kUnlabeled;
+  }
+  EXPECT_EQ(labelled, returned);
+  std::size_t labelled_without = 0;
+  for (const Label l : without.labels.pixels()) labelled_without += l != kUnlabeled;
+  EXPECT_LT(labelled_without, returned / 2);  // small islands, most below min_region_pixels
+  params.max_gap_pixels = -1;
+  EXPECT_ERROR_MENTIONS(segment_regions(points, normals, params), "max_gap_pixels");
+}
+
+TEST(SemanticRegions, MergesCoplanarPiecesButNotALeafInFrontOfItsWall) {
+  // Columns 0-29: wall at 3 m; 30-54: a leaf 5 cm in front; 55-79: the wall again. Rows are cut
+  // into three bands by hand, as noisy normals would cut them.
+  const PointImage points = wall_points(
+      3.0, [](int, int) { return true; },
+      [](int u, int) { return u >= 30 && u < 55 ? 0.05 : 0.0; });
+  RegionSegmentation regions;
+  regions.labels = LabelImage(80, 60, kUnlabeled);
+  for (int v = 0; v < 60; ++v) {
+    for (int u = 0; u < 80; ++u) {
+      const int band = v / 20;  // 0, 1, 2
+      const int part = u < 30 ? 0 : (u < 55 ? 1 : 2);
+      regions.labels(u, v) = static_cast<Label>(1 + part * 3 + band);
+    }
+  }
+  regions.region_count = 9;
+  for (int u = 0; u < 80; ++u) regions.labels(u, 20) = kUnlabeled;  // a seam within the gap limit
+  EXPECT_EQ(merge_coplanar_regions(points, regions), 6);
+  EXPECT_EQ(regions.region_count, 3);
+  EXPECT_EQ(regions.labels(0, 0), regions.labels(29, 59));   // left wall bands: one region
+  EXPECT_EQ(regions.labels(30, 0), regions.labels(54, 59));  // leaf bands: one region
+  EXPECT_NE(regions.labels(29, 0), regions.labels(30, 0));   // leaf and wall stay apart
+  EXPECT_NE(regions.labels(54, 0), regions.labels(55, 0));
+  // The right wall piece touches only the leaf: coplanar with the left one, but not adjacent.
+  EXPECT_NE(regions.labels(0, 0), regions.labels(79, 0));
+  EXPECT_EQ(regions.labels(0, 20), kUnlabeled);
+}
+
+TEST(SemanticNormalsImage, MeasuresRangeNoise) {
+  std::mt19937 rng(3);
+  std::normal_distribution<double> noise(0.0, 0.01);
+  std::vector<double> offsets(80 * 60);
+  for (double& o : offsets) o = noise(rng);
+  const PointImage points = wall_points(
+      2.0, [](int, int) { return true; }, [&](int u, int v) { return offsets[v * 80 + u]; });
+  const RangeNoiseProfile profile = estimate_range_noise(points, 0.25, 100);
+  EXPECT_NEAR(profile.at(2.0), 0.01, 0.0015);
+  ASSERT_FALSE(profile.sigma.empty());
+  EXPECT_EQ(profile.at(9.0), profile.sigma.back());  // beyond the farthest bin: its value
+  EXPECT_NEAR(profile.at(0.5), 0.01, 0.0015);        // no samples there: the nearest bin's
+  EXPECT_EQ(estimate_range_noise(PointImage(4, 4, invalid_point())).at(1.0), 0.0);
 }
 
 // Regions from hand-made measurements: a room rotated by `rotation`, the sensor 0.8 m above the

@@ -51,6 +51,7 @@ struct LabelledPoints {
   std::vector<SemanticClass> labels;
   Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
   semantic::SemanticLabelling view;
+  PointImage view_points;  // the points of `view`, in its sensor frame
   int views = 0, views_without_gravity = 0;
 };
 
@@ -82,6 +83,7 @@ LabelledPoints scan_points(const SemanticOptions& o, const compute::Context& con
   const PointImage points = cloud.to_point_image();
   LabelledPoints out;
   out.view = semantic::label_organized_points(context, points);
+  out.view_points = points;
   out.views = 1;
   append_view(points, out.view, Eigen::Isometry3d::Identity(), out);
   make_up_z(out.view.gravity.up, out);
@@ -125,7 +127,12 @@ LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context&
     ++out.views;
     up_sum += labelling.gravity.support_area * (pose->linear() * labelling.gravity.up);
     append_view(points, labelling, *pose, out);
-    if (first) out.sensor = pose->translation(), out.view = std::move(labelling), first = false;
+    if (first) {
+      out.sensor = pose->translation();
+      out.view = std::move(labelling);
+      out.view_points = points;
+      first = false;
+    }
   }
   require(out.views > 0, "semantic: no frame of '" + o.input.string() + "' could be labelled" +
                              (first_failure.empty() ? " (none has a pose)" : ": " + first_failure));
@@ -136,11 +143,70 @@ LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context&
   return out;
 }
 
-// The class colours of the grid picture's legend, per pixel (black: no point).
-RgbImage colour_labels(const SemanticImage& labels) {
-  RgbImage picture(labels.width(), labels.height());
-  for (std::size_t i = 0; i < labels.size(); ++i)
-    picture.data()[i] = semantic::class_colour(labels.data()[i]);
+// Whether the image's first rows see lower things than its last rows (a scanner whose scan lines
+// start at its own height): its pictures are then turned upside down, so up is up.
+bool rows_run_upwards(const PointImage& points, const Eigen::Vector3d& up) {
+  const int third = points.height() / 3;
+  double low_sum = 0, high_sum = 0;
+  int low_count = 0, high_count = 0;
+  for (int y = 0; y < points.height(); ++y) {
+    if (y >= third && y < points.height() - third) continue;
+    for (int x = 0; x < points.width(); ++x) {
+      const Point4f& p = points(x, y);
+      if (!is_valid(p)) continue;
+      const double height = p.head<3>().cast<double>().dot(up);
+      (y < third ? low_sum : high_sum) += height;
+      ++(y < third ? low_count : high_count);
+    }
+  }
+  return low_count > 0 && high_count > 0 && low_sum / low_count < high_sum / high_count;
+}
+
+// Colours of a view's classes; the grid's legend colours (walls black, unknown red: obstacles on a
+// map) would make a picture of clutter look like an alarm.
+Rgb8 view_colour(SemanticClass c) {
+  switch (c) {
+    case SemanticClass::floor:
+      return {90, 175, 90};
+    case SemanticClass::wall:
+      return {205, 205, 205};
+    case SemanticClass::ceiling:
+      return {95, 145, 235};
+    case SemanticClass::door:
+      return {240, 140, 20};
+    case SemanticClass::furniture:
+      return {150, 80, 180};
+    case SemanticClass::unknown:
+      break;
+  }
+  return {130, 95, 75};
+}
+
+// A picture of a view for people: class colours (view_colour) shaded by how squarely each surface
+// faces the sensor (black: no point), or the normals; rows turned so up is up.
+RgbImage view_picture(const PointImage& points, const semantic::SemanticLabelling& labelling,
+                      bool normals_only) {
+  const RgbImage normals =
+      semantic::normals_to_rgb(labelling.normals, semantic::NormalEncoding::absolute);
+  const int w = points.width(), h = points.height();
+  const bool flip = rows_run_upwards(points, labelling.gravity.up);
+  RgbImage picture(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      Rgb8 colour = normals(x, y);
+      if (!normals_only) {
+        const Point4f& p = points(x, y);
+        const Point4f& n = labelling.normals(x, y);
+        double shade = 1.0;
+        if (is_valid(p) && is_valid(n) && p.head<3>().norm() > 0) {
+          shade = 0.55 + 0.45 * std::fabs(n.head<3>().dot(p.head<3>().normalized()));
+        }
+        const Rgb8 c = is_valid(p) ? view_colour(labelling.semantic(x, y)) : Rgb8{};
+        for (std::size_t k = 0; k < 3; ++k) colour[k] = static_cast<std::uint8_t>(c[k] * shade);
+      }
+      picture(x, flip ? h - 1 - y : y) = colour;
+    }
+  }
   return picture;
 }
 
@@ -206,9 +272,9 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
 
   fs::create_directories(o.out_dir);
   io::write_semantic_png(o.out_dir / "labels.png", labelling.semantic);
-  io::write_png(o.out_dir / "labels_color.png", colour_labels(labelling.semantic));
-  io::write_png(o.out_dir / "normals.png",
-                semantic::normals_to_rgb(labelling.normals, semantic::NormalEncoding::absolute));
+  io::write_png(o.out_dir / "labels_color.png",
+                view_picture(labelled.view_points, labelling, false));
+  io::write_png(o.out_dir / "normals.png", view_picture(labelled.view_points, labelling, true));
   io::write_png(o.out_dir / "semantic.png", picture.image);
   const OccupancyGrid occupancy = semantic::to_occupancy_grid(grid);
   io::write_ros_map(o.out_dir / "occupancy.yaml", occupancy);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdlib>
 #include <numbers>
 
 #include <Eigen/Geometry>
@@ -89,7 +90,8 @@ class RegionRules {
   // against it, as long as half a door's height is in view.
   bool door_shaped(const RegionMeasurements& r) const {
     if (r.orientation != RegionOrientation::vertical) return false;
-    if (r.width < params_.door_min_width || r.width > params_.door_max_width) return false;
+    if (r.width > params_.door_max_width) return false;
+    if (r.width < params_.door_min_width && !r.cut_sideways) return false;  // a close-up of a leaf
     if (!reaches_floor(r) && !r.cut_below) return false;
     const double top = height_above_floor(r.max_height);
     if (top > params_.door_max_height) return false;
@@ -126,6 +128,24 @@ class RegionRules {
       if (gap <= params_.door_max_wall_gap) return true;
     }
     return false;
+  }
+
+  // In the plane of a wall (parallel, centroid within coplanar_wall_offset of the wall's plane)
+  // and no farther than coplanar_wall_gap from it along the wall: the same wall, parted from its
+  // labelled part by windows, pictures or clutter.
+  bool in_wall_plane(const RegionMeasurements& r, const std::vector<SemanticClass>& classes) const {
+    if (r.orientation != RegionOrientation::vertical) return false;
+    return std::any_of(regions_.begin(), regions_.end(), [&](const RegionMeasurements& o) {
+      if (classes[o.id - 1u] != SemanticClass::wall || o.id == r.id ||
+          o.plane_normal.dot(r.plane_normal) < cos_deg(params_.parallel_tolerance_deg)) {
+        return false;
+      }
+      if (std::fabs(o.plane_normal.dot(r.centroid - o.centroid)) > params_.coplanar_wall_offset)
+        return false;
+      const Eigen::Vector3d along = up_.cross(o.plane_normal).normalized();
+      const double gap = std::fabs(along.dot(r.centroid - o.centroid)) - 0.5 * (r.width + o.width);
+      return gap <= params_.coplanar_wall_gap;
+    });
   }
 
   bool beside(const RegionMeasurements& r, const std::vector<SemanticClass>& classes,
@@ -201,7 +221,11 @@ std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> 
   for (bool changed = true; changed;) {
     changed = false;
     for (std::size_t i = 0; i < regions.size(); ++i) {
-      if (candidate(i) && rules.beside(regions[i], classes, SemanticClass::wall)) {
+      const bool joined = candidate(i) && rules.beside(regions[i], classes, SemanticClass::wall);
+      const bool coplanar = classes[i] == SemanticClass::unknown &&
+                            regions[i].area >= params.coplanar_wall_min_area &&
+                            rules.in_wall_plane(regions[i], classes);
+      if (joined || coplanar) {
         classes[i] = SemanticClass::wall;
         changed = true;
       }
@@ -238,9 +262,15 @@ SemanticLabelling label_organized_points(const compute::Context& context, const 
   presmoothed.smoothing_radius = 0;
   out.normals = estimate_organized_normals(context, smoothed, presmoothed);
   out.regions = segment_regions(points, out.normals, params.regions);
+  merge_coplanar_regions(points, out.regions, params.merge);
   const int unsplit_count = out.regions.region_count;
+  // Offsets from a narrower window than the normals': a wide one blurs a leaf's 5 cm step into
+  // the wall around it, and the blurred band stays with the leaf.
+  NormalsImageParams layer_smoothing = params.normals;
+  layer_smoothing.smoothing_radius = params.layers.smoothing_radius;
+  const PointImage layer_points = smooth_organized_points(points, layer_smoothing);
   const std::vector<Label> parents =
-      split_offset_layers(smoothed, out.normals, out.regions, params.layers);
+      split_offset_layers(layer_points, out.normals, out.regions, params.layers);
   const auto provisional =
       measure_regions(points, out.normals, out.regions, Eigen::Vector3d::UnitZ(), params.measure);
   GravityParams gravity_params = params.gravity;

@@ -1,6 +1,7 @@
 #include "kartograf/semantic/regions.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <numbers>
 #include <set>
@@ -39,6 +40,28 @@ double trimmed_extent(std::vector<double> values, double trim, double& low, doub
   low = quantile(values, trim);
   high = quantile(values, 1.0 - trim);
   return high - low;
+}
+
+// The 4 neighbours of pixel i across gaps: in each direction the first pixel that is `usable`
+// within 1 + max_gap steps (-1 where there is none). Dark surfaces return depth on a sparse subset
+// of pixels (a dark door leaf under a structured-light sensor); without bridging, such a subset
+// does not percolate through 4-neighbours and never forms a region.
+template <typename Usable>
+std::array<int, 4> gap_neighbours(int w, int h, int i, int max_gap, const Usable& usable) {
+  const int x = i % w, y = i / w;
+  constexpr int dx[4] = {-1, 1, 0, 0}, dy[4] = {0, 0, -1, 1};
+  std::array<int, 4> out{-1, -1, -1, -1};
+  for (int d = 0; d < 4; ++d) {
+    for (int step = 1; step <= 1 + max_gap; ++step) {
+      const int u = x + step * dx[d], v = y + step * dy[d];
+      if (u < 0 || v < 0 || u >= w || v >= h) break;
+      if (usable(v * w + u)) {
+        out[static_cast<std::size_t>(d)] = v * w + u;
+        break;
+      }
+    }
+  }
+  return out;
 }
 
 // Whether each region's points span a plane (PCA: smallest spread well below the middle one) whose
@@ -98,14 +121,12 @@ void fill_from_planes(const PointImage& points, const NormalImage& normals,
     centroid[r] /= count[r];
     normal[r].normalize();
   }
+  auto has_point = [&](int i) { return is_valid(points.pixels()[static_cast<std::size_t>(i)]); };
   for (std::size_t head = 0; head < queue.size(); ++head) {
     const int i = queue[head];
     const Label l = out.labels.pixels()[static_cast<std::size_t>(i)];
     const Point4f& p = points.pixels()[static_cast<std::size_t>(i)];
-    const int x = i % w, y = i / w;
-    const int candidates[4] = {x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1,
-                               y + 1 < h ? i + w : -1};
-    for (const int j : candidates) {
+    for (const int j : gap_neighbours(w, h, i, params.max_gap_pixels, has_point)) {
       if (j < 0 || out.labels.pixels()[static_cast<std::size_t>(j)] != kUnlabeled) continue;
       const Point4f& q = points.pixels()[static_cast<std::size_t>(j)];
       if (!is_valid(q) || !ranges_continuous(p, q, params.max_relative_range_jump)) continue;
@@ -136,6 +157,7 @@ RegionSegmentation segment_regions(const PointImage& points, const NormalImage& 
   require(params.max_relative_range_jump > 0,
           "segment_regions: max_relative_range_jump must be > 0");
   require(params.min_region_pixels >= 1, "segment_regions: min_region_pixels must be >= 1");
+  require(params.max_gap_pixels >= 0, "segment_regions: max_gap_pixels must be >= 0");
 
   const int w = points.width(), h = points.height();
   const double neighbour_cos = cos_deg(params.max_neighbour_angle_deg);
@@ -160,10 +182,7 @@ RegionSegmentation segment_regions(const PointImage& points, const NormalImage& 
       const Eigen::Vector3d n = vec3(normals.pixels()[static_cast<std::size_t>(i)]);
       normal_sum += n;
       const Eigen::Vector3d mean = normal_sum.normalized();
-      const int x = i % w, y = i / w;
-      const int candidates[4] = {x > 0 ? i - 1 : -1, x + 1 < w ? i + 1 : -1, y > 0 ? i - w : -1,
-                                 y + 1 < h ? i + w : -1};
-      for (const int j : candidates) {
+      for (const int j : gap_neighbours(w, h, i, params.max_gap_pixels, usable)) {
         if (j < 0 || region_of[static_cast<std::size_t>(j)] != kUnvisited || !usable(j)) continue;
         const Eigen::Vector3d m = vec3(normals.pixels()[static_cast<std::size_t>(j)]);
         if (m.dot(n) < neighbour_cos || m.dot(mean) < region_cos ||
@@ -193,6 +212,109 @@ RegionSegmentation segment_regions(const PointImage& points, const NormalImage& 
   }
   fill_from_planes(points, normals, params, out);
   return out;
+}
+
+namespace {
+
+// Point moments of a set of regions, for its plane.
+struct PlaneMoments {
+  double count = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+
+  Eigen::Vector3d centroid() const { return sum / count; }
+  Eigen::Vector3d normal() const {
+    const Eigen::Vector3d c = centroid();
+    const Eigen::Matrix3d covariance = outer / count - c * c.transpose();
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
+  }
+};
+
+int find_root(std::vector<int>& parent, int i) {
+  while (parent[static_cast<std::size_t>(i)] != i) {
+    parent[static_cast<std::size_t>(i)] =
+        parent[static_cast<std::size_t>(parent[static_cast<std::size_t>(i)])];
+    i = parent[static_cast<std::size_t>(i)];
+  }
+  return i;
+}
+
+}  // namespace
+
+int merge_coplanar_regions(const PointImage& points, RegionSegmentation& regions,
+                           const CoplanarMergeParams& params) {
+  const int w = points.width(), h = points.height();
+  require(regions.labels.width() == w && regions.labels.height() == h,
+          "merge_coplanar_regions: points and labels must have one size");
+  require(params.max_angle_deg > 0 && params.max_angle_deg < 90 && params.max_offset > 0 &&
+              params.max_gap_pixels >= 0,
+          "merge_coplanar_regions: angle must be in (0, 90) degrees, offset > 0, gap >= 0");
+  const auto n = static_cast<std::size_t>(regions.region_count);
+  const LabelImage& labels = regions.labels;
+  // Moments about the first point seen keep the sums well-conditioned.
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();
+  bool have_origin = false;
+  std::vector<PlaneMoments> moments(n);
+  std::set<std::pair<Label, Label>> pairs;
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const Label a = labels(x, y);
+      if (a == kUnlabeled) continue;
+      const Eigen::Vector3d p = vec3(points(x, y));
+      if (!have_origin) origin = p, have_origin = true;
+      PlaneMoments& m = moments[a - 1u];
+      m.count += 1;
+      m.sum += p - origin;
+      m.outer += (p - origin) * (p - origin).transpose();
+      for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
+        for (int step = 1; step <= 1 + params.max_gap_pixels; ++step) {
+          const int u = x + step * dx, v = y + step * dy;
+          if (u >= w || v >= h) break;
+          const Label b = labels(u, v);
+          if (b == kUnlabeled) continue;
+          if (b != a) pairs.emplace(std::min(a, b), std::max(a, b));
+          break;
+        }
+      }
+    }
+  }
+  const double angle_cos = cos_deg(params.max_angle_deg);
+  std::vector<int> parent(n);
+  for (std::size_t k = 0; k < n; ++k) parent[k] = static_cast<int>(k);
+  int merges = 0;
+  for (const auto& [a, b] : pairs) {
+    const int ra = find_root(parent, a - 1), rb = find_root(parent, b - 1);
+    if (ra == rb) continue;
+    const PlaneMoments& ma = moments[static_cast<std::size_t>(ra)];
+    const PlaneMoments& mb = moments[static_cast<std::size_t>(rb)];
+    const Eigen::Vector3d na = ma.normal(), nb = mb.normal();
+    const Eigen::Vector3d ca = ma.centroid(), cb = mb.centroid();
+    if (std::fabs(na.dot(nb)) < angle_cos || std::fabs(na.dot(cb - ca)) > params.max_offset ||
+        std::fabs(nb.dot(ca - cb)) > params.max_offset) {
+      continue;
+    }
+    const int keep = std::min(ra, rb), gone = std::max(ra, rb);
+    PlaneMoments& mk = moments[static_cast<std::size_t>(keep)];
+    const PlaneMoments& mg = moments[static_cast<std::size_t>(gone)];
+    mk.count += mg.count;
+    mk.sum += mg.sum;
+    mk.outer += mg.outer;
+    parent[static_cast<std::size_t>(gone)] = keep;
+    ++merges;
+  }
+  if (merges == 0) return 0;
+  std::vector<Label> relabel(n, kUnlabeled);
+  Label next = 0;
+  for (std::size_t k = 0; k < n; ++k) {
+    const auto root = static_cast<std::size_t>(find_root(parent, static_cast<int>(k)));
+    if (relabel[root] == kUnlabeled) relabel[root] = ++next;
+    relabel[k] = relabel[root];
+  }
+  for (Label& l : regions.labels.pixels()) {
+    if (l != kUnlabeled) l = relabel[l - 1u];
+  }
+  regions.region_count = next;
+  return merges;
 }
 
 std::vector<Label> split_offset_layers(const PointImage& smoothed_points,

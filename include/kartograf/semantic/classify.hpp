@@ -24,7 +24,9 @@
 //    room height is assumed_room_height above the floor; without a floor, below the ceiling - but
 //    the sensor (height 0) always lies between the two. A vertical region
 //    next to a wall and reaching above door_min_height is a wall too (door jambs, wall pieces
-//    between doors);
+//    between doors), as is a vertical region of at least coplanar_wall_min_area in a wall's plane
+//    and within coplanar_wall_gap of it along the wall (wall below a window band, between
+//    shelves);
 //  - a horizontal region facing down below the ceiling and adjacent to a wall (a lintel's
 //    underside) is wall;
 //  - everything else, and pixels in no region, unknown (furniture included: M2 has no furniture
@@ -56,6 +58,11 @@ struct ClassificationParams {
   double door_max_wall_gap = 0.5;  // m along the wall between a leaf and its wall's visible part
   double door_max_wall_offset = 0.09;  // m: a leaf is ~5 cm out; a wall step (thickness) >= 10 cm
   double parallel_tolerance_deg = 15.0;
+  // A vertical region in a wall's plane (within coplanar_wall_offset, below a door leaf's 3 cm)
+  // and within coplanar_wall_gap of it along the wall is that wall, whatever its height.
+  double coplanar_wall_offset = 0.025;   // m
+  double coplanar_wall_gap = 1.0;        // m
+  double coplanar_wall_min_area = 0.05;  // m^2
 };
 
 // Classes per region (index = label - 1).
@@ -66,6 +73,7 @@ std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> 
 struct LabellingParams {
   NormalsImageParams normals;
   RegionParams regions;
+  CoplanarMergeParams merge;
   LayerSplitParams layers;
   MeasureParams measure;
   GravityParams gravity;

@@ -3,8 +3,9 @@
 // their 3-D measurements.
 //
 // Region growing (flood fill, 4-neighbours, seeds in raster order): a pixel joins the region of a
-// neighbour when both have normals, the angle between the two normals is at most
-// max_neighbour_angle_deg, the angle to the region's running mean normal is at most
+// neighbour (the nearest pixel with a point in each of the 4 directions, across at most
+// max_gap_pixels pixels without one) when both have normals, the angle between the two normals is
+// at most max_neighbour_angle_deg, the angle to the region's running mean normal is at most
 // max_region_angle_deg, and their ranges (distances to the sensor at the origin) differ by at most
 // max_relative_range_jump times the smaller one. Regions with fewer than min_region_pixels pixels
 // are dropped (label 0). Labels are 1..count in order of their seed.
@@ -38,6 +39,8 @@ struct RegionParams {
   double fill_plane_distance = 0.01;      // m
   double fill_relative_distance = 0.008;  // x range
   double fill_quadratic_distance = 0.0;   // x range^2 [1/m]
+  // Neighbours are looked for across up to this many pixels without a point (sparse returns).
+  int max_gap_pixels = 2;
 };
 
 struct RegionSegmentation {
@@ -49,6 +52,23 @@ struct RegionSegmentation {
 RegionSegmentation segment_regions(const PointImage& points, const NormalImage& normals,
                                    const RegionParams& params = {});
 
+// Merges adjacent regions that lie in one plane: noisy normals (a dark surface with sparse
+// returns, far Kinect depth) break one surface into several regions that the rules would measure
+// one by one, too small for a wall or a door. Two regions are adjacent when a pixel of one is at
+// most max_gap_pixels unlabelled pixels right of or below a pixel of the other; they merge when
+// their fitted planes (PCA of their points, merged moments after each merge) are within
+// max_angle_deg and each centroid lies within max_offset of the other's plane. max_offset stays
+// below LayerSplitParams::min_offset so a door leaf (5 cm off its wall) never merges into it.
+// Labels are renumbered 1..count in order of their smallest old label. Returns the merges made.
+struct CoplanarMergeParams {
+  double max_angle_deg = 10.0;
+  double max_offset = 0.02;  // m
+  int max_gap_pixels = 3;
+};
+
+int merge_coplanar_regions(const PointImage& points, RegionSegmentation& regions,
+                           const CoplanarMergeParams& params = {});
+
 // Splits layers off regions: pixels of a region lying more than min_offset in front of or behind
 // the region's plane (offset: the median of n . p over the region, n its mean normal) form
 // 4-connected components; those of at least min_pixels become new regions (labels after the
@@ -58,6 +78,9 @@ RegionSegmentation segment_regions(const PointImage& points, const NormalImage& 
 struct LayerSplitParams {
   double min_offset = 0.025;  // m
   int min_pixels = 50;
+  // label_organized_points smooths the points for the offsets over (2r + 1)^2 pixels: narrower
+  // than the normals' window, which blurs a 5 cm step into a band that stays with the leaf.
+  int smoothing_radius = 2;
 };
 
 // Returns, for each region added, the region it was split from. Throws Error when the sizes differ.
