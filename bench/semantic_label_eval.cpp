@@ -236,22 +236,28 @@ int main(int argc, char** argv) {
     if (const char* s = std::getenv("KG_DOORW")) p.classes.door_max_width = std::atof(s);
   };
   tune(frame_params);
+  // Renders a frame from `pose`, labels it and adds it to `totals` (dump name: prefix + index).
+  auto score_frame = [&](const Eigen::Isometry3d& pose, std::uint64_t noise_seed, Totals& totals,
+                         const std::string& prefix, int index) {
+    const auto frame =
+        synth::render(world, k, pose,
+                      kinect ? synth::NoiseModel::kinect() : synth::NoiseModel::none(), noise_seed);
+    const PointImage points = geometry::backproject(context, frame.depth, k, {5000.0, 0.1, 10.0});
+    const std::string name = prefix + " " + std::to_string(index);
+    try {
+      const auto result = semantic::label_organized_points(context, points, frame_params);
+      add(totals, points, frame.semantic, result.semantic, name);
+      dump(prefix + std::to_string(index), points, frame.semantic, result);
+    } catch (const Error& e) {
+      std::printf("%s: %s\n", name.c_str(), e.what());
+    }
+  };
 
   Totals frame_totals;
   header(kinect ? "RGB-D frames (Kinect noise), furniture ignored" : "RGB-D frames (no noise)");
   for (int f = 0; f < frames; ++f) {
     const int index = 15 + f * (tour.size() - 30) / std::max(1, frames - 1);
-    const auto frame =
-        synth::render(world, k, tour[index].pose,
-                      kinect ? synth::NoiseModel::kinect() : synth::NoiseModel::none(), 100 + f);
-    const PointImage points = geometry::backproject(context, frame.depth, k, {5000.0, 0.1, 10.0});
-    try {
-      const auto result = semantic::label_organized_points(context, points, frame_params);
-      add(frame_totals, points, frame.semantic, result.semantic, "frame " + std::to_string(index));
-      dump("frame" + std::to_string(index), points, frame.semantic, result);
-    } catch (const Error& e) {
-      std::printf("frame %d: %s\n", index, e.what());
-    }
+    score_frame(tour[index].pose, 100 + f, frame_totals, "frame", index);
   }
   report("ALL frames (ignored)", frame_totals.ignored);
   report("ALL frames (counted)", frame_totals.counted);
@@ -265,16 +271,7 @@ int main(int argc, char** argv) {
     const Eigen::Isometry3d pose =
         synth::camera_pose(tour[index].pose.translation(), std::atan2(view.y(), view.x()),
                            -20 * std::numbers::pi / 180);
-    const auto frame = synth::render(
-        world, k, pose, kinect ? synth::NoiseModel::kinect() : synth::NoiseModel::none(), 300 + f);
-    const PointImage points = geometry::backproject(context, frame.depth, k, {5000.0, 0.1, 10.0});
-    try {
-      const auto result = semantic::label_organized_points(context, points, frame_params);
-      add(up_totals, points, frame.semantic, result.semantic, "up frame " + std::to_string(index));
-      dump("up" + std::to_string(index), points, frame.semantic, result);
-    } catch (const Error& e) {
-      std::printf("up frame %d: %s\n", index, e.what());
-    }
+    score_frame(pose, 300 + f, up_totals, "up", index);
   }
   report("ALL up frames (ign.)", up_totals.ignored);
   report("ALL up frames (cnt.)", up_totals.counted);
@@ -297,18 +294,7 @@ int main(int argc, char** argv) {
     const double yaw = std::atan2(look.y(), look.x());
     const Eigen::Isometry3d pose =
         synth::camera_pose(Eigen::Vector3d(eye.x(), eye.y(), 1.3), yaw, 0.0);
-    const auto frame = synth::render(
-        world, k, pose, kinect ? synth::NoiseModel::kinect() : synth::NoiseModel::none(),
-        500 + leaf.doorway);
-    const PointImage points = geometry::backproject(context, frame.depth, k, {5000.0, 0.1, 10.0});
-    try {
-      const auto result = semantic::label_organized_points(context, points, frame_params);
-      add(door_totals, points, frame.semantic, result.semantic,
-          "door leaf " + std::to_string(leaf.doorway));
-      dump("door" + std::to_string(leaf.doorway), points, frame.semantic, result);
-    } catch (const Error& e) {
-      std::printf("door leaf %d: %s\n", leaf.doorway, e.what());
-    }
+    score_frame(pose, 500 + leaf.doorway, door_totals, "door", leaf.doorway);
   }
   report("ALL door frames (ign.)", door_totals.ignored);
   report("ALL door frames (cnt.)", door_totals.counted);
