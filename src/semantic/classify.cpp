@@ -257,7 +257,10 @@ std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> 
 SemanticLabelling label_organized_points(const compute::Context& context, const PointImage& points,
                                          const LabellingParams& params) {
   SemanticLabelling out;
-  const PointImage smoothed = smooth_organized_points(points, params.normals);
+  // Measured once, for both smoothing windows.
+  const RangeNoiseProfile noise =
+      params.normals.noise_sigmas > 0 ? estimate_range_noise(points) : RangeNoiseProfile{};
+  const PointImage smoothed = smooth_organized_points(points, params.normals, noise);
   NormalsImageParams presmoothed = params.normals;
   presmoothed.smoothing_radius = 0;
   out.normals = estimate_organized_normals(context, smoothed, presmoothed);
@@ -268,7 +271,7 @@ SemanticLabelling label_organized_points(const compute::Context& context, const 
   // the wall around it, and the blurred band stays with the leaf.
   NormalsImageParams layer_smoothing = params.normals;
   layer_smoothing.smoothing_radius = params.layers.smoothing_radius;
-  const PointImage layer_points = smooth_organized_points(points, layer_smoothing);
+  const PointImage layer_points = smooth_organized_points(points, layer_smoothing, noise);
   const std::vector<Label> parents =
       split_offset_layers(layer_points, out.normals, out.regions, params.layers);
   const auto provisional =

@@ -75,6 +75,13 @@ RangeNoiseProfile estimate_range_noise(const PointImage& points, double bin_widt
 }
 
 PointImage smooth_organized_points(const PointImage& points, const NormalsImageParams& params) {
+  const bool measure = params.noise_sigmas > 0 && params.smoothing_radius > 0;
+  return smooth_organized_points(points, params,
+                                 measure ? estimate_range_noise(points) : RangeNoiseProfile{});
+}
+
+PointImage smooth_organized_points(const PointImage& points, const NormalsImageParams& params,
+                                   const RangeNoiseProfile& noise) {
   require(params.smoothing_radius >= 0,
           "smooth_organized_points: smoothing_radius must be >= 0, got " +
               std::to_string(params.smoothing_radius));
@@ -82,9 +89,6 @@ PointImage smooth_organized_points(const PointImage& points, const NormalsImageP
           "smooth_organized_points: max_relative_range_jump must be positive");
   require(std::isfinite(params.noise_sigmas) && params.noise_sigmas >= 0,
           "smooth_organized_points: noise_sigmas must be >= 0");
-  const RangeNoiseProfile noise = params.noise_sigmas > 0 && params.smoothing_radius > 0
-                                      ? estimate_range_noise(points)
-                                      : RangeNoiseProfile{};
   const int w = points.width(), h = points.height(), r = params.smoothing_radius;
   PointImage smoothed(w, h, invalid_point());
   for (int y = 0; y < h; ++y) {

@@ -64,15 +64,39 @@ std::array<int, 4> gap_neighbours(int w, int h, int i, int max_gap, const Usable
   return out;
 }
 
+// Point moments (offsets from a common origin) of a set of points, for the plane they span.
+struct PlaneMoments {
+  double count = 0;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
+
+  void add(const Eigen::Vector3d& offset) {
+    count += 1;
+    sum += offset;
+    outer += offset * offset.transpose();
+  }
+  void add(const PlaneMoments& other) {
+    count += other.count;
+    sum += other.sum;
+    outer += other.outer;
+  }
+  Eigen::Vector3d centroid() const { return sum / count; }
+  // Eigenvalues ascending: the first eigenvector is the plane's normal.
+  Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca() const {
+    const Eigen::Vector3d c = centroid();
+    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(outer / count - c * c.transpose());
+  }
+  Eigen::Vector3d normal() const { return pca().eigenvectors().col(0); }
+};
+
 // Whether each region's points span a plane (PCA: smallest spread well below the middle one) whose
 // normal agrees with the region's mean normal (see regions.hpp).
 std::vector<bool> consistent_planes(const PointImage& points, const NormalImage& normals,
                                     const std::vector<int>& region_of,
                                     const std::vector<int>& sizes, const RegionParams& params) {
   const std::size_t n = sizes.size();
-  std::vector<Eigen::Vector3d> sum(n, Eigen::Vector3d::Zero()), normal(n, Eigen::Vector3d::Zero());
-  std::vector<Eigen::Matrix3d> outer(n, Eigen::Matrix3d::Zero());
-  std::vector<Eigen::Vector3d> origin(n, Eigen::Vector3d::Zero());
+  std::vector<PlaneMoments> moments(n);
+  std::vector<Eigen::Vector3d> normal(n, Eigen::Vector3d::Zero()), origin(n);
   std::vector<bool> seen(n, false);
   for (std::size_t i = 0; i < region_of.size(); ++i) {
     const int r = region_of[i];
@@ -81,18 +105,14 @@ std::vector<bool> consistent_planes(const PointImage& points, const NormalImage&
     const Eigen::Vector3d p = vec3(points.pixels()[i]);
     if (!seen[k])
       origin[k] = p, seen[k] = true;  // offsets from a member keep sums well-conditioned
-    const Eigen::Vector3d d = p - origin[k];
-    sum[k] += d;
-    outer[k] += d * d.transpose();
+    moments[k].add(p - origin[k]);
     normal[k] += vec3(normals.pixels()[i]);
   }
   std::vector<bool> planar(n, false);
   const double region_cos = cos_deg(params.max_region_angle_deg);
   for (std::size_t k = 0; k < n; ++k) {
     if (!seen[k]) continue;
-    const Eigen::Vector3d mean = sum[k] / sizes[k];
-    const Eigen::Matrix3d covariance = outer[k] / sizes[k] - mean * mean.transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> pca(covariance);
+    const auto pca = moments[k].pca();
     const Eigen::Vector3d spread = pca.eigenvalues();  // ascending
     planar[k] = spread(0) * params.min_plane_spread_ratio <= spread(1) &&
                 std::fabs(pca.eigenvectors().col(0).dot(normal[k].normalized())) >= region_cos;
@@ -216,20 +236,6 @@ RegionSegmentation segment_regions(const PointImage& points, const NormalImage& 
 
 namespace {
 
-// Point moments of a set of regions, for its plane.
-struct PlaneMoments {
-  double count = 0;
-  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d outer = Eigen::Matrix3d::Zero();
-
-  Eigen::Vector3d centroid() const { return sum / count; }
-  Eigen::Vector3d normal() const {
-    const Eigen::Vector3d c = centroid();
-    const Eigen::Matrix3d covariance = outer / count - c * c.transpose();
-    return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(covariance).eigenvectors().col(0);
-  }
-};
-
 int find_root(std::vector<int>& parent, int i) {
   while (parent[static_cast<std::size_t>(i)] != i) {
     parent[static_cast<std::size_t>(i)] =
@@ -262,10 +268,7 @@ int merge_coplanar_regions(const PointImage& points, RegionSegmentation& regions
       if (a == kUnlabeled) continue;
       const Eigen::Vector3d p = vec3(points(x, y));
       if (!have_origin) origin = p, have_origin = true;
-      PlaneMoments& m = moments[a - 1u];
-      m.count += 1;
-      m.sum += p - origin;
-      m.outer += (p - origin) * (p - origin).transpose();
+      moments[a - 1u].add(p - origin);
       for (const auto& [dx, dy] : {std::pair{1, 0}, std::pair{0, 1}}) {
         for (int step = 1; step <= 1 + params.max_gap_pixels; ++step) {
           const int u = x + step * dx, v = y + step * dy;
@@ -294,11 +297,7 @@ int merge_coplanar_regions(const PointImage& points, RegionSegmentation& regions
       continue;
     }
     const int keep = std::min(ra, rb), gone = std::max(ra, rb);
-    PlaneMoments& mk = moments[static_cast<std::size_t>(keep)];
-    const PlaneMoments& mg = moments[static_cast<std::size_t>(gone)];
-    mk.count += mg.count;
-    mk.sum += mg.sum;
-    mk.outer += mg.outer;
+    moments[static_cast<std::size_t>(keep)].add(moments[static_cast<std::size_t>(gone)]);
     parent[static_cast<std::size_t>(gone)] = keep;
     ++merges;
   }

@@ -48,6 +48,10 @@ RangeNoiseProfile estimate_range_noise(const PointImage& points, double bin_widt
 
 // The organized mean filter described above; invalid pixels stay invalid.
 PointImage smooth_organized_points(const PointImage& points, const NormalsImageParams& params);
+// The same with the range noise already measured (estimate_range_noise of the same points), for
+// callers that smooth one image with several windows.
+PointImage smooth_organized_points(const PointImage& points, const NormalsImageParams& params,
+                                   const RangeNoiseProfile& noise);
 
 // Smoothing, then geometry::estimate_normals on `context`, normals facing the sensor (origin).
 NormalImage estimate_organized_normals(const compute::Context& context, const PointImage& points,
