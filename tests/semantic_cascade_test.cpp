@@ -13,6 +13,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/semantic/cascade_training.hpp"
 #include "kartograf/semantic/haar_cascade.hpp"
+#include "kartograf/semantic/object_detector.hpp"
 #include "kartograf/semantic/synthetic_stairs.hpp"
 
 namespace kartograf::semantic {
@@ -255,6 +256,56 @@ TEST(SemanticCascade, SyntheticStairsViewsAndPositives) {
   ASSERT_EQ(positives.size(), 5u);
   for (const GrayImage& p : positives) EXPECT_EQ(p.width(), 20);
   EXPECT_FALSE(render_stairs_view(context, 3, false, options).object.has_value());
+}
+
+// The shipped stairs cascade through ObjectDetector on held-out camera frames of 640x480 (twice
+// the training views' size): it finds the stairs (IoU >= 0.5 with the true box) in at least 5 of 6
+// views with stairs and nothing in 3 views without; the found stairs become a map object whose
+// footprint lies around the stairs' points and whose cells the grid marks.
+TEST(SemanticCascade, ShippedStairsDetectorPlacesStairsOnTheMap) {
+  const compute::Context context = compute::Context::cpu();
+  const ObjectDetector detector = ObjectDetector::stairs();
+  EXPECT_EQ(detector.object_class(), "stairs");
+  StairsViewOptions options;
+  options.width = 640, options.height = 480, options.focal = 500;
+  int found = 0;
+  for (std::uint64_t seed = 2000000; seed < 2000006; ++seed) {
+    const StairsView view = render_stairs_view(context, seed, true, options);
+    ASSERT_TRUE(view.object.has_value());
+    const std::vector<ViewDetection> detections = detector.detect(context, view.points);
+    const auto hit = std::find_if(detections.begin(), detections.end(), [&](const auto& d) {
+      return intersection_over_union(d.box, *view.object) >= 0.5;
+    });
+    if (hit == detections.end()) continue;
+    ++found;
+    // Camera frame (y down) to a z-up map frame: (x, z, -y).
+    std::vector<Eigen::Vector3d> up_points;
+    for (const Eigen::Vector3d& p : hit->points) up_points.emplace_back(p.x(), p.z(), -p.y());
+    const ObjectDetection object = to_map_detection(up_points, SemanticClass::furniture, "stairs");
+    ASSERT_GE(object.footprint.size(), 3u);
+    EXPECT_LT(object.z_max - object.z_min, 2.5);
+    std::vector<Eigen::Vector3d> floor;
+    std::vector<SemanticClass> labels;
+    for (double x = -3; x <= 3; x += 0.05)
+      for (double y = 0.5; y <= 7; y += 0.05) floor.emplace_back(x, y, object.z_min - 0.01);
+    labels.assign(floor.size(), SemanticClass::floor);
+    const SemanticGrid grid =
+        build_semantic_grid(floor, labels, {}, std::vector<ObjectDetection>{object});
+    const auto detection = std::find_if(grid.objects.begin(), grid.objects.end(),
+                                        [](auto& o) { return o.kind == ObjectKind::detection; });
+    ASSERT_NE(detection, grid.objects.end());
+    EXPECT_EQ(detection->name, "stairs");
+    EXPECT_GT(detection->cells.size(), 10u);
+  }
+  EXPECT_GE(found, 5);
+  for (std::uint64_t seed = 2000100; seed < 2000103; ++seed) {
+    EXPECT_TRUE(
+        detector.detect(context, render_stairs_view(context, seed, false, options).points).empty());
+  }
+  EXPECT_THROW(to_map_detection(
+                   {Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(2, 0, 1)},
+                   SemanticClass::furniture, "a line"),
+               Error);
 }
 
 TEST(SemanticCascade, BadInputThrows) {

@@ -149,6 +149,9 @@ struct SemanticOptions {
   int step = 10;            // sequence: every k-th frame
   std::string goto_target;  // empty, "door" or "wall"
   double resolution = 0.05;
+  std::vector<double> viewpoint;  // unorganized map without --trajectory: x y z (default: centroid)
+  double angular_step = 1.0;      // unorganized map: range image degrees per pixel
+  std::string detect;             // empty or "stairs": run the shipped cascade on every view
   std::string backend = "auto", backend_source = "default";
   bool force = false;
 };

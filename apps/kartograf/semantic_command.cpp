@@ -20,14 +20,17 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
+#include "kartograf/geometry/range_image.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/occupancy_map_io.hpp"
 #include "kartograf/io/pcd.hpp"
+#include "kartograf/io/ply.hpp"
 #include "kartograf/io/semantic_map_io.hpp"
 #include "kartograf/io/sequence_detect.hpp"
 #include "kartograf/io/tum.hpp"
 #include "kartograf/semantic/classify.hpp"
 #include "kartograf/semantic/normals_image.hpp"
+#include "kartograf/semantic/object_detector.hpp"
 #include "kartograf/semantic/planning.hpp"
 #include "kartograf/semantic/semantic_grid.hpp"
 #include "output_folder.hpp"
@@ -49,6 +52,7 @@ constexpr std::initializer_list<const char*> kOutputs = {
 struct LabelledPoints {
   std::vector<Eigen::Vector3d> points;
   std::vector<SemanticClass> labels;
+  std::vector<std::vector<Eigen::Vector3d>> detections;  // the points of each detected object
   Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
   semantic::SemanticLabelling view;
   PointImage view_points;  // the points of `view`, in its sensor frame
@@ -72,28 +76,113 @@ void make_up_z(const Eigen::Vector3d& up, LabelledPoints& out) {
       Eigen::Quaterniond::FromTwoVectors(up.normalized(), Eigen::Vector3d::UnitZ())
           .toRotationMatrix();
   for (Eigen::Vector3d& p : out.points) p = rotation * p;
+  for (std::vector<Eigen::Vector3d>& object : out.detections)
+    for (Eigen::Vector3d& p : object) p = rotation * p;
   out.sensor = rotation * out.sensor;
 }
 
-LabelledPoints scan_points(const SemanticOptions& o, const compute::Context& context) {
+// What every view goes through: the backend, and the object detector (--detect) if any.
+struct Views {
+  const compute::Context& context;
+  std::optional<semantic::ObjectDetector> detector;
+};
+
+// A labelled view of points seen from `pose`: its points join the map in the world frame, its up
+// direction the area-weighted vote; the first view is the one pictured and the sensor's place.
+void add_view(const PointImage& points, semantic::SemanticLabelling labelling,
+              const Eigen::Isometry3d& pose, Eigen::Vector3d& up_sum, const Views& views,
+              LabelledPoints& out) {
+  up_sum += labelling.gravity.support_area * (pose.linear() * labelling.gravity.up);
+  append_view(points, labelling, pose, out);
+  if (views.detector) {
+    for (semantic::ViewDetection& d : views.detector->detect(views.context, points)) {
+      for (Eigen::Vector3d& p : d.points) p = pose * p;
+      out.detections.push_back(std::move(d.points));
+    }
+  }
+  if (out.views++ == 0) {
+    out.sensor = pose.translation();
+    out.view = std::move(labelling);
+    out.view_points = points;
+  }
+}
+
+// An unorganized map (a fused SLAM map, merged scans): labelled on spherical range images from
+// every --step-th camera position of --trajectory, or from one viewpoint (--viewpoint, else the
+// file's own, else the centroid). A camera's range image stands upright in the camera's frame
+// (image up = -y); others in the map's (up = +z).
+LabelledPoints map_points(const SemanticOptions& o, const Views& views, const PointCloud& cloud,
+                          std::optional<Eigen::Isometry3d> file_viewpoint, std::ostream& err) {
+  require(!cloud.empty(), "semantic: '" + o.input.string() + "' holds no point");
+  std::vector<Eigen::Isometry3d> viewpoints;
+  if (!o.trajectory.empty()) {
+    const Trajectory trajectory = io::read_tum_trajectory(o.trajectory);
+    Eigen::Matrix3d sensor_axes;  // in the camera frame: x ahead = camera z, y left = -x, up = -y
+    sensor_axes << 0, -1, 0, 0, 0, -1, 1, 0, 0;
+    for (std::size_t i = 0; i < trajectory.size(); i += static_cast<std::size_t>(o.step)) {
+      Eigen::Isometry3d sensor = trajectory[i].pose;
+      sensor.linear() = trajectory[i].pose.linear() * sensor_axes;
+      viewpoints.push_back(sensor);
+    }
+    require(!viewpoints.empty(), "semantic: '" + o.trajectory.string() + "' holds no pose");
+  } else {
+    Eigen::Isometry3d sensor = Eigen::Isometry3d::Identity();
+    if (!o.viewpoint.empty()) {
+      require(o.viewpoint.size() == 3, "semantic: --viewpoint takes x y z");
+      sensor.translation() = Eigen::Vector3d(o.viewpoint[0], o.viewpoint[1], o.viewpoint[2]);
+    } else if (file_viewpoint) {
+      sensor.translation() = file_viewpoint->translation();
+    } else {
+      for (const Eigen::Vector3f& p : cloud.points) sensor.translation() += p.cast<double>();
+      sensor.translation() /= static_cast<double>(cloud.size());
+    }
+    viewpoints.push_back(sensor);
+  }
+  geometry::RangeImageParams range_params;
+  range_params.angular_step_deg = o.angular_step;
+  LabelledPoints out;
+  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
+  std::string first_failure;
+  for (const Eigen::Isometry3d& viewpoint : viewpoints) {
+    const geometry::RangeImage image =
+        geometry::make_range_image(cloud.points, viewpoint, range_params);
+    semantic::SemanticLabelling labelling;
+    try {
+      labelling = semantic::label_organized_points(views.context, image.points);
+    } catch (const Error& e) {
+      if (++out.views_without_gravity == 1) first_failure = e.what();
+      continue;
+    }
+    add_view(image.points, std::move(labelling), viewpoint, up_sum, views, out);
+  }
+  require(out.views > 0,
+          "semantic: no view of '" + o.input.string() + "' could be labelled: " + first_failure);
+  if (out.views_without_gravity > 0)
+    err << "semantic: " << out.views_without_gravity
+        << " viewpoints left out, e.g.: " << first_failure << "\n";
+  make_up_z(up_sum, out);
+  return out;
+}
+
+// A PCD or PLY file: an organized scan is labelled on its own pixel grid, anything else as a map
+// (a PCD's VIEWPOINT is where its sensor stood).
+LabelledPoints scan_points(const SemanticOptions& o, const Views& views, std::ostream& err) {
+  if (o.input.extension() == ".ply")
+    return map_points(o, views, io::read_ply(o.input), std::nullopt, err);
   const io::PcdCloud cloud = io::read_pcd(o.input);
-  require(cloud.organized(), "semantic: '" + o.input.string() +
-                                 "' is not organized (height 1): the labelling needs the "
-                                 "scan's pixel grid");
+  if (!cloud.organized()) return map_points(o, views, cloud.to_point_cloud(), cloud.viewpoint, err);
   const PointImage points = cloud.to_point_image();
   LabelledPoints out;
-  out.view = semantic::label_organized_points(context, points);
-  out.view_points = points;
-  out.views = 1;
-  append_view(points, out.view, Eigen::Isometry3d::Identity(), out);
+  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
+  add_view(points, semantic::label_organized_points(views.context, points),
+           Eigen::Isometry3d::Identity(), up_sum, views, out);
   make_up_z(out.view.gravity.up, out);
   return out;
 }
 
 // Every --step-th frame with a pose; up is the area-weighted mean of the views' estimated up
 // directions in the world frame (views that see no floor or ceiling cannot say and are left out).
-LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context& context,
-                               std::ostream& err) {
+LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std::ostream& err) {
   const io::OpenedSequence opened = io::open_sequence(o.input);
   const io::Sequence& sequence = *opened.sequence;
   std::optional<Trajectory> trajectory;
@@ -106,7 +195,6 @@ LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context&
   range.units_per_metre = sequence.depth_units_per_metre();
   LabelledPoints out;
   Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
-  bool first = true;
   std::string first_failure;
   for (std::size_t i = 0; i < count; i += static_cast<std::size_t>(o.step)) {
     const io::RgbdFrame frame = sequence.frame(i);
@@ -115,24 +203,16 @@ LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context&
       pose = i < trajectory->size() ? std::optional((*trajectory)[i].pose) : std::nullopt;
     if (!pose) continue;
     const PointImage points =
-        geometry::backproject(context, frame.depth, sequence.intrinsics(), range);
+        geometry::backproject(views.context, frame.depth, sequence.intrinsics(), range);
     semantic::SemanticLabelling labelling;
     try {
-      labelling = semantic::label_organized_points(context, points, params);
+      labelling = semantic::label_organized_points(views.context, points, params);
     } catch (const Error& e) {
       // e.g. a wall seen from close by: no floor or ceiling to find gravity
       if (++out.views_without_gravity == 1) first_failure = e.what();
       continue;
     }
-    ++out.views;
-    up_sum += labelling.gravity.support_area * (pose->linear() * labelling.gravity.up);
-    append_view(points, labelling, *pose, out);
-    if (first) {
-      out.sensor = pose->translation();
-      out.view = std::move(labelling);
-      out.view_points = points;
-      first = false;
-    }
+    add_view(points, std::move(labelling), *pose, up_sum, views, out);
   }
   require(out.views > 0, "semantic: no frame of '" + o.input.string() + "' could be labelled" +
                              (first_failure.empty() ? " (none has a pose)" : ": " + first_failure));
@@ -140,6 +220,40 @@ LabelledPoints sequence_points(const SemanticOptions& o, const compute::Context&
     err << "semantic: " << out.views_without_gravity << " frames left out, e.g.: " << first_failure
         << "\n";
   make_up_z(up_sum, out);
+  return out;
+}
+
+// One map object per detected thing: detections (of several views) whose centres lie within
+// kSameObjectDistance of each other are one object seen again; their points are pooled.
+constexpr double kSameObjectDistance = 1.0;  // [m]
+
+std::vector<semantic::ObjectDetection> place_detections(const LabelledPoints& labelled,
+                                                        const std::string& object_class,
+                                                        std::ostream& err) {
+  std::vector<std::vector<Eigen::Vector3d>> objects;
+  std::vector<Eigen::Vector2d> centres;
+  for (const std::vector<Eigen::Vector3d>& points : labelled.detections) {
+    if (points.size() < 3) continue;
+    Eigen::Vector2d centre = Eigen::Vector2d::Zero();
+    for (const Eigen::Vector3d& p : points) centre += p.head<2>();
+    centre /= static_cast<double>(points.size());
+    std::size_t k = 0;
+    while (k < centres.size() && (centres[k] - centre).norm() > kSameObjectDistance) ++k;
+    if (k == centres.size()) {
+      centres.push_back(centre);
+      objects.emplace_back();
+    }
+    objects[k].insert(objects[k].end(), points.begin(), points.end());
+  }
+  std::vector<semantic::ObjectDetection> out;
+  for (std::size_t k = 0; k < objects.size(); ++k) {
+    try {
+      out.push_back(semantic::to_map_detection(objects[k], SemanticClass::furniture,
+                                               object_class + " " + std::to_string(k + 1)));
+    } catch (const Error& e) {
+      err << "semantic: " << e.what() << ": left off the map\n";  // seen edge-on
+    }
+  }
   return out;
 }
 
@@ -219,18 +333,33 @@ CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& o) {
       "ceiling, doors, traversability, and a path (methods.md M2)");
   command
       ->add_option("INPUT", o.input,
-                   "Organized PCD (a 3-D laser scan or a depth frame), or an RGB-D sequence "
-                   "folder with poses (TUM, 7-Scenes, kartograf synth)")
+                   "Organized PCD (a 3-D laser scan or a depth frame), an unorganized map (PCD "
+                   "or PLY: labelled on range images), or an RGB-D sequence folder with poses "
+                   "(TUM, 7-Scenes, kartograf synth)")
       ->required();
   command->add_option("--trajectory", o.trajectory,
                       "Sequence: camera poses in TUM format, one per frame (e.g. a SLAM run's "
-                      "trajectory.txt; default: the ground truth)");
+                      "trajectory.txt; default: the ground truth). Map: every --step-th pose "
+                      "is a viewpoint of a range image");
+  command
+      ->add_option("--viewpoint", o.viewpoint,
+                   "Map without --trajectory: where the range image is seen from, x y z "
+                   "(default: a PCD's VIEWPOINT, a PLY's centroid)")
+      ->expected(3);
+  command->add_option("--angular-step", o.angular_step, "Map: range image degrees per pixel")
+      ->capture_default_str();
   command->add_option("--frames", o.frames, "Sequence: only the first N frames (0: all)");
-  command->add_option("--step", o.step, "Sequence: every k-th frame")->capture_default_str();
+  command->add_option("--step", o.step, "Sequence: every k-th frame (map: k-th viewpoint)")
+      ->capture_default_str();
   command->add_option("--out", o.out_dir, "Output folder")->required();
   command->add_option("--goto", o.goto_target, "Plan from the sensor: door | wall")
       ->check(CLI::IsMember({"door", "wall"}));
   command->add_option("--resolution", o.resolution, "Grid cell size [m]")->capture_default_str();
+  command
+      ->add_option("--detect", o.detect,
+                   "Run the shipped Haar cascade of this class on every view; its finds are "
+                   "objects on the grid (obstacles)")
+      ->check(CLI::IsMember({"stairs"}));
   add_backend_option(*command, o.backend, o.backend_source, "Where the normals run: ");
   command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
   return command;
@@ -243,13 +372,17 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
   require(fs::exists(o.input), "semantic: " + o.input.string() + ": no such file or folder");
   check_output_folder("semantic", o.out_dir, kOutputs, o.force);
   const compute::Context context = backend_context(o.backend, o.backend_source);
+  Views views{context, std::nullopt};
+  if (o.detect == "stairs") views.detector = semantic::ObjectDetector::stairs();
   const LabelledPoints labelled =
-      fs::is_directory(o.input) ? sequence_points(o, context, err) : scan_points(o, context);
+      fs::is_directory(o.input) ? sequence_points(o, views, err) : scan_points(o, views, err);
+  const std::vector<semantic::ObjectDetection> detections =
+      place_detections(labelled, o.detect, err);
   const semantic::SemanticLabelling& labelling = labelled.view;
   semantic::SemanticGridOptions grid_options;
   grid_options.resolution = o.resolution;
   const semantic::SemanticGrid grid =
-      semantic::build_semantic_grid(labelled.points, labelled.labels, grid_options);
+      semantic::build_semantic_grid(labelled.points, labelled.labels, grid_options, detections);
 
   // Everything is computed (and the path planned) before the first file is written.
   semantic::MapPicture picture = semantic::render_map(grid);
