@@ -106,6 +106,35 @@ TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
   EXPECT_EQ(class_at(kX1 + 0.2, 1.5), SemanticClass::unknown);
 }
 
+// A table seen only by its edges (top dropped out), labelled unknown as M2 leaves it: the floor it
+// encloses is blocked. An L of unknown clutter in the open encloses nothing: the floor beside it
+// stays free.
+TEST(SemanticGrid, UnclassifiedOutlinesThatEncloseFloorBlockIt) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 3.012, 0}, C::floor);
+  s.box_face({1.012, 1.012, 0.72}, {2.212, 1.012, 0.76}, C::unknown);  // table edges, 1.2 x 0.8
+  s.box_face({1.012, 1.812, 0.72}, {2.212, 1.812, 0.76}, C::unknown);
+  s.box_face({1.012, 1.012, 0.72}, {1.012, 1.812, 0.76}, C::unknown);
+  s.box_face({2.212, 1.012, 0.72}, {2.212, 1.812, 0.76}, C::unknown);
+  s.box_face({2.812, 0.512, 0.3}, {3.612, 0.512, 0.6}, C::unknown);  // an L of clutter
+  s.box_face({2.812, 0.512, 0.3}, {2.812, 1.312, 0.6}, C::unknown);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  const auto at = [&](double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return std::pair{grid.classes(c.x(), c.y()), grid.weight(c.x(), c.y())};
+  };
+  EXPECT_EQ(at(1.6, 1.4), std::pair(C::unknown, 0.0f));  // under the table
+  EXPECT_EQ(at(1.1, 1.1), std::pair(C::unknown, 0.0f));
+  EXPECT_EQ(at(3.2, 0.9), std::pair(C::floor, 1.0f));  // inside the L's corner
+  EXPECT_EQ(at(3.0, 2.5), std::pair(C::floor, 1.0f));
+  SemanticGridOptions off;
+  off.max_furniture_fill_area = 0;
+  const SemanticGrid unfilled = build_semantic_grid(s.points, s.labels, off);
+  const Eigen::Vector2i under = unfilled.cell_of({1.6, 1.4});
+  EXPECT_EQ(unfilled.classes(under.x(), under.y()), C::floor);
+}
+
 TEST_F(SemanticGridRoom, DoorWallsAndFurnitureAreObjects) {
   const auto doors = objects_of(ObjectKind::doorway);
   ASSERT_EQ(doors.size(), 1u);

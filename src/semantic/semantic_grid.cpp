@@ -336,6 +336,40 @@ void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double m
   }
 }
 
+// Unclassified obstacles that enclose floor (the legs and edges of a table whose top dropped out of
+// grazing views; M2 has no furniture rule): each enclosed hole of at most max_area is obstacle.
+// Only closed loops count: an L of clutter along two walls encloses nothing.
+void fill_enclosed_by_unclassified(SemanticGrid& grid, double max_area, float weight) {
+  const int w = grid.width(), h = grid.height();
+  cv::Mat mask(h, w, CV_8U);
+  for (int row = 0; row < h; ++row)
+    for (int col = 0; col < w; ++col)
+      mask.at<std::uint8_t>(row, col) =
+          grid.classes(col, row) == SemanticClass::unknown && grid.weight(col, row) == 0.0f ? 255
+                                                                                            : 0;
+  cv::Mat closed;
+  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  std::vector<std::vector<cv::Point>> contours;
+  std::vector<cv::Vec4i> hierarchy;
+  cv::findContours(closed, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_SIMPLE);
+  cv::Mat fill = cv::Mat::zeros(h, w, CV_8U);
+  const double cell_area = grid.resolution * grid.resolution;
+  for (std::size_t k = 0; k < contours.size(); ++k) {
+    const bool hole = hierarchy[k][3] >= 0;
+    if (hole && cv::contourArea(contours[k]) * cell_area <= max_area)
+      cv::drawContours(fill, contours, static_cast<int>(k), 255, cv::FILLED);
+  }
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      if (!fill.at<std::uint8_t>(row, col) || grid.classes(col, row) != SemanticClass::floor)
+        continue;
+      grid.classes(col, row) = SemanticClass::unknown;
+      grid.weight(col, row) = weight;
+    }
+  }
+}
+
 // A surface on the boundary between two cells (the synthetic world's walls lie on the 5 cm
 // lattice) puts noisy points on both sides of it. The cell that sees floor and whose band points
 // hug the side facing an obstacle cell with less floor is free: the surface belongs to the other.
@@ -580,6 +614,8 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   if (options.max_furniture_fill_area > 0)
     fill_furniture(grid, furniture, options.max_furniture_fill_area,
                    options.weights.of(SemanticClass::furniture));
+  if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
+    fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
   int doorway_count = 0;
   int leaf_count = 0;
   for (auto& cells : components(leaf))

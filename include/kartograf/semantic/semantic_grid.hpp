@@ -15,7 +15,8 @@
 //   nothing             -> unobserved (class unknown, weight NaN)
 // Clean-up before objects: an obstacle cell that sees floor and only holds points spilled over
 // from a surface on its boundary is floor; isolated obstacle cells are specks; furniture outlines
-// are filled to their convex hull (table tops drop out of grazing views).
+// are filled to their convex hull (table tops drop out of grazing views), and floor enclosed by a
+// closed loop of unclassified obstacle cells (a table's edges labelled unknown) is an obstacle.
 // Objects: straight wall pieces (wall cells grouped by their local direction), doorways (with
 // centre and width), door leaves and furniture (connected components of their cells); detections
 // add their own objects on the cells their footprint covers.
@@ -82,6 +83,7 @@ struct SemanticGridOptions {
   bool remove_isolated_obstacles = true;
   // Furniture outlines (legs, edges: a table top drops out at grazing views) are closed and
   // filled to their convex hull when that is at most this area [m^2]; 0: off.
+  // The same bound holds for floor enclosed by unclassified obstacles.
   double max_furniture_fill_area = 4.0;  // obstacle cells without an obstacle neighbour: specks
   int min_floor_points = 1;
   double margin = 0.25;          // metres of grid around the data
