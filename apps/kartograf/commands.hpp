@@ -54,6 +54,9 @@ struct SynthOptions {
   int frames = 300;
   std::string trajectory = "robot";  // robot | handheld
   int room = 0;                      // handheld: room id, 0 = the largest
+  double look_around_deg = 30.0;     // robot: the yaw sweep inside each room
+  double pitch_deg = 12.0;           // robot: the camera's downward pitch
+  bool survey = false;               // robot: a full turn in every room (TourOptions::survey)
   PinholeIntrinsics intrinsics{640, 480, 525.0, 525.0, 319.5, 239.5};
   bool intrinsics_given = false;  // any of --fx --fy --cx --cy; else scaled to --width/--height
   bool no_noise = false;
@@ -157,5 +160,18 @@ struct SemanticOptions {
 };
 CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& options);
 int run_semantic_command(const SemanticOptions& options, std::ostream& out, std::ostream& err);
+
+// `map SEQUENCE --out DIR`: the end-to-end pipeline (pipeline/map_pipeline.hpp) and its report.
+struct MapOptions {
+  SequenceRunOptions run;
+  std::filesystem::path out_dir;
+  std::size_t label_step = 5;
+  int label_width = 320;
+  double resolution = 0.05;
+  std::string room_method = "distance";
+  bool force = false;
+};
+CLI::App* add_map_command(CLI::App& app, MapOptions& options);
+int run_map_command(const MapOptions& options, std::ostream& out, std::ostream& err);
 
 }  // namespace kartograf::cli

@@ -43,6 +43,8 @@ int main(int argc, char** argv) {
   CLI::App* rooms_eval = kartograf::cli::add_rooms_eval_command(app, rooms_eval_options);
   kartograf::cli::SemanticOptions semantic_options;
   CLI::App* semantic = kartograf::cli::add_semantic_command(app, semantic_options);
+  kartograf::cli::MapOptions map_options;
+  CLI::App* map = kartograf::cli::add_map_command(app, map_options);
 
   try {
     app.parse(argc, argv);
@@ -68,6 +70,7 @@ int main(int argc, char** argv) {
     if (*rooms_eval) {
       return kartograf::cli::run_rooms_eval_command(rooms_eval_options, std::cout, std::cerr);
     }
+    if (*map) return kartograf::cli::run_map_command(map_options, std::cout, std::cerr);
     if (*semantic)
       return kartograf::cli::run_semantic_command(semantic_options, std::cout, std::cerr);
   } catch (const std::exception& e) {

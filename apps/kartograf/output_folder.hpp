@@ -3,7 +3,9 @@
 // to, and say so before any work is done.
 #include <filesystem>
 #include <initializer_list>
+#include <string>
 #include <string_view>
+#include <vector>
 
 namespace kartograf::cli {
 
@@ -11,5 +13,7 @@ namespace kartograf::cli {
 // `files`, unless `force`.
 void check_output_folder(std::string_view command, const std::filesystem::path& dir,
                          std::initializer_list<const char*> files, bool force);
+void check_output_folder(std::string_view command, const std::filesystem::path& dir,
+                         const std::vector<std::string>& files, bool force);
 
 }  // namespace kartograf::cli

@@ -29,6 +29,7 @@
 #include "kartograf/io/sequence_detect.hpp"
 #include "kartograf/io/tum.hpp"
 #include "kartograf/semantic/classify.hpp"
+#include "kartograf/semantic/labelled_views.hpp"
 #include "kartograf/semantic/normals_image.hpp"
 #include "kartograf/semantic/object_detector.hpp"
 #include "kartograf/semantic/planning.hpp"
@@ -50,32 +51,16 @@ constexpr std::initializer_list<const char*> kOutputs = {
 // Labelled points in a frame whose +z is up (the grid's), where the sensor stood, and the labels
 // and normals of one view for the pictures.
 struct LabelledPoints {
-  std::vector<Eigen::Vector3d> points;
-  std::vector<SemanticClass> labels;
+  semantic::LabelledViews pooled;
   std::vector<std::vector<Eigen::Vector3d>> detections;  // the points of each detected object
   Eigen::Vector3d sensor = Eigen::Vector3d::Zero();
   semantic::SemanticLabelling view;
   PointImage view_points;  // the points of `view`, in its sensor frame
-  int views = 0, views_without_gravity = 0;
 };
 
-// Appends the valid points of a labelled view, moved by `to_world`.
-void append_view(const PointImage& points, const semantic::SemanticLabelling& labelling,
-                 const Eigen::Isometry3d& to_world, LabelledPoints& out) {
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const Point4f& p = points.data()[i];
-    if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
-    out.points.push_back(to_world * p.head<3>().cast<double>());
-    out.labels.push_back(labelling.semantic.data()[i]);
-  }
-}
-
-// Turns every point (and the sensor) so that `up` becomes +z.
-void make_up_z(const Eigen::Vector3d& up, LabelledPoints& out) {
-  const Eigen::Matrix3d rotation =
-      Eigen::Quaterniond::FromTwoVectors(up.normalized(), Eigen::Vector3d::UnitZ())
-          .toRotationMatrix();
-  for (Eigen::Vector3d& p : out.points) p = rotation * p;
+// Turns every point (and the sensor) so that the views' up becomes +z.
+void make_up_z(LabelledPoints& out) {
+  const Eigen::Matrix3d rotation = out.pooled.make_up_z();
   for (std::vector<Eigen::Vector3d>& object : out.detections)
     for (Eigen::Vector3d& p : object) p = rotation * p;
   out.sensor = rotation * out.sensor;
@@ -90,17 +75,15 @@ struct Views {
 // A labelled view of points seen from `pose`: its points join the map in the world frame, its up
 // direction the area-weighted vote; the first view is the one pictured and the sensor's place.
 void add_view(const PointImage& points, semantic::SemanticLabelling labelling,
-              const Eigen::Isometry3d& pose, Eigen::Vector3d& up_sum, const Views& views,
-              LabelledPoints& out) {
-  up_sum += labelling.gravity.support_area * (pose.linear() * labelling.gravity.up);
-  append_view(points, labelling, pose, out);
+              const Eigen::Isometry3d& pose, const Views& views, LabelledPoints& out) {
+  out.pooled.add(points, labelling.semantic, labelling.gravity, pose);
   if (views.detector) {
     for (semantic::ViewDetection& d : views.detector->detect(views.context, points)) {
       for (Eigen::Vector3d& p : d.points) p = pose * p;
       out.detections.push_back(std::move(d.points));
     }
   }
-  if (out.views++ == 0) {
+  if (out.pooled.views() == 1) {
     out.sensor = pose.translation();
     out.view = std::move(labelling);
     out.view_points = points;
@@ -141,8 +124,6 @@ LabelledPoints map_points(const SemanticOptions& o, const Views& views, const Po
   geometry::RangeImageParams range_params;
   range_params.angular_step_deg = o.angular_step;
   LabelledPoints out;
-  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
-  std::string first_failure;
   for (const Eigen::Isometry3d& viewpoint : viewpoints) {
     const geometry::RangeImage image =
         geometry::make_range_image(cloud.points, viewpoint, range_params);
@@ -150,17 +131,17 @@ LabelledPoints map_points(const SemanticOptions& o, const Views& views, const Po
     try {
       labelling = semantic::label_organized_points(views.context, image.points);
     } catch (const Error& e) {
-      if (++out.views_without_gravity == 1) first_failure = e.what();
+      out.pooled.skip(e.what());
       continue;
     }
-    add_view(image.points, std::move(labelling), viewpoint, up_sum, views, out);
+    add_view(image.points, std::move(labelling), viewpoint, views, out);
   }
-  require(out.views > 0,
-          "semantic: no view of '" + o.input.string() + "' could be labelled: " + first_failure);
-  if (out.views_without_gravity > 0)
-    err << "semantic: " << out.views_without_gravity
-        << " viewpoints left out, e.g.: " << first_failure << "\n";
-  make_up_z(up_sum, out);
+  require(out.pooled.views() > 0, "semantic: no view of '" + o.input.string() +
+                                      "' could be labelled: " + out.pooled.first_skip_reason());
+  if (out.pooled.skipped() > 0)
+    err << "semantic: " << out.pooled.skipped()
+        << " viewpoints left out, e.g.: " << out.pooled.first_skip_reason() << "\n";
+  make_up_z(out);
   return out;
 }
 
@@ -173,10 +154,9 @@ LabelledPoints scan_points(const SemanticOptions& o, const Views& views, std::os
   if (!cloud.organized()) return map_points(o, views, cloud.to_point_cloud(), cloud.viewpoint, err);
   const PointImage points = cloud.to_point_image();
   LabelledPoints out;
-  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
   add_view(points, semantic::label_organized_points(views.context, points),
-           Eigen::Isometry3d::Identity(), up_sum, views, out);
-  make_up_z(out.view.gravity.up, out);
+           Eigen::Isometry3d::Identity(), views, out);
+  make_up_z(out);
   return out;
 }
 
@@ -194,8 +174,6 @@ LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std
   geometry::DepthRange range;
   range.units_per_metre = sequence.depth_units_per_metre();
   LabelledPoints out;
-  Eigen::Vector3d up_sum = Eigen::Vector3d::Zero();
-  std::string first_failure;
   for (std::size_t i = 0; i < count; i += static_cast<std::size_t>(o.step)) {
     const io::RgbdFrame frame = sequence.frame(i);
     std::optional<Eigen::Isometry3d> pose = frame.pose;
@@ -209,17 +187,18 @@ LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std
       labelling = semantic::label_organized_points(views.context, points, params);
     } catch (const Error& e) {
       // e.g. a wall seen from close by: no floor or ceiling to find gravity
-      if (++out.views_without_gravity == 1) first_failure = e.what();
+      out.pooled.skip(e.what());
       continue;
     }
-    add_view(points, std::move(labelling), *pose, up_sum, views, out);
+    add_view(points, std::move(labelling), *pose, views, out);
   }
-  require(out.views > 0, "semantic: no frame of '" + o.input.string() + "' could be labelled" +
-                             (first_failure.empty() ? " (none has a pose)" : ": " + first_failure));
-  if (out.views_without_gravity > 0)
-    err << "semantic: " << out.views_without_gravity << " frames left out, e.g.: " << first_failure
-        << "\n";
-  make_up_z(up_sum, out);
+  const std::string& failure = out.pooled.first_skip_reason();
+  require(out.pooled.views() > 0, "semantic: no frame of '" + o.input.string() +
+                                      "' could be labelled" +
+                                      (failure.empty() ? " (none has a pose)" : ": " + failure));
+  if (out.pooled.skipped() > 0)
+    err << "semantic: " << out.pooled.skipped() << " frames left out, e.g.: " << failure << "\n";
+  make_up_z(out);
   return out;
 }
 
@@ -381,8 +360,8 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
   const semantic::SemanticLabelling& labelling = labelled.view;
   semantic::SemanticGridOptions grid_options;
   grid_options.resolution = o.resolution;
-  const semantic::SemanticGrid grid =
-      semantic::build_semantic_grid(labelled.points, labelled.labels, grid_options, detections);
+  const semantic::SemanticGrid grid = semantic::build_semantic_grid(
+      labelled.pooled.points(), labelled.pooled.labels(), grid_options, detections);
 
   // Everything is computed (and the path planned) before the first file is written.
   semantic::MapPicture picture = semantic::render_map(grid);
@@ -418,7 +397,7 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
   std::map<std::string, int> kinds;
   for (const semantic::SemanticObject& object : grid.objects)
     ++kinds[std::string(semantic::to_string(object.kind))];
-  out << o.input.string() << ": " << labelled.views << " view(s), " << grid.width() << "x"
+  out << o.input.string() << ": " << labelled.pooled.views() << " view(s), " << grid.width() << "x"
       << grid.height() << " cells of " << grid.resolution << " m;";
   for (const auto& [kind, count] : kinds) out << " " << count << " " << kind;
   for (const io::NamedPath& p : paths)

@@ -24,6 +24,16 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
   synth->add_option("--trajectory", o.trajectory, "robot: a tour of every room; handheld: one room")
       ->capture_default_str()
       ->check(CLI::IsMember({"robot", "handheld"}));
+  synth
+      ->add_option("--look-around", o.look_around_deg,
+                   "robot: how far the camera turns left and right inside each room [deg]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 170.0));
+  synth->add_flag("--survey", o.survey,
+                  "robot: turn once all the way round in every room and corridor pass");
+  synth->add_option("--pitch", o.pitch_deg, "robot: the camera's downward pitch [deg]")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 60.0));
   synth->add_option("--room", o.room, "handheld: the room id (default: the largest room)");
   synth
       ->add_option(
@@ -60,6 +70,9 @@ int run_synth_command(const SynthOptions& o, std::ostream& out, std::ostream& er
   options.trajectory = o.trajectory == "handheld" ? io::SyntheticTrajectory::handheld
                                                   : io::SyntheticTrajectory::robot;
   options.handheld_room = static_cast<Label>(o.room);
+  options.tour.look_around_deg = o.look_around_deg;
+  options.tour.pitch_deg = o.pitch_deg;
+  options.tour.survey = o.survey;
   require(o.room >= 0 && o.room <= 65535, "--room must be a room id");
   options.intrinsics = o.intrinsics;
   if (!o.intrinsics_given) {

@@ -413,4 +413,25 @@ SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir
   return summary;
 }
 
+std::optional<FloorPlanTruth> read_floor_plan_truth(const std::filesystem::path& dir) {
+  const std::filesystem::path files[] = {dir / "floor_plan.yaml", dir / "rooms.png",
+                                         dir / "semantic_grid.png"};
+  int present = 0;
+  for (const auto& file : files) present += std::filesystem::exists(file);
+  if (present == 0) return std::nullopt;
+  for (const auto& file : files)
+    require(std::filesystem::exists(file), "floor plan ground truth in " + dir.string() + ": " +
+                                               file.filename().string() + " is missing");
+  FloorPlanTruth truth{read_ros_map(files[0]), read_label_png(files[1]),
+                       read_semantic_png(files[2])};
+  for (const auto& [size, name] :
+       {std::pair{Eigen::Vector2i(truth.rooms.width(), truth.rooms.height()), "rooms.png"},
+        std::pair{Eigen::Vector2i(truth.classes.width(), truth.classes.height()),
+                  "semantic_grid.png"}})
+    require(size == Eigen::Vector2i(truth.plan.width(), truth.plan.height()),
+            "floor plan ground truth in " + dir.string() + ": " + name +
+                " differs in size from floor_plan.yaml's map");
+  return truth;
+}
+
 }  // namespace kartograf::io

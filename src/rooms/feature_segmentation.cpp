@@ -1,4 +1,5 @@
 #include "kartograf/rooms/feature_segmentation.hpp"
+#include "kartograf/core/models.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -306,7 +307,7 @@ Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier
 std::filesystem::path default_room_classifier_path() {
   if (const char* configured = std::getenv("KARTOGRAF_ROOM_MODEL"); configured && *configured)
     return configured;
-  return std::filesystem::path(KARTOGRAF_MODELS_DIR) / "rooms" / "room_hallway_boost.yml.gz";
+  return models_dir() / "rooms" / "room_hallway_boost.yml.gz";
 }
 
 RoomSegmentation segment_feature_based(const OccupancyGrid& map, const RoomClassifier& classifier,

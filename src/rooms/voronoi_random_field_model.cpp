@@ -11,6 +11,7 @@
 #include <opencv2/ml.hpp>
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/models.hpp"
 #include "kartograf/rooms/voronoi_random_field.hpp"
 
 namespace kartograf::rooms {
@@ -406,7 +407,7 @@ VrfModel VrfModel::load(const std::filesystem::path& path) {
 std::filesystem::path default_vrf_model_path() {
   if (const char* configured = std::getenv("KARTOGRAF_VRF_MODEL"); configured && *configured)
     return configured;
-  return std::filesystem::path(KARTOGRAF_MODELS_DIR) / "rooms" / "vrf_model.yml.gz";
+  return models_dir() / "rooms" / "vrf_model.yml.gz";
 }
 
 }  // namespace kartograf::rooms

@@ -1,4 +1,5 @@
 #include "kartograf/semantic/ground_texture.hpp"
+#include "kartograf/core/models.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -322,11 +323,7 @@ std::filesystem::path default_ground_texture_model_path() {
   if (const char* configured = std::getenv("KARTOGRAF_GROUND_TEXTURE_MODEL");
       configured && *configured)
     return configured;
-#ifdef KARTOGRAF_MODELS_DIR
-  return std::filesystem::path(KARTOGRAF_MODELS_DIR) / "semantic" / "ground_texture.yml.gz";
-#else
-  return std::filesystem::path("models") / "semantic" / "ground_texture.yml.gz";
-#endif
+  return models_dir() / "semantic" / "ground_texture.yml.gz";
 }
 
 // ---- Synthetic patches -------------------------------------------------------------------------

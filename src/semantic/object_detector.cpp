@@ -1,4 +1,5 @@
 #include "kartograf/semantic/object_detector.hpp"
+#include "kartograf/core/models.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -52,11 +53,7 @@ ObjectDetector::ObjectDetector(HaarCascade cascade, SizeLimits limits, ObjectDet
 }
 
 std::filesystem::path ObjectDetector::default_stairs_model_path() {
-#ifdef KARTOGRAF_MODELS_DIR
-  return std::filesystem::path(KARTOGRAF_MODELS_DIR) / "semantic" / "stairs_cascade.yml.gz";
-#else
-  return std::filesystem::path("models") / "semantic" / "stairs_cascade.yml.gz";
-#endif
+  return models_dir() / "semantic" / "stairs_cascade.yml.gz";
 }
 
 ObjectDetector ObjectDetector::stairs() {

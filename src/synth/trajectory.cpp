@@ -32,6 +32,11 @@ double look_shape(double x) {
   return std::sin(2 * std::numbers::pi * x) * std::pow(std::sin(std::numbers::pi * x), 2) / peak;
 }
 
+// One full turn to the left on [0, 1], with zero turn rate at both ends.
+double turn_shape(double x) {
+  return 2 * std::numbers::pi * x - std::sin(2 * std::numbers::pi * x);
+}
+
 struct Interval {
   double begin, end;
 };
@@ -40,8 +45,8 @@ struct Interval {
 // the straight stretches at its doorways), a look to the left and to the right.
 class TourPlan {
  public:
-  TourPlan(const World& world, double look_around_deg)
-      : path_(route_path(world)), amplitude_(look_around_deg * kDegree) {
+  TourPlan(const World& world, double look_around_deg, bool survey)
+      : path_(route_path(world)), amplitude_(look_around_deg * kDegree), survey_(survey) {
     const auto& s = path_.vertex_positions();
     std::vector<std::size_t> doors;
     for (std::size_t i = 0; i < world.route.size(); ++i) {
@@ -55,7 +60,8 @@ class TourPlan {
       if (end < begin - 1e-9) end += length;  // wraps past the start
       if (end - begin < 0.5) continue;
       const Label room = world.room_at(path_.position(0.5 * (begin + end)));
-      if (room && world.room(room).kind == RoomKind::room) looks_.push_back({begin, end});
+      if (room && (survey || world.room(room).kind == RoomKind::room))
+        looks_.push_back({begin, end});
     }
   }
 
@@ -66,7 +72,7 @@ class TourPlan {
     for (const Interval& look : looks_) {
       for (double shift : {0.0, path_.length()}) {  // an interval may wrap past the end
         const double x = (s + shift - look.begin) / (look.end - look.begin);
-        if (x > 0 && x < 1) yaw += amplitude_ * look_shape(x);
+        if (x > 0 && x < 1) yaw += survey_ ? turn_shape(x) : amplitude_ * look_shape(x);
       }
     }
     return yaw;
@@ -75,6 +81,7 @@ class TourPlan {
  private:
   RoutePath path_;
   double amplitude_;
+  bool survey_;
   std::vector<Interval> looks_;
 };
 
@@ -151,7 +158,9 @@ double frames_at_limits(const TourPlan& plan, const TourOptions& options) {
 
 int tour_frames_needed(const World& world, const TourOptions& options) {
   options.validate();
-  return static_cast<int>(std::ceil(frames_at_limits(TourPlan(world, 0.0), options))) + 1;
+  return static_cast<int>(
+             std::ceil(frames_at_limits(TourPlan(world, 0.0, options.survey), options))) +
+         1;
 }
 
 Trajectory robot_tour(const World& world, int frame_count, const TourOptions& options) {
@@ -162,7 +171,7 @@ Trajectory robot_tour(const World& world, int frame_count, const TourOptions& op
   // needed grow with it).
   const double budget = frame_count - 1;
   auto fits = [&](double look) {
-    return frames_at_limits(TourPlan(world, look), options) <= budget;
+    return frames_at_limits(TourPlan(world, look, options.survey), options) <= budget;
   };
   double look = options.look_around_deg;
   if (!fits(look)) {
@@ -175,7 +184,7 @@ Trajectory robot_tour(const World& world, int frame_count, const TourOptions& op
     }
     look = lo;
   }
-  const TourPlan plan(world, look);
+  const TourPlan plan(world, look, options.survey);
   int samples = 0;
   const std::vector<double> rate = frames_per_metre(plan, options, samples);
   const double length = plan.path().length();

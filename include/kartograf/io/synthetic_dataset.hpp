@@ -26,9 +26,12 @@
 #include <cstdint>
 #include <filesystem>
 #include <functional>
+#include <optional>
 #include <string>
 
 #include "kartograf/core/intrinsics.hpp"
+#include "kartograf/core/label_image.hpp"
+#include "kartograf/core/occupancy_grid.hpp"
 #include "kartograf/core/trajectory.hpp"
 #include "kartograf/synth/laser_scan.hpp"
 #include "kartograf/synth/render.hpp"
@@ -69,6 +72,16 @@ struct SyntheticDatasetSummary {
 // cannot be created, and naming the file when a write fails.
 SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir,
                                                 const SyntheticDatasetOptions& options);
+
+// The floor plan a data set folder holds as ground truth (floor_plan.yaml + .pgm, rooms.png,
+// semantic_grid.png), as pipeline/map_evaluation.hpp takes it; nullopt when the folder has none of
+// them. Throws Error when only some are there or one cannot be read.
+struct FloorPlanTruth {
+  OccupancyGrid plan;
+  LabelImage rooms;
+  SemanticImage classes;
+};
+std::optional<FloorPlanTruth> read_floor_plan_truth(const std::filesystem::path& dir);
 
 // The TUM file name stem of a timestamp: 6 decimals ("1.033333").
 std::string timestamp_name(double timestamp);

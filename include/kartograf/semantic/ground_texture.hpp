@@ -103,7 +103,7 @@ class GroundTextureClassifier {
 };
 
 // The shipped model: $KARTOGRAF_GROUND_TEXTURE_MODEL when set, else
-// <models folder>/semantic/ground_texture.yml.gz (KARTOGRAF_MODELS_DIR at build time).
+// <models folder>/semantic/ground_texture.yml.gz (core/models.hpp).
 std::filesystem::path default_ground_texture_model_path();
 
 // ---- Synthetic labelled patches ----------------------------------------------------------------

@@ -37,8 +37,8 @@ class ObjectDetector {
  public:
   // Throws Error on an empty cascade or bad limits.
   ObjectDetector(HaarCascade cascade, SizeLimits limits, ObjectDetectorParams params = {});
-  // The shipped stairs cascade (models/semantic/stairs_cascade.yml.gz, KARTOGRAF_MODELS_DIR at
-  // build time) with stairs_size_limits().
+  // The shipped stairs cascade (semantic/stairs_cascade.yml.gz under core/models.hpp's folder)
+  // with stairs_size_limits().
   static ObjectDetector stairs();
   static std::filesystem::path default_stairs_model_path();
 

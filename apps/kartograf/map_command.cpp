@@ -1,0 +1,178 @@
+// `kartograf map SEQUENCE --out DIR`: the whole pipeline (pipeline/map_pipeline.hpp) on an RGB-D
+// sequence, scored against the sequence's ground truth where it has one (poses; a synthetic
+// building's floor plan), written by io/map_outputs.hpp. Progress per stage on stderr, the report's
+// path on stdout. Wiring only.
+#include <csignal>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <ostream>
+#include <string>
+
+#include <pthread.h>
+
+#include "commands.hpp"
+#include "kartograf/io/map_outputs.hpp"
+#include "kartograf/io/synthetic_dataset.hpp"
+#include "kartograf/pipeline/map_evaluation.hpp"
+#include "kartograf/pipeline/map_pipeline.hpp"
+#include "output_folder.hpp"
+#include "sequence_run.hpp"
+
+namespace kartograf::cli {
+
+namespace {
+
+// Holds back SIGINT, SIGTERM and SIGHUP while the files are written, so that an interrupted run
+// leaves all of them or none of this run's; a signal that came meanwhile acts on destruction.
+class SignalsHeldBack {
+ public:
+  SignalsHeldBack() {
+    sigemptyset(&held_);
+    for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&held_, s);
+    pthread_sigmask(SIG_BLOCK, &held_, &previous_);
+  }
+  ~SignalsHeldBack() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
+  SignalsHeldBack(const SignalsHeldBack&) = delete;
+  SignalsHeldBack& operator=(const SignalsHeldBack&) = delete;
+
+ private:
+  sigset_t held_, previous_;
+};
+
+Json parameters_json(const MapOptions& o, const pipeline::MapPipelineParams& p) {
+  return {{"method", o.run.method},
+          {"reestimate_interval", o.run.reestimate_interval},
+          {"label_step", p.label_step},
+          {"label_width", p.label_width},
+          {"grid_resolution_m", p.grid.resolution},
+          {"map_voxel_m", p.slam.map.voxel_size},
+          {"room_method", rooms::to_string(p.room_method)}};
+}
+
+void print_summary(std::ostream& out, const pipeline::MapPipelineResult& r,
+                   const std::optional<pipeline::MapEvaluation>& e) {
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "  %zu frames, %d views labelled, %zu planes, %zu objects on a %dx%d grid, %zu "
+                "rooms (%s)\n",
+                r.poses.size(), r.labelled_views, r.planes.size(), r.semantic.objects.size(),
+                r.semantic.width(), r.semantic.height(), r.rooms.records.size(),
+                r.rooms.method.c_str());
+  out << line << "  seconds";
+  for (const pipeline::StageTiming& t : r.timings) {
+    std::snprintf(line, sizeof(line), " %s %.1f,", t.stage.c_str(), t.seconds);
+    out << line;
+  }
+  std::snprintf(line, sizeof(line), " total %.1f\n", r.total_seconds());
+  out << line;
+  if (!e) return;
+  if (e->trajectory) {
+    std::snprintf(line, sizeof(line), "  ate_rmse_m %.4f  rpe_rmse_m %.4f\n",
+                  e->trajectory->ate.translation_m.rmse, e->trajectory->rpe.translation_m.rmse);
+    out << line;
+  }
+  if (e->rooms) {
+    std::snprintf(line, sizeof(line), "  rooms recall %.3f precision %.3f mcc %.3f\n",
+                  e->rooms->recall_mean, e->rooms->precision_mean, e->rooms->mcc);
+    out << line;
+  }
+  if (e->semantic) {
+    out << "  iou";
+    for (int c = 1; c < kSemanticClassCount; ++c) {
+      const auto& iou = e->semantic->iou[static_cast<std::size_t>(c)];
+      if (!iou) continue;
+      std::snprintf(line, sizeof(line), " %s %.3f",
+                    std::string(to_string(SemanticClass(c))).c_str(), *iou);
+      out << line;
+    }
+    out << "\n";
+  }
+}
+
+}  // namespace
+
+CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
+  CLI::App* command = app.add_subcommand(
+      "map",
+      "The whole pipeline on an RGB-D sequence: SLAM, planes, occupancy grid, rooms, semantic "
+      "grid, and a report (with every metric its ground truth allows)");
+  add_sequence_run_options(*command, o.run);
+  command->add_option("--out", o.out_dir, "Output folder (created if missing)")->required();
+  command->add_option("--label-step", o.label_step, "Label and extract planes in every k-th frame")
+      ->check(CLI::Range(1, 1000))
+      ->capture_default_str();
+  command
+      ->add_option("--label-width", o.label_width, "Labelled views: at most this many pixels wide")
+      ->check(CLI::Range(64, 4096))
+      ->capture_default_str();
+  command->add_option("--resolution", o.resolution, "Grid cell size [m]")
+      ->check(CLI::Range(0.01, 1.0))
+      ->capture_default_str();
+  command->add_option("--rooms", o.room_method, "Room segmentation method")
+      ->check(CLI::IsMember({"morphological", "distance", "voronoi", "feature", "vrf"}))
+      ->capture_default_str();
+  command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
+  return command;
+}
+
+int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
+  check_output_folder("map", o.out_dir, io::map_output_files(), o.force);
+  const OpenedRun run = open_run(o.run);
+  const compute::Context context = make_run_context(o.run);
+  pipeline::MapPipelineParams params;
+  params.slam.odometry = odometry_params(o.run);
+  params.label_step = o.label_step;
+  params.label_width = o.label_width;
+  params.grid.resolution = o.resolution;
+  params.room_method = rooms::parse_room_method(o.room_method);
+  params.rooms.context = &context;
+
+  ProgressBar bar(err, o.run.progress);
+  pipeline::MapPipelineObserver observer;
+  observer.slam.on_frame = [&](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
+  observer.slam.on_progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
+    bar.update(stage, done, total);
+  };
+  int stage_number = 0;
+  observer.on_stage = [&](std::string_view stage) {
+    bar.finish();
+    if (o.run.progress) err << "map: stage " << ++stage_number << "/5: " << stage << "\n";
+  };
+  const pipeline::MapPipelineResult result =
+      pipeline::run_map_pipeline(context, *run.source, params, observer);
+  bar.finish();
+  if (result.unlabelled_views > 0)
+    err << "map: " << result.unlabelled_views << " of "
+        << result.labelled_views + result.unlabelled_views << " views could not be labelled, e.g. "
+        << result.first_unlabelled_reason << "\n";
+
+  pipeline::MapGroundTruth truth;
+  truth.poses = run.source->ground_truth();
+  if (const auto plan = io::read_floor_plan_truth(o.run.sequence)) {
+    truth.plan = plan->plan;
+    truth.rooms = plan->rooms;
+    truth.classes = plan->classes;
+  }
+  std::optional<pipeline::MapEvaluation> evaluation;
+  if (!truth.poses.empty()) evaluation = pipeline::evaluate_map(result, truth);
+
+  io::MapRunInfo info;
+  info.sequence = o.run.sequence.string();
+  info.layout = std::string(io::to_string(run.opened.detected.layout));
+  info.backend = std::string(compute::to_string(context.backend()));
+  info.device = context.device_info().name;
+  info.has_timestamps = run.opened.detected.has_timestamps;
+  info.parameters_json = parameters_json(o, params).dump();
+  {
+    const SignalsHeldBack held;
+    io::write_map_outputs(o.out_dir, result, evaluation, info);
+  }
+  out << "map: " << info.sequence << " (" << info.layout << "), backend " << info.backend << " ("
+      << info.device << ")\n";
+  print_summary(out, result, evaluation);
+  out << "  report: " << (o.out_dir / "report.html").string() << "\n";
+  return 0;
+}
+
+}  // namespace kartograf::cli

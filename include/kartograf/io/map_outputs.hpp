@@ -1,0 +1,41 @@
+#pragma once
+// The files of a map pipeline run (pipeline/map_pipeline.hpp), all in one folder and one map
+// frame (z up, floor at z = 0):
+//   trajectory.txt          camera-to-map poses (TUM)
+//   map.ply                 the fused coloured map
+//   planes.json             the map's planes with their classes
+//   occupancy.yaml/.pgm     ROS map_server occupancy grid; occupancy.png the same for browsers
+//   rooms.png, rooms.json   the rooms in colour over the grid, and their records (rooms_labels.png:
+//                           16-bit room ids)
+//   semantic.png/.json      the metric-semantic grid with its legend, and its objects
+//   top_view.png            the map from above with the trajectory
+//   report.json             run, per-stage timings, counts and every metric the ground truth allows
+//   report.html             the same for people, with the pictures
+// Each file is written atomically (a reader never sees part of one); everything is rendered
+// before the first is written.
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "kartograf/pipeline/map_evaluation.hpp"
+#include "kartograf/pipeline/map_pipeline.hpp"
+
+namespace kartograf::io {
+
+struct MapRunInfo {
+  std::string sequence;  // where the frames came from
+  std::string layout;    // tum, 7scenes, synthetic, ...
+  std::string backend, device;
+  bool has_timestamps = true;   // false: trajectory.txt stamps frame numbers
+  std::string parameters_json;  // a JSON object (text) stored as "parameters", or empty
+};
+
+// The names written by write_map_outputs, in order.
+const std::vector<std::string>& map_output_files();
+
+void write_map_outputs(const std::filesystem::path& dir, const pipeline::MapPipelineResult& result,
+                       const std::optional<pipeline::MapEvaluation>& evaluation,
+                       const MapRunInfo& info);
+
+}  // namespace kartograf::io

@@ -1,0 +1,89 @@
+#pragma once
+// The end-to-end mapping pipeline behind `kartograf map`: an RGB-D sequence in, everything a robot
+// needs out, in one gravity-aligned map frame (z up, the floor at z = 0, x and y those of the
+// first camera's heading).
+//
+//   1. slam       odometry, loop closure, pose graph, fused coloured map (mapping/slam.hpp, M3)
+//   2. views      every label_step-th frame at its optimised pose, at most label_width pixels
+//                 wide: per-pixel semantic classes (semantic/classify.hpp, M2) and planes
+//                 (segmentation/plane_extraction.hpp, M1), pooled in the map
+//                 (semantic/labelled_views.hpp, mapping/plane_map.hpp); the views vote for up
+//   3. gravity    the voted up becomes +z; the floor's median height becomes z = 0
+//   4. grid       the metric-semantic grid (semantic/semantic_grid.hpp): floor evidence free,
+//                 obstacles in the robot's height band, doors, traversability; the occupancy grid
+//                 is its free / occupied / unknown view
+//   5. rooms      room segmentation of the occupancy grid (rooms/room_methods.hpp, M4)
+// Library only: pipeline/map_evaluation.hpp scores a result against ground truth and
+// io/map_outputs.hpp writes the files and the report.
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/occupancy_grid.hpp"
+#include "kartograf/core/point_cloud.hpp"
+#include "kartograf/mapping/frame_source.hpp"
+#include "kartograf/mapping/plane_map.hpp"
+#include "kartograf/mapping/slam.hpp"
+#include "kartograf/rooms/room_methods.hpp"
+#include "kartograf/segmentation/plane_extraction.hpp"
+#include "kartograf/semantic/classify.hpp"
+#include "kartograf/semantic/semantic_grid.hpp"
+
+namespace kartograf::pipeline {
+
+// Plane extraction on decimated views: planes of a quarter of the default's pixels count.
+segmentation::PlaneExtractionParams view_plane_params();
+
+struct MapPipelineParams {
+  mapping::SlamParams slam;  // its build_map is always on
+  std::size_t label_step = 5;  // views: every k-th frame
+  int label_width = 320;       // views: decimated to at most this many pixels per row
+  semantic::LabellingParams labelling;  // gravity.prior_up defaults to the camera's -y
+  segmentation::PlaneExtractionParams planes = view_plane_params();
+  mapping::PlaneMapParams plane_map;
+  semantic::SemanticGridOptions grid;
+  rooms::RoomMethod room_method = rooms::RoomMethod::distance;
+  rooms::RoomMethodOptions rooms;
+
+  void validate() const;  // throws Error naming the first bad field
+};
+
+// Stages in run order, with their names as reported ("slam", "views", "gravity", "grid", "rooms").
+struct StageTiming {
+  std::string stage;
+  double seconds = 0;
+};
+
+struct MapPipelineResult {
+  mapping::SlamResult slam;                  // in the SLAM frame (the first camera's)
+  Eigen::Isometry3d map_from_slam = Eigen::Isometry3d::Identity();
+  std::vector<Eigen::Isometry3d> poses;      // camera-to-map, one per frame
+  PointCloud map;                            // the fused map in the map frame
+  std::vector<mapping::MapPlane> planes;     // map frame
+  semantic::SemanticGrid semantic;
+  OccupancyGrid occupancy;                   // the grid's free / occupied / unknown cells
+  rooms::RoomSegmentation rooms;             // on `occupancy`
+  int labelled_views = 0, unlabelled_views = 0;
+  std::string first_unlabelled_reason;
+  std::vector<StageTiming> timings;
+  double total_seconds() const;
+};
+
+struct MapPipelineObserver {
+  mapping::SlamObserver slam;  // its on_progress also reports stage "views"
+  std::function<void(std::string_view stage)> on_stage;  // when a stage starts
+};
+
+// Throws Error when a stage cannot go on (no frame, bad parameters, no view could be labelled,
+// no floor seen, ...), naming the stage.
+MapPipelineResult run_map_pipeline(const compute::Context& context,
+                                   const mapping::FrameSource& source,
+                                   const MapPipelineParams& params = {},
+                                   const MapPipelineObserver& observer = {});
+
+}  // namespace kartograf::pipeline

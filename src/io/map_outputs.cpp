@@ -1,0 +1,327 @@
+#include "kartograf/io/map_outputs.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <map>
+#include <sstream>
+#include <string>
+
+#include <nlohmann/json.hpp>
+
+#include "io/atomic_file.hpp"
+#include "io/json_array.hpp"
+#include "kartograf/io/image_io.hpp"
+#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/io/ply.hpp"
+#include "kartograf/io/room_io.hpp"
+#include "kartograf/io/semantic_map_io.hpp"
+#include "kartograf/io/top_view.hpp"
+#include "kartograf/io/tum.hpp"
+
+namespace kartograf::io {
+
+namespace {
+
+namespace fs = std::filesystem;
+using Json = nlohmann::ordered_json;
+using detail::json_array;
+
+void write_text(const fs::path& path, const std::string& text) {
+  detail::write_file_atomically(path, text.data(), text.size());
+}
+
+Json planes_json(const std::vector<mapping::MapPlane>& planes, const std::string& source) {
+  Json list = Json::array();
+  for (const mapping::MapPlane& p : planes) {
+    list.push_back({{"id", p.id},
+                    {"label", std::string(to_string(p.label))},
+                    {"normal", json_array(p.normal)},
+                    {"offset", p.offset},
+                    {"centroid", json_array(p.centroid)},
+                    {"major_axis", json_array(p.major_axis)},
+                    {"minor_axis", json_array(p.minor_axis)},
+                    {"extent_min", json_array(p.extent_min)},
+                    {"extent_max", json_array(p.extent_max)},
+                    {"area_m2", p.area},
+                    {"points", p.point_count},
+                    {"rms_error_m", p.rms_error},
+                    {"views", p.views}});
+  }
+  return {{"format", "kartograf-map-planes"},
+          {"version", 1},
+          {"source", source},
+          {"frame", "map: z up, floor at z = 0; n . p + offset = 0, n towards the viewer"},
+          {"planes", std::move(list)}};
+}
+
+// ROS map_server's grey levels: free white, occupied black, unknown grey.
+GrayImage occupancy_picture(const OccupancyGrid& grid) {
+  GrayImage picture(grid.width(), grid.height());
+  for (int y = 0; y < grid.height(); ++y) {
+    for (int x = 0; x < grid.width(); ++x) {
+      const CellState c = grid.cells(x, y);
+      picture(x, y) = c == CellState::free ? 254 : c == CellState::occupied ? 0 : 205;
+    }
+  }
+  return picture;
+}
+
+Json optional_number(const std::optional<double>& value) {
+  return value ? Json(*value) : Json();
+}
+
+Json evaluation_json(const pipeline::MapEvaluation& e) {
+  Json json = Json::object();
+  if (e.trajectory) {
+    const eval::TrajectoryEvaluation& t = *e.trajectory;
+    json["trajectory"] = {{"ate_rmse_m", t.ate.translation_m.rmse},
+                          {"ate_max_m", t.ate.translation_m.max},
+                          {"rpe_translation_rmse_m", t.rpe.translation_m.rmse},
+                          {"rpe_rotation_rmse_deg", t.rpe.rotation_deg.rmse},
+                          {"poses", t.ate.translation_m.count}};
+  }
+  if (e.rooms) {
+    const eval::RoomSegmentationScores& r = *e.rooms;
+    json["rooms"] = {{"ground_truth_rooms", r.ground_truth_rooms},
+                     {"segments", r.segments},
+                     {"recall_mean", r.recall_mean},
+                     {"recall_total", r.recall_total},
+                     {"precision_mean", r.precision_mean},
+                     {"precision_total", r.precision_total},
+                     {"mcc", r.mcc},
+                     {"room_recall", r.room_recall},
+                     {"segment_precision", r.segment_precision}};
+  }
+  if (e.semantic) {
+    Json iou = Json::object();
+    for (int c = 0; c < kSemanticClassCount; ++c)
+      iou[std::string(to_string(static_cast<SemanticClass>(c)))] =
+          optional_number(e.semantic->iou[static_cast<std::size_t>(c)]);
+    json["classes"] = {{"iou", std::move(iou)},
+                       {"mean_iou", e.semantic->mean_iou},
+                       {"overall_accuracy", e.semantic->overall_accuracy},
+                       {"cells", e.semantic->evaluated_pixels}};
+  }
+  json["not_scored"] = e.skipped;
+  return json;
+}
+
+Json report_json(const pipeline::MapPipelineResult& r,
+                 const std::optional<pipeline::MapEvaluation>& evaluation, const MapRunInfo& info) {
+  Json json;
+  json["format"] = "kartograf-map-report";
+  json["version"] = 1;
+  json["sequence"] = info.sequence;
+  json["layout"] = info.layout;
+  json["backend"] = info.backend;
+  json["device"] = info.device;
+  json["frames"] = r.poses.size();
+  Json stages = Json::array();
+  for (const pipeline::StageTiming& t : r.timings)
+    stages.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
+  json["timing_s"] = {{"total", r.total_seconds()}, {"stages", std::move(stages)}};
+  std::size_t accepted = 0, pruned = 0;
+  for (const mapping::LoopClosureRecord& l : r.slam.loop_closures) {
+    accepted += l.closure.report.accepted();
+    pruned += l.pruned;
+  }
+  json["slam"] = {{"loop_candidates", r.slam.loop_candidates},
+                  {"loop_closures_accepted", accepted},
+                  {"loop_closures_pruned", pruned},
+                  {"pose_graph_converged", r.slam.final_graph.converged},
+                  {"map_points", r.map.size()}};
+  json["views"] = {{"labelled", r.labelled_views},
+                   {"unlabelled", r.unlabelled_views},
+                   {"first_unlabelled_reason", r.first_unlabelled_reason}};
+  std::map<std::string, int> plane_classes;
+  for (const mapping::MapPlane& p : r.planes) ++plane_classes[std::string(to_string(p.label))];
+  json["planes"] = {{"count", r.planes.size()}, {"by_class", plane_classes}};
+  std::map<std::string, int> objects;
+  for (const semantic::SemanticObject& o : r.semantic.objects)
+    ++objects[std::string(semantic::to_string(o.kind))];
+  json["grid"] = {{"width", r.semantic.width()},
+                  {"height", r.semantic.height()},
+                  {"resolution_m", r.semantic.resolution},
+                  {"objects", objects}};
+  json["rooms"] = {{"method", r.rooms.method}, {"count", r.rooms.records.size()}};
+  if (evaluation) json["evaluation"] = evaluation_json(*evaluation);
+  if (!info.parameters_json.empty()) json["parameters"] = Json::parse(info.parameters_json);
+  return json;
+}
+
+std::string html_escape(const std::string& text) {
+  std::string out;
+  for (const char c : text) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+std::string number(double value, const char* format = "%.3f") {
+  char text[64];
+  std::snprintf(text, sizeof(text), format, value);
+  return text;
+}
+
+// A two-column table of a JSON object's scalar members (nested objects flattened a.b).
+void table_rows(std::ostringstream& html, const Json& object, const std::string& prefix = "") {
+  for (const auto& [key, value] : object.items()) {
+    const std::string name = prefix.empty() ? key : prefix + "." + key;
+    if (value.is_object()) {
+      table_rows(html, value, name);
+    } else if (value.is_number_float()) {
+      html << "<tr><td>" << html_escape(name) << "</td><td>" << number(value.get<double>(), "%.4f")
+           << "</td></tr>\n";
+    } else if (!value.is_array()) {
+      html << "<tr><td>" << html_escape(name) << "</td><td>"
+           << html_escape(value.is_string() ? value.get<std::string>() : value.dump())
+           << "</td></tr>\n";
+    }
+  }
+}
+
+std::string report_html(const Json& report) {
+  std::ostringstream html;
+  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
+       << "<title>Kartograf map: " << html_escape(report["sequence"].get<std::string>())
+       << "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
+       << "table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #bbb;"
+       << "padding:0.2em 0.6em;text-align:left}img{max-width:100%;border:1px solid #ccc}"
+       << "figure{display:inline-block;margin:0 1em 1em 0;vertical-align:top;max-width:32em}"
+       << "</style></head><body>\n";
+  html << "<h1>Kartograf map</h1>\n<p>" << html_escape(report["sequence"].get<std::string>())
+       << " (" << html_escape(report["layout"].get<std::string>()) << "), "
+       << report["frames"].get<std::size_t>() << " frames, backend "
+       << html_escape(report["backend"].get<std::string>()) << " ("
+       << html_escape(report["device"].get<std::string>()) << ")</p>\n";
+
+  html << "<h2>Metrics against ground truth</h2>\n";
+  if (report.contains("evaluation")) {
+    const Json& e = report["evaluation"];
+    html << "<table><tr><th>metric</th><th>value</th></tr>\n";
+    for (const char* part : {"trajectory", "rooms", "classes"})
+      if (e.contains(part)) table_rows(html, e[part], part);
+    html << "</table>\n";
+    for (const Json& reason : e["not_scored"])
+      html << "<p>Not scored: " << html_escape(reason.get<std::string>()) << "</p>\n";
+  } else {
+    html << "<p>The sequence has no ground truth.</p>\n";
+  }
+
+  html << "<h2>Stages</h2>\n<table><tr><th>stage</th><th>seconds</th><th>share</th></tr>\n";
+  const double total = report["timing_s"]["total"].get<double>();
+  for (const Json& stage : report["timing_s"]["stages"]) {
+    const double s = stage["seconds"].get<double>();
+    html << "<tr><td>" << html_escape(stage["stage"].get<std::string>()) << "</td><td>"
+         << number(s, "%.2f") << "</td><td>" << number(total > 0 ? 100 * s / total : 0, "%.0f")
+         << " %</td></tr>\n";
+  }
+  html << "<tr><th>total</th><th>" << number(total, "%.2f") << "</th><th>"
+       << number(total > 0 ? report["frames"].get<double>() / total : 0, "%.1f")
+       << " frames/s</th></tr></table>\n";
+
+  html << "<h2>Result</h2>\n<table><tr><th>what</th><th>value</th></tr>\n";
+  for (const char* part : {"slam", "views", "planes", "grid", "rooms"})
+    table_rows(html, report[part], part);
+  html << "</table>\n";
+
+  html << "<h2>Pictures</h2>\n";
+  const std::pair<const char*, const char*> pictures[] = {
+      {"top_view.png", "The map from above, the trajectory in red (start green, end blue)"},
+      {"semantic.png", "The metric-semantic grid: classes and traversability"},
+      {"rooms.png", "Rooms"},
+      {"occupancy.png", "Occupancy: free white, occupied black, unknown grey"}};
+  for (const auto& [file, caption] : pictures)
+    html << "<figure><img src=\"" << file << "\" alt=\"" << caption << "\"><figcaption>" << caption
+         << "</figcaption></figure>\n";
+
+  html << "<h2>Files</h2>\n<ul>\n";
+  for (const std::string& file : map_output_files())
+    html << "<li><a href=\"" << file << "\">" << file << "</a></li>\n";
+  html << "</ul>\n</body></html>\n";
+  return html.str();
+}
+
+// Truth above ours: classes (the grid's colours) left, rooms right, on the plan's cells.
+RgbImage evaluation_picture(const pipeline::MapEvaluation& e) {
+  const int w = e.true_classes.width(), h = e.true_classes.height(), gap = 4;
+  RgbImage picture(2 * w + gap, 2 * h + gap, Rgb8{255, 255, 255});
+  const RgbImage rooms[] = {colorize_labels(e.true_rooms), colorize_labels(e.rooms_on_plan)};
+  const SemanticImage* classes[] = {&e.true_classes, &e.classes_on_plan};
+  for (int k = 0; k < 2; ++k) {
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        const SemanticClass c = (*classes[k])(x, y);
+        picture(x, y + k * (h + gap)) =
+            c == SemanticClass::unknown ? semantic::kUnobservedColour : semantic::class_colour(c);
+        picture(x + w + gap, y + k * (h + gap)) = rooms[k](x, y);
+      }
+    }
+  }
+  return picture;
+}
+
+}  // namespace
+
+const std::vector<std::string>& map_output_files() {
+  static const std::vector<std::string> files = {
+      "trajectory.txt", "map.ply",      "planes.json",      "occupancy.yaml", "occupancy.pgm",
+      "occupancy.png",  "rooms.png",    "rooms_labels.png", "rooms.json",     "semantic.png",
+      "semantic.json",  "top_view.png", "report.json",      "report.html"};
+  return files;
+}
+
+void write_map_outputs(const fs::path& dir, const pipeline::MapPipelineResult& result,
+                       const std::optional<pipeline::MapEvaluation>& evaluation,
+                       const MapRunInfo& info) {
+  // Everything that can fail on the data is rendered before the first file is written.
+  Trajectory trajectory;
+  const std::vector<double>& timestamps = result.slam.odometry.timestamps;
+  for (std::size_t i = 0; i < result.poses.size(); ++i) {
+    const double t =
+        info.has_timestamps && i < timestamps.size() ? timestamps[i] : static_cast<double>(i);
+    trajectory.push_back({t, result.poses[i]});
+  }
+  const std::string planes = planes_json(result.planes, info.sequence).dump(1) + "\n";
+  const GrayImage occupancy = occupancy_picture(result.occupancy);
+  const RgbImage rooms = room_overlay(result.occupancy, result.rooms.rooms);
+  const RgbImage semantic = semantic::render_map(result.semantic).image;
+  const RgbImage top_view = render_top_view(result.map, result.poses);
+  const Json report = report_json(result, evaluation, info);
+  const std::string html = report_html(report);
+  const bool scored = evaluation && !evaluation->true_classes.empty();
+  const RgbImage scored_picture = scored ? evaluation_picture(*evaluation) : RgbImage();
+
+  fs::create_directories(dir);
+  write_tum_trajectory(dir / "trajectory.txt", trajectory);
+  write_ply(dir / "map.ply", result.map);
+  write_text(dir / "planes.json", planes);
+  write_ros_map(dir / "occupancy.yaml", result.occupancy);
+  write_png(dir / "occupancy.png", occupancy);
+  write_png(dir / "rooms.png", rooms);
+  write_label_png(dir / "rooms_labels.png", result.rooms.rooms);
+  write_rooms_json(dir / "rooms.json", result.rooms, result.occupancy, info.sequence);
+  write_png(dir / "semantic.png", semantic);
+  write_semantic_json(dir / "semantic.json", result.semantic, {}, info.sequence);
+  write_png(dir / "top_view.png", top_view);
+  if (scored) write_png(dir / "evaluation.png", scored_picture);
+  write_text(dir / "report.json", report.dump(1) + "\n");
+  write_text(dir / "report.html", html);
+}
+
+}  // namespace kartograf::io

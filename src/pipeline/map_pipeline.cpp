@@ -1,0 +1,177 @@
+#include "kartograf/pipeline/map_pipeline.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <optional>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/semantic/labelled_views.hpp"
+
+namespace kartograf::pipeline {
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_since(Clock::time_point start) {
+  return std::chrono::duration<double>(Clock::now() - start).count();
+}
+
+// Every factor-th pixel of every factor-th row: a smaller camera with the same rays.
+template <typename Pixel>
+Image<Pixel> decimate(const Image<Pixel>& image, int factor) {
+  if (factor == 1 || image.empty()) return image;
+  Image<Pixel> out(image.width() / factor, image.height() / factor);
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) out(x, y) = image(x * factor, y * factor);
+  return out;
+}
+
+PinholeIntrinsics decimate(const PinholeIntrinsics& k, int factor) {
+  return {k.width / factor, k.height / factor, k.fx / factor,
+          k.fy / factor,    k.cx / factor,     k.cy / factor};
+}
+
+// A grey image where the source has no colour: region growing then splits by geometry alone.
+RgbImage colour_or_grey(const registration::RgbdImages& frame) {
+  if (!frame.color.empty()) return frame.color;
+  return RgbImage(frame.depth.width(), frame.depth.height(), Rgb8{128, 128, 128});
+}
+
+// Median height of the points of one class, if any.
+std::optional<double> median_height(const semantic::LabelledViews& views, SemanticClass label) {
+  std::vector<double> z;
+  for (std::size_t i = 0; i < views.points().size(); ++i)
+    if (views.labels()[i] == label) z.push_back(views.points()[i].z());
+  if (z.empty()) return std::nullopt;
+  std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2), z.end());
+  return z[z.size() / 2];
+}
+
+PointCloud transformed(const PointCloud& cloud, const Eigen::Isometry3d& transform) {
+  PointCloud out = cloud;
+  const Eigen::Isometry3f t = transform.cast<float>();
+  for (Eigen::Vector3f& p : out.points) p = t * p;
+  for (Eigen::Vector3f& n : out.normals) n = t.linear() * n;
+  return out;
+}
+
+// Stage bookkeeping: announces a stage, and records its time when the next one starts.
+class StageClock {
+ public:
+  StageClock(const MapPipelineObserver& observer, std::vector<StageTiming>& timings)
+      : observer_(observer), timings_(timings) {}
+  void start(std::string stage) {
+    stop();
+    timings_.push_back({std::move(stage), 0});
+    start_ = Clock::now();
+    if (observer_.on_stage) observer_.on_stage(timings_.back().stage);
+  }
+  void stop() {
+    if (!timings_.empty() && timings_.back().seconds == 0)
+      timings_.back().seconds = seconds_since(start_);
+  }
+
+ private:
+  const MapPipelineObserver& observer_;
+  std::vector<StageTiming>& timings_;
+  Clock::time_point start_;
+};
+
+}  // namespace
+
+segmentation::PlaneExtractionParams view_plane_params() {
+  segmentation::PlaneExtractionParams params;
+  params.min_plane_pixels = 150;
+  return params;
+}
+
+void MapPipelineParams::validate() const {
+  require(label_step >= 1, "MapPipelineParams: label_step must be >= 1");
+  require(label_width >= 64, "MapPipelineParams: label_width must be >= 64 pixels");
+  planes.validate();
+  plane_map.validate();
+  grid.validate();
+}
+
+double MapPipelineResult::total_seconds() const {
+  return std::accumulate(timings.begin(), timings.end(), 0.0,
+                         [](double sum, const StageTiming& t) { return sum + t.seconds; });
+}
+
+MapPipelineResult run_map_pipeline(const compute::Context& context,
+                                   const mapping::FrameSource& source,
+                                   const MapPipelineParams& params,
+                                   const MapPipelineObserver& observer) {
+  params.validate();
+  require(source.size() > 0, "map: the sequence holds no frame");
+  MapPipelineResult result;
+  StageClock clock(observer, result.timings);
+
+  clock.start("slam");
+  mapping::SlamParams slam_params = params.slam;
+  slam_params.build_map = true;
+  result.slam = mapping::run_slam(context, source, slam_params, observer.slam);
+
+  clock.start("views");
+  const PinholeIntrinsics camera = source.camera();
+  const int factor = std::max(1, (camera.width + params.label_width - 1) / params.label_width);
+  const PinholeIntrinsics view_camera = decimate(camera, factor);
+  geometry::DepthRange range;
+  range.units_per_metre = source.depth_units_per_metre();
+  semantic::LabellingParams labelling_params = params.labelling;
+  if (!labelling_params.gravity.prior_up)
+    labelling_params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);  // image up
+  segmentation::PlaneExtractor extractor(context, view_camera, params.planes);
+  semantic::LabelledViews views;
+  mapping::PlaneMap plane_map(params.plane_map);
+  const std::size_t frames = result.slam.poses.size();
+  for (std::size_t i = 0; i < frames; i += params.label_step) {
+    const registration::RgbdImages frame = source.frame(i);
+    const PointImage points = geometry::backproject(context, decimate(frame.depth, factor),
+                                                    view_camera, range);
+    const Eigen::Isometry3d& pose = result.slam.poses[i];
+    try {
+      const semantic::SemanticLabelling labelling =
+          semantic::label_organized_points(context, points, labelling_params);
+      views.add(points, labelling.semantic, labelling.gravity, pose);
+      plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)),
+                         points, labelling.semantic, pose);
+    } catch (const Error& e) {
+      views.skip("frame " + std::to_string(i) + ": " + e.what());  // e.g. a wall seen close by
+    }
+    if (observer.slam.on_progress) observer.slam.on_progress("views", i + 1, frames);
+  }
+  result.labelled_views = views.views();
+  result.unlabelled_views = views.skipped();
+  result.first_unlabelled_reason = views.first_skip_reason();
+  require(views.views() > 0, "map: views: no frame could be labelled (" +
+                                 views.first_skip_reason() + ")");
+
+  clock.start("gravity");
+  const Eigen::Matrix3d up_to_z = views.make_up_z();
+  const std::optional<double> floor_height = median_height(views, SemanticClass::floor);
+  require(floor_height.has_value(), "map: gravity: no view saw the floor");
+  Eigen::Isometry3d& map_from_slam = result.map_from_slam;
+  map_from_slam = Eigen::Isometry3d::Identity();
+  map_from_slam.linear() = up_to_z;
+  map_from_slam.translation() = Eigen::Vector3d(0, 0, -*floor_height);
+  views.transform(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -*floor_height)));
+  for (const Eigen::Isometry3d& pose : result.slam.poses) result.poses.push_back(map_from_slam * pose);
+  result.map = transformed(result.slam.map, map_from_slam);
+  result.planes = plane_map.planes(map_from_slam);
+
+  clock.start("grid");
+  result.semantic = semantic::build_semantic_grid(views.points(), views.labels(), params.grid);
+  result.occupancy = semantic::to_occupancy_grid(result.semantic);
+
+  clock.start("rooms");
+  result.rooms = rooms::segment_rooms(result.occupancy, params.room_method, params.rooms);
+  clock.stop();
+  return result;
+}
+
+}  // namespace kartograf::pipeline
