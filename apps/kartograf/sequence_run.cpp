@@ -140,14 +140,7 @@ Trajectory ground_truth_trajectory(const io::SequenceFrameSource& source,
 
 std::optional<eval::AteResult> absolute_trajectory_error(
     const io::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses) {
-  eval::MatchedPoses matched;
-  const auto& truth = source.ground_truth();
-  for (std::size_t i = 0; i < truth.size() && i < poses.size(); ++i) {
-    if (!truth[i]) continue;
-    const double t = static_cast<double>(i);
-    matched.ground_truth.push_back({t, *truth[i]});
-    matched.estimate.push_back({t, poses[i]});
-  }
+  const eval::MatchedPoses matched = eval::match_frames(source.ground_truth(), poses);
   if (matched.size() < 3) return std::nullopt;
   return eval::compute_ate(matched, eval::Alignment::se3);
 }

@@ -72,6 +72,18 @@ std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs(const MatchedPoses& p
 
 }  // namespace
 
+MatchedPoses match_frames(std::span<const std::optional<Eigen::Isometry3d>> ground_truth,
+                          std::span<const Eigen::Isometry3d> estimate) {
+  MatchedPoses matched;
+  for (std::size_t i = 0; i < ground_truth.size() && i < estimate.size(); ++i) {
+    if (!ground_truth[i]) continue;
+    const double t = static_cast<double>(i);
+    matched.ground_truth.push_back({t, *ground_truth[i]});
+    matched.estimate.push_back({t, estimate[i]});
+  }
+  return matched;
+}
+
 MatchedPoses match_poses(const Trajectory& ground_truth, const Trajectory& estimate,
                          std::span<const std::pair<std::size_t, std::size_t>> pairs) {
   MatchedPoses matched;

@@ -18,7 +18,8 @@ void resample_onto_plan(const MapPipelineResult& result, const OccupancyGrid& pl
   for (int row = 0; row < plan.height(); ++row) {
     for (int col = 0; col < plan.width(); ++col) {
       const Eigen::Vector2d world = plan.cell_center(col, row);
-      const Eigen::Vector2d map = (map_from_world * Eigen::Vector3d(world.x(), world.y(), 0)).head<2>();
+      const Eigen::Vector2d map =
+          (map_from_world * Eigen::Vector3d(world.x(), world.y(), 0)).head<2>();
       const Eigen::Vector2i room_cell = result.occupancy.cell_of(map);
       if (result.occupancy.contains(room_cell))
         out.rooms_on_plan(col, row) = result.rooms.rooms(room_cell.x(), room_cell.y());
@@ -33,15 +34,10 @@ void resample_onto_plan(const MapPipelineResult& result, const OccupancyGrid& pl
 
 MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth& truth) {
   MapEvaluation out;
-  eval::MatchedPoses matched;
-  for (std::size_t i = 0; i < truth.poses.size() && i < result.poses.size(); ++i) {
-    if (!truth.poses[i]) continue;
-    const double t = static_cast<double>(i);
-    matched.ground_truth.push_back({t, *truth.poses[i]});
-    matched.estimate.push_back({t, result.poses[i]});
-  }
+  const eval::MatchedPoses matched = eval::match_frames(truth.poses, result.poses);
   if (matched.size() < kMinMatchedPoses) {
-    out.skipped.push_back("trajectory, rooms, classes: fewer than 3 frames have a ground-truth pose");
+    out.skipped.push_back(
+        "trajectory, rooms, classes: fewer than 3 frames have a ground-truth pose");
     return out;
   }
   out.trajectory = eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeOptions{});

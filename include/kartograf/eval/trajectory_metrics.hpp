@@ -21,11 +21,13 @@
 //   With Sim(3) alignment, RPE is measured on the scaled estimate; a rigid alignment does not
 //   change relative motion.
 #include <cstddef>
+#include <optional>
 #include <span>
 #include <utility>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "kartograf/core/trajectory.hpp"
 
@@ -42,6 +44,11 @@ struct MatchedPoses {
 // estimate times, max_difference). Throws Error on an index out of range.
 MatchedPoses match_poses(const Trajectory& ground_truth, const Trajectory& estimate,
                          std::span<const std::pair<std::size_t, std::size_t>> pairs);
+
+// Frame k of the estimate against frame k of the ground truth, for the frames that have a
+// ground-truth pose (a data set's poses per frame); timestamps are the frame numbers.
+MatchedPoses match_frames(std::span<const std::optional<Eigen::Isometry3d>> ground_truth,
+                          std::span<const Eigen::Isometry3d> estimate);
 
 // count, RMSE, mean, median, population standard deviation, min and max of a list of errors.
 struct ErrorStatistics {
