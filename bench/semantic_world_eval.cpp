@@ -2,6 +2,8 @@
 // plan, and "go to the door" paths checked against the true doors and obstacles.
 //   kartograf_semantic_world_eval [seed=5] [frames=300] [step=3] [width=320] [noise 0/1=1] [outdir]
 //       [survey 0/1=0]
+// TOUR_SURVEY=1 in the environment: the tour itself is a survey (TourOptions::survey);
+// TOUR_PITCH=degrees: the tour's camera pitch.
 // Frames: every step-th frame of the robot tour, plus (survey) 12 headings x 2 pitches at each
 // room's most open point and every 25th tour pose. Labels: the synthetic ground truth, or with
 // OURS=1 in the environment Kartograf's own (semantic::label_organized_points per frame; frames
@@ -38,7 +40,10 @@ int main(int argc, char** argv) {
   const PinholeIntrinsics k{width, height, f, f, (width - 1) / 2.0, (height - 1) / 2.0};
 
   const synth::World world = synth::make_building(seed);
-  const Trajectory tour = synth::robot_tour(world, frames);
+  synth::TourOptions tour_options;
+  tour_options.survey = std::getenv("TOUR_SURVEY") != nullptr;  // turns in place (TourOptions)
+  if (const char* pitch = std::getenv("TOUR_PITCH")) tour_options.pitch_deg = std::stod(pitch);
+  const Trajectory tour = synth::robot_tour(world, frames, tour_options);
   std::vector<Eigen::Vector3d> points;
   std::vector<SemanticClass> labels;
   const auto t0 = std::chrono::steady_clock::now();

@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # The main job on the built-in default input: install what is missing, build, list the compute
-# devices, write the default synthetic building (300 RGB-D frames of a robot's tour, with ground
-# truth) and map it: SLAM, planes, occupancy grid, rooms, semantic grid and a report with every
-# metric against the building's ground truth. The last line says where the report is.
+# devices, write the default synthetic building (a robot's survey of it: ~1300 RGB-D frames with
+# one full turn in every room and corridor pass, ground truth included) and map it: SLAM, planes,
+# occupancy grid, rooms, semantic grid and a report with every metric against the building's
+# ground truth. The last line says where the report is.
 #   bash scripts/demo.sh [OUT_DIR=out]
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -12,8 +13,8 @@ build_dir="${KARTOGRAF_BUILD_DIR:-build}"
 out="${1:-out}"
 kartograf="$build_dir/apps/kartograf/kartograf"
 "$kartograf" devices
-if [ ! -f "$out/building/world.json" ]; then
-  rm -rf "$out/building"
-  "$kartograf" synth --out "$out/building"
+if [ ! -f "$out/survey/world.json" ]; then
+  rm -rf "$out/survey"
+  "$kartograf" synth --out "$out/survey" --survey --pitch 20
 fi
-"$kartograf" map "$out/building" --out "$out/map" --force
+"$kartograf" map "$out/survey" --out "$out/map" --force

@@ -149,6 +149,53 @@ TEST(GrowRooms, ByClearanceRoomsMeetAtTheDoorway) {
     for (int x = 102; x < 131; ++x) EXPECT_EQ(by_clearance(x, y), 2);
 }
 
+// Rooms take the cells their walls enclose (a table, floor nobody saw), never the outside.
+TEST(GrowRooms, RoomsTakeWhatTheirWallsEncloseButNotTheOutside) {
+  // 12 x 7 cells: room 1 in x 1..4, room 2 in x 6..10, walls (not fillable) around and between;
+  // a hole in room 1 at (2..3, 3), a gap in room 2's east wall that lets the outside in at (11, 3).
+  LabelImage rooms(12, 7, 0);
+  Image<std::uint8_t> fillable(12, 7, 1);
+  for (int y = 0; y < 7; ++y) {
+    for (int x = 0; x < 12; ++x) {
+      const bool wall = x == 0 || x == 5 || (x == 11 && y != 3) || y == 0 || y == 6;
+      fillable(x, y) = !wall;
+      if (!wall && x < 5 && !(y == 3 && (x == 2 || x == 3))) rooms(x, y) = 1;
+      if (!wall && x > 5 && x < 11 && !(x >= 8 && y >= 2 && y <= 4)) rooms(x, y) = 2;
+    }
+  }
+  // Room 2's unlabelled patch (8..10, 2..4) touches the gap at (11, 3): the outside.
+  const std::size_t taken = rooms::extend_rooms_over_enclosed(rooms, fillable);
+  EXPECT_EQ(rooms(2, 3), 1);
+  EXPECT_EQ(rooms(3, 3), 1);
+  EXPECT_EQ(taken, 2u);
+  for (int y = 2; y <= 4; ++y)
+    for (int x = 8; x <= 10; ++x) EXPECT_EQ(rooms(x, y), 0) << x << "," << y;
+  EXPECT_EQ(rooms(11, 3), 0);
+  EXPECT_EQ(rooms(0, 3), 0);  // walls stay
+  EXPECT_ERROR_MENTIONS(rooms::extend_rooms_over_enclosed(rooms, Image<std::uint8_t>(3, 3, 1)),
+                        "differs");
+}
+
+// A small room touching a big one directly is a fragment of it; one behind a wall stays.
+TEST(GrowRooms, SmallFragmentsJoinTheRoomTheyTouch) {
+  LabelImage rooms(20, 10, 0);
+  for (int y = 0; y < 10; ++y) {
+    for (int x = 0; x < 20; ++x) {
+      if (x < 12) rooms(x, y) = 1;
+      if (x >= 12 && x < 15 && y < 3) rooms(x, y) = 2;  // 9 cells touching room 1
+      if (x >= 17 && y < 3) rooms(x, y) = 3;            // 9 cells, cells of no room between
+    }
+  }
+  const double cell_area = 0.05 * 0.05;
+  EXPECT_EQ(rooms::merge_room_fragments(rooms, cell_area, 10 * cell_area), 1);
+  EXPECT_EQ(rooms(13, 1), 1);
+  EXPECT_EQ(rooms(18, 1), 3);
+  // Below the area limit nothing merges.
+  rooms(13, 1) = 4;
+  EXPECT_EQ(rooms::merge_room_fragments(rooms, cell_area, 0.5 * cell_area), 0);
+  EXPECT_EQ(rooms(13, 1), 4);
+}
+
 TEST(GrowRooms, ClearanceIsTheDistanceToTheNearestObstacle) {
   const OccupancyGrid map = testing::carve_map(9, 5, {{1, 1, 8, 4}});
   const Image<float> c = rooms::clearance(map);

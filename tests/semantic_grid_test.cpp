@@ -106,6 +106,50 @@ TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
   EXPECT_EQ(class_at(kX1 + 0.2, 1.5), SemanticClass::unknown);
 }
 
+// A doorway in a 0.2 m thick wall, both faces and the reveals seen: its opening is measured on the
+// jambs' points, finer than the cells, and its cells fill the wall's thickness, no more.
+TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
+  using C = SemanticClass;
+  constexpr double kFace0 = 3.012, kFace1 = 3.212;  // the wall's faces (y)
+  LabelledPoints s;
+  s.box_face({kX0, kY0, 0}, {kX1, kFace0, 0}, C::floor);             // room
+  s.box_face({kX0, kFace1, 0}, {kX1, kHallY1, 0}, C::floor);         // hall
+  s.box_face({kDoorX0, kFace0, 0}, {kDoorX1, kFace1, 0}, C::floor);  // doorway floor
+  for (const double y : {kFace0, kFace1}) {                          // both faces
+    s.box_face({kX0, y, 0.02}, {kDoorX0, y, kHeight}, C::wall);
+    s.box_face({kDoorX1, y, 0.02}, {kX1, y, kHeight}, C::wall);
+  }
+  for (const double x : {kDoorX0, kDoorX1})  // the reveals
+    s.box_face({x, kFace0, 0.02}, {x, kFace1, 2.0}, C::wall);
+  s.box_face({kX0, kY0, 0.02}, {kX0, kHallY1, kHeight}, C::wall);  // west and east
+  s.box_face({kX1, kY0, 0.02}, {kX1, kHallY1, kHeight}, C::wall);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  std::vector<const SemanticObject*> doors;
+  for (const auto& o : grid.objects)
+    if (o.kind == ObjectKind::doorway) doors.push_back(&o);
+  ASSERT_EQ(doors.size(), 1u);
+  EXPECT_NEAR(doors[0]->width, kDoorX1 - kDoorX0, 0.03);
+  EXPECT_NEAR(doors[0]->centre.x(), 0.5 * (kDoorX0 + kDoorX1), 0.02);
+  EXPECT_NEAR(doors[0]->centre.y(), 0.5 * (kFace0 + kFace1), 0.02);
+  int inside = 0;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2d c = grid.cell_center({col, row});
+      const bool in_opening = c.x() > kDoorX0 + 0.03 && c.x() < kDoorX1 - 0.03 &&
+                              c.y() > kFace0 + 0.005 && c.y() < kFace1 - 0.005;
+      if (in_opening) {
+        ++inside;
+        EXPECT_EQ(grid.classes(col, row), C::door) << c.transpose();
+      }
+      if (grid.classes(col, row) == C::door) {
+        EXPECT_GT(c.y(), kFace0 - 0.01) << "sticks out into the room at " << c.transpose();
+        EXPECT_LT(c.y(), kFace1 + 0.01) << "sticks out into the hall at " << c.transpose();
+      }
+    }
+  }
+  EXPECT_EQ(inside, 4 * 17);  // 4 rows of cells in the wall, 17 columns well inside the opening
+}
+
 // A table seen only by its edges (top dropped out), labelled unknown as M2 leaves it: the floor it
 // encloses is blocked. An L of unknown clutter in the open encloses nothing: the floor beside it
 // stays free.

@@ -3,6 +3,7 @@
 // camera_intrinsics.json reader behind open_tum_sequence.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <set>
@@ -103,6 +104,23 @@ TEST_F(SynthDataset, RefusesANonEmptyFolderUnlessForced) {
   EXPECT_NO_THROW(io::write_synthetic_dataset(dir() / "set", options));
   std::ofstream(dir() / "file") << "x";
   EXPECT_THROW(io::write_synthetic_dataset(dir() / "file", options), Error);
+}
+
+// frames 0: a robot tour takes the frames it needs to keep its per-frame limits; a hand-held
+// sequence has no such count.
+TEST_F(SynthDataset, ZeroFramesMeansTheTourOwnCount) {
+  io::SyntheticDatasetOptions options = small_options();
+  options.intrinsics = {16, 12, 13.125, 13.125, 7.5, 5.5};
+  options.frames = 0;
+  const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(dir() / "tour", options);
+  EXPECT_GT(summary.tour_frames_needed, 100);
+  EXPECT_EQ(summary.trajectory.size(), static_cast<std::size_t>(summary.tour_frames_needed));
+  const std::string poses = testing::read_text(dir() / "tour" / "groundtruth.txt");
+  EXPECT_EQ(static_cast<std::size_t>(std::count(poses.begin(), poses.end(), '\n')),
+            summary.trajectory.size() + 1);  // one comment line
+  options.trajectory = io::SyntheticTrajectory::handheld;
+  EXPECT_ERROR_MENTIONS(io::write_synthetic_dataset(dir() / "handheld", options), "frames",
+                        "got 0");
 }
 
 TEST_F(SynthDataset, GroundTruthFilesAgreeWithWorldJson) {

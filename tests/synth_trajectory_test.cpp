@@ -72,6 +72,51 @@ TEST(SynthTrajectory, RobotTourVisitsEveryRoomAndClosesTheLoopWithinLimits) {
   }
 }
 
+// A survey stops once in every room and corridor pass and turns all the way round in place there,
+// within the same per-frame limits, and still closes its loop.
+TEST(SynthTrajectory, SurveyTurnsAllTheWayRoundInPlaceInEveryRoom) {
+  for (std::uint64_t seed = 1; seed <= 3; ++seed) {
+    SCOPED_TRACE("seed " + std::to_string(seed));
+    const World w = make_building(seed);
+    TourOptions options;
+    options.survey = true;
+    options.pitch_deg = 20;
+    const int frames = tour_frames_needed(w, options);
+    ASSERT_LE(frames, 1500) << "about 150 frames per stop on top of the route";
+    const Trajectory t = robot_tour(w, frames, options);
+    std::set<Label> turned_in;
+    int turns = 0;
+    double turned = 0;  // in the current stop
+    for (std::size_t i = 1; i < t.size(); ++i) {
+      const Eigen::Vector3d step = t[i].pose.translation() - t[i - 1].pose.translation();
+      const double rotation = rotation_between(t[i - 1].pose, t[i].pose);
+      EXPECT_LE(step.norm(), 0.12) << "frame " << i;
+      EXPECT_LE(rotation, 4 * kDegree + 1e-9) << "frame " << i;
+      EXPECT_NEAR(t[i].pose.linear().col(2).z(), -std::sin(20 * kDegree), 1e-12);
+      if (step.norm() < 1e-12) {
+        turned += rotation;
+        continue;
+      }
+      if (turned > 0) {
+        EXPECT_NEAR(turned, 2 * std::numbers::pi, 8 * kDegree) << "stop before frame " << i;
+        turns += turned > std::numbers::pi;
+        turned_in.insert(w.room_at(t[i - 1].pose.translation().head<2>()));
+      }
+      turned = 0;
+      if (i + 1 < t.size()) {
+        const Eigen::Vector3d after = t[i + 1].pose.translation() - t[i].pose.translation();
+        // Bounded acceleration; the last frame before a stop may land half a millimetre short.
+        EXPECT_LE(std::fabs(after.norm() - step.norm()), 0.0025) << "frame " << i;
+      }
+    }
+    turned_in.erase(0);
+    EXPECT_EQ(turned_in.size(), w.rooms.size()) << "a turn in every room and the corridor";
+    EXPECT_GE(turns, static_cast<int>(w.rooms.size()));
+    EXPECT_LE((t.back().pose.translation() - t.front().pose.translation()).norm(), 1e-9);
+    EXPECT_LE(rotation_between(t.back().pose, t.front().pose), 1e-6);
+  }
+}
+
 TEST(SynthTrajectory, ShortToursStillLoopAndOptionsAreChecked) {
   const World w = make_building(2);
   const Trajectory t = robot_tour(w, 20);

@@ -52,6 +52,7 @@ struct SynthOptions {
   std::filesystem::path out_dir;
   std::uint64_t seed = 1;
   int frames = 300;
+  bool frames_given = false;         // else a survey takes as many as its tour needs
   std::string trajectory = "robot";  // robot | handheld
   int room = 0;                      // handheld: room id, 0 = the largest
   double look_around_deg = 30.0;     // robot: the yaw sweep inside each room

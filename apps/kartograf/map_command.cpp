@@ -47,7 +47,10 @@ Json parameters_json(const MapOptions& o, const pipeline::MapPipelineParams& p) 
           {"label_width", p.label_width},
           {"grid_resolution_m", p.grid.resolution},
           {"map_voxel_m", p.slam.map.voxel_size},
-          {"room_method", rooms::to_string(p.room_method)}};
+          {"room_method", rooms::to_string(p.room_method)},
+          {"rooms_end_at_doorways", p.rooms_end_at_doorways},
+          {"rooms_take_enclosed", p.rooms_take_enclosed},
+          {"room_fragment_area_m2", p.room_fragment_area_m2}};
 }
 
 void print_summary(std::ostream& out, const pipeline::MapPipelineResult& r,

@@ -18,9 +18,12 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
       "synth", "Write a synthetic indoor RGB-D data set (TUM layout) with exact ground truth");
   synth->add_option("--out", o.out_dir, "Output folder (must be empty unless --force)")->required();
   synth->add_option("--seed", o.seed, "World and noise seed")->capture_default_str();
-  synth->add_option("--frames", o.frames, "Number of frames (30 Hz)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 100000));
+  synth
+      ->add_option("--frames", o.frames,
+                   "Number of frames (30 Hz); default 300, with --survey as many as the tour "
+                   "needs to keep its per-frame limits")
+      ->check(CLI::Range(1, 100000))
+      ->each([&o](const std::string&) { o.frames_given = true; });
   synth->add_option("--trajectory", o.trajectory, "robot: a tour of every room; handheld: one room")
       ->capture_default_str()
       ->check(CLI::IsMember({"robot", "handheld"}));
@@ -66,7 +69,7 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
 int run_synth_command(const SynthOptions& o, std::ostream& out, std::ostream& err) {
   io::SyntheticDatasetOptions options;
   options.seed = o.seed;
-  options.frames = o.frames;
+  options.frames = o.survey && !o.frames_given ? 0 : o.frames;
   options.trajectory = o.trajectory == "handheld" ? io::SyntheticTrajectory::handheld
                                                   : io::SyntheticTrajectory::robot;
   options.handheld_room = static_cast<Label>(o.room);

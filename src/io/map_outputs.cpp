@@ -93,11 +93,17 @@ Json evaluation_json(const pipeline::MapEvaluation& e) {
                      {"segment_precision", r.segment_precision}};
   }
   if (e.semantic) {
-    Json iou = Json::object();
-    for (int c = 0; c < kSemanticClassCount; ++c)
-      iou[std::string(to_string(static_cast<SemanticClass>(c)))] =
-          optional_number(e.semantic->iou[static_cast<std::size_t>(c)]);
+    Json iou = Json::object(), confusion = Json::object();
+    for (int c = 0; c < kSemanticClassCount; ++c) {
+      const std::string name(to_string(static_cast<SemanticClass>(c)));
+      iou[name] = optional_number(e.semantic->iou[static_cast<std::size_t>(c)]);
+      Json row = Json::object();  // cells of true class c, by our class
+      for (int p = 0; p < kSemanticClassCount; ++p)
+        row[std::string(to_string(static_cast<SemanticClass>(p)))] = e.semantic->confusion(c, p);
+      confusion[name] = std::move(row);
+    }
     json["classes"] = {{"iou", std::move(iou)},
+                       {"confusion", std::move(confusion)},
                        {"mean_iou", e.semantic->mean_iou},
                        {"overall_accuracy", e.semantic->overall_accuracy},
                        {"cells", e.semantic->evaluated_pixels}};
@@ -143,7 +149,9 @@ Json report_json(const pipeline::MapPipelineResult& r,
                   {"height", r.semantic.height()},
                   {"resolution_m", r.semantic.resolution},
                   {"objects", objects}};
-  json["rooms"] = {{"method", r.rooms.method}, {"count", r.rooms.records.size()}};
+  json["rooms"] = {{"method", r.rooms.method},
+                   {"count", r.rooms.records.size()},
+                   {"enclosed_cells_taken", r.enclosed_cells_taken}};
   if (evaluation) json["evaluation"] = evaluation_json(*evaluation);
   if (!info.parameters_json.empty()) json["parameters"] = Json::parse(info.parameters_json);
   return json;

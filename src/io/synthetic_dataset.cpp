@@ -285,8 +285,10 @@ std::string timestamp_name(double timestamp) {
 
 SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir,
                                                 const SyntheticDatasetOptions& options) {
-  require(options.frames >= 1 && options.frames <= 100000,
-          "synthetic data set: frames must be in 1..100000, got " + std::to_string(options.frames));
+  const bool robot = options.trajectory == SyntheticTrajectory::robot;
+  require((options.frames >= 1 || (robot && options.frames == 0)) && options.frames <= 100000,
+          "synthetic data set: frames must be in 1..100000 (0: a robot tour's own count), got " +
+              std::to_string(options.frames));
   options.intrinsics.validate("synthetic data set intrinsics");
   options.noise.validate();
   options.laser.validate();
@@ -308,18 +310,20 @@ SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir
            std::to_string(world.planes.size()) + " planes");
 
   Label handheld_room = 0;
-  if (options.trajectory == SyntheticTrajectory::robot) {
-    // A tour of 1 frame is no tour: render its start.
-    summary.trajectory = synth::robot_tour(world, std::max(2, options.frames), options.tour);
-    summary.trajectory.resize(static_cast<std::size_t>(options.frames));
+  int frames = options.frames;
+  if (robot) {
     summary.tour_frames_needed = synth::tour_frames_needed(world, options.tour);
-    if (summary.tour_frames_needed > options.frames) {
+    if (frames == 0) frames = summary.tour_frames_needed;
+    // A tour of 1 frame is no tour: render its start.
+    summary.trajectory = synth::robot_tour(world, std::max(2, frames), options.tour);
+    summary.trajectory.resize(static_cast<std::size_t>(frames));
+    if (summary.tour_frames_needed > frames) {
       char note[200];
       std::snprintf(note, sizeof(note),
                     "note: the tour needs %d frames to stay within %.3g m and %.3g deg per frame; "
                     "with %d it moves faster",
                     summary.tour_frames_needed, options.tour.max_step,
-                    options.tour.max_yaw_step_deg, options.frames);
+                    options.tour.max_yaw_step_deg, frames);
       progress(note);
     }
   } else {
@@ -334,7 +338,7 @@ SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir
 
   // Twice as many workers as cores: while one waits for its files to reach the disk (the atomic
   // writes fsync), another renders.
-  progress("rendering " + std::to_string(options.frames) + " frames of " +
+  progress("rendering " + std::to_string(frames) + " frames of " +
            std::to_string(options.intrinsics.width) + "x" +
            std::to_string(options.intrinsics.height) + " on " + std::to_string(threads) +
            " threads");
@@ -382,7 +386,7 @@ SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir
 
   Json json = world_json(world);
   Json dataset;
-  dataset["frames"] = options.frames;
+  dataset["frames"] = summary.trajectory.size();
   dataset["trajectory"] = options.trajectory == SyntheticTrajectory::robot ? "robot" : "handheld";
   if (handheld_room) dataset["handheld_room"] = handheld_room;
   dataset["frame_rate"] =

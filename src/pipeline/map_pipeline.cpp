@@ -81,6 +81,74 @@ class StageClock {
   Clock::time_point start_;
 };
 
+// Rooms separated by a doorway of the grid are neighbours through it: the first room cell on
+// either side of the doorway's middle (within reach) names the two, the doorway's opening is their
+// doorway. Neighbours already touching keep their own record.
+void connect_rooms_through_doorways(const semantic::SemanticGrid& grid,
+                                    rooms::RoomSegmentation& segmentation) {
+  constexpr double kReach = 0.6;  // metres from the doorway's line
+  const LabelImage& labels = segmentation.rooms;
+  const auto room_towards = [&](const Eigen::Vector2d& from, const Eigen::Vector2d& direction) {
+    for (double t = 0; t <= kReach; t += 0.5 * grid.resolution) {
+      const Eigen::Vector2i c = grid.cell_of(from + t * direction);
+      if (!grid.contains(c)) break;
+      if (const Label room = labels(c.x(), c.y())) return room;
+    }
+    return Label{0};
+  };
+  for (const semantic::SemanticObject& door : grid.objects) {
+    if (door.kind != semantic::ObjectKind::doorway || door.width <= 0) continue;
+    const Eigen::Vector2d u = (door.axis_end - door.axis_start).normalized();
+    const Eigen::Vector2d n(-u.y(), u.x());
+    const Label a = room_towards(door.centre, n), b = room_towards(door.centre, -n);
+    if (!a || !b || a == b) continue;
+    for (const auto& [room, other] : {std::pair{a, b}, std::pair{b, a}}) {
+      rooms::RoomRecord& record = segmentation.records[room - 1];
+      const auto at = std::lower_bound(record.neighbours.begin(), record.neighbours.end(), other);
+      if (at != record.neighbours.end() && *at == other) continue;
+      const auto index = at - record.neighbours.begin();
+      record.neighbours.insert(at, other);
+      rooms::Doorway doorway;
+      doorway.other = other;
+      doorway.from = door.axis_start, doorway.to = door.axis_end, doorway.width_m = door.width;
+      doorway.cells = static_cast<int>(door.cells.size());
+      record.doorways.insert(record.doorways.begin() + index, doorway);
+    }
+  }
+}
+
+// Stage 5: rooms on the occupancy grid (doorways closed if asked), then over what they enclose.
+void segment_rooms(const MapPipelineParams& params, MapPipelineResult& result) {
+  const semantic::SemanticGrid& grid = result.semantic;
+  OccupancyGrid room_map = result.occupancy;
+  if (params.rooms_end_at_doorways) {
+    for (const semantic::SemanticObject& object : grid.objects) {
+      if (object.kind != semantic::ObjectKind::doorway) continue;
+      for (const Eigen::Vector2i& c : object.cells)
+        room_map.cells(c.x(), c.y()) = CellState::occupied;
+    }
+  }
+  result.rooms = rooms::segment_rooms(room_map, params.room_method, params.rooms);
+  if (params.rooms_take_enclosed) {
+    // Walls and doors bound rooms; everything else (furniture, unclassified obstacles, floor no
+    // room reached, cells never observed) may belong to the room around it.
+    Image<std::uint8_t> fillable(grid.width(), grid.height(), 0);
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const SemanticClass c = grid.classes(col, row);
+        fillable(col, row) = c != SemanticClass::wall && c != SemanticClass::door;
+      }
+    }
+    result.enclosed_cells_taken = rooms::extend_rooms_over_enclosed(result.rooms.rooms, fillable);
+    if (params.room_fragment_area_m2 > 0) {
+      const double cell_area = grid.resolution * grid.resolution;
+      rooms::merge_room_fragments(result.rooms.rooms, cell_area, params.room_fragment_area_m2);
+    }
+    result.rooms.records = rooms::describe_rooms(result.rooms.rooms, result.occupancy);
+  }
+  connect_rooms_through_doorways(grid, result.rooms);
+}
+
 }  // namespace
 
 segmentation::PlaneExtractionParams view_plane_params() {
@@ -92,6 +160,8 @@ segmentation::PlaneExtractionParams view_plane_params() {
 void MapPipelineParams::validate() const {
   require(label_step >= 1, "MapPipelineParams: label_step must be >= 1");
   require(label_width >= 64, "MapPipelineParams: label_width must be >= 64 pixels");
+  require(room_fragment_area_m2 >= 0 && std::isfinite(room_fragment_area_m2),
+          "MapPipelineParams: room_fragment_area_m2 must be finite and >= 0");
   planes.validate();
   plane_map.validate();
   grid.validate();
@@ -131,15 +201,15 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   const std::size_t frames = result.slam.poses.size();
   for (std::size_t i = 0; i < frames; i += params.label_step) {
     const registration::RgbdImages frame = source.frame(i);
-    const PointImage points = geometry::backproject(context, decimate(frame.depth, factor),
-                                                    view_camera, range);
+    const PointImage points =
+        geometry::backproject(context, decimate(frame.depth, factor), view_camera, range);
     const Eigen::Isometry3d& pose = result.slam.poses[i];
     try {
       const semantic::SemanticLabelling labelling =
           semantic::label_organized_points(context, points, labelling_params);
       views.add(points, labelling.semantic, labelling.gravity, pose);
-      plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)),
-                         points, labelling.semantic, pose);
+      plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)), points,
+                         labelling.semantic, pose);
     } catch (const Error& e) {
       views.skip("frame " + std::to_string(i) + ": " + e.what());  // e.g. a wall seen close by
     }
@@ -148,8 +218,8 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   result.labelled_views = views.views();
   result.unlabelled_views = views.skipped();
   result.first_unlabelled_reason = views.first_skip_reason();
-  require(views.views() > 0, "map: views: no frame could be labelled (" +
-                                 views.first_skip_reason() + ")");
+  require(views.views() > 0,
+          "map: views: no frame could be labelled (" + views.first_skip_reason() + ")");
 
   clock.start("gravity");
   const Eigen::Matrix3d up_to_z = views.make_up_z();
@@ -160,7 +230,8 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   map_from_slam.linear() = up_to_z;
   map_from_slam.translation() = Eigen::Vector3d(0, 0, -*floor_height);
   views.transform(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -*floor_height)));
-  for (const Eigen::Isometry3d& pose : result.slam.poses) result.poses.push_back(map_from_slam * pose);
+  for (const Eigen::Isometry3d& pose : result.slam.poses)
+    result.poses.push_back(map_from_slam * pose);
   result.map = transformed(result.slam.map, map_from_slam);
   result.planes = plane_map.planes(map_from_slam);
 
@@ -169,7 +240,7 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   result.occupancy = semantic::to_occupancy_grid(result.semantic);
 
   clock.start("rooms");
-  result.rooms = rooms::segment_rooms(result.occupancy, params.room_method, params.rooms);
+  segment_rooms(params, result);
   clock.stop();
   return result;
 }

@@ -1,6 +1,7 @@
 #include "kartograf/rooms/room_segmentation.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <map>
 #include <string>
@@ -62,6 +63,91 @@ void grow_rooms(LabelImage& rooms, const OccupancyGrid& map) {
   require(rooms.width() == map.width() && rooms.height() == map.height(),
           "grow_rooms: the label image differs from the map in size");
   flood_rooms(rooms, map, 0, [](std::size_t) { return 0; });
+}
+
+std::size_t extend_rooms_over_enclosed(LabelImage& rooms, const Image<std::uint8_t>& fillable) {
+  const int width = rooms.width(), height = rooms.height();
+  require(fillable.width() == width && fillable.height() == height,
+          "extend_rooms_over_enclosed: the fillable mask differs from the label image in size");
+  const auto open = [&](int x, int y) { return fillable(x, y) && rooms(x, y) == 0; };
+  constexpr std::array<std::array<int, 2>, 4> kSteps = {{{1, 0}, {-1, 0}, {0, 1}, {0, -1}}};
+  // Mark the open components that reach the border: the outside.
+  Image<std::uint8_t> outside(width, height, 0);
+  std::vector<Eigen::Vector2i> queue;
+  const auto push_outside = [&](int x, int y) {
+    if (open(x, y) && !outside(x, y)) outside(x, y) = 1, queue.emplace_back(x, y);
+  };
+  for (int x = 0; x < width; ++x) push_outside(x, 0), push_outside(x, height - 1);
+  for (int y = 0; y < height; ++y) push_outside(0, y), push_outside(width - 1, y);
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    for (const auto& [dx, dy] : kSteps) {
+      const int x = queue[k].x() + dx, y = queue[k].y() + dy;
+      if (x >= 0 && y >= 0 && x < width && y < height) push_outside(x, y);
+    }
+  }
+  // Breadth first from every labelled cell into the enclosed open cells.
+  queue.clear();
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      if (rooms(x, y)) queue.emplace_back(x, y);
+    }
+  }
+  std::size_t taken = 0;
+  for (std::size_t k = 0; k < queue.size(); ++k) {
+    const Label room = rooms(queue[k].x(), queue[k].y());
+    for (const auto& [dx, dy] : kSteps) {
+      const int x = queue[k].x() + dx, y = queue[k].y() + dy;
+      if (x < 0 || y < 0 || x >= width || y >= height || !open(x, y) || outside(x, y)) continue;
+      rooms(x, y) = room;
+      queue.emplace_back(x, y);
+      ++taken;
+    }
+  }
+  return taken;
+}
+
+int merge_room_fragments(LabelImage& rooms, double cell_area_m2, double max_area_m2) {
+  require(cell_area_m2 > 0 && max_area_m2 >= 0,
+          "merge_room_fragments: cell area must be positive and the area limit not negative");
+  const int width = rooms.width(), height = rooms.height();
+  int merged = 0;
+  for (;;) {
+    std::map<Label, std::size_t> cells;
+    for (const Label l : rooms.pixels()) {
+      if (l) ++cells[l];
+    }
+    // Borders between 4-neighbouring cells of two rooms.
+    std::map<std::pair<Label, Label>, int> border;
+    for (int y = 0; y < height; ++y) {
+      for (int x = 0; x < width; ++x) {
+        const Label a = rooms(x, y);
+        if (!a) continue;
+        for (const auto& [nx, ny] : {std::pair{x + 1, y}, std::pair{x, y + 1}}) {
+          if (nx >= width || ny >= height) continue;
+          const Label b = rooms(nx, ny);
+          if (b && b != a) ++border[{std::min(a, b), std::max(a, b)}];
+        }
+      }
+    }
+    // The smallest fragment, and its neighbour with the longest border.
+    Label fragment = 0, into = 0;
+    std::size_t fragment_cells = 0;
+    int longest = 0;
+    for (const auto& [pair, length] : border) {
+      for (const auto& [small, other] : {pair, std::pair{pair.second, pair.first}}) {
+        const std::size_t n = cells[small];
+        if (static_cast<double>(n) * cell_area_m2 >= max_area_m2) continue;
+        if (!fragment || n < fragment_cells || (small == fragment && length > longest)) {
+          fragment = small, fragment_cells = n, into = other, longest = length;
+        }
+      }
+    }
+    if (!fragment) return merged;
+    for (Label& l : rooms.pixels()) {
+      if (l == fragment) l = into;
+    }
+    ++merged;
+  }
 }
 
 Image<float> clearance(const OccupancyGrid& map) {

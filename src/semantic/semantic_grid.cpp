@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <deque>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <string>
@@ -49,6 +50,43 @@ std::optional<double> median_z(std::span<const Eigen::Vector3d> points,
   std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
   return z[z.size() / 2];
 }
+
+// The wall-labelled points in the robot's height band, by cell (compressed rows): doorway jambs
+// are measured on them, finer than the cells.
+class WallPointIndex {
+ public:
+  WallPointIndex(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
+                 std::span<const SemanticClass> labels, const SemanticGridOptions& options)
+      : grid_(grid), start_(static_cast<std::size_t>(grid.width()) * grid.height() + 1, 0) {
+    const auto in_band = [&](std::size_t i) {
+      const double h = points[i].z() - grid.floor_z;
+      return labels[i] == SemanticClass::wall && points[i].allFinite() && h >= options.band_min &&
+             h <= options.band_max;
+    };
+    const auto slot = [&](std::size_t i) {
+      const Eigen::Vector2i c = grid.cell_of(points[i].head<2>());
+      return static_cast<std::size_t>(c.y()) * grid.width() + c.x();
+    };
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (in_band(i)) ++start_[slot(i) + 1];
+    }
+    for (std::size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
+    points_.resize(start_.back());
+    std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
+    for (std::size_t i = 0; i < points.size(); ++i) {
+      if (in_band(i)) points_[next[slot(i)]++] = points[i].head<2>();
+    }
+  }
+  std::span<const Eigen::Vector2d> in_cell(const Eigen::Vector2i& c) const {
+    const std::size_t k = static_cast<std::size_t>(c.y()) * grid_.width() + c.x();
+    return {points_.data() + start_[k], start_[k + 1] - start_[k]};
+  }
+
+ private:
+  const SemanticGrid& grid_;
+  std::vector<std::size_t> start_;
+  std::vector<Eigen::Vector2d> points_;
+};
 
 // Fills an object's metric description from its cells: centre, main axis and extent along it,
 // area, outline, height range.
@@ -181,19 +219,127 @@ bool point_in_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2
   return inside;
 }
 
+// How far beyond an opening's ends, and how far either side of its line, its jambs are looked
+// for [m] (walls are at most kMaxWallThickness thick).
+constexpr double kJambDepth = 0.15;
+constexpr double kMaxWallThickness = 0.3;
+
 // An opening found between two collinear wall pieces: its two ends on the wall line.
 struct WallGap {
   Eigen::Vector2d a, b;
   int merged = 1;
 };
 
+// A doorway's opening in the frame of its gap (centre; along the wall; across it) [m].
+struct Opening {
+  double along_min, along_max, across_min, across_max;
+  bool contains(double along, double across) const {
+    return along >= along_min && along <= along_max && across >= across_min && across <= across_max;
+  }
+};
+
+double quantile(std::vector<double>& values, double q) {
+  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
+  std::nth_element(values.begin(), values.begin() + k, values.end());
+  return values[k];
+}
+
+// Distance from the opening's centre line to one jamb's reveal, from the |along| of that jamb's
+// points: the reveal (a surface across the wall) piles its points up at one distance, the
+// faces spread theirs evenly beyond it. The densest centimetre within 10 cm of the nearest points
+// (a low quantile: flying pixels), refined by the mean around it.
+double reveal_distance(std::vector<double>& along) {
+  for (double& a : along) a = std::fabs(a);
+  const double nearest = quantile(along, 0.02);
+  constexpr int kBins = 10;  // 1 cm each
+  std::array<int, kBins> counts{};
+  for (const double a : along) {
+    const int bin = static_cast<int>((a - nearest) / 0.01);
+    if (bin >= 0 && bin < kBins) ++counts[bin];
+  }
+  const auto peak = std::max_element(counts.begin(), counts.end()) - counts.begin();
+  const double centre = nearest + 0.01 * (static_cast<double>(peak) + 0.5);
+  double sum = 0;
+  int n = 0;
+  for (const double a : along) {
+    if (std::fabs(a - centre) <= 0.015) sum += a, ++n;
+  }
+  return sum / n;
+}
+
+// The opening between two jambs, measured on their wall points (finer than the cells, which
+// straddle the faces): the reveals bound it along the wall, the faces (and the reveals, which
+// span the wall) across it. Empty when either jamb has too few points or the result is no
+// plausible doorway.
+std::optional<Opening> measure_jambs(const SemanticGrid& grid, const WallPointIndex& walls,
+                                     const Eigen::Vector2d& centre, const Eigen::Vector2d& u,
+                                     double width, const SemanticGridOptions& options) {
+  constexpr double kInside = 0.1;  // jamb points may lie this far inside the cells' opening
+  constexpr std::size_t kMinPoints = 10;
+  constexpr double kRevealMargin = 0.03;  // face points lie this far beyond the reveals
+  const Eigen::Vector2d n(-u.y(), u.x());
+  std::vector<double> side_a, side_b, alongs, offsets;
+  const double res = grid.resolution;
+  const Eigen::Vector2i c0 = grid.cell_of(centre);
+  const int reach =
+      static_cast<int>(std::ceil((0.5 * width + kJambDepth + kMaxWallThickness) / res)) + 1;
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const Eigen::Vector2i c = c0 + Eigen::Vector2i(dx, dy);
+      if (!grid.contains(c)) continue;
+      for (const Eigen::Vector2d& p : walls.in_cell(c)) {
+        const double along = u.dot(p - centre), off = n.dot(p - centre);
+        if (std::fabs(off) > kMaxWallThickness || std::fabs(along) < 0.5 * width - kInside ||
+            std::fabs(along) > 0.5 * width + kJambDepth)
+          continue;
+        (along < 0 ? side_a : side_b).push_back(along);
+        alongs.push_back(along);
+        offsets.push_back(off);
+      }
+    }
+  }
+  if (side_a.size() < kMinPoints || side_b.size() < kMinPoints) return std::nullopt;
+  Opening o{-reveal_distance(side_a), reveal_distance(side_b), 0, 0};
+  // The faces: two means of the offsets of the points beyond the reveals (on the faces), started
+  // at their extremes; the mean of a face's points is unbiased where the cells straddle it.
+  std::vector<double> faces;
+  for (std::size_t i = 0; i < offsets.size(); ++i) {
+    const double along = alongs[i];
+    if (along < o.along_min - kRevealMargin || along > o.along_max + kRevealMargin)
+      faces.push_back(offsets[i]);
+  }
+  if (faces.size() < 2 * kMinPoints) return std::nullopt;
+  double lo = quantile(faces, 0.02), hi = quantile(faces, 0.98);
+  for (int iteration = 0; iteration < 10; ++iteration) {
+    double sum_lo = 0, sum_hi = 0;
+    std::size_t n_lo = 0, n_hi = 0;
+    for (const double f : faces) {
+      if (f - lo < hi - f)
+        sum_lo += f, ++n_lo;
+      else
+        sum_hi += f, ++n_hi;
+    }
+    if (n_lo < kMinPoints || n_hi < kMinPoints) return std::nullopt;
+    lo = sum_lo / n_lo, hi = sum_hi / n_hi;
+  }
+  o.across_min = lo, o.across_max = hi;
+  const double measured_width = o.along_max - o.along_min;
+  const bool plausible = measured_width >= 0.75 * options.min_door_width &&
+                         measured_width <= 1.25 * options.max_door_width &&
+                         std::fabs(measured_width - width) <= 2 * kInside &&
+                         o.across_max - o.across_min >= 2 * res &&
+                         o.across_max - o.across_min <= kMaxWallThickness;
+  if (!plausible) return std::nullopt;
+  return o;
+}
+
 // Doorways as gaps of door width in a wall line, with observed floor along the gap and no obstacle
 // across its middle. The two faces of a wall give one gap each; gaps whose centres are closer
 // than half the smallest door width merge.
 template <class AddObject>
 void add_gap_doorways(SemanticGrid& grid, const SemanticGridOptions& options,
-                      const std::vector<int>& wall_ids, int& doorway_count,
-                      AddObject&& add_object) {
+                      const WallPointIndex& walls, const std::vector<int>& wall_ids,
+                      int& doorway_count, AddObject&& add_object) {
   const double res = grid.resolution;
   auto floor_fraction = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     const double length = (b - a).norm();
@@ -273,19 +419,26 @@ void add_gap_doorways(SemanticGrid& grid, const SemanticGridOptions& options,
   for (WallGap& gap : merged) {
     gap.a /= gap.merged, gap.b /= gap.merged;
     const Eigen::Vector2d centre = 0.5 * (gap.a + gap.b);
-    // Its cells: passable cells across the wall's thickness along the gap.
+    // Its cells: passable cells inside the opening as its jambs measure it, else along the gap
+    // within the faces' misalignment of its line.
     const double width = (gap.b - gap.a).norm();
     const Eigen::Vector2d u = (gap.b - gap.a) / width, n(-u.y(), u.x());
     const double across = 0.5 * options.max_wall_misalignment + res;
+    Opening opening{-0.5 * width, 0.5 * width, -across, across};
+    if (const auto measured = measure_jambs(grid, walls, centre, u, width, options))
+      opening = *measured;
+    const Eigen::Vector2d door_centre = centre + 0.5 * (opening.along_min + opening.along_max) * u +
+                                        0.5 * (opening.across_min + opening.across_max) * n;
     std::vector<Eigen::Vector2i> cells;
     const Eigen::Vector2i c0 = grid.cell_of(centre);
-    const int reach = static_cast<int>(std::ceil((0.5 * width + across) / res)) + 1;
+    const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
     for (int dy = -reach; dy <= reach; ++dy) {
       for (int dx = -reach; dx <= reach; ++dx) {
         const Eigen::Vector2i c = c0 + Eigen::Vector2i(dx, dy);
         if (!grid.contains(c) || !(grid.weight(c.x(), c.y()) > 0)) continue;
-        const Eigen::Vector2d d = grid.cell_center(c) - centre;
-        if (std::fabs(u.dot(d)) <= 0.5 * width && std::fabs(n.dot(d)) <= across) cells.push_back(c);
+        if (opening.contains(u.dot(grid.cell_center(c) - centre),
+                             n.dot(grid.cell_center(c) - centre)))
+          cells.push_back(c);
       }
     }
     if (cells.empty()) continue;
@@ -296,7 +449,10 @@ void add_gap_doorways(SemanticGrid& grid, const SemanticGridOptions& options,
     SemanticObject& door =
         add_object(ObjectKind::doorway, SemanticClass::door,
                    "doorway " + std::to_string(++doorway_count), std::move(cells));
-    door.centre = centre, door.axis_start = gap.a, door.axis_end = gap.b, door.width = width;
+    door.centre = door_centre;
+    door.axis_start = centre + opening.along_min * u + (door_centre - centre).dot(n) * n;
+    door.axis_end = centre + opening.along_max * u + (door_centre - centre).dot(n) * n;
+    door.width = opening.along_max - opening.along_min;
   }
 }
 
@@ -687,7 +843,8 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
     describe_cells(grid, evidence, wall, /*keep_axis=*/true);
   }
 
-  add_gap_doorways(grid, options, wall_ids, doorway_count, add_object);
+  add_gap_doorways(grid, options, WallPointIndex(grid, points, labels, options), wall_ids,
+                   doorway_count, add_object);
 
   // Detections: their own objects on the cells whose centres their footprint covers.
   for (std::size_t d = 0; d < detections.size(); ++d) {

@@ -14,7 +14,7 @@ namespace kartograf::synth {
 namespace {
 
 constexpr double kDegree = std::numbers::pi / 180.0;
-constexpr double kSampleStep = 0.005;  // metres: the tour's speed profile is tabulated this finely
+constexpr double kSampleStep = 0.001;  // metres: the tour's speed profile is tabulated this finely
 constexpr double kMaxSpeedChange = 0.002;  // metres per frame, per frame (1.8 m/s^2 at 30 Hz)
 constexpr double kSafety = 0.97;           // plan slightly inside the limits (finite differences)
 
@@ -41,12 +41,35 @@ struct Interval {
   double begin, end;
 };
 
-// Heading of the camera along the route: the direction of travel plus, inside each room (between
-// the straight stretches at its doorways), a look to the left and to the right.
+// The obstacles (furniture, door leaves) in or near `room`.
+std::vector<Rect2> obstacles_near(const World& world, const Room& room) {
+  std::vector<Rect2> obstacles;
+  for (const Rect2& r : world.obstacle_footprints()) {
+    if (r.overlaps(room.rect.expanded(0.5))) obstacles.push_back(r);
+  }
+  return obstacles;
+}
+
+// Distance from p to the walls of `room` and to the obstacles (furniture, door leaves).
+double clearance(const Room& room, const std::vector<Rect2>& obstacles, const Eigen::Vector2d& p) {
+  double c = std::min((p - room.rect.min).minCoeff(), (room.rect.max - p).minCoeff());
+  for (const Rect2& r : obstacles) c = std::min(c, r.distance(p));
+  return c;
+}
+
+// Virtual length [m] of one turn in place: the tour's parameter runs over the route's length plus
+// this much per stop, so the speed profile below limits turning speed and its changes too.
+constexpr double kTurnLength = 2.0;
+
+// The camera along the route, by a parameter u that runs over the route's length plus, in a
+// survey, kTurnLength per stop (u advances while the robot turns in place). Heading: the direction
+// of travel plus, inside each room (between the straight stretches at its doorways), a look to
+// the left and to the right; or, in a survey, one full turn in place at the most open point of
+// each room's and corridor pass's stretch of route.
 class TourPlan {
  public:
   TourPlan(const World& world, double look_around_deg, bool survey)
-      : path_(route_path(world)), amplitude_(look_around_deg * kDegree), survey_(survey) {
+      : path_(route_path(world)), amplitude_(look_around_deg * kDegree) {
     const auto& s = path_.vertex_positions();
     std::vector<std::size_t> doors;
     for (std::size_t i = 0; i < world.route.size(); ++i) {
@@ -60,52 +83,111 @@ class TourPlan {
       if (end < begin - 1e-9) end += length;  // wraps past the start
       if (end - begin < 0.5) continue;
       const Label room = world.room_at(path_.position(0.5 * (begin + end)));
-      if (room && (survey || world.room(room).kind == RoomKind::room))
+      if (!room) continue;
+      if (survey) {
+        stops_.push_back(most_open_route_position(world, world.room(room), begin, end));
+      } else if (world.room(room).kind == RoomKind::room) {
         looks_.push_back({begin, end});
+      }
     }
+    std::sort(stops_.begin(), stops_.end());
   }
 
   const RoutePath& path() const { return path_; }
+  double length() const { return path_.length() + kTurnLength * stops_.size(); }
 
-  double yaw(double s) const {
-    double yaw = path_.heading(s);
+  // Route position at u, and how far (0..1) through a turn in place it is (0 while moving).
+  double route_position(double u, double* turned = nullptr, int* turns_done = nullptr) const {
+    double offset = 0;
+    int done = 0;
+    for (double stop : stops_) {
+      if (u < stop + offset) break;
+      if (u < stop + offset + kTurnLength) {
+        if (turned) *turned = (u - stop - offset) / kTurnLength;
+        if (turns_done) *turns_done = done;
+        return stop;
+      }
+      offset += kTurnLength;
+      ++done;
+    }
+    if (turned) *turned = 0;
+    if (turns_done) *turns_done = done;
+    return u - offset;
+  }
+
+  double yaw(double u) const {
+    double turned = 0;
+    int turns_done = 0;
+    const double s = route_position(u, &turned, &turns_done);
+    double yaw = path_.heading(s) + 2 * std::numbers::pi * turns_done + turn_shape(turned);
     for (const Interval& look : looks_) {
       for (double shift : {0.0, path_.length()}) {  // an interval may wrap past the end
         const double x = (s + shift - look.begin) / (look.end - look.begin);
-        if (x > 0 && x < 1) yaw += survey_ ? turn_shape(x) : amplitude_ * look_shape(x);
+        if (x > 0 && x < 1) yaw += amplitude_ * look_shape(x);
       }
     }
     return yaw;
   }
 
+  // Whether [u0, u1] contains the start or the end of a turn in place (the robot stands still
+  // there).
+  bool starts_or_ends_turn(double u0, double u1) const {
+    double offset = 0;
+    for (double stop : stops_) {
+      for (double edge : {stop + offset, stop + offset + kTurnLength}) {
+        if (edge >= u0 && edge <= u1) return true;
+      }
+      offset += kTurnLength;
+    }
+    return false;
+  }
+
  private:
+  // The route position in [begin, end] (wrapped) farthest from the room's walls and obstacles.
+  double most_open_route_position(const World& world, const Room& room, double begin,
+                                  double end) const {
+    const std::vector<Rect2> obstacles = obstacles_near(world, room);
+    double best_s = 0.5 * (begin + end), best = -1;
+    for (double s = begin; s <= end; s += 0.05) {
+      const double c = clearance(room, obstacles, path_.position(s));
+      if (c > best) best = c, best_s = s;
+    }
+    return std::fmod(best_s, path_.length());
+  }
+
   RoutePath path_;
   double amplitude_;
-  bool survey_;
   std::vector<Interval> looks_;
+  std::vector<double> stops_;  // route positions of the turns in place, ascending
 };
 
-// Frames per metre of route at each tabulated position: the inverse of a speed profile that
-// keeps every frame within the step and yaw limits and changes speed by at most kMaxSpeedChange
-// per frame (a bounded acceleration: continuous velocity, C1 positions). The classic two-pass
-// construction: the pointwise speed limit, then forward and backward passes bounding
-// d(v^2)/ds by 2 a, around the closed route.
+// Frames per unit of tour parameter at each tabulated position: the inverse of a speed profile
+// that keeps every frame within the step and yaw limits, stands still where a turn in place starts
+// or ends, and changes speed by at most kMaxSpeedChange per frame (a bounded acceleration:
+// continuous velocity, C1 positions). The classic two-pass construction: the pointwise speed
+// limit, then forward and backward passes bounding d(v^2)/du by 2 a, around the closed tour.
 std::vector<double> frames_per_metre(const TourPlan& plan, const TourOptions& options,
                                      int& samples) {
-  const double length = plan.path().length();
+  const double length = plan.length();
   samples = std::max(8, static_cast<int>(std::ceil(length / kSampleStep)));
-  const double ds = length / samples;
+  const double du = length / samples;
   const double max_step = kSafety * options.max_step;
   const double max_yaw = kSafety * options.max_yaw_step_deg * kDegree;
-  std::vector<double> speed(samples);  // metres per frame
-  double yaw_prev = plan.yaw(0);
+  std::vector<double> speed(samples);  // parameter units per frame
+  double yaw_prev = plan.yaw(0), s_prev = plan.route_position(0);
   for (int i = 0; i < samples; ++i) {
-    const double yaw_next = plan.yaw((i + 1) * ds);
-    const double yaw_rate = std::fabs(yaw_next - yaw_prev) / ds;  // rad per metre
-    speed[i] = yaw_rate > 0 ? std::min(max_step, max_yaw / yaw_rate) : max_step;
+    const double u = (i + 1) * du;
+    const double yaw_next = plan.yaw(u), s_next = plan.route_position(u);
+    const double yaw_rate = std::fabs(yaw_next - yaw_prev) / du;  // rad per unit
+    const double step_rate = std::fabs(s_next - s_prev) / du;     // metres per unit
+    double v = step_rate > 0 ? max_step / step_rate : max_step;
+    if (yaw_rate > 0) v = std::min(v, max_yaw / yaw_rate);
+    if (plan.starts_or_ends_turn(i * du, u)) v = 0.25 * kMaxSpeedChange;  // all but stopped
+    speed[i] = v;
     yaw_prev = yaw_next;
+    s_prev = s_next;
   }
-  const double reach = 2.0 * kSafety * kMaxSpeedChange * ds;  // the most v^2 may change per sample
+  const double reach = 2.0 * kSafety * kMaxSpeedChange * du;  // the most v^2 may change per sample
   for (int pass = 0; pass < 2; ++pass) {                      // twice: the route is a loop
     for (int i = 1; i <= samples; ++i) {
       double& v = speed[i % samples];
@@ -152,7 +234,7 @@ double frames_at_limits(const TourPlan& plan, const TourOptions& options) {
   int samples = 0;
   const std::vector<double> rate = frames_per_metre(plan, options, samples);
   double total = 0;
-  for (double r : rate) total += r * plan.path().length() / samples;
+  for (double r : rate) total += r * plan.length() / samples;
   return total;
 }
 
@@ -187,10 +269,10 @@ Trajectory robot_tour(const World& world, int frame_count, const TourOptions& op
   const TourPlan plan(world, look, options.survey);
   int samples = 0;
   const std::vector<double> rate = frames_per_metre(plan, options, samples);
-  const double length = plan.path().length();
-  const double ds = length / samples;
+  const double length = plan.length();
+  const double du = length / samples;
   std::vector<double> cumulative(samples + 1, 0.0);  // frames spent up to sample i
-  for (int i = 0; i < samples; ++i) cumulative[i + 1] = cumulative[i] + rate[i] * ds;
+  for (int i = 0; i < samples; ++i) cumulative[i + 1] = cumulative[i] + rate[i] * du;
 
   Trajectory trajectory;
   trajectory.reserve(static_cast<std::size_t>(frame_count));
@@ -201,11 +283,11 @@ Trajectory robot_tour(const World& world, int frame_count, const TourOptions& op
     const auto it = std::upper_bound(cumulative.begin(), cumulative.end(), target);
     const int i = std::clamp(static_cast<int>(it - cumulative.begin()) - 1, 0, samples - 1);
     const double fraction = (target - cumulative[i]) / (cumulative[i + 1] - cumulative[i]);
-    const double s = k == frame_count - 1 ? length : (i + std::clamp(fraction, 0.0, 1.0)) * ds;
-    const Eigen::Vector2d p = plan.path().position(s);
+    const double u = k == frame_count - 1 ? length : (i + std::clamp(fraction, 0.0, 1.0)) * du;
+    const Eigen::Vector2d p = plan.path().position(plan.route_position(u));
     StampedPose pose;
     pose.timestamp = options.start_time + k / options.frame_rate;
-    pose.pose = camera_pose({p.x(), p.y(), options.camera_height}, plan.yaw(s), pitch);
+    pose.pose = camera_pose({p.x(), p.y(), options.camera_height}, plan.yaw(u), pitch);
     trajectory.push_back(pose);
   }
   return trajectory;
@@ -213,10 +295,7 @@ Trajectory robot_tour(const World& world, int frame_count, const TourOptions& op
 
 std::pair<Eigen::Vector2d, double> most_open_point(const World& world, Label room_id) {
   const Room& room = world.room(room_id);
-  std::vector<Rect2> obstacles;
-  for (const Rect2& r : world.obstacle_footprints()) {
-    if (r.overlaps(room.rect.expanded(0.5))) obstacles.push_back(r);
-  }
+  const std::vector<Rect2> obstacles = obstacles_near(world, room);
   constexpr double kStep = 0.05;
   const Eigen::Vector2i cells = (room.rect.size() / kStep).array().floor().cast<int>();
   Eigen::Vector2d best = room.rect.center();
@@ -224,10 +303,9 @@ std::pair<Eigen::Vector2d, double> most_open_point(const World& world, Label roo
   for (int j = 0; j < cells.y(); ++j) {
     for (int i = 0; i < cells.x(); ++i) {
       const Eigen::Vector2d p = room.rect.min + kStep * Eigen::Vector2d(i + 0.5, j + 0.5);
-      double clearance = std::min((p - room.rect.min).minCoeff(), (room.rect.max - p).minCoeff());
-      for (const Rect2& r : obstacles) clearance = std::min(clearance, r.distance(p));
-      if (clearance > best_clearance + 1e-12) {
-        best_clearance = clearance;
+      const double c = clearance(room, obstacles, p);
+      if (c > best_clearance + 1e-12) {
+        best_clearance = c;
         best = p;
       }
     }

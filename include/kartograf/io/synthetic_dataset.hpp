@@ -44,7 +44,7 @@ enum class SyntheticTrajectory { robot, handheld };
 
 struct SyntheticDatasetOptions {
   std::uint64_t seed = 1;
-  int frames = 300;
+  int frames = 300;  // robot tours: 0 = as many as the tour needs to keep its per-frame limits
   SyntheticTrajectory trajectory = SyntheticTrajectory::robot;
   Label handheld_room = 0;  // handheld: a World::rooms id; 0 = the largest room
   PinholeIntrinsics intrinsics{640, 480, 525.0, 525.0, 319.5, 239.5};  // TUM's default Kinect

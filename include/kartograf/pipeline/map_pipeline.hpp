@@ -12,7 +12,10 @@
 //   4. grid       the metric-semantic grid (semantic/semantic_grid.hpp): floor evidence free,
 //                 obstacles in the robot's height band, doors, traversability; the occupancy grid
 //                 is its free / occupied / unknown view
-//   5. rooms      room segmentation of the occupancy grid (rooms/room_methods.hpp, M4)
+//   5. rooms      room segmentation of the occupancy grid (rooms/room_methods.hpp, M4), with
+//                 the grid's doorways closed (rooms end at the doors the semantic grid found);
+//                 then each room takes the furniture and unobserved cells its walls enclose, and
+//                 small fragments join the room they touch
 // Library only: pipeline/map_evaluation.hpp scores a result against ground truth and
 // io/map_outputs.hpp writes the files and the report.
 #include <cstddef>
@@ -40,15 +43,22 @@ namespace kartograf::pipeline {
 segmentation::PlaneExtractionParams view_plane_params();
 
 struct MapPipelineParams {
-  mapping::SlamParams slam;  // its build_map is always on
-  std::size_t label_step = 5;  // views: every k-th frame
-  int label_width = 320;       // views: decimated to at most this many pixels per row
+  mapping::SlamParams slam;             // its build_map is always on
+  std::size_t label_step = 5;           // views: every k-th frame
+  int label_width = 320;                // views: decimated to at most this many pixels per row
   semantic::LabellingParams labelling;  // gravity.prior_up defaults to the camera's -y
   segmentation::PlaneExtractionParams planes = view_plane_params();
   mapping::PlaneMapParams plane_map;
   semantic::SemanticGridOptions grid;
   rooms::RoomMethod room_method = rooms::RoomMethod::distance;
   rooms::RoomMethodOptions rooms;
+  bool rooms_end_at_doorways = true;  // doorway cells count as occupied for the segmentation
+  // Rooms take the unlabelled cells their walls and doorways enclose: furniture, floor the views
+  // missed (rooms::extend_rooms_over_enclosed). Off: rooms cover observed free floor only.
+  bool rooms_take_enclosed = true;
+  // Then rooms under this area touching another room directly (no wall or doorway between: a
+  // corner cut off by furniture) join it (rooms::merge_room_fragments); 0: off.
+  double room_fragment_area_m2 = 2.0;
 
   void validate() const;  // throws Error naming the first bad field
 };
@@ -60,14 +70,15 @@ struct StageTiming {
 };
 
 struct MapPipelineResult {
-  mapping::SlamResult slam;                  // in the SLAM frame (the first camera's)
+  mapping::SlamResult slam;  // in the SLAM frame (the first camera's)
   Eigen::Isometry3d map_from_slam = Eigen::Isometry3d::Identity();
-  std::vector<Eigen::Isometry3d> poses;      // camera-to-map, one per frame
-  PointCloud map;                            // the fused map in the map frame
-  std::vector<mapping::MapPlane> planes;     // map frame
+  std::vector<Eigen::Isometry3d> poses;   // camera-to-map, one per frame
+  PointCloud map;                         // the fused map in the map frame
+  std::vector<mapping::MapPlane> planes;  // map frame
   semantic::SemanticGrid semantic;
-  OccupancyGrid occupancy;                   // the grid's free / occupied / unknown cells
-  rooms::RoomSegmentation rooms;             // on `occupancy`
+  OccupancyGrid occupancy;               // the grid's free / occupied / unknown cells
+  rooms::RoomSegmentation rooms;         // on `occupancy` (see rooms_take_enclosed)
+  std::size_t enclosed_cells_taken = 0;  // cells beyond the free space the rooms took
   int labelled_views = 0, unlabelled_views = 0;
   std::string first_unlabelled_reason;
   std::vector<StageTiming> timings;

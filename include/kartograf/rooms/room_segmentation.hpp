@@ -63,6 +63,19 @@ std::vector<RoomRecord> describe_rooms(LabelImage& rooms, const OccupancyGrid& m
 // reaches stay 0.
 void grow_rooms(LabelImage& rooms, const OccupancyGrid& map);
 
+// Grows labelled rooms over the unlabelled cells marked in `fillable` (e.g. furniture and floor
+// the sensor never saw, inside a room's walls) that are enclosed: their 4-connected component of
+// unlabelled fillable cells does not reach the image border (which would make it the outside).
+// Breadth first from every room at once through 4-neighbours; each cell takes the room that
+// reaches it first. Components no room touches stay 0. Returns how many cells were taken.
+std::size_t extend_rooms_over_enclosed(LabelImage& rooms, const Image<std::uint8_t>& fillable);
+
+// Rooms smaller than max_area_m2 that touch another room directly (4-neighbours, no wall or
+// doorway between) are fragments of it: each joins the neighbour it shares the longest border
+// with, smallest fragment first. Rooms behind walls and doorways stay, however small. Returns the
+// number of rooms merged away (labels are not renumbered: describe_rooms does that).
+int merge_room_fragments(LabelImage& rooms, double cell_area_m2, double max_area_m2);
+
 // Euclidean distance [cells] of every free cell to the nearest cell that is not free (0 there);
 // the map's outside counts as not free.
 Image<float> clearance(const OccupancyGrid& map);

@@ -23,9 +23,10 @@ struct TourOptions {
   double camera_height = 1.0;     // metres above the floor
   double pitch_deg = 12.0;        // downwards
   double look_around_deg = 30.0;  // yaw sweep inside each room: up to this far left, then right
-  // Survey: instead of looking left and right, turn once all the way round inside each room and
-  // on each pass through the corridor, as a robot exploring the building would (sees every room's
-  // floor and walls; needs about 90 frames more per turn at max_yaw_step_deg 4).
+  // Survey: instead of looking left and right, stop once in each room and on each pass through
+  // the corridor, at the route's point farthest from walls and furniture there, and turn all the
+  // way round in place, as a robot exploring the building would (sees every room's floor and
+  // walls; needs about 100 frames more per turn at max_yaw_step_deg 4).
   bool survey = false;
   double max_step = 0.12;         // metres per frame
   double max_yaw_step_deg = 4.0;  // degrees per frame
