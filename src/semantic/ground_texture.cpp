@@ -16,6 +16,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
 #include "kartograf/synth/random.hpp"
+#include "semantic/quantile.hpp"
 
 namespace kartograf::semantic {
 
@@ -47,12 +48,6 @@ double default_traversability(GroundClass ground) {
 // ---- Features ----------------------------------------------------------------------------------
 
 namespace {
-
-double percentile(std::vector<double> values, double fraction) {
-  const auto k = static_cast<std::ptrdiff_t>(fraction * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[static_cast<std::size_t>(k)];
-}
 
 // Mean and population standard deviation of each column.
 struct ColumnStats {
@@ -202,7 +197,8 @@ GroundFeatures ground_features(const PointCloud& patch, const GroundFeatureParam
     f[static_cast<std::size_t>(which)] = static_cast<float>(value);
   };
   set(GroundFeature::height_std, std::sqrt(height_var / static_cast<double>(n)));
-  set(GroundFeature::height_range, percentile(heights, 0.98) - percentile(heights, 0.02));
+  set(GroundFeature::height_range,
+      detail::quantile(heights, 0.98) - detail::quantile(heights, 0.02));
   set(GroundFeature::roughness, grid.roughness);
   set(GroundFeature::max_step, grid.max_step);
   set(GroundFeature::slope,

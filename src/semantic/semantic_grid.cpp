@@ -14,6 +14,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/connected_components.hpp"
+#include "semantic/quantile.hpp"
 
 namespace kartograf::semantic {
 namespace {
@@ -238,19 +239,13 @@ struct Opening {
   }
 };
 
-double quantile(std::vector<double>& values, double q) {
-  const auto k = static_cast<std::ptrdiff_t>(q * static_cast<double>(values.size() - 1));
-  std::nth_element(values.begin(), values.begin() + k, values.end());
-  return values[k];
-}
-
 // Distance from the opening's centre line to one jamb's reveal, from the |along| of that jamb's
 // points: the reveal (a surface across the wall) piles its points up at one distance, the
 // faces spread theirs evenly beyond it. The densest centimetre within 10 cm of the nearest points
 // (a low quantile: flying pixels), refined by the mean around it.
 double reveal_distance(std::vector<double>& along) {
   for (double& a : along) a = std::fabs(a);
-  const double nearest = quantile(along, 0.02);
+  const double nearest = detail::quantile(along, 0.02);
   constexpr int kBins = 10;  // 1 cm each
   std::array<int, kBins> counts{};
   for (const double a : along) {
@@ -309,7 +304,7 @@ std::optional<Opening> measure_jambs(const SemanticGrid& grid, const WallPointIn
       faces.push_back(offsets[i]);
   }
   if (faces.size() < 2 * kMinPoints) return std::nullopt;
-  double lo = quantile(faces, 0.02), hi = quantile(faces, 0.98);
+  double lo = detail::quantile(faces, 0.02), hi = detail::quantile(faces, 0.98);
   for (int iteration = 0; iteration < 10; ++iteration) {
     double sum_lo = 0, sum_hi = 0;
     std::size_t n_lo = 0, n_hi = 0;
