@@ -16,6 +16,8 @@ packages=(
   nlohmann-json3-dev                               # io and CLI: JSON files
   libcli11-dev                                     # the kartograf CLI
   libgtest-dev libbenchmark-dev                    # tests and benchmarks
+  libjs-three                                      # io: three.js, inlined into report.html
+  chromium                                         # tests: report.html in headless Chromium
 )
 
 missing=()

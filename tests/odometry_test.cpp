@@ -109,6 +109,32 @@ TEST(Odometry, ReestimationAgainstFrameKBackReducesDrift) {
   EXPECT_EQ(chained.constraints().size(), tour().frames.size() - 1);
 }
 
+TEST(Odometry, MemoryDoesNotGrowWithTheReestimationInterval) {
+  // Issue 20 defect 3: k = 1000 allocated 1001 frame pyramids up front (12.9 GB at 640x480).
+  // Only the current frame, the previous one and the last multiple of k are registered against.
+  const compute::Context context = compute::Context::cpu();
+  const RgbdOdometry chained = track_all(context, tour(), synthetic_params(0));
+  const RgbdOdometry far = track_all(context, tour(), synthetic_params(1000));
+  EXPECT_LE(chained.kept_pyramids(), 2u);
+  EXPECT_LE(far.kept_pyramids(), 3u);
+  // 30 frames never reach frame 1000: the same poses as without re-estimation.
+  ASSERT_EQ(far.poses().size(), chained.poses().size());
+  for (std::size_t i = 0; i < far.poses().size(); ++i) {
+    EXPECT_TRUE(far.poses()[i].isApprox(chained.poses()[i], 1e-12)) << "frame " << i;
+  }
+  // k = 7 re-registers frames 7, 14, 21 and 28 against the anchors it kept.
+  const RgbdOdometry seventh = track_all(context, tour(), synthetic_params(7));
+  EXPECT_LE(seventh.kept_pyramids(), 3u);
+  std::size_t k_back = 0;
+  for (const auto& frame : seventh.frames()) {
+    if (!frame.reestimate) continue;
+    ++k_back;
+    EXPECT_EQ(frame.index % 7, 0u);
+    EXPECT_TRUE(frame.reestimate->accepted()) << "frame " << frame.index;
+  }
+  EXPECT_EQ(k_back, (tour().frames.size() - 1) / 7);
+}
+
 TEST(Odometry, UnusableFrameFallsBackToTheMotionModelAndIsReported) {
   RenderedSequence sequence = tour();
   sequence.frames.resize(16);

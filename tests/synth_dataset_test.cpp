@@ -209,7 +209,10 @@ TEST_F(SynthDataset, CameraIntrinsicsJsonRoundTripAndErrors) {
     o.frames = 1;
     return o;
   }());
-  EXPECT_DOUBLE_EQ(io::open_tum_sequence(dir() / "set", 0.02, k)->intrinsics().fx, 262.5);
+  const PinholeIntrinsics given{80, 60, 262.5, 263.0, 39.5, 29.75};
+  EXPECT_DOUBLE_EQ(io::open_tum_sequence(dir() / "set", 0.02, given)->intrinsics().fx, 262.5);
+  // A camera for other frames than the folder's is refused, naming both sizes.
+  EXPECT_ERROR_MENTIONS(io::open_tum_sequence(dir() / "set", 0.02, k), "320x240", "80x60");
   EXPECT_DOUBLE_EQ(io::open_tum_sequence(dir() / "set")->intrinsics().fx, 65.625);
 }
 

@@ -26,6 +26,7 @@ struct DemoOptions {
   std::filesystem::path out_dir = "kartograf-demo";
   std::string backend = "auto";
   std::string backend_source = "--backend";  // names the setting in errors
+  bool force = false;
 };
 
 // Renders a depth frame of the default synthetic world (synth/), back-projects it, estimates
@@ -67,14 +68,23 @@ struct SynthOptions {
 CLI::App* add_synth_command(CLI::App& app, SynthOptions& options);
 int run_synth_command(const SynthOptions& options, std::ostream& out, std::ostream& err);
 
-// Options shared by `odometry` and `slam` (sequence_run.hpp).
+// How every command that takes a sequence folder reads it (sequence_run.hpp:
+// add_sequence_input_options; io::SequenceOptions).
+struct SequenceInputOptions {
+  std::string camera;                           // --camera; empty: the folder's
+  double depth_scale = 0;                       // --depth-scale [units per metre]; 0: the layout's
+  std::size_t first = 0, frames = 0, step = 1;  // --first, --frames (0: all), --step
+  bool skip_bad_frames = false;
+};
+
+// Options shared by `odometry`, `slam` and `map` (sequence_run.hpp).
 struct SequenceRunOptions {
   std::filesystem::path sequence;  // a folder in any supported layout (io/sequence_detect.hpp)
+  SequenceInputOptions input;
   std::string method = "p2plane";  // p2p | p2plane | color | planar
   std::string backend = "auto";
   std::string backend_source = "--backend";  // names the setting in errors
   int reestimate_interval = 5;
-  std::size_t frames = 0;  // 0: all
   bool progress = true;
 };
 
@@ -83,6 +93,7 @@ struct SequenceRunOptions {
 struct OdometryOptions {
   SequenceRunOptions run;
   std::filesystem::path out, stats;
+  bool force = false;  // replace existing files
 };
 CLI::App* add_odometry_command(CLI::App& app, OdometryOptions& options);
 int run_odometry_command(const OdometryOptions& options, std::ostream& out, std::ostream& err);
@@ -95,6 +106,7 @@ struct SlamOptions {
   bool no_loop_closure = false;
   bool no_map = false;
   double voxel_size = 0.02;
+  bool force = false;  // replace an earlier run's folder
 };
 CLI::App* add_slam_command(CLI::App& app, SlamOptions& options);
 int run_slam_command(const SlamOptions& options, std::ostream& out, std::ostream& err);
@@ -102,9 +114,10 @@ int run_slam_command(const SlamOptions& options, std::ostream& out, std::ostream
 // `planes INPUT --out DIR`: planes of an organized PCD, an RGB-D frame or a sequence's frames.
 struct PlanesOptions {
   std::filesystem::path input, out_dir;
-  std::filesystem::path color, intrinsics;      // depth PNG input
-  double fx = 0, fy = 0, cx = -1, cy = -1;      // depth PNG input; 0 / -1: Kinect-like defaults
-  double depth_scale = 1000;                    // depth PNG input: units per metre
+  std::filesystem::path color, intrinsics;  // depth PNG input
+  double fx = 0, fy = 0, cx = -1, cy = -1;  // depth PNG input; 0 / -1: Kinect-like defaults
+  double depth_scale = 0;  // units per metre; 0: 1000 for a depth PNG, the layout's for a sequence
+  SequenceInputOptions sequence;                // sequences: --camera, --skip-bad-frames
   std::size_t first = 0, frames = 0, step = 1;  // sequences
   double lab_threshold = 15;
   double normal_angle_deg = 30;
@@ -138,6 +151,7 @@ int run_rooms_command(const RoomsOptions& options, bool resolution_given, std::o
 // `rooms-eval FOLDER`: every method on every map with a ground truth: tables on out, CSV.
 struct RoomsEvalOptions {
   std::filesystem::path folder, csv;
+  bool force = false;                // replace an existing CSV
   std::vector<std::string> methods;  // empty: all
   std::string only;                  // map name filter
   RoomsOptions map;                  // resolution, free threshold, area limits
@@ -149,9 +163,10 @@ int run_rooms_eval_command(const RoomsEvalOptions& options, std::ostream& out, s
 // `semantic SCAN --out DIR [--goto door|wall]`: the metric-semantic grid map of an organized scan.
 struct SemanticOptions {
   std::filesystem::path input, out_dir, trajectory;
-  std::size_t frames = 0;   // sequence: 0 = all
-  int step = 10;            // sequence: every k-th frame
-  std::string goto_target;  // empty, "door" or "wall"
+  std::size_t frames = 0;         // sequence: 0 = all
+  int step = 10;                  // sequence: every k-th frame
+  SequenceInputOptions sequence;  // sequence: --camera, --depth-scale, --skip-bad-frames
+  std::string goto_target;        // empty, "door" or "wall"
   double resolution = 0.05;
   std::vector<double> viewpoint;  // unorganized map without --trajectory: x y z (default: centroid)
   double angular_step = 1.0;      // unorganized map: range image degrees per pixel

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
@@ -21,6 +22,7 @@
 #include "kartograf/io/ply.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
+#include "output_transaction.hpp"
 
 namespace kartograf::cli {
 
@@ -94,24 +96,13 @@ std::string percent_of(std::size_t part, std::size_t whole) {
   return text.str();
 }
 
-// Creates the output directory up front, so that a bad path fails before any work is done.
-void prepare_output_dir(const std::filesystem::path& dir) {
-  std::error_code error;
-  if (std::filesystem::exists(dir, error) && !std::filesystem::is_directory(dir, error)) {
-    throw Error("output path '" + dir.string() + "' exists and is not a directory");
-  }
-  std::filesystem::create_directories(dir, error);
-  if (error) {
-    throw Error("cannot create output directory '" + dir.string() + "': " + error.message());
-  }
-}
-
 }  // namespace
 
 int run_demo_command(const DemoOptions& options, std::ostream& out) {
   compute::ContextOptions context_options = compute::ContextOptions::from_environment();
   context_options.backend = compute::parse_backend_choice(options.backend, options.backend_source);
-  prepare_output_dir(options.out_dir);
+  OutputFolder folder("demo", options.out_dir, options.force,
+                      {"depth.png", "depth_color.png", "normals.png", "cloud.ply"});
 
   out << "backends:\n";
   print_backend_summary(out, compute::probe_backends());
@@ -156,15 +147,16 @@ int run_demo_command(const DemoOptions& options, std::ostream& out) {
   const double colormap_max_metres =
       std::max<double>(1, *std::max_element(depths.begin(), depths.end())) / kUnitsPerMetre;
 
-  const std::filesystem::path& dir = options.out_dir;
-  const std::vector<std::filesystem::path> written = timer.time("write", [&] {
+  const std::filesystem::path& dir = folder.dir();
+  const std::vector<std::string> written = timer.time("write", [&] {
+    const InterruptsDeferred writing;  // a signal waits for the files, then drops them
     io::write_png(dir / "depth.png", frame.depth);
     io::write_png(dir / "depth_color.png",
                   io::colorize_depth(frame.depth, kUnitsPerMetre, colormap_max_metres));
     io::write_png(dir / "normals.png", io::colorize_normals(normals));
     io::write_ply(dir / "cloud.ply", points, &normals);
-    return std::vector<std::filesystem::path>{dir / "depth.png", dir / "depth_color.png",
-                                              dir / "normals.png", dir / "cloud.ply"};
+    folder.commit();
+    return std::vector<std::string>{"depth.png", "depth_color.png", "normals.png", "cloud.ply"};
   });
 
   const std::size_t pixels = points.size();
@@ -176,7 +168,7 @@ int run_demo_command(const DemoOptions& options, std::ostream& out) {
       << percent_of(valid_normals, pixels) << ")\n";
   timer.print(out);
   out << "wrote:\n";
-  for (const auto& path : written) out << "  " << path.string() << "\n";
+  for (const auto& name : written) out << "  " << (options.out_dir / name).string() << "\n";
   return 0;
 }
 

@@ -21,6 +21,7 @@
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/io/occupancy_map_io.hpp"
 #include "kartograf/io/tum.hpp"
+#include "option_checks.hpp"
 
 namespace kartograf::cli {
 
@@ -254,19 +255,23 @@ CLI::App* add_eval_command(CLI::App& app, EvalOptions& options) {
   CLI::App* traj = add_metric("traj", "ATE and RPE of a trajectory (TUM format)",
                               "Ground-truth trajectory (timestamp tx ty tz qx qy qz qw)",
                               "Estimated trajectory, same format");
-  traj->add_option("--delta", options.delta, "RPE step")->capture_default_str();
+  traj->add_option("--delta", options.delta, "RPE step")
+      ->check(finite_positive())
+      ->capture_default_str();
   traj->add_option("--delta-unit", options.delta_unit, "Unit of --delta")
       ->check(CLI::IsMember({"frames", "seconds"}))
       ->capture_default_str();
   traj->add_flag("--sim3", options.sim3, "Align with a scale too (monocular estimates)");
   traj->add_option("--max-difference", options.max_difference,
                    "Largest timestamp difference of a matched pose pair [s]")
+      ->check(finite_number())
       ->capture_default_str();
 
   CLI::App* planes = add_metric("planes", "SegComp scores of a plane label image",
                                 "Ground-truth labels (16-bit PNG, 0 = none)",
                                 "Predicted labels (16-bit PNG, 0 = none)");
   planes->add_option("--threshold", options.threshold, "Overlap threshold T, in (0.5, 1]")
+      ->check(finite_in(0.5, 1.0))
       ->capture_default_str();
 
   add_metric("rooms", "Recall, precision and MCC of a room segmentation",

@@ -1,13 +1,33 @@
 // kartograf: the command-line front end. Subcommands live in *_command.cpp.
+#include <csignal>
 #include <cstdlib>
 #include <exception>
 #include <iostream>
+#include <new>
+#include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "interrupts.hpp"
+#include "output_transaction.hpp"
+
+namespace {
+
+int report_error(const std::string& message) {
+  std::cout.flush();
+  std::cerr << "kartograf: error: " << kartograf::cli::describe_output_error(message) << "\n";
+  kartograf::cli::exit_if_interrupted();  // a signal that waited for the error: its exit status
+  return 1;
+}
+
+}  // namespace
 
 int main(int argc, char** argv) {
+  // Before any thread exists: every thread inherits the blocked signals (interrupts.hpp).
+  kartograf::cli::start_interrupt_watcher();
+  // A file over RLIMIT_FSIZE fails like a full disk (EFBIG), with a message, instead of killing.
+  std::signal(SIGXFSZ, SIG_IGN);
   CLI::App app{"Kartograf: dense RGB-D mapping on CPU, Vulkan and OpenCL"};
   app.require_subcommand(1);
 
@@ -26,6 +46,7 @@ int main(int argc, char** argv) {
   CLI::Option* backend_option =
       demo->add_option("--backend", demo_options.backend,
                        "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)");
+  demo->add_flag("--force", demo_options.force, "Replace the files of an earlier run");
 
   kartograf::cli::EvalOptions eval_options;
   CLI::App* eval = kartograf::cli::add_eval_command(app, eval_options);
@@ -73,10 +94,13 @@ int main(int argc, char** argv) {
     if (*map) return kartograf::cli::run_map_command(map_options, std::cout, std::cerr);
     if (*semantic)
       return kartograf::cli::run_semantic_command(semantic_options, std::cout, std::cerr);
+  } catch (const std::bad_alloc&) {
+    const std::string command = app.get_subcommands().front()->get_name();
+    return report_error("out of memory (std::bad_alloc) in 'kartograf " + command +
+                        "': the input or the options need more memory than this machine has; "
+                        "try a smaller input, fewer frames or coarser options");
   } catch (const std::exception& e) {
-    std::cout.flush();
-    std::cerr << "kartograf: error: " << e.what() << "\n";
-    return 1;
+    return report_error(e.what());
   }
   return 1;
 }

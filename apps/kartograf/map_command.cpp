@@ -2,43 +2,25 @@
 // sequence, scored against the sequence's ground truth where it has one (poses; a synthetic
 // building's floor plan), written by io/map_outputs.hpp. Progress per stage on stderr, the report's
 // path on stdout. Wiring only.
-#include <csignal>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
 #include <ostream>
 #include <string>
 
-#include <pthread.h>
-
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/io/map_outputs.hpp"
 #include "kartograf/io/synthetic_dataset.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
-#include "output_folder.hpp"
+#include "option_checks.hpp"
+#include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
 
 namespace {
-
-// Holds back SIGINT, SIGTERM and SIGHUP while the files are written, so that an interrupted run
-// leaves all of them or none of this run's; a signal that came meanwhile acts on destruction.
-class SignalsHeldBack {
- public:
-  SignalsHeldBack() {
-    sigemptyset(&held_);
-    for (const int s : {SIGINT, SIGTERM, SIGHUP}) sigaddset(&held_, s);
-    pthread_sigmask(SIG_BLOCK, &held_, &previous_);
-  }
-  ~SignalsHeldBack() { pthread_sigmask(SIG_SETMASK, &previous_, nullptr); }
-  SignalsHeldBack(const SignalsHeldBack&) = delete;
-  SignalsHeldBack& operator=(const SignalsHeldBack&) = delete;
-
- private:
-  sigset_t held_, previous_;
-};
 
 Json parameters_json(const MapOptions& o, const pipeline::MapPipelineParams& p) {
   return {{"method", o.run.method},
@@ -110,7 +92,7 @@ CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
       ->check(CLI::Range(64, 4096))
       ->capture_default_str();
   command->add_option("--resolution", o.resolution, "Grid cell size [m]")
-      ->check(CLI::Range(0.01, 1.0))
+      ->check(finite_in(0.01, 1.0))
       ->capture_default_str();
   command->add_option("--rooms", o.room_method, "Room segmentation method")
       ->check(CLI::IsMember({"morphological", "distance", "voronoi", "feature", "vrf"}))
@@ -120,8 +102,10 @@ CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
 }
 
 int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
-  check_output_folder("map", o.out_dir, io::map_output_files(), o.force);
-  const OpenedRun run = open_run(o.run);
+  std::vector<std::string> known_files = io::map_output_files();
+  known_files.push_back("evaluation.png");
+  OutputFolder folder("map", o.out_dir, o.force, known_files);
+  const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   pipeline::MapPipelineParams params;
   params.slam.odometry = odometry_params(o.run);
@@ -167,12 +151,15 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   info.device = context.device_info().name;
   info.has_timestamps = run.opened.detected.has_timestamps;
   info.parameters_json = parameters_json(o, params).dump();
+  info.input_json = input_json(run.opened).dump();
   {
-    const SignalsHeldBack held;
-    io::write_map_outputs(o.out_dir, result, evaluation, info);
+    const InterruptsDeferred writing;  // a signal waits for the files, then drops them
+    io::write_map_outputs(folder.dir(), result, evaluation, info);
   }
+  folder.commit();
   out << "map: " << info.sequence << " (" << info.layout << "), backend " << info.backend << " ("
       << info.device << ")\n";
+  out << "  " << io::describe_input(run.opened) << "\n";
   print_summary(out, result, evaluation);
   out << "  report: " << (o.out_dir / "report.html").string() << "\n";
   return 0;

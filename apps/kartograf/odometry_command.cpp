@@ -2,13 +2,16 @@
 // (mapping::run_odometry), the trajectory in TUM format, a summary with throughput and, when the
 // sequence has ground truth, the ATE. Wiring only.
 #include <cstdio>
+#include <filesystem>
 #include <ostream>
 #include <string>
 
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/io/text_file.hpp"
 #include "kartograf/io/tum.hpp"
 #include "kartograf/mapping/slam.hpp"
+#include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
@@ -20,11 +23,16 @@ CLI::App* add_odometry_command(CLI::App& app, OdometryOptions& o) {
   command->add_option("--out", o.out, "Trajectory file (TUM: timestamp tx ty tz qx qy qz qw)")
       ->required();
   command->add_option("--stats", o.stats, "Also write per-frame statistics (JSON)");
+  command->add_flag("--force", o.force, "Replace the files of an earlier run");
   return command;
 }
 
 int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostream& err) {
-  const OpenedRun run = open_run(o.run);
+  OutputFiles files("odometry", o.force);
+  const std::filesystem::path trajectory_file = files.add("--out", o.out);
+  const std::filesystem::path stats_file =
+      o.stats.empty() ? o.stats : files.add("--stats", o.stats);
+  const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   const registration::OdometryParams params = odometry_params(o.run);
   const bool has_timestamps = run.opened.detected.has_timestamps;
@@ -38,7 +46,8 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
   const mapping::OdometryRun result = mapping::run_odometry(context, *run.source, params, observer);
   bar.finish();
 
-  io::write_tum_trajectory(o.out,
+  const InterruptsDeferred writing;  // a signal waits for the files, then drops them
+  io::write_tum_trajectory(trajectory_file,
                            stamped_trajectory(result.poses, result.timestamps, has_timestamps));
   const auto ate = absolute_trajectory_error(*run.source, result.poses);
   const double frames = static_cast<double>(result.poses.size());
@@ -50,6 +59,7 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
       << io::to_string(run.opened.detected.layout) << ", " << result.poses.size()
       << " frames), method " << o.run.method << ", backend "
       << compute::to_string(context.backend()) << " (" << context.device_info().name << ")\n"
+      << "  " << io::describe_input(run.opened) << "\n"
       << "  trajectory " << o.out.string() << "\n";
   char line[256];
   std::snprintf(line, sizeof(line),
@@ -68,6 +78,7 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
     Json json;
     json["sequence"] = o.run.sequence.string();
     json["layout"] = io::to_string(run.opened.detected.layout);
+    json["input"] = input_json(run.opened);
     json["method"] = o.run.method;
     json["backend"] = compute::to_string(context.backend());
     json["device"] = context.device_info().name;
@@ -81,8 +92,9 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
     Json per_frame = Json::array();
     for (const auto& f : result.frames) per_frame.push_back(frame_json(f));
     json["per_frame"] = std::move(per_frame);
-    io::write_text_file(o.stats, json.dump(1) + "\n");
+    io::write_text_file(stats_file, json.dump(1) + "\n");
   }
+  files.commit();
   return 0;
 }
 

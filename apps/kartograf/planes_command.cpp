@@ -16,6 +16,7 @@
 
 #include "backend_option.hpp"
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
@@ -27,7 +28,8 @@
 #include "kartograf/io/sequence.hpp"
 #include "kartograf/io/sequence_detect.hpp"
 #include "kartograf/io/text_file.hpp"
-#include "output_folder.hpp"
+#include "option_checks.hpp"
+#include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
@@ -115,14 +117,16 @@ PlaneInput rgbd_input(const PlanesOptions& o, const compute::Context& context) {
   PlaneInput input{o.input.string(), {}, std::move(color), frame_intrinsics(o, depth)};
   input.intrinsics.validate("planes");
   geometry::DepthRange range;
-  range.units_per_metre = o.depth_scale;
+  range.units_per_metre = o.depth_scale > 0 ? o.depth_scale : 1000.0;
   input.points = geometry::backproject(context, depth, input.intrinsics, range);
   return input;
 }
 
-// Extracts and writes one frame's files into dir; returns its summary.
+// Extracts and writes one frame's files into dir (staging; shown_dir: where they will be); returns
+// its summary.
 Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& input,
-                   const fs::path& dir, const Json& run, std::ostream& out) {
+                   const fs::path& dir, const fs::path& shown_dir, const Json& run,
+                   std::ostream& out) {
   const segmentation::PlaneSet set = extractor.extract(input.points, input.color);
   std::size_t valid = 0, labelled = 0;
   for (std::size_t i = 0; i < input.points.size(); ++i) {
@@ -131,21 +135,24 @@ Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& in
     labelled += set.labels.data()[i] != kUnlabeled;
   }
   require(valid > 0, "planes: " + input.name + " has no valid depth");
-  fs::create_directories(dir);
-  io::write_label_png(dir / "labels.png", set.labels);
-  io::write_png(dir / "segmentation.png", io::plane_overlay(input.color, set.labels));
-  io::write_ply(dir / "planes.ply", io::plane_points(input.points, set.labels));
-  io::write_planes_json(dir / "planes.json", set, {input.name, input.intrinsics, run.dump()});
+  {
+    const InterruptsDeferred writing;  // a signal waits for the frame's files, then drops them
+    fs::create_directories(dir);
+    io::write_label_png(dir / "labels.png", set.labels);
+    io::write_png(dir / "segmentation.png", io::plane_overlay(input.color, set.labels));
+    io::write_ply(dir / "planes.ply", io::plane_points(input.points, set.labels));
+    io::write_planes_json(dir / "planes.json", set, {input.name, input.intrinsics, run.dump()});
+  }
   const double coverage = 100.0 * static_cast<double>(labelled) / static_cast<double>(valid);
   char line[256];
   std::snprintf(line, sizeof(line),
                 "planes: %s: %zu planes (%u segments, %u merged), %.1f %% of valid pixels, %.1f ms"
                 " -> %s\n",
                 input.name.c_str(), set.planes.size(), set.segment_count, set.merged_count,
-                coverage, set.timings.total(), dir.string().c_str());
+                coverage, set.timings.total(), shown_dir.string().c_str());
   out << line;
   return {{"source", input.name},
-          {"dir", dir.string()},
+          {"dir", shown_dir.string()},
           {"planes", set.planes.size()},
           {"segments", set.segment_count},
           {"valid_pixels", valid},
@@ -166,26 +173,37 @@ CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
   command->add_option("--color", o.color, "Colour image of a depth PNG input");
   command->add_option("--intrinsics", o.intrinsics,
                       "Depth PNG input: camera_intrinsics.json (Open3D format)");
-  command->add_option("--fx", o.fx, "Depth PNG input: focal length [px] (default 525 at 640 wide)");
-  command->add_option("--fy", o.fy, "Depth PNG input: focal length [px]");
-  command->add_option("--cx", o.cx, "Depth PNG input: principal point [px] (default: centre)");
-  command->add_option("--cy", o.cy, "Depth PNG input: principal point [px]");
-  command->add_option("--depth-scale", o.depth_scale, "Depth PNG input: units per metre")
-      ->check(CLI::PositiveNumber)
+  // Checked when given: 0 and -1 are the defaults' "not given", never a value to fall back from.
+  command->add_option("--fx", o.fx, "Depth PNG input: focal length [px] (default 525 at 640 wide)")
+      ->check(finite_positive());
+  command->add_option("--fy", o.fy, "Depth PNG input: focal length [px]")->check(finite_positive());
+  command->add_option("--cx", o.cx, "Depth PNG input: principal point [px] (default: centre)")
+      ->check(finite_in(0, 1e6));
+  command->add_option("--cy", o.cy, "Depth PNG input: principal point [px]")
+      ->check(finite_in(0, 1e6));
+  command
+      ->add_option("--depth-scale", o.depth_scale,
+                   "Units per metre (default: 1000 for a depth PNG, the layout's for a sequence)")
+      ->check(finite_positive())
       ->capture_default_str();
-  command->add_option("--first", o.first, "Sequence: first frame")->capture_default_str();
+  command->add_option("--first", o.first, "Sequence: first frame")
+      ->check(whole_number(kMaxFrames))
+      ->capture_default_str();
   command->add_option("--frames", o.frames, "Sequence: number of frames (0: to the end)")
+      ->check(whole_number(kMaxFrames))
       ->capture_default_str();
+  add_sequence_input_options(*command, o.sequence, false, false);
   command->add_option("--step", o.step, "Sequence: every step-th frame")
       ->check(CLI::Range(1, 1000000))
       ->capture_default_str();
   command->add_option("--lab-threshold", o.lab_threshold, "Region growing: Lab distance")
-      ->check(CLI::Range(0.1, 1000.0))
+      ->check(finite_in(0.1, 1000.0))
       ->capture_default_str();
   command->add_option("--normal-angle", o.normal_angle_deg, "Merging: max normal angle [deg]")
-      ->check(CLI::Range(0.0, 180.0))
+      ->check(finite_in(0.0, 180.0))
       ->capture_default_str();
   command->add_option("--min-plane-pixels", o.min_plane_pixels, "Smallest plane kept [pixels]")
+      ->check(whole_number(1000000000))
       ->capture_default_str();
   command->add_option("--neighbours", o.neighbours, "Merging neighbours: pixel | bbox (the paper)")
       ->check(CLI::IsMember({"pixel", "bbox"}))
@@ -194,7 +212,7 @@ CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
       ->check(CLI::IsMember({"tls", "eq6"}))
       ->capture_default_str();
   add_backend_option(*command, o.backend, o.backend_source);
-  command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
+  command->add_flag("--force", o.force, "Replace the folder of an earlier run as a whole");
   command->add_flag("!--no-progress", o.progress, "No progress bar on stderr (sequences)");
   return command;
 }
@@ -205,7 +223,9 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
   const segmentation::PlaneExtractionParams params = extraction_params(o);
   params.validate();
   const Json run = run_json(o, context);
-  check_output_folder("planes", o.out_dir, {"planes.json", "labels.png", "summary.json"}, o.force);
+  OutputFolder folder(
+      "planes", o.out_dir, o.force,
+      {"planes.json", "labels.png", "segmentation.png", "planes.ply", "summary.json"});
 
   if (!fs::is_directory(o.input)) {
     std::string extension = o.input.extension().string();
@@ -213,40 +233,44 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     const PlaneInput input = extension == ".pcd" ? pcd_input(o.input) : rgbd_input(o, context);
     segmentation::PlaneExtractor extractor(context, input.intrinsics, params);
-    extract_frame(extractor, input, o.out_dir, run, out);
+    extract_frame(extractor, input, folder.dir(), o.out_dir, run, out);
+    folder.commit();
     return 0;
   }
 
-  const io::OpenedSequence opened = io::open_sequence(o.input);
+  SequenceInputOptions reading = o.sequence;
+  reading.depth_scale = o.depth_scale;
+  reading.first = o.first;
+  reading.frames = o.frames;
+  reading.step = o.step;
+  const io::OpenedSequence opened = open_input(o.input, reading, err);
   const io::Sequence& sequence = *opened.sequence;
-  const std::size_t end =
-      o.frames > 0 ? std::min(sequence.size(), o.first + o.frames * o.step) : sequence.size();
-  require(o.first < sequence.size(), "planes: --first " + std::to_string(o.first) + " but " +
-                                         o.input.string() + " has " +
-                                         std::to_string(sequence.size()) + " frames");
   segmentation::PlaneExtractor extractor(context, sequence.intrinsics(), params);
   geometry::DepthRange range;
   range.units_per_metre = sequence.depth_units_per_metre();
   ProgressBar bar(err, o.progress);
   Json frames = Json::array();
-  const std::size_t total = (end - o.first + o.step - 1) / o.step;
-  for (std::size_t i = o.first; i < end; i += o.step) {
+  const std::size_t total = sequence.size();
+  for (std::size_t i = 0; i < total; ++i) {
     io::RgbdFrame frame = sequence.frame(i);
     char number[32];
     std::snprintf(number, sizeof(number), "%06zu", frame.index);
     PlaneInput input{o.input.string() + " frame " + std::to_string(frame.index),
                      geometry::backproject(context, frame.depth, sequence.intrinsics(), range),
                      std::move(frame.color), sequence.intrinsics()};
-    frames.push_back(extract_frame(extractor, input, o.out_dir / number, run, out));
+    frames.push_back(
+        extract_frame(extractor, input, folder.dir() / number, o.out_dir / number, run, out));
     bar.update("planes", frames.size(), total);
   }
   bar.finish();
   Json summary;
   summary["sequence"] = o.input.string();
   summary["layout"] = io::to_string(opened.detected.layout);
+  summary["input"] = input_json(opened);
   summary["run"] = run;
   summary["frames"] = std::move(frames);
-  io::write_text_file(o.out_dir / "summary.json", summary.dump(1) + "\n");
+  io::write_text_file(folder.dir() / "summary.json", summary.dump(1) + "\n");
+  folder.commit();
   return 0;
 }
 

@@ -21,6 +21,7 @@
 
 #include "backend_option.hpp"
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/room_metrics.hpp"
@@ -29,7 +30,8 @@
 #include "kartograf/io/room_io.hpp"
 #include "kartograf/io/text_file.hpp"
 #include "kartograf/rooms/room_methods.hpp"
-#include "output_folder.hpp"
+#include "option_checks.hpp"
+#include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
@@ -84,12 +86,16 @@ std::optional<compute::Context> scan_context(const RoomsOptions& o, bool needed)
 
 void add_map_options(CLI::App* command, RoomsOptions& o) {
   command->add_option("--resolution", o.resolution, "PNG maps: metres per cell")
+      ->check(finite_positive())
       ->capture_default_str();
   command->add_option("--free-threshold", o.free_threshold, "PNG maps: grey >= this is free space")
       ->check(CLI::Range(1, 255))
       ->capture_default_str();
-  command->add_option("--min-area", o.min_area_m2, "Smallest room [m^2] (default: the method's)");
-  command->add_option("--max-area", o.max_area_m2, "Largest room [m^2] (default: the method's)");
+  // Checked when given: the negative defaults mean "the method's", never a value to fall back from.
+  command->add_option("--min-area", o.min_area_m2, "Smallest room [m^2] (default: the method's)")
+      ->check(finite_in(0, 1e12));
+  command->add_option("--max-area", o.max_area_m2, "Largest room [m^2] (default: the method's)")
+      ->check(finite_in(0, 1e12));
   add_backend_option(*command, o.backend, o.backend_source, "feature: where the laser scans run, ");
   command->add_flag("--keep-furniture", o.keep_furniture,
                     "Segment the map as it is, furniture included (the reference's behaviour)");
@@ -142,7 +148,7 @@ CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& o) {
   command->add_option("--out", o.out_dir, "Output folder")->required();
   command->add_option("--method", o.method, method_names())->capture_default_str();
   add_map_options(command, o);
-  command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
+  command->add_flag("--force", o.force, "Replace the folder of an earlier run as a whole");
   return command;
 }
 
@@ -153,15 +159,17 @@ int run_rooms_command(const RoomsOptions& o, bool resolution_given, std::ostream
       scan_context(o, method == rooms::RoomMethod::feature);
   if (context) options.context = &*context;
   const OccupancyGrid map = read_map(o.map, o.resolution, o.free_threshold, resolution_given);
-  check_output_folder("rooms", o.out_dir, {"rooms.png", "rooms_color.png", "rooms.json"}, o.force);
+  OutputFolder folder("rooms", o.out_dir, o.force, {"rooms.png", "rooms_color.png", "rooms.json"});
   const rooms::RoomSegmentation result = rooms::segment_rooms(map, method, options);
-  fs::create_directories(o.out_dir);
+  const InterruptsDeferred writing;  // a signal waits for the files, then drops them
+  const fs::path& dir = folder.dir();
   // Everything is computed before the first file is written; each write is atomic.
   const nlohmann::ordered_json run = {
       {"method", o.method}, {"resolution", map.resolution}, {"free_threshold", o.free_threshold}};
-  io::write_label_png(o.out_dir / "rooms.png", result.rooms);
-  io::write_png(o.out_dir / "rooms_color.png", io::room_overlay(map, result.rooms));
-  io::write_rooms_json(o.out_dir / "rooms.json", result, map, o.map.string(), run.dump());
+  io::write_label_png(dir / "rooms.png", result.rooms);
+  io::write_png(dir / "rooms_color.png", io::room_overlay(map, result.rooms));
+  io::write_rooms_json(dir / "rooms.json", result, map, o.map.string(), run.dump());
+  folder.commit();
   double area = 0;
   for (const rooms::RoomRecord& r : result.records) area += r.area_m2;
   out << o.map.string() << ": " << result.records.size() << " rooms, " << fixed(area, 1) << " m^2, "
@@ -179,6 +187,7 @@ CLI::App* add_rooms_eval_command(CLI::App& app, RoomsEvalOptions& o) {
   command->add_option("--methods", o.methods, "Methods to run (default: all): " + method_names())
       ->delimiter(',');
   command->add_option("--csv", o.csv, "Write one row per method and map here");
+  command->add_flag("--force", o.force, "Replace an existing --csv file");
   command->add_option("--only", o.only, "Only maps whose name contains this");
   add_map_options(command, o.map);
   command->add_flag("!--no-progress", o.progress, "No progress on stderr");
@@ -186,6 +195,8 @@ CLI::App* add_rooms_eval_command(CLI::App& app, RoomsEvalOptions& o) {
 }
 
 int run_rooms_eval_command(const RoomsEvalOptions& o, std::ostream& out, std::ostream& err) {
+  OutputFiles files("rooms-eval", o.force);
+  const fs::path csv_file = o.csv.empty() ? o.csv : files.add("--csv", o.csv);
   std::vector<rooms::RoomMethod> methods;
   for (const std::string& name : o.methods) methods.push_back(rooms::parse_room_method(name));
   if (methods.empty()) methods = rooms::all_room_methods();
@@ -244,7 +255,11 @@ int run_rooms_eval_command(const RoomsEvalOptions& o, std::ostream& out, std::os
     }
     out.flush();
   }
-  if (!o.csv.empty()) io::write_text_file(o.csv, csv.str());
+  if (!o.csv.empty()) {
+    const InterruptsDeferred writing;  // a signal waits for the file, then drops it
+    io::write_text_file(csv_file, csv.str());
+    files.commit();
+  }
   return 0;
 }
 

@@ -17,6 +17,7 @@
 
 #include "backend_option.hpp"
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
@@ -34,7 +35,9 @@
 #include "kartograf/semantic/object_detector.hpp"
 #include "kartograf/semantic/planning.hpp"
 #include "kartograf/semantic/semantic_grid.hpp"
-#include "output_folder.hpp"
+#include "option_checks.hpp"
+#include "output_transaction.hpp"
+#include "sequence_run.hpp"
 
 namespace kartograf::cli {
 
@@ -163,12 +166,20 @@ LabelledPoints scan_points(const SemanticOptions& o, const Views& views, std::os
 // Every --step-th frame with a pose; up is the area-weighted mean of the views' estimated up
 // directions in the world frame (views that see no floor or ceiling cannot say and are left out).
 LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std::ostream& err) {
-  const io::OpenedSequence opened = io::open_sequence(o.input);
+  SequenceInputOptions reading = o.sequence;
+  reading.frames = o.frames;
+  const io::OpenedSequence opened = open_input(o.input, reading, err);
   const io::Sequence& sequence = *opened.sequence;
+  const std::size_t count = sequence.size();
   std::optional<Trajectory> trajectory;
-  if (!o.trajectory.empty()) trajectory = io::read_tum_trajectory(o.trajectory);
-  const std::size_t count =
-      o.frames > 0 ? std::min<std::size_t>(o.frames, sequence.size()) : sequence.size();
+  if (!o.trajectory.empty()) {
+    trajectory = io::read_tum_trajectory(o.trajectory);
+    // One pose per frame, in order: a shorter file would leave frames without a place.
+    require(trajectory->size() >= count,
+            "semantic: --trajectory '" + o.trajectory.string() + "' holds " +
+                std::to_string(trajectory->size()) + " poses, the sequence '" + o.input.string() +
+                "' has " + std::to_string(count) + " frames (one pose per frame, in order)");
+  }
   semantic::LabellingParams params;
   params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);  // a camera looking ahead: image up
   geometry::DepthRange range;
@@ -177,8 +188,7 @@ LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std
   for (std::size_t i = 0; i < count; i += static_cast<std::size_t>(o.step)) {
     const io::RgbdFrame frame = sequence.frame(i);
     std::optional<Eigen::Isometry3d> pose = frame.pose;
-    if (trajectory)
-      pose = i < trajectory->size() ? std::optional((*trajectory)[i].pose) : std::nullopt;
+    if (trajectory) pose = (*trajectory)[i].pose;
     if (!pose) continue;
     const PointImage points =
         geometry::backproject(views.context, frame.depth, sequence.intrinsics(), range);
@@ -324,23 +334,30 @@ CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& o) {
       ->add_option("--viewpoint", o.viewpoint,
                    "Map without --trajectory: where the range image is seen from, x y z "
                    "(default: a PCD's VIEWPOINT, a PLY's centroid)")
-      ->expected(3);
+      ->expected(3)
+      ->check(finite_number());
+  // 0.1 degrees is 3600 x 1500 pixels, finer than a map's samples seen from a few metres.
   command->add_option("--angular-step", o.angular_step, "Map: range image degrees per pixel")
+      ->check(finite_in(0.1, 10.0))
       ->capture_default_str();
-  command->add_option("--frames", o.frames, "Sequence: only the first N frames (0: all)");
+  command->add_option("--frames", o.frames, "Sequence: only the first N frames (0: all)")
+      ->check(whole_number(kMaxFrames));
+  add_sequence_input_options(*command, o.sequence, false, true);
   command->add_option("--step", o.step, "Sequence: every k-th frame (map: k-th viewpoint)")
       ->capture_default_str();
   command->add_option("--out", o.out_dir, "Output folder")->required();
   command->add_option("--goto", o.goto_target, "Plan from the sensor: door | wall")
       ->check(CLI::IsMember({"door", "wall"}));
-  command->add_option("--resolution", o.resolution, "Grid cell size [m]")->capture_default_str();
+  command->add_option("--resolution", o.resolution, "Grid cell size [m]")
+      ->check(finite_in(0.005, 10.0))
+      ->capture_default_str();
   command
       ->add_option("--detect", o.detect,
                    "Run the shipped Haar cascade of this class on every view; its finds are "
                    "objects on the grid (obstacles)")
       ->check(CLI::IsMember({"stairs"}));
   add_backend_option(*command, o.backend, o.backend_source, "Where the normals run: ");
-  command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
+  command->add_flag("--force", o.force, "Replace the folder of an earlier run as a whole");
   return command;
 }
 
@@ -349,7 +366,7 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
           "semantic: --resolution must be > 0 m, got " + std::to_string(o.resolution));
   require(o.step >= 1, "semantic: --step must be >= 1");
   require(fs::exists(o.input), "semantic: " + o.input.string() + ": no such file or folder");
-  check_output_folder("semantic", o.out_dir, kOutputs, o.force);
+  OutputFolder folder("semantic", o.out_dir, o.force, {kOutputs.begin(), kOutputs.end()});
   const compute::Context context = backend_context(o.backend, o.backend_source);
   Views views{context, std::nullopt};
   if (o.detect == "stairs") views.detector = semantic::ObjectDetector::stairs();
@@ -382,17 +399,18 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
     paths.push_back({"along wall", semantic::plan_along_nearest_wall(grid, sensor)});
   for (const io::NamedPath& p : paths) semantic::draw_path(picture, p.path);
 
-  fs::create_directories(o.out_dir);
-  io::write_semantic_png(o.out_dir / "labels.png", labelling.semantic);
-  io::write_png(o.out_dir / "labels_color.png",
-                view_picture(labelled.view_points, labelling, false));
-  io::write_png(o.out_dir / "normals.png", view_picture(labelled.view_points, labelling, true));
-  io::write_png(o.out_dir / "semantic.png", picture.image);
+  const InterruptsDeferred writing;  // a signal waits for the files, then drops them
+  const fs::path& dir = folder.dir();
+  io::write_semantic_png(dir / "labels.png", labelling.semantic);
+  io::write_png(dir / "labels_color.png", view_picture(labelled.view_points, labelling, false));
+  io::write_png(dir / "normals.png", view_picture(labelled.view_points, labelling, true));
+  io::write_png(dir / "semantic.png", picture.image);
   const OccupancyGrid occupancy = semantic::to_occupancy_grid(grid);
-  io::write_ros_map(o.out_dir / "occupancy.yaml", occupancy);
-  io::write_ros_costmap(o.out_dir / "costmap.yaml", semantic::to_costmap(grid), grid.resolution,
+  io::write_ros_map(dir / "occupancy.yaml", occupancy);
+  io::write_ros_costmap(dir / "costmap.yaml", semantic::to_costmap(grid), grid.resolution,
                         occupancy.origin);
-  io::write_semantic_json(o.out_dir / "semantic.json", grid, paths, o.input.string());
+  io::write_semantic_json(dir / "semantic.json", grid, paths, o.input.string());
+  folder.commit();
 
   std::map<std::string, int> kinds;
   for (const semantic::SemanticObject& object : grid.objects)

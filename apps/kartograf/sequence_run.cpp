@@ -8,14 +8,42 @@
 
 #include "backend_option.hpp"
 #include "kartograf/core/error.hpp"
+#include "option_checks.hpp"
 
 namespace kartograf::cli {
+
+void add_sequence_input_options(CLI::App& command, SequenceInputOptions& o, bool with_range,
+                                bool with_depth_scale) {
+  std::string presets;
+  for (const std::string& name : io::camera_preset_names())
+    presets += (presets.empty() ? "" : "|") + name;
+  command.add_option("--camera", o.camera,
+                     "Camera intrinsics: a preset (" + presets +
+                         "), fx,fy,cx,cy, or a file (camera-intrinsics.txt with a 3x3 matrix, "
+                         "Open3D camera_intrinsics.json); default: the folder's own");
+  if (with_depth_scale) {
+    command
+        .add_option("--depth-scale", o.depth_scale,
+                    "Depth units per metre (1000: millimetres, 5000: TUM); default: the layout's")
+        ->check(CLI::PositiveNumber);
+  }
+  command.add_flag("--skip-bad-frames", o.skip_bad_frames,
+                   "Leave out missing or unreadable frames (each reported) instead of stopping");
+  if (!with_range) return;
+  command.add_option("--first", o.first, "First frame (0: the folder's first, in its order)")
+      ->check(whole_number(kMaxFrames));
+  command.add_option("--frames", o.frames, "Use at most N frames (0: all)")
+      ->check(whole_number(kMaxFrames));
+  command.add_option("--step", o.step, "Use every S-th frame")->check(CLI::Range(1, 1000000));
+}
 
 void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   command
       .add_option("SEQUENCE", o.sequence,
-                  "RGB-D sequence folder: TUM (rgb.txt, depth.txt), kartograf synth, or 7-Scenes")
+                  "RGB-D sequence folder: TUM (rgb.txt, depth.txt), kartograf synth, 7-Scenes / "
+                  "3DMatch / SUN3D (frame-N.*), or rgb/ + depth/ folders")
       ->required();
+  add_sequence_input_options(command, o.input, true, true);
   command.add_option("--method", o.method, "ICP error metric and pair rejection")
       ->check(CLI::IsMember({"p2p", "p2plane", "color", "planar"}))
       ->capture_default_str();
@@ -26,8 +54,50 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
                   "reduction; 0: off)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
-  command.add_option("--frames", o.frames, "Use only the first N frames (0: all)");
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
+}
+
+io::SequenceOptions sequence_options(const SequenceInputOptions& o) {
+  io::SequenceOptions options;
+  options.camera = o.camera;
+  if (o.depth_scale > 0) options.depth_units_per_metre = o.depth_scale;
+  options.first = o.first;
+  if (o.frames > 0) options.count = o.frames;
+  options.step = o.step;
+  options.skip_bad_frames = o.skip_bad_frames;
+  return options;
+}
+
+io::OpenedSequence open_input(const std::filesystem::path& folder, const SequenceInputOptions& o,
+                              std::ostream& err) {
+  io::OpenedSequence opened = io::open_sequence(folder, sequence_options(o));
+  for (const std::string& warning : opened.warnings) err << "warning: " << warning << "\n";
+  for (const io::SkippedFrame& skipped : opened.skipped)
+    err << "warning: frame " << skipped.position << " left out: " << skipped.reason << "\n";
+  err << "input: " << opened.sequence->size() << " frames";
+  if (!opened.skipped.empty()) err << " (" << opened.skipped.size() << " bad frames left out)";
+  err << "; " << io::describe_input(opened) << "\n";
+  return opened;
+}
+
+Json input_json(const io::OpenedSequence& opened) {
+  const PinholeIntrinsics& k = opened.camera.intrinsics;
+  Json skipped = Json::array();
+  for (const io::SkippedFrame& frame : opened.skipped)
+    skipped.push_back({{"frame", frame.position}, {"reason", frame.reason}});
+  return {{"camera",
+           {{"fx", k.fx},
+            {"fy", k.fy},
+            {"cx", k.cx},
+            {"cy", k.cy},
+            {"width", k.width},
+            {"height", k.height},
+            {"source", opened.camera.source},
+            {"description", opened.camera.description}}},
+          {"depth_units_per_metre", opened.sequence->depth_units_per_metre()},
+          {"depth_scale_source", opened.depth_scale_source},
+          {"frames_skipped", opened.skipped.size()},
+          {"skipped_frames", std::move(skipped)}};
 }
 
 registration::OdometryParams odometry_params(const SequenceRunOptions& options) {
@@ -45,12 +115,13 @@ compute::Context make_run_context(const SequenceRunOptions& options) {
   return backend_context(options.backend, options.backend_source);
 }
 
-OpenedRun open_run(const SequenceRunOptions& options) {
+OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
   OpenedRun run;
-  run.opened = io::open_sequence(options.sequence);
-  const std::optional<std::size_t> count =
-      options.frames > 0 ? std::optional<std::size_t>(options.frames) : std::nullopt;
-  run.source = std::make_unique<io::SequenceFrameSource>(*run.opened.sequence, count);
+  run.opened = open_input(options.sequence, options.input, err);
+  geometry::DepthRange range = odometry_params(options).depth_range;
+  range.units_per_metre = run.opened.sequence->depth_units_per_metre();
+  io::check_depth_usable(*run.opened.sequence, range);
+  run.source = std::make_unique<io::SequenceFrameSource>(*run.opened.sequence);
   return run;
 }
 

@@ -4,6 +4,7 @@
 // scoring against ground truth and per-frame statistics as JSON. Wiring only.
 #include <chrono>
 #include <cstddef>
+#include <cstdint>
 #include <filesystem>
 #include <memory>
 #include <optional>
@@ -26,8 +27,23 @@ namespace kartograf::cli {
 
 using Json = nlohmann::ordered_json;
 
-// Registers SEQUENCE, --method, --backend, --reestimate-every, --frames, --no-progress.
+// The most frames a frame option takes (--first, --frames): far beyond any recording.
+inline constexpr std::uint64_t kMaxFrames = 100000000;
+
+// Registers --camera, --skip-bad-frames, with_depth_scale --depth-scale and, with_range, --first,
+// --frames, --step (a command that has some of them already registers them itself).
+void add_sequence_input_options(CLI::App& command, SequenceInputOptions& options, bool with_range,
+                                bool with_depth_scale);
+// Registers SEQUENCE, the input options, --method, --backend, --reestimate-every, --no-progress.
 void add_sequence_run_options(CLI::App& command, SequenceRunOptions& options);
+
+io::SequenceOptions sequence_options(const SequenceInputOptions& options);
+// Opens a sequence folder as the options say; on err: warnings (a camera assumed), each frame left
+// out, and one line with the frame count, the camera and the depth scale.
+io::OpenedSequence open_input(const std::filesystem::path& folder,
+                              const SequenceInputOptions& options, std::ostream& err);
+// The camera, depth scale and frames left out, for stats.json and summaries.
+Json input_json(const io::OpenedSequence& opened);
 
 registration::OdometryParams odometry_params(const SequenceRunOptions& options);
 compute::Context make_run_context(const SequenceRunOptions& options);
@@ -37,7 +53,8 @@ struct OpenedRun {
   io::OpenedSequence opened;
   std::unique_ptr<io::SequenceFrameSource> source;
 };
-OpenedRun open_run(const SequenceRunOptions& options);
+// open_input, then the first frames' depth checked against the odometry's depth range.
+OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err);
 
 // A bar on a terminal (redrawn in place), else a line every 10 %.
 class ProgressBar {

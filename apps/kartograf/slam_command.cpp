@@ -9,11 +9,14 @@
 #include <string>
 
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/io/ply.hpp"
 #include "kartograf/io/text_file.hpp"
 #include "kartograf/io/top_view.hpp"
 #include "kartograf/io/tum.hpp"
 #include "kartograf/mapping/slam.hpp"
+#include "option_checks.hpp"
+#include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
 namespace kartograf::cli {
@@ -56,13 +59,17 @@ CLI::App* add_slam_command(CLI::App& app, SlamOptions& o) {
                     "Optimise odometry edges only (frame-to-frame and k-back)");
   command->add_flag("--no-map", o.no_map, "Skip the map (no second pass over the frames)");
   command->add_option("--voxel", o.voxel_size, "Map voxel size [m]")
-      ->check(CLI::Range(0.001, 10.0))
+      ->check(finite_in(0.001, 10.0))
       ->capture_default_str();
+  command->add_flag("--force", o.force, "Replace the folder of an earlier run as a whole");
   return command;
 }
 
 int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err) {
-  const OpenedRun run = open_run(o.run);
+  OutputFolder folder("slam", o.out_dir, o.force,
+                      {"trajectory.txt", "odometry.txt", "groundtruth.txt", "map.ply",
+                       "top_view.png", "stats.json"});
+  const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   mapping::SlamParams params;
   params.odometry = odometry_params(o.run);
@@ -70,7 +77,6 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   params.build_map = !o.no_map;
   params.map.voxel_size = o.voxel_size;
   const bool has_timestamps = run.opened.detected.has_timestamps;
-  std::filesystem::create_directories(o.out_dir);
 
   ProgressBar bar(err, o.run.progress);
   mapping::SlamObserver observer;
@@ -81,15 +87,17 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   const mapping::SlamResult result = mapping::run_slam(context, *run.source, params, observer);
   bar.finish();
 
+  const InterruptsDeferred writing;  // a signal waits for the files, then drops them
+  const std::filesystem::path& dir = folder.dir();
   const std::vector<double>& timestamps = result.odometry.timestamps;
-  io::write_tum_trajectory(o.out_dir / "trajectory.txt",
+  io::write_tum_trajectory(dir / "trajectory.txt",
                            stamped_trajectory(result.poses, timestamps, has_timestamps));
-  io::write_tum_trajectory(o.out_dir / "odometry.txt",
+  io::write_tum_trajectory(dir / "odometry.txt",
                            stamped_trajectory(result.odometry.poses, timestamps, has_timestamps));
   const Trajectory truth = ground_truth_trajectory(*run.source, timestamps, has_timestamps);
-  if (!truth.empty()) io::write_tum_trajectory(o.out_dir / "groundtruth.txt", truth);
-  if (params.build_map) io::write_ply(o.out_dir / "map.ply", result.map);
-  io::write_top_view_png(o.out_dir / "top_view.png", result.map, result.poses);
+  if (!truth.empty()) io::write_tum_trajectory(dir / "groundtruth.txt", truth);
+  if (params.build_map) io::write_ply(dir / "map.ply", result.map);
+  io::write_top_view_png(dir / "top_view.png", result.map, result.poses);
 
   const auto slam_ate = absolute_trajectory_error(*run.source, result.poses);
   const auto odometry_ate = absolute_trajectory_error(*run.source, result.odometry.poses);
@@ -106,6 +114,7 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   Json json;
   json["sequence"] = o.run.sequence.string();
   json["layout"] = io::to_string(run.opened.detected.layout);
+  json["input"] = input_json(run.opened);
   json["frames"] = result.poses.size();
   json["method"] = o.run.method;
   json["backend"] = compute::to_string(context.backend());
@@ -138,12 +147,14 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   Json per_frame = Json::array();
   for (const auto& f : result.odometry.frames) per_frame.push_back(frame_json(f));
   json["per_frame"] = std::move(per_frame);
-  io::write_text_file(o.out_dir / "stats.json", json.dump(1) + "\n");
+  io::write_text_file(dir / "stats.json", json.dump(1) + "\n");
+  folder.commit();
 
   char line[256];
   out << "slam: " << o.run.sequence.string() << " (" << io::to_string(run.opened.detected.layout)
       << ", " << result.poses.size() << " frames), method " << o.run.method << ", backend "
       << compute::to_string(context.backend()) << " (" << context.device_info().name << ")\n";
+  out << "  " << io::describe_input(run.opened) << "\n";
   out << "  " << frame_summary_line(json["odometry"]) << "\n";
   std::snprintf(line, sizeof(line),
                 "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",

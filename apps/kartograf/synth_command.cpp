@@ -1,23 +1,33 @@
 // `kartograf synth`: writes a synthetic RGB-D data set with exact ground truth
 // (io/synthetic_dataset.hpp). Wiring only: options in, io::write_synthetic_dataset, a summary out.
 #include <chrono>
+#include <cstdint>
 #include <iomanip>
+#include <limits>
 #include <ostream>
 #include <string>
 
 #include <CLI/CLI.hpp>
 
 #include "commands.hpp"
+#include "interrupts.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/synthetic_dataset.hpp"
+#include "option_checks.hpp"
+#include "output_transaction.hpp"
 
 namespace kartograf::cli {
 
 CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
   CLI::App* synth = app.add_subcommand(
       "synth", "Write a synthetic indoor RGB-D data set (TUM layout) with exact ground truth");
-  synth->add_option("--out", o.out_dir, "Output folder (must be empty unless --force)")->required();
-  synth->add_option("--seed", o.seed, "World and noise seed")->capture_default_str();
+  synth
+      ->add_option("--out", o.out_dir,
+                   "Output folder (new, empty, or an earlier run's with --force)")
+      ->required();
+  synth->add_option("--seed", o.seed, "World and noise seed")
+      ->check(whole_number(std::numeric_limits<std::uint64_t>::max()))
+      ->capture_default_str();
   synth
       ->add_option("--frames", o.frames,
                    "Number of frames (30 Hz); default 300, with --survey as many as the tour "
@@ -31,12 +41,12 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
       ->add_option("--look-around", o.look_around_deg,
                    "robot: how far the camera turns left and right inside each room [deg]")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 170.0));
+      ->check(finite_in(0.0, 170.0));
   synth->add_flag("--survey", o.survey,
                   "robot: turn once all the way round in every room and corridor pass");
   synth->add_option("--pitch", o.pitch_deg, "robot: the camera's downward pitch [deg]")
       ->capture_default_str()
-      ->check(CLI::Range(0.0, 60.0));
+      ->check(finite_in(0.0, 60.0));
   synth->add_option("--room", o.room, "handheld: the room id (default: the largest room)");
   synth
       ->add_option(
@@ -48,25 +58,36 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& o) {
       ->capture_default_str()
       ->check(CLI::Range(1, 8192));
   synth->add_option("--fx", o.intrinsics.fx, "Focal length x [px]")
+      ->check(finite_positive())
       ->capture_default_str()
       ->each([&o](const std::string&) { o.intrinsics_given = true; });
   synth->add_option("--fy", o.intrinsics.fy, "Focal length y [px]")
+      ->check(finite_positive())
       ->capture_default_str()
       ->each([&o](const std::string&) { o.intrinsics_given = true; });
   synth->add_option("--cx", o.intrinsics.cx, "Principal point x [px]")
+      ->check(finite_number())
       ->capture_default_str()
       ->each([&o](const std::string&) { o.intrinsics_given = true; });
   synth->add_option("--cy", o.intrinsics.cy, "Principal point y [px]")
+      ->check(finite_number())
       ->capture_default_str()
       ->each([&o](const std::string&) { o.intrinsics_given = true; });
   synth->add_flag("--no-noise", o.no_noise,
                   "Exact depth (to 0.2 mm) with every return, clean colour");
-  synth->add_flag("--force", o.force, "Write into a folder that is not empty");
-  synth->add_option("--threads", o.threads, "Worker threads (0: all cores)")->capture_default_str();
+  synth->add_flag("--force", o.force, "Replace the folder of an earlier run as a whole");
+  synth->add_option("--threads", o.threads, "Worker threads (0: all cores)")
+      ->check(whole_number(4096))
+      ->capture_default_str();
   return synth;
 }
 
 int run_synth_command(const SynthOptions& o, std::ostream& out, std::ostream& err) {
+  OutputFolder folder("synth", o.out_dir, o.force,
+                      {"rgb", "depth", "gt", "rgb.txt", "depth.txt", "groundtruth.txt",
+                       "camera_intrinsics.json", "world.json", "floor_plan.yaml", "floor_plan.pgm",
+                       "floor_plan.png", "floor_plan_gt_segmentation.png", "rooms.png",
+                       "semantic_grid.png", "laser_scan.pcd", "preview.png"});
   io::SyntheticDatasetOptions options;
   options.seed = o.seed;
   options.frames = o.survey && !o.frames_given ? 0 : o.frames;
@@ -87,10 +108,17 @@ int run_synth_command(const SynthOptions& o, std::ostream& out, std::ostream& er
   options.noise = o.no_noise ? synth::NoiseModel::none() : synth::NoiseModel::kinect();
   options.force = o.force;
   options.threads = o.threads;
-  options.progress = [&err](const std::string& line) { err << "synth: " << line << std::endl; };
+  options.progress = [&err](const std::string& line) {
+    err << "synth: " << line << std::endl;
+    exit_if_interrupted();  // the frames are written while they are rendered: stop between them
+  };
 
   const auto start = std::chrono::steady_clock::now();
-  const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(o.out_dir, options);
+  const io::SyntheticDatasetSummary summary = [&] {
+    const InterruptsDeferred writing;
+    return io::write_synthetic_dataset(folder.dir(), options);
+  }();
+  folder.commit();
   const std::chrono::duration<double> elapsed = std::chrono::steady_clock::now() - start;
 
   const synth::World& world = summary.world;

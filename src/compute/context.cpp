@@ -33,9 +33,16 @@ namespace detail {
 std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextOptions& options,
                           std::string_view backend) {
   if (options.device_index) {
-    require(*options.device_index < static_cast<int>(usable.size()),
-            std::string(backend) + ": device index " + std::to_string(*options.device_index) +
-                " requested, " + std::to_string(usable.size()) + " usable device(s) present");
+    if (*options.device_index < 0 || *options.device_index >= static_cast<int>(usable.size())) {
+      std::string devices;
+      for (std::size_t i = 0; i < usable.size(); ++i) {
+        devices += (i == 0 ? " [" : ", [") + std::to_string(i) + "] " + usable[i]->name;
+      }
+      throw Error(options.device_index_source + "=" + std::to_string(*options.device_index) +
+                  ": no such device; the " + std::string(backend) + " backend has " +
+                  std::to_string(usable.size()) + " usable device(s):" + devices +
+                  " (see `kartograf devices`)");
+    }
     return static_cast<std::size_t>(*options.device_index);
   }
   for (DeviceType preferred : {DeviceType::discrete_gpu, DeviceType::integrated_gpu}) {
@@ -52,17 +59,24 @@ ContextOptions ContextOptions::from_environment() {
   if (const char* backend = env("KARTOGRAF_BACKEND")) {
     options.backend = parse_backend_choice(backend, "KARTOGRAF_BACKEND");
   }
+  options.read_device_environment();
+  return options;
+}
+
+void ContextOptions::read_device_environment() {
   if (const char* index = env("KARTOGRAF_DEVICE")) {
-    char* end = nullptr;
-    const long value = std::strtol(index, &end, 10);
-    require(end && *end == '\0' && value >= 0,
-            std::string("KARTOGRAF_DEVICE: expected a device index >= 0, got '") + index + "'");
-    options.device_index = static_cast<int>(value);
+    const std::string text = index;
+    // Digits only (no sign, blanks or suffix), and few enough to be an int.
+    const bool digits =
+        text.size() <= 9 && text.find_first_not_of("0123456789") == std::string::npos;
+    require(digits, "KARTOGRAF_DEVICE='" + text +
+                        "': expected a device index (0, 1, ...; `kartograf devices` lists them)");
+    device_index = std::stoi(text);
+    device_index_source = "KARTOGRAF_DEVICE";
   }
   if (const char* validation = env("KARTOGRAF_VULKAN_VALIDATION")) {
-    options.vulkan_validation = std::string(validation) != "0";
+    vulkan_validation = std::string(validation) != "0";
   }
-  return options;
 }
 
 Context::Context() : cpu_info_(detail::cpu_device_info()) {}
@@ -70,6 +84,7 @@ Context::Context() : cpu_info_(detail::cpu_device_info()) {}
 Context::Context(const ContextOptions& options) : Context() {
   switch (options.backend) {
     case BackendChoice::cpu:
+      detail::choose_device({&cpu_info_}, options, "cpu");  // checks device_index
       break;
     case BackendChoice::vulkan:
       device_ = detail::create_vulkan_device(options);
@@ -80,13 +95,16 @@ Context::Context(const ContextOptions& options) : Context() {
     case BackendChoice::automatic: {
       // CPU-hosted drivers (lavapipe, PoCL) are for correctness, not speed: only a GPU beats the
       // CPU reference, so automatic takes a GPU or nothing.
+      // A device index given applies to the backend taken.
       ContextOptions chosen = options;
       if (auto index = best_gpu(detail::probe_vulkan())) {
-        chosen.device_index = *index;
+        chosen.device_index = options.device_index.value_or(*index);
         device_ = detail::create_vulkan_device(chosen);
       } else if (auto cl_index = best_gpu(detail::probe_opencl())) {
-        chosen.device_index = *cl_index;
+        chosen.device_index = options.device_index.value_or(*cl_index);
         device_ = detail::create_opencl_device(chosen);
+      } else {
+        detail::choose_device({&cpu_info_}, options, "cpu");
       }
       break;
     }

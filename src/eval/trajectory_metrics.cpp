@@ -172,7 +172,8 @@ AteResult compute_ate(const MatchedPoses& poses, Alignment alignment) {
   for (std::size_t k = 0; k < errors.size(); ++k) {
     errors[k] = residuals.col(static_cast<Eigen::Index>(k)).norm();
   }
-  result.translation_m = summarize_errors(std::move(errors));
+  result.translation_m = summarize_errors(errors);
+  result.errors_m = std::move(errors);
   return result;
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/memory_budget.hpp"
 
 namespace kartograf::geometry {
 
@@ -61,6 +62,9 @@ class SphericalLayout {
 
 void RangeImageParams::validate() const {
   require_positive(angular_step_deg, "angular_step_deg");
+  // Finer steps would overflow the image's int size (360 / step columns).
+  require(angular_step_deg >= 1e-3, "range image: angular_step_deg must be >= 0.001, got " +
+                                        std::to_string(angular_step_deg));
   require(std::isfinite(min_elevation_deg) && std::isfinite(max_elevation_deg) &&
               min_elevation_deg >= -90 && max_elevation_deg <= 90 &&
               max_elevation_deg - min_elevation_deg >= angular_step_deg,
@@ -84,6 +88,12 @@ RangeImage make_range_image(std::span<const Eigen::Vector3f> points,
   require(sensor_to_world.matrix().allFinite(), "range image: the viewpoint pose is not finite");
   const SphericalLayout layout(params);
   const int w = layout.columns(), h = layout.rows();
+  // Two float images, the index and the points, per pixel.
+  constexpr double kBytesPerPixel = 2 * sizeof(float) + sizeof(std::int32_t) + sizeof(Point4f);
+  require_fits_in_memory(kBytesPerPixel * w * h,
+                         "range image: " + std::to_string(w) + " x " + std::to_string(h) +
+                             " pixels at an angular step of " +
+                             std::to_string(params.angular_step_deg) + " degrees");
   const Eigen::Isometry3d world_to_sensor = sensor_to_world.inverse();
 
   constexpr float kFar = std::numeric_limits<float>::infinity();

@@ -10,6 +10,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/json_array.hpp"
+#include "io/map_report_html.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/occupancy_map_io.hpp"
 #include "kartograf/io/ply.hpp"
@@ -122,6 +123,7 @@ Json report_json(const pipeline::MapPipelineResult& r,
   json["backend"] = info.backend;
   json["device"] = info.device;
   json["frames"] = r.poses.size();
+  if (!info.input_json.empty()) json["input"] = Json::parse(info.input_json);
   Json stages = Json::array();
   for (const pipeline::StageTiming& t : r.timings)
     stages.push_back({{"stage", t.stage}, {"seconds", t.seconds}});
@@ -157,114 +159,6 @@ Json report_json(const pipeline::MapPipelineResult& r,
   return json;
 }
 
-std::string html_escape(const std::string& text) {
-  std::string out;
-  for (const char c : text) {
-    switch (c) {
-      case '&':
-        out += "&amp;";
-        break;
-      case '<':
-        out += "&lt;";
-        break;
-      case '>':
-        out += "&gt;";
-        break;
-      case '"':
-        out += "&quot;";
-        break;
-      default:
-        out += c;
-    }
-  }
-  return out;
-}
-
-std::string number(double value, const char* format = "%.3f") {
-  char text[64];
-  std::snprintf(text, sizeof(text), format, value);
-  return text;
-}
-
-// A two-column table of a JSON object's scalar members (nested objects flattened a.b).
-void table_rows(std::ostringstream& html, const Json& object, const std::string& prefix = "") {
-  for (const auto& [key, value] : object.items()) {
-    const std::string name = prefix.empty() ? key : prefix + "." + key;
-    if (value.is_object()) {
-      table_rows(html, value, name);
-    } else if (value.is_number_float()) {
-      html << "<tr><td>" << html_escape(name) << "</td><td>" << number(value.get<double>(), "%.4f")
-           << "</td></tr>\n";
-    } else if (!value.is_array()) {
-      html << "<tr><td>" << html_escape(name) << "</td><td>"
-           << html_escape(value.is_string() ? value.get<std::string>() : value.dump())
-           << "</td></tr>\n";
-    }
-  }
-}
-
-std::string report_html(const Json& report) {
-  std::ostringstream html;
-  html << "<!DOCTYPE html>\n<html lang=\"en\"><head><meta charset=\"utf-8\">\n"
-       << "<title>Kartograf map: " << html_escape(report["sequence"].get<std::string>())
-       << "</title>\n<style>body{font-family:sans-serif;margin:2em;max-width:70em}"
-       << "table{border-collapse:collapse;margin-bottom:1.5em}td,th{border:1px solid #bbb;"
-       << "padding:0.2em 0.6em;text-align:left}img{max-width:100%;border:1px solid #ccc}"
-       << "figure{display:inline-block;margin:0 1em 1em 0;vertical-align:top;max-width:32em}"
-       << "</style></head><body>\n";
-  html << "<h1>Kartograf map</h1>\n<p>" << html_escape(report["sequence"].get<std::string>())
-       << " (" << html_escape(report["layout"].get<std::string>()) << "), "
-       << report["frames"].get<std::size_t>() << " frames, backend "
-       << html_escape(report["backend"].get<std::string>()) << " ("
-       << html_escape(report["device"].get<std::string>()) << ")</p>\n";
-
-  html << "<h2>Metrics against ground truth</h2>\n";
-  if (report.contains("evaluation")) {
-    const Json& e = report["evaluation"];
-    html << "<table><tr><th>metric</th><th>value</th></tr>\n";
-    for (const char* part : {"trajectory", "rooms", "classes"})
-      if (e.contains(part)) table_rows(html, e[part], part);
-    html << "</table>\n";
-    for (const Json& reason : e["not_scored"])
-      html << "<p>Not scored: " << html_escape(reason.get<std::string>()) << "</p>\n";
-  } else {
-    html << "<p>The sequence has no ground truth.</p>\n";
-  }
-
-  html << "<h2>Stages</h2>\n<table><tr><th>stage</th><th>seconds</th><th>share</th></tr>\n";
-  const double total = report["timing_s"]["total"].get<double>();
-  for (const Json& stage : report["timing_s"]["stages"]) {
-    const double s = stage["seconds"].get<double>();
-    html << "<tr><td>" << html_escape(stage["stage"].get<std::string>()) << "</td><td>"
-         << number(s, "%.2f") << "</td><td>" << number(total > 0 ? 100 * s / total : 0, "%.0f")
-         << " %</td></tr>\n";
-  }
-  html << "<tr><th>total</th><th>" << number(total, "%.2f") << "</th><th>"
-       << number(total > 0 ? report["frames"].get<double>() / total : 0, "%.1f")
-       << " frames/s</th></tr></table>\n";
-
-  html << "<h2>Result</h2>\n<table><tr><th>what</th><th>value</th></tr>\n";
-  for (const char* part : {"slam", "views", "planes", "grid", "rooms"})
-    table_rows(html, report[part], part);
-  html << "</table>\n";
-
-  html << "<h2>Pictures</h2>\n";
-  const std::pair<const char*, const char*> pictures[] = {
-      {"top_view.png", "The map from above, the trajectory in red (start green, end blue)"},
-      {"semantic.png", "The metric-semantic grid: classes and traversability"},
-      {"rooms.png", "Rooms"},
-      {"occupancy.png", "Occupancy: free white, occupied black, unknown grey"}};
-  for (const auto& [file, caption] : pictures)
-    html << "<figure><img src=\"" << file << "\" alt=\"" << caption << "\"><figcaption>" << caption
-         << "</figcaption></figure>\n";
-
-  html << "<h2>Files</h2>\n<ul>\n";
-  for (const std::string& file : map_output_files())
-    html << "<li><a href=\"" << file << "\">" << file << "</a></li>\n";
-  html << "</ul>\n</body></html>\n";
-  return html.str();
-}
-
 // Truth above ours: classes (the grid's colours) left, rooms right, on the plan's cells.
 RgbImage evaluation_picture(const pipeline::MapEvaluation& e) {
   const int w = e.true_classes.width(), h = e.true_classes.height(), gap = 4;
@@ -282,6 +176,15 @@ RgbImage evaluation_picture(const pipeline::MapEvaluation& e) {
     }
   }
   return picture;
+}
+
+// The true camera positions in the map frame, for the top view; empty without ground truth.
+std::vector<Eigen::Vector3d> true_path(const std::optional<pipeline::MapEvaluation>& evaluation) {
+  std::vector<Eigen::Vector3d> path;
+  if (evaluation)
+    for (const pipeline::FrameTrajectoryError& f : evaluation->frame_errors)
+      path.push_back(f.true_position_in_map);
+  return path;
 }
 
 }  // namespace
@@ -309,10 +212,10 @@ void write_map_outputs(const fs::path& dir, const pipeline::MapPipelineResult& r
   const GrayImage occupancy = occupancy_picture(result.occupancy);
   const RgbImage rooms = room_overlay(result.occupancy, result.rooms.rooms);
   const RgbImage semantic = semantic::render_map(result.semantic).image;
-  const RgbImage top_view = render_top_view(result.map, result.poses);
+  const RgbImage top_view = render_top_view(result.map, result.poses, {}, true_path(evaluation));
   const Json report = report_json(result, evaluation, info);
-  const std::string html = report_html(report);
   const bool scored = evaluation && !evaluation->true_classes.empty();
+  const std::string html = detail::map_report_html({report, result, evaluation, scored});
   const RgbImage scored_picture = scored ? evaluation_picture(*evaluation) : RgbImage();
 
   fs::create_directories(dir);

@@ -17,6 +17,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "io/atomic_file.hpp"
+#include "io/input_file.hpp"
 #include "io/opencv_decode.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/image_io.hpp"
@@ -129,15 +130,17 @@ class YamlKeys {
 
 RosMapHeader read_ros_header(const fs::path& yaml_path) {
   const std::string file = "ROS map YAML " + quoted(yaml_path);
+  // A map YAML is a few lines: read at most kMaxYamlBytes, from a regular file only.
+  constexpr std::uintmax_t kMaxYamlBytes = 1 << 20;
   std::error_code error;
   const auto status = fs::status(yaml_path, error);
-  if (status.type() == fs::file_type::not_found) throw Error(file + ": no such file");
-  if (fs::is_directory(status)) throw Error(file + ": is a directory, not a file");
+  if (status.type() == fs::file_type::regular && fs::file_size(yaml_path, error) > kMaxYamlBytes) {
+    throw Error(file + ": larger than 1 MB, not a map description");
+  }
+  const std::vector<std::uint8_t> bytes = detail::read_file_bytes(yaml_path, file);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(yaml_path.string());
-  } catch (const YAML::BadFile&) {
-    throw Error(file + ": cannot open: " + std::strerror(errno));
+    root = YAML::Load(std::string(bytes.begin(), bytes.end()));
   } catch (const YAML::Exception& e) {
     throw Error(file + ": line " + std::to_string(e.mark.line + 1) + ", column " +
                 std::to_string(e.mark.column + 1) + ": not valid YAML: " + e.msg);

@@ -18,6 +18,7 @@
 #include "io/input_file.hpp"
 #include "io/text_fields.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/memory_budget.hpp"
 
 namespace kartograf::io {
 
@@ -234,7 +235,7 @@ class PcdParser {
       if (keyword == "COLUMNS") keyword = "FIELDS";  // PCD v0.5
       const auto found = std::find(kKeywords.begin(), kKeywords.end(), keyword);
       if (found == kKeywords.end()) {
-        fail_header(line_, "unknown keyword '" + std::string(tokens[0].substr(0, 40)) +
+        fail_header(line_, "unknown keyword '" + detail::printable(tokens[0]) +
                                "' (not a PCD file, or a corrupt header)");
       }
       HeaderLine& entry = lines[static_cast<std::size_t>(found - kKeywords.begin())];
@@ -293,8 +294,8 @@ class PcdParser {
       field.name = names.values[i];
       const std::string_view type = types->values[i];
       if (type != "F" && type != "I" && type != "U") {
-        fail_header(types->number, "TYPE '" + std::string(type) + "' of field '" + field.name +
-                                       "' is not F, I or U");
+        fail_header(types->number, "TYPE '" + detail::printable(type) + "' of field '" +
+                                       detail::printable(field.name) + "' is not F, I or U");
       }
       field.type = type[0];
       const auto size = parse_integer<std::uint64_t>(sizes->values[i]);
@@ -302,16 +303,18 @@ class PcdParser {
           size && (field.type == 'F' ? (*size == 4 || *size == 8)
                                      : (*size == 1 || *size == 2 || *size == 4 || *size == 8));
       if (!valid_size) {
-        fail_header(sizes->number, "SIZE '" + std::string(sizes->values[i]) + "' of field '" +
-                                       field.name + "' is not valid for TYPE " + field.type +
+        fail_header(sizes->number, "SIZE '" + detail::printable(sizes->values[i]) + "' of field '" +
+                                       detail::printable(field.name) + "' is not valid for TYPE " +
+                                       field.type +
                                        (field.type == 'F' ? " (4 or 8)" : " (1, 2, 4 or 8)"));
       }
       field.size = *size;
       if (counts) {
         const auto count = parse_integer<std::uint64_t>(counts->values[i]);
         if (!count || *count == 0 || *count > std::numeric_limits<std::uint32_t>::max()) {
-          fail_header(counts->number, "COUNT '" + std::string(counts->values[i]) + "' of field '" +
-                                          field.name + "' is not a positive 32-bit integer");
+          fail_header(counts->number, "COUNT '" + detail::printable(counts->values[i]) +
+                                          "' of field '" + detail::printable(field.name) +
+                                          "' is not a positive 32-bit integer");
         }
         field.count = *count;
       }
@@ -400,7 +403,8 @@ class PcdParser {
       }
       if (field.name == "rgb" || field.name == "rgba") {
         if (known.color) {
-          fail("fields '" + known.color->name + "' and '" + field.name + "' both hold colours");
+          fail("fields '" + detail::printable(known.color->name) + "' and '" +
+               detail::printable(field.name) + "' both hold colours");
         }
         claim(field, known.color);
         if (field.size != 4) {
@@ -495,6 +499,18 @@ class PcdParser {
     }
   }
 
+  // The cloud (and `staging_bytes` of decompressed data) must fit in memory: checked before
+  // allocating, since LZF data expands up to 88 times and POINTS is the file's word.
+  void require_memory(const Header& header, const KnownFields& known,
+                      std::uint64_t staging_bytes) const {
+    const double per_point = sizeof(Eigen::Vector3f) * (known.normal[0] ? 2.0 : 1.0) +
+                             (known.color ? sizeof(Rgb8) : 0) +
+                             (known.label ? sizeof(std::uint32_t) : 0);
+    require_fits_in_memory(
+        static_cast<double>(header.points) * per_point + static_cast<double>(staging_bytes),
+        "PCD file " + quoted(name_) + " (" + std::to_string(header.points) + " points)");
+  }
+
   std::string point_name(std::uint64_t i, std::uint64_t n) const {
     return "point " + std::to_string(i) + " (of " + std::to_string(n) + ")";
   }
@@ -508,6 +524,7 @@ class PcdParser {
                                   " bytes of binary data but the file has " +
                                   std::to_string(remaining()) + " after the header");
     }
+    require_memory(header, known, 0);
     const std::uint8_t* data = bytes_.data() + position_;
     const std::size_t step = static_cast<std::size_t>(header.point_bytes);
     decode(
@@ -548,6 +565,7 @@ class PcdParser {
                               " compressed bytes cannot hold " + std::to_string(uncompressed) +
                               " bytes (LZF compresses at most 88:1)");
     }
+    require_memory(header, known, uncompressed);
     std::vector<std::uint8_t> soa(static_cast<std::size_t>(uncompressed));
     if (uncompressed > 0) {
       const unsigned int produced =
@@ -584,6 +602,7 @@ class PcdParser {
                                   " values cannot fit in the ascii data (" +
                                   std::to_string(remaining()) + " bytes after the header)");
     }
+    require_memory(header, known, 0);
     const std::size_t n = static_cast<std::size_t>(header.points);
     cloud.points.resize(n);
     if (known.normal[0]) cloud.normals.resize(n);
@@ -650,7 +669,7 @@ class PcdParser {
     }
     if (!value) {
       fail_at_line(i, n,
-                   "field '" + field.name + "' is '" + std::string(token.substr(0, 40)) +
+                   "field '" + detail::printable(field.name) + "' is '" + detail::printable(token) +
                        "', not a valid " + field.type + std::to_string(field.size) + " number");
     }
     return static_cast<float>(*value);
@@ -670,8 +689,8 @@ class PcdParser {
     }
     if (!bits) {
       fail_at_line(i, n,
-                   "colour field '" + field.name + "' is '" + std::string(token.substr(0, 40)) +
-                       "', not a packed colour");
+                   "colour field '" + detail::printable(field.name) + "' is '" +
+                       detail::printable(token) + "', not a packed colour");
     }
     return unpack_pcl_rgb(*bits);
   }
@@ -679,9 +698,8 @@ class PcdParser {
   std::uint32_t ascii_label(std::string_view token, std::size_t i, std::size_t n) const {
     const auto label = parse_integer<std::uint32_t>(token);
     if (!label) {
-      fail_at_line(i, n,
-                   "label is '" + std::string(token.substr(0, 40)) +
-                       "', not an integer from 0 to 4294967295");
+      fail_at_line(
+          i, n, "label is '" + detail::printable(token) + "', not an integer from 0 to 4294967295");
     }
     return *label;
   }

@@ -19,6 +19,7 @@
 #include "io/input_file.hpp"
 #include "io/text_fields.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/memory_budget.hpp"
 
 namespace kartograf::io {
 
@@ -342,10 +343,10 @@ class PlyReader {
         } else if (tokens[1] == "binary_big_endian") {
           header.format = Format::binary_big_endian;
         } else {
-          fail_header(line_, "unknown format '" + std::string(tokens[1]) + "'");
+          fail_header(line_, "unknown format '" + detail::printable(tokens[1]) + "'");
         }
         if (tokens[2] != "1.0") {
-          fail_header(line_, "unsupported PLY version '" + std::string(tokens[2]) + "'");
+          fail_header(line_, "unsupported PLY version '" + detail::printable(tokens[2]) + "'");
         }
         saw_format = true;
       } else if (keyword == "element") {
@@ -354,7 +355,7 @@ class PlyReader {
         element.name = tokens[1];
         const auto count = detail::parse_number<std::uint64_t>(tokens[2]);
         if (!count) {
-          fail_header(line_, "element count '" + std::string(tokens[2]) +
+          fail_header(line_, "element count '" + detail::printable(tokens[2]) +
                                  "' is not a non-negative integer");
         }
         element.count = *count;
@@ -363,7 +364,7 @@ class PlyReader {
         if (header.elements.empty()) fail_header(line_, "property before any element");
         header.elements.back().properties.push_back(parse_property(tokens));
       } else {
-        fail_header(line_, "unknown keyword '" + std::string(keyword) + "'");
+        fail_header(line_, "unknown keyword '" + detail::printable(keyword) + "'");
       }
     }
     if (!saw_format) fail("the header has no 'format' line");
@@ -375,7 +376,7 @@ class PlyReader {
   Property parse_property(const std::vector<std::string_view>& tokens) const {
     auto scalar = [&](std::string_view name) {
       const auto type = parse_scalar(name);
-      if (!type) fail_header(line_, "unknown property type '" + std::string(name) + "'");
+      if (!type) fail_header(line_, "unknown property type '" + detail::printable(name) + "'");
       return *type;
     };
     Property property;
@@ -403,7 +404,7 @@ class PlyReader {
       for (std::size_t i = 0; i < vertex.properties.size(); ++i) {
         if (vertex.properties[i].name == name) {
           if (vertex.properties[i].list_count_type) {
-            fail("vertex property '" + std::string(name) + "' is a list, expected a scalar");
+            fail("vertex property '" + detail::printable(name) + "' is a list, expected a scalar");
           }
           return static_cast<int>(i);
         }
@@ -441,6 +442,11 @@ class PlyReader {
     const std::size_t remaining = bytes_.size() - position_;
     const std::size_t reservation =
         static_cast<std::size_t>(std::min<std::uint64_t>(vertex.count, remaining / 2 + 1));
+    const double vertex_bytes = sizeof(Eigen::Vector3f) * (fields.has_normals() ? 2.0 : 1.0) +
+                                (fields.has_colors() ? sizeof(Rgb8) : 0);
+    require_fits_in_memory(
+        static_cast<double>(reservation) * vertex_bytes,
+        "PLY file " + quoted(path_) + " (" + std::to_string(vertex.count) + " vertices)");
     cloud.points.reserve(reservation);
     if (fields.has_normals()) cloud.normals.reserve(reservation);
     if (fields.has_colors()) cloud.colors.reserve(reservation);
@@ -472,7 +478,7 @@ class PlyReader {
   }
 
   std::string instance_name(const Element& element, std::uint64_t index) const {
-    return element.name + " index " + std::to_string(index) + " (of " +
+    return detail::printable(element.name) + " index " + std::to_string(index) + " (of " +
            std::to_string(element.count) + ")";
   }
 
@@ -504,8 +510,9 @@ class PlyReader {
         const double count = load_scalar(*property.list_count_type,
                                          take(size_of(*property.list_count_type)), byte_order());
         if (count < 0) {
-          fail_at_byte(start, instance_name(element, index) + ": list '" + property.name +
-                                  "' has negative length " + std::to_string(count));
+          fail_at_byte(start, instance_name(element, index) + ": list '" +
+                                  detail::printable(property.name) + "' has negative length " +
+                                  std::to_string(count));
         }
         const double bytes = count * static_cast<double>(size_of(property.type));
         take(bytes > static_cast<double>(bytes_.size()) ? bytes_.size() + 1
@@ -538,15 +545,15 @@ class PlyReader {
       const std::string_view token = tokens[next++];
       const auto parsed = detail::parse_number<double>(token);
       if (!parsed) {
-        fail_at_line(instance_name(element, index) + ": " + what + " is '" + std::string(token) +
-                     "', not a number");
+        fail_at_line(instance_name(element, index) + ": " + what + " is '" +
+                     detail::printable(token) + "', not a number");
       }
       const double value = *parsed;
       if (is_integer(type)) {
         const auto [low, high] = integer_range(type);
         if (value != std::floor(value) || value < low || value > high) {
-          fail_at_line(instance_name(element, index) + ": " + what + " is '" + std::string(token) +
-                       "', not a valid " + std::string(name_of(type)));
+          fail_at_line(instance_name(element, index) + ": " + what + " is '" +
+                       detail::printable(token) + "', not a valid " + std::string(name_of(type)));
         }
       }
       return value;
@@ -554,10 +561,12 @@ class PlyReader {
     for (std::size_t p = 0; p < element.properties.size(); ++p) {
       const Property& property = element.properties[p];
       if (property.list_count_type) {
-        const double count = number(*property.list_count_type, "length of '" + property.name + "'");
+        const double count = number(*property.list_count_type,
+                                    "length of '" + detail::printable(property.name) + "'");
         if (count < 0 || count > static_cast<double>(tokens.size())) {
-          fail_at_line(instance_name(element, index) + ": list '" + property.name +
-                       "' has impossible length " + std::string(tokens[next - 1]));
+          fail_at_line(instance_name(element, index) + ": list '" +
+                       detail::printable(property.name) + "' has impossible length " +
+                       std::string(tokens[next - 1]));
         }
         for (std::size_t k = 0; k < static_cast<std::size_t>(count); ++k) {
           number(property.type, "item of '" + property.name + "'");

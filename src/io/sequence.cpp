@@ -12,6 +12,7 @@
 
 #include "io/atomic_file.hpp"
 #include "io/input_file.hpp"
+#include "io/listed_sequence.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/io/image_io.hpp"
 #include "kartograf/io/tum.hpp"
@@ -34,6 +35,11 @@ std::vector<double> read_numbers(const std::filesystem::path& path, std::size_t 
   return values;
 }
 
+template <class Pixel>
+std::string size_text(const Image<Pixel>& image) {
+  return std::to_string(image.width()) + "x" + std::to_string(image.height());
+}
+
 Eigen::Matrix4d matrix_from(const std::vector<double>& values, std::size_t offset) {
   Eigen::Matrix4d m;
   for (int r = 0; r < 4; ++r) {
@@ -41,107 +47,6 @@ Eigen::Matrix4d matrix_from(const std::vector<double>& values, std::size_t offse
   }
   return m;
 }
-
-class TumSequence final : public Sequence {
- public:
-  TumSequence(const std::filesystem::path& folder, double max_difference, const PinholeIntrinsics& intrinsics)
-      : folder_(folder), intrinsics_(intrinsics) {
-    const auto rgb = read_tum_file_list(folder / "rgb.txt");
-    const auto depth = read_tum_file_list(folder / "depth.txt");
-    std::vector<double> rgb_times, depth_times;
-    for (const auto& f : rgb) rgb_times.push_back(f.timestamp);
-    for (const auto& f : depth) depth_times.push_back(f.timestamp);
-    Trajectory ground_truth;
-    std::vector<double> gt_times;
-    if (std::filesystem::exists(folder / "groundtruth.txt")) {
-      ground_truth = read_tum_trajectory(folder / "groundtruth.txt");
-      for (const auto& p : ground_truth) gt_times.push_back(p.timestamp);
-    }
-    for (const auto& [i, j] : associate_timestamps(rgb_times, depth_times, max_difference)) {
-      Entry entry{depth_times[j], rgb[i].file, depth[j].file, std::nullopt};
-      entries_.push_back(entry);
-    }
-    std::vector<double> frame_times;
-    for (const Entry& e : entries_) frame_times.push_back(e.timestamp);
-    for (const auto& [f, g] : associate_timestamps(frame_times, gt_times, max_difference)) {
-      entries_[f].pose = ground_truth[g].pose;
-    }
-    require(!entries_.empty(), quoted(folder) + ": no rgb/depth pair within " + std::to_string(max_difference) +
-                                   " s (empty or mismatched rgb.txt / depth.txt)");
-  }
-
-  std::size_t size() const override { return entries_.size(); }
-  PinholeIntrinsics intrinsics() const override { return intrinsics_; }
-  double depth_units_per_metre() const override { return 5000.0; }
-
-  RgbdFrame frame(std::size_t i) const override {
-    const Entry& e = entries_.at(i);
-    RgbdFrame frame;
-    frame.index = i;
-    frame.timestamp = e.timestamp;
-    frame.color = read_color_image(folder_ / e.color);
-    frame.depth = read_depth_png(folder_ / e.depth);
-    frame.pose = e.pose;
-    return frame;
-  }
-
- private:
-  struct Entry {
-    double timestamp;
-    std::string color, depth;
-    std::optional<Eigen::Isometry3d> pose;
-  };
-  std::filesystem::path folder_;
-  PinholeIntrinsics intrinsics_;
-  std::vector<Entry> entries_;
-};
-
-class SevenScenesSequence final : public Sequence {
- public:
-  explicit SevenScenesSequence(const std::filesystem::path& folder) {
-    frames_ = std::filesystem::is_directory(folder / "frames") ? folder / "frames" : folder;
-    intrinsics_ = PinholeIntrinsics::kinect_7scenes();
-    if (std::filesystem::exists(folder / "camera-intrinsics.txt")) {
-      const auto k = read_numbers(folder / "camera-intrinsics.txt", 9);
-      intrinsics_.fx = k[0];
-      intrinsics_.cx = k[2];
-      intrinsics_.fy = k[4];
-      intrinsics_.cy = k[5];
-      intrinsics_.validate(quoted(folder / "camera-intrinsics.txt"));
-    }
-    while (std::filesystem::exists(path(count_, ".depth.png"))) ++count_;
-    require(count_ > 0, quoted(frames_) + ": no frame-000000.depth.png (not a 7-Scenes folder)");
-  }
-
-  std::size_t size() const override { return count_; }
-  PinholeIntrinsics intrinsics() const override { return intrinsics_; }
-  double depth_units_per_metre() const override { return 1000.0; }
-
-  RgbdFrame frame(std::size_t i) const override {
-    require(i < count_, "7-Scenes frame " + std::to_string(i) + " requested, the sequence has " +
-                            std::to_string(count_));
-    RgbdFrame frame;
-    frame.index = i;
-    frame.timestamp = static_cast<double>(i) / 30.0;
-    frame.color = read_color_image(path(i, ".color.jpg"));
-    frame.depth = read_depth_png(path(i, ".depth.png"));
-    if (std::filesystem::exists(path(i, ".pose.txt"))) {
-      frame.pose = orthonormalized_pose(matrix_from(read_numbers(path(i, ".pose.txt"), 16), 0));
-    }
-    return frame;
-  }
-
- private:
-  std::filesystem::path path(std::size_t i, const char* suffix) const {
-    char name[64];
-    std::snprintf(name, sizeof(name), "frame-%06zu%s", i, suffix);
-    return frames_ / name;
-  }
-
-  std::filesystem::path frames_;
-  PinholeIntrinsics intrinsics_;
-  std::size_t count_ = 0;
-};
 
 }  // namespace
 
@@ -156,6 +61,66 @@ Eigen::Isometry3d orthonormalized_pose(const Eigen::Matrix4d& matrix) {
   return pose;
 }
 
+Eigen::Isometry3d rotation_pose(const Eigen::Matrix4d& matrix, const std::string& where) {
+  require(matrix.allFinite(), where + ": the pose matrix has a value that is not finite");
+  const Eigen::Matrix3d r = matrix.topLeftCorner<3, 3>();
+  const double off = (r.transpose() * r - Eigen::Matrix3d::Identity()).norm();
+  const double det = r.determinant();
+  char numbers[160];
+  std::snprintf(numbers, sizeof(numbers),
+                "||R^T R - I|| = %.3g, det(R) = %.3g; accepted: ||R^T R - I|| under %g, det > 0",
+                off, det, kPoseRotationTolerance);
+  require(off < kPoseRotationTolerance && det > 0,
+          where + ": the pose's 3x3 block is not a rotation (" + numbers + ")");
+  const Eigen::RowVector4d last = matrix.row(3);
+  require((last - Eigen::RowVector4d(0, 0, 0, 1)).norm() < 1e-6,
+          where + ": the pose matrix's last row is not 0 0 0 1");
+  return orthonormalized_pose(matrix);
+}
+
+namespace detail {
+
+ListedSequence::ListedSequence(std::vector<FrameFiles> frames, const PinholeIntrinsics& camera,
+                               double depth_units_per_metre)
+    : frames_(std::move(frames)), camera_(camera), depth_units_per_metre_(depth_units_per_metre) {
+  camera_.validate("sequence camera");
+  require(std::isfinite(depth_units_per_metre) && depth_units_per_metre > 0,
+          "depth scale must be a positive number of units per metre, got " +
+              std::to_string(depth_units_per_metre));
+}
+
+RgbdFrame ListedSequence::frame(std::size_t i) const {
+  require(i < frames_.size(), "sequence frame " + std::to_string(i) +
+                                  " requested, the sequence has " + std::to_string(frames_.size()));
+  const FrameFiles& files = frames_[i];
+  require(files.missing.empty(), quoted(files.missing) + ": no such file (frame " +
+                                     std::to_string(i) + " of the sequence)");
+  RgbdFrame frame;
+  frame.index = files.position;
+  frame.timestamp = files.timestamp;
+  frame.color_file = files.color;
+  frame.depth_file = files.depth;
+  frame.depth = read_depth_png(files.depth);
+  require(frame.depth.width() == camera_.width && frame.depth.height() == camera_.height,
+          "depth image " + quoted(files.depth) + " is " + size_text(frame.depth) +
+              ", the sequence's frames are " + std::to_string(camera_.width) + "x" +
+              std::to_string(camera_.height));
+  frame.color = read_color_image(files.color);
+  require(
+      frame.color.width() == frame.depth.width() && frame.color.height() == frame.depth.height(),
+      "colour image " + quoted(files.color) + " is " + size_text(frame.color) +
+          ", its depth image " + quoted(files.depth) + " is " + size_text(frame.depth) +
+          " (colour must be on the depth image's pixel grid)");
+  frame.pose = files.pose;
+  if (!files.pose_file.empty()) {
+    frame.pose =
+        rotation_pose(matrix_from(read_numbers(files.pose_file, 16), 0), quoted(files.pose_file));
+  }
+  return frame;
+}
+
+}  // namespace detail
+
 PinholeIntrinsics read_camera_intrinsics_json(const std::filesystem::path& path) {
   std::ifstream in = detail::open_text_file(path);
   nlohmann::json json;
@@ -165,7 +130,8 @@ PinholeIntrinsics read_camera_intrinsics_json(const std::filesystem::path& path)
     throw Error(quoted(path) + ": not valid JSON: " + e.what());
   }
   auto field = [&](const char* name) -> const nlohmann::json& {
-    require(json.is_object() && json.contains(name), quoted(path) + ": missing field '" + name + "'");
+    require(json.is_object() && json.contains(name),
+            quoted(path) + ": missing field '" + name + "'");
     return json.at(name);
   };
   auto number = [&](const nlohmann::json& value, const std::string& what) {
@@ -175,15 +141,18 @@ PinholeIntrinsics read_camera_intrinsics_json(const std::filesystem::path& path)
   };
   auto integer = [&](const char* name) {
     const nlohmann::json& value = field(name);
-    require(value.is_number_integer() && value.get<long long>() > 0 && value.get<long long>() <= 1 << 20,
+    require(value.is_number_integer() && value.get<long long>() > 0 &&
+                value.get<long long>() <= 1 << 20,
             quoted(path) + ": field '" + name + "' must be a positive integer");
     return static_cast<int>(value.get<long long>());
   };
   const nlohmann::json& matrix = field("intrinsic_matrix");
-  require(matrix.is_array() && matrix.size() == 9,
-          quoted(path) + ": field 'intrinsic_matrix' must be an array of 9 numbers (column-major 3x3)");
+  require(
+      matrix.is_array() && matrix.size() == 9,
+      quoted(path) + ": field 'intrinsic_matrix' must be an array of 9 numbers (column-major 3x3)");
   double m[9];
-  for (int i = 0; i < 9; ++i) m[i] = number(matrix[i], "intrinsic_matrix[" + std::to_string(i) + "]");
+  for (int i = 0; i < 9; ++i)
+    m[i] = number(matrix[i], "intrinsic_matrix[" + std::to_string(i) + "]");
   PinholeIntrinsics k;
   k.width = integer("width");
   k.height = integer("height");
@@ -192,8 +161,9 @@ PinholeIntrinsics read_camera_intrinsics_json(const std::filesystem::path& path)
   k.cx = m[6];
   k.cy = m[7];
   require(m[1] == 0 && m[2] == 0 && m[3] == 0 && m[5] == 0 && m[8] == 1,
-          quoted(path) + ": field 'intrinsic_matrix' is not a pinhole matrix [fx 0 0 0 fy 0 cx cy 1] "
-                         "(skew or a non-unit last element)");
+          quoted(path) +
+              ": field 'intrinsic_matrix' is not a pinhole matrix [fx 0 0 0 fy 0 cx cy 1] "
+              "(skew or a non-unit last element)");
   k.validate(quoted(path));
   return k;
 }
@@ -208,17 +178,16 @@ void write_camera_intrinsics_json(const std::filesystem::path& path, const Pinho
   detail::write_file_atomically(path, text.data(), text.size());
 }
 
-std::unique_ptr<Sequence> open_tum_sequence(const std::filesystem::path& folder, double max_difference,
+std::unique_ptr<Sequence> open_tum_sequence(const std::filesystem::path& folder,
+                                            double max_difference,
                                             std::optional<PinholeIntrinsics> intrinsics) {
-  const std::filesystem::path json = folder / "camera_intrinsics.json";
-  if (!intrinsics && std::filesystem::exists(json)) intrinsics = read_camera_intrinsics_json(json);
-  const PinholeIntrinsics k = intrinsics.value_or(PinholeIntrinsics{640, 480, 525.0, 525.0, 319.5, 239.5});
-  k.validate("TUM intrinsics");
-  return std::make_unique<TumSequence>(folder, max_difference, k);
+  detail::FrameList list = detail::list_tum_frames(folder, max_difference);
+  if (intrinsics) list.camera = {*intrinsics, "option", "given"};
+  return detail::open_listed(std::move(list), {}).sequence;
 }
 
 std::unique_ptr<Sequence> open_seven_scenes(const std::filesystem::path& folder) {
-  return std::make_unique<SevenScenesSequence>(folder);
+  return detail::open_listed(detail::list_numbered_frames(folder), {}).sequence;
 }
 
 Trajectory read_redwood_log(const std::filesystem::path& path) {
@@ -242,14 +211,17 @@ Trajectory read_redwood_log(const std::filesystem::path& path) {
       require(next_line(), quoted(path) + ": truncated after line " + std::to_string(line_number) +
                                " (a 4x4 matrix needs 4 rows)");
       double v[4];
-      require(std::sscanf(line.c_str(), "%lf %lf %lf %lf", &v[0], &v[1], &v[2], &v[3]) == 4 &&
-                  std::isfinite(v[0] + v[1] + v[2] + v[3]),
-              quoted(path) + " line " + std::to_string(line_number) + ": expected 4 finite numbers");
+      require(
+          std::sscanf(line.c_str(), "%lf %lf %lf %lf", &v[0], &v[1], &v[2], &v[3]) == 4 &&
+              std::isfinite(v[0] + v[1] + v[2] + v[3]),
+          quoted(path) + " line " + std::to_string(line_number) + ": expected 4 finite numbers");
       for (int c = 0; c < 4; ++c) m(r, c) = v[c];
     }
     StampedPose pose;
     pose.timestamp = static_cast<double>(trajectory.size());
-    pose.pose = orthonormalized_pose(m);
+    pose.pose =
+        rotation_pose(m, quoted(path) + " matrix at lines " + std::to_string(line_number - 3) +
+                             "-" + std::to_string(line_number));
     trajectory.push_back(pose);
   }
   return trajectory;

@@ -3,6 +3,7 @@
 #include <string>
 
 #include "io/atomic_file.hpp"
+#include "io/listed_sequence.hpp"
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::io {
@@ -17,6 +18,8 @@ std::string_view to_string(SequenceLayout layout) {
       return "tum";
     case SequenceLayout::seven_scenes:
       return "7scenes";
+    case SequenceLayout::rgb_depth_folders:
+      return "rgb-depth";
   }
   return "unknown";
 }
@@ -29,23 +32,30 @@ DetectedSequence detect_sequence(const fs::path& folder) {
     const bool synthetic = fs::is_regular_file(folder / "world.json");
     return {synthetic ? SequenceLayout::synthetic : SequenceLayout::tum, true};
   }
-  const char* first_frame = "frame-000000.depth.png";
-  if (fs::is_regular_file(folder / first_frame) ||
-      fs::is_regular_file(folder / "frames" / first_frame)) {
-    return {SequenceLayout::seven_scenes, false};
-  }
-  throw Error(
-      detail::quoted(folder) +
-      ": not a known RGB-D sequence layout (looked for rgb.txt and depth.txt: TUM or "
-      "kartograf synth; frame-000000.depth.png or frames/frame-000000.depth.png: 7-Scenes)");
+  if (detail::numbered_frames_folder(folder)) return {SequenceLayout::seven_scenes, false};
+  if (fs::is_directory(folder / "rgb") && fs::is_directory(folder / "depth"))
+    return {SequenceLayout::rgb_depth_folders, false};
+  throw Error(detail::quoted(folder) +
+              ": not a known RGB-D sequence layout (looked for rgb.txt and depth.txt: TUM or "
+              "kartograf synth; frame-N.depth.png (e.g. frame-000000.depth.png), in the folder "
+              "or in frames/: 7-Scenes, 3DMatch, SUN3D; rgb/ and depth/ folders of images)");
 }
 
-OpenedSequence open_sequence(const fs::path& folder) {
-  OpenedSequence opened;
-  opened.detected = detect_sequence(folder);
-  opened.sequence = opened.detected.layout == SequenceLayout::seven_scenes
-                        ? open_seven_scenes(folder)
-                        : open_tum_sequence(folder);
+OpenedSequence open_sequence(const fs::path& folder, const SequenceOptions& options) {
+  const DetectedSequence detected = detect_sequence(folder);
+  detail::FrameList list;
+  switch (detected.layout) {
+    case SequenceLayout::seven_scenes:
+      list = detail::list_numbered_frames(folder);
+      break;
+    case SequenceLayout::rgb_depth_folders:
+      list = detail::list_rgb_depth_frames(folder);
+      break;
+    default:
+      list = detail::list_tum_frames(folder, 0.02);
+  }
+  OpenedSequence opened = detail::open_listed(std::move(list), options);
+  opened.detected = detected;
   return opened;
 }
 

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <string>
 #include <string_view>
 #include <system_error>
 #include <vector>
@@ -21,6 +22,11 @@ std::optional<std::string_view> next_line(std::span<const std::uint8_t> bytes,
 
 // The non-empty runs of line between the characters in `separators` (each format has its own).
 std::vector<std::string_view> split_fields(std::string_view line, std::string_view separators);
+
+// text for an error message: bytes outside printable ASCII as \xNN (a binary file's header must
+// not reach a terminal raw), cut after max_chars characters with "..." so that a megabyte-long
+// field stays one readable line.
+std::string printable(std::string_view text, std::size_t max_chars = 40);
 
 // token as a Number, all of it, the way std::from_chars reads it (no leading '+' or blanks; for
 // floating point also "nan", "inf" and exponents); nothing when any character is not part of the

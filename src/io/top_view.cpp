@@ -102,7 +102,8 @@ Eigen::Vector3d estimate_up(const std::vector<Eigen::Isometry3d>& camera_poses) 
 }
 
 RgbImage render_top_view(const PointCloud& map, const std::vector<Eigen::Isometry3d>& camera_poses,
-                         const TopViewOptions& options) {
+                         const TopViewOptions& options,
+                         const std::vector<Eigen::Vector3d>& true_path) {
   require(options.size >= 16 && options.size <= 16384 && options.margin >= 0,
           "top view: size must be in [16, 16384] and margin >= 0");
   const FloorFrame frame = floor_frame(camera_poses);
@@ -131,6 +132,10 @@ RgbImage render_top_view(const PointCloud& map, const std::vector<Eigen::Isometr
     if (height > ceiling) continue;
     const Rgb8 color = map.has_colors() ? map.colors[i] : height_shade(height, low, ceiling);
     canvas.plot_highest(canvas.pixel(frame.plane(p)), height, color);
+  }
+  for (std::size_t i = 1; i < true_path.size(); ++i) {
+    canvas.line(canvas.pixel(frame.plane(true_path[i - 1])),
+                canvas.pixel(frame.plane(true_path[i])), Rgb8{255, 200, 0});
   }
   for (std::size_t i = 1; i < camera_poses.size(); ++i) {
     canvas.line(canvas.pixel(frame.plane(camera_poses[i - 1].translation())),

@@ -4,6 +4,9 @@
 #include <chrono>
 #include <numbers>
 #include <optional>
+#include <string>
+
+#include "kartograf/core/error.hpp"
 
 namespace kartograf::mapping {
 
@@ -79,13 +82,15 @@ class GraphState {
   GraphState(const PoseGraphOptions& options, const LoopConsistency& consistency)
       : options_(options), consistency_(consistency) {}
 
-  // Brings the estimate of frames after the anchor up to date with the odometry (whose last k
-  // poses a re-estimate may have changed).
+  // Brings the estimate of frames after the anchor up to date with the odometry: the new frame,
+  // and the last k poses when it was re-estimated (every k-th frame), so the work per frame does
+  // not grow with k.
   void follow(const std::vector<Eigen::Isometry3d>& odometry, std::size_t reestimate_interval) {
     const std::size_t last = odometry.size() - 1;
     estimate_.resize(odometry.size());
-    const std::size_t first =
-        std::max(anchor_ + 1, last >= reestimate_interval ? last - reestimate_interval : 0);
+    const std::size_t k = reestimate_interval;
+    const bool reestimated = k > 0 && last >= k && last % k == 0;
+    const std::size_t first = std::max(anchor_ + 1, reestimated ? last - k : last);
     const Eigen::Isometry3d offset = anchor_estimate_ * anchor_odometry_.inverse();
     for (std::size_t m = first; m <= last; ++m) estimate_[m] = offset * odometry[m];
     if (last == 0) estimate_[0] = odometry[0];
@@ -187,6 +192,13 @@ class GraphState {
 // The colour of each pyramid pixel: the top-left pixel of its 2^level x 2^level block (the
 // pyramid averages depth; colour from an unregistered camera is only approximately aligned anyway).
 void colors_at_level(const RgbImage& color, int level, int width, int height, RgbImage& out) {
+  // The frame source checks colour against depth; a source that does not must not read past
+  // the colour image.
+  require(width > 0 && height > 0 && ((width - 1) << level) < color.width() &&
+              ((height - 1) << level) < color.height(),
+          "colour image is " + std::to_string(color.width()) + "x" +
+              std::to_string(color.height()) + ", smaller than the depth camera's pixel grid (" +
+              std::to_string(width << level) + "x" + std::to_string(height << level) + ")");
   if (out.width() != width || out.height() != height) out = RgbImage(width, height);
   for (int v = 0; v < height; ++v) {
     for (int u = 0; u < width; ++u) out(u, v) = color(u << level, v << level);

@@ -30,6 +30,20 @@ void resample_onto_plan(const MapPipelineResult& result, const OccupancyGrid& pl
   }
 }
 
+// The inverse of the ATE's alignment takes the true positions into the map frame.
+std::vector<FrameTrajectoryError> frame_errors(const eval::MatchedPoses& matched,
+                                               const eval::AteResult& ate) {
+  const eval::SimilarityTransform& a = ate.alignment;
+  std::vector<FrameTrajectoryError> errors(matched.size());
+  for (std::size_t k = 0; k < matched.size(); ++k) {
+    const Eigen::Vector3d world = matched.ground_truth[k].pose.translation();
+    errors[k].frame = static_cast<std::size_t>(matched.ground_truth[k].timestamp);
+    errors[k].error_m = ate.errors_m[k];
+    errors[k].true_position_in_map = a.rotation.transpose() * (world - a.translation) / a.scale;
+  }
+  return errors;
+}
+
 }  // namespace
 
 MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth& truth) {
@@ -41,6 +55,7 @@ MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth
     return out;
   }
   out.trajectory = eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeOptions{});
+  out.frame_errors = frame_errors(matched, out.trajectory->ate);
   if (!truth.plan) {
     out.skipped.push_back("rooms, classes: no floor plan");
     return out;

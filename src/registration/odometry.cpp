@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 
+#include "kartograf/core/memory_budget.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/registration/depth_weighted_finder.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
@@ -110,7 +111,7 @@ struct RgbdOdometry::PlanarFrames {
 
   segmentation::PlaneExtractor extractor;
   IcpEngine engine;
-  std::vector<geometry::DeviceCloud> samples;  // per ring slot
+  std::vector<geometry::DeviceCloud> samples;  // per frame slot
 };
 
 RgbdOdometry::~RgbdOdometry() = default;
@@ -128,7 +129,17 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
       builder_(context, camera, params_.depth_range),
       engine_(context, params_.icp, finder_for(context, params_)) {
   validate(params_);
-  const std::size_t slots = static_cast<std::size_t>(std::max(params_.reestimate_interval, 1)) + 1;
+  // The frame being tracked, the previous one and, with re-estimation, the last multiple of k:
+  // whatever k, no other frame is registered against again.
+  const std::size_t slots = params_.reestimate_interval > 1 ? 3 : 2;
+  // Per pixel and slot: points, normals and packed colours over the pyramid's levels (4/3 of the
+  // finest), and the colour kept for photometric refinement.
+  const double pixel_bytes = (2 * sizeof(Point4f) + sizeof(std::uint32_t)) * 4.0 / 3 + sizeof(Rgb8);
+  require_fits_in_memory(pixel_bytes * slots * camera.width * camera.height,
+                         "odometry: " + std::to_string(slots) + " frame pyramids of " +
+                             std::to_string(camera.width) + " x " + std::to_string(camera.height) +
+                             " pixels");
+  slot_frames_.assign(slots, kNoFrame);
   ring_.reserve(slots);
   for (std::size_t i = 0; i < slots; ++i)
     ring_.emplace_back(context, camera, pyramid_params(params_, finest_level_, information_level_));
@@ -139,8 +150,31 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
   }
 }
 
+std::size_t RgbdOdometry::slot_of(std::size_t frame) const {
+  const auto found = std::find(slot_frames_.begin(), slot_frames_.end(), frame);
+  require(found != slot_frames_.end(),
+          "odometry: frame " + std::to_string(frame) + " is no longer kept (internal error)");
+  return static_cast<std::size_t>(found - slot_frames_.begin());
+}
+
+std::size_t RgbdOdometry::claim_slot(std::size_t frame) {
+  // Keep frame-1 (the next frame's previous) and the last multiple of k before this frame (the
+  // anchor of the next re-estimate, when this frame is not itself one).
+  const auto k = static_cast<std::size_t>(params_.reestimate_interval);
+  const std::size_t previous = frame == 0 ? kNoFrame : frame - 1;
+  const std::size_t anchor = (k > 1 && frame > 0) ? (frame - 1) / k * k : kNoFrame;
+  for (std::size_t slot = 0; slot < slot_frames_.size(); ++slot) {
+    const std::size_t held = slot_frames_[slot];
+    if (held == kNoFrame || (held != previous && held != anchor)) {
+      slot_frames_[slot] = frame;
+      return slot;
+    }
+  }
+  throw Error("odometry: no free frame slot (internal error)");
+}
+
 FramePyramid& RgbdOdometry::pyramid_of(std::size_t frame) {
-  return ring_[frame % ring_.size()];
+  return ring_[slot_of(frame)];
 }
 
 RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
@@ -202,7 +236,14 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   const auto start = std::chrono::steady_clock::now();
   OdometryFrame frame;
   frame.index = poses_.size();
-  FramePyramid& pyramid = pyramid_of(frame.index);
+  // Colour is read on the depth image's pixel grid (photometric refinement, planes).
+  require(color == nullptr || color->empty() ||
+              (color->width() == depth.width() && color->height() == depth.height()),
+          "odometry: frame " + std::to_string(frame.index) + ": colour image is " +
+              std::to_string(color ? color->width() : 0) + "x" +
+              std::to_string(color ? color->height() : 0) + ", its depth image is " +
+              std::to_string(depth.width()) + "x" + std::to_string(depth.height()));
+  FramePyramid& pyramid = ring_[claim_slot(frame.index)];
   builder_.build(depth, color, pyramid);
   if (planar_) {
     require(color != nullptr && !color->empty(),

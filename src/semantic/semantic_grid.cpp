@@ -13,6 +13,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/memory_budget.hpp"
 #include "kartograf/eval/connected_components.hpp"
 #include "semantic/quantile.hpp"
 
@@ -680,6 +681,13 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   require(static_cast<double>(size.x()) * size.y() < 1e8,
           "build_semantic_grid: the points span " + std::to_string(size.x()) + " x " +
               std::to_string(size.y()) + " cells: too many (outliers far away?)");
+  // The grid's images and the per-cell evidence and masks below, twice for the working copies.
+  const double cell_bytes =
+      2.0 * (sizeof(SemanticClass) + sizeof(float) + sizeof(std::vector<int>) +
+             sizeof(CellEvidence) + 2 * sizeof(std::uint8_t));
+  require_fits_in_memory(cell_bytes * size.x() * size.y(),
+                         "build_semantic_grid: a grid of " + std::to_string(size.x()) + " x " +
+                             std::to_string(size.y()) + " cells at " + std::to_string(res) + " m");
   grid.classes = Image<SemanticClass>(size.x(), size.y(), SemanticClass::unknown);
   grid.weight = Image<float>(size.x(), size.y(), kUnobserved);
   grid.cell_objects = Image<std::vector<int>>(size.x(), size.y());

@@ -16,8 +16,11 @@ class Device;
 
 struct ContextOptions {
   BackendChoice backend = BackendChoice::automatic;
-  // Index into the backend's usable devices; empty: the best one (discrete > integrated > other).
+  // Index into the backend's usable devices (the CPU backend has one: 0); empty: the best one
+  // (discrete > integrated > other). With `automatic`, an index into the backend it takes.
   std::optional<int> device_index;
+  // What set device_index, for messages ("KARTOGRAF_DEVICE" when read from the environment).
+  std::string device_index_source = "device index";
   // Vulkan only: enable VK_LAYER_KHRONOS_validation with synchronization validation, and count
   // every error it reports (see Context::validation_errors). Ignored when the layer is missing.
   bool vulkan_validation = false;
@@ -25,6 +28,10 @@ struct ContextOptions {
   // KARTOGRAF_BACKEND=auto|cpu|vulkan|opencl, KARTOGRAF_DEVICE=<index>,
   // KARTOGRAF_VULKAN_VALIDATION=1.
   static ContextOptions from_environment();
+  // Only KARTOGRAF_DEVICE and KARTOGRAF_VULKAN_VALIDATION, for callers that choose the backend
+  // themselves (the CLI's --backend). Throws Error naming the variable and its value when
+  // KARTOGRAF_DEVICE is not a device index.
+  void read_device_environment();
 };
 
 class Context {

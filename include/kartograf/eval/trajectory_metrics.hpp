@@ -76,6 +76,7 @@ Trajectory transform_trajectory(const Trajectory& trajectory, const SimilarityTr
 struct AteResult {
   SimilarityTransform alignment;
   ErrorStatistics translation_m;
+  std::vector<double> errors_m;  // per matched pose, in order: what translation_m summarises
 };
 AteResult compute_ate(const MatchedPoses& poses, Alignment alignment);
 

@@ -8,9 +8,10 @@
 //   rooms.png, rooms.json   the rooms in colour over the grid, and their records (rooms_labels.png:
 //                           16-bit room ids)
 //   semantic.png/.json      the metric-semantic grid with its legend, and its objects
-//   top_view.png            the map from above with the trajectory
+//   top_view.png            the map from above with the trajectory (and the true one if known)
 //   report.json             run, per-stage timings, counts and every metric the ground truth allows
-//   report.html             the same for people, with the pictures
+//   report.html             the same for people: summary, pictures, plots, a 3-D view
+//                           (self-contained: src/io/map_report_html.hpp)
 // Each file is written atomically (a reader never sees part of one); everything is rendered
 // before the first is written.
 #include <filesystem>
@@ -29,11 +30,17 @@ struct MapRunInfo {
   std::string backend, device;
   bool has_timestamps = true;   // false: trajectory.txt stamps frame numbers
   std::string parameters_json;  // a JSON object (text) stored as "parameters", or empty
+  // The input as read, a JSON object (text) stored as "input": the camera, where it came from
+  // (preset, file, option, default), the depth scale and the frames left out; or empty.
+  std::string input_json;
 };
 
 // The names written by write_map_outputs, in order.
 const std::vector<std::string>& map_output_files();
 
+// Writes the files into dir (created if missing), as they are: `kartograf map` gives it a staging
+// folder and moves that in as a whole (apps/kartograf/output_transaction.hpp), so that a failed
+// or interrupted run never leaves a mix of two runs' files.
 void write_map_outputs(const std::filesystem::path& dir, const pipeline::MapPipelineResult& result,
                        const std::optional<pipeline::MapEvaluation>& evaluation,
                        const MapRunInfo& info);

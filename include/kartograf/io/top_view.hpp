@@ -2,7 +2,7 @@
 // A picture of a map seen from above, for people to look at: the map's points projected on the
 // floor plane (the highest point of each pixel wins, so furniture shows over the floor; points
 // far above the cameras, the ceiling, are left out), with the camera trajectory drawn over it in
-// red (start green, end blue).
+// red (start green, end blue) and, where known, the true one in yellow.
 //
 // "Up" is the mean of the cameras' up axes (-y of the optical frame): a robot's or a hand-held
 // camera is held roughly upright, whatever the world frame is (SLAM's world is the first camera).
@@ -26,9 +26,12 @@ struct TopViewOptions {
 // Unit up vector of camera-to-world poses; throws Error when there are none.
 Eigen::Vector3d estimate_up(const std::vector<Eigen::Isometry3d>& camera_poses);
 
-// Points without colours are shaded by height. Throws Error when there are no poses.
+// Points without colours are shaded by height. true_path (e.g. the ground truth's camera
+// positions in the map's frame) is drawn in yellow under the trajectory. Throws Error when there
+// are no poses.
 RgbImage render_top_view(const PointCloud& map, const std::vector<Eigen::Isometry3d>& camera_poses,
-                         const TopViewOptions& options = {});
+                         const TopViewOptions& options = {},
+                         const std::vector<Eigen::Vector3d>& true_path = {});
 
 // render_top_view, written as PNG (atomic).
 void write_top_view_png(const std::filesystem::path& path, const PointCloud& map,

@@ -28,8 +28,16 @@ struct MapGroundTruth {
   SemanticImage classes;
 };
 
+// One frame that has a ground-truth pose, after the ATE's alignment.
+struct FrameTrajectoryError {
+  std::size_t frame = 0;
+  double error_m = 0;                    // |true position - aligned estimate|
+  Eigen::Vector3d true_position_in_map;  // the true camera position carried into the map frame
+};
+
 struct MapEvaluation {
   std::optional<eval::TrajectoryEvaluation> trajectory;
+  std::vector<FrameTrajectoryError> frame_errors;  // in frame order; empty without a trajectory
   std::optional<eval::RoomSegmentationScores> rooms;
   std::optional<eval::SemanticScores> semantic;
   // Ours at the plan's cells (rooms 0: none; classes unknown: unobserved), beside the truth.

@@ -22,7 +22,9 @@
 // re-estimate is accepted it replaces frame n's pose, and the correction is spread over frames
 // n-k+1..n-1 in proportion to their position (so the trajectory has no jump); chaining then
 // continues from the corrected pose. Every registration is kept as a RelativePose, so a pose graph
-// (mapping/) can use both the frame-to-frame and the k-back measurements.
+// (mapping/) can use both the frame-to-frame and the k-back measurements. Only two earlier frames
+// are registered against (the previous one and the last multiple of k), so the odometry holds at
+// most three frame pyramids with the current one, whatever k.
 //
 // Information of an edge: InformationModel applied to the geometric information, plus the weak
 // prior of an unmeasured step (fallback_sigma_*) so that no direction is entirely free.
@@ -157,6 +159,9 @@ class RgbdOdometry {
   const std::vector<RelativePose>& constraints() const { return constraints_; }
   const std::vector<std::size_t>& keyframes() const { return keyframes_; }
   const OdometryParams& params() const { return params_; }
+  // Frame pyramids held: the current frame, the previous one and the anchor of the next
+  // re-estimate (at most 3, whatever reestimate_interval).
+  std::size_t kept_pyramids() const { return ring_.size(); }
 
  private:
   struct Attempt {
@@ -173,9 +178,12 @@ class RgbdOdometry {
   void reestimate(OdometryFrame& frame);
   bool is_keyframe(const OdometryFrame& frame) const;
   FramePyramid& pyramid_of(std::size_t frame);
-  std::size_t slot_of(std::size_t frame) const { return frame % ring_.size(); }
+  // The slot holding `frame`'s pyramid, colour and plane samples; throws when it is not kept.
+  std::size_t slot_of(std::size_t frame) const;
+  // A slot for a new frame: one holding neither the previous frame nor the re-estimation anchor.
+  std::size_t claim_slot(std::size_t frame);
 
-  struct PlanarFrames;  // OdometryMethod::planar: the plane samples of the frames in the ring
+  struct PlanarFrames;  // OdometryMethod::planar: the plane samples of the kept frames
 
   const compute::Context* context_;
   OdometryParams params_;
@@ -183,10 +191,12 @@ class RgbdOdometry {
   int information_level_;  // pyramid level of the geometric information
   RgbdPyramidBuilder builder_;
   IcpEngine engine_;
-  std::vector<FramePyramid> ring_;     // the last max(k, 1) + 1 frames
-  std::vector<RgbImage> colors_;       // their colours (photometric refinement), same slots
-  GeometricInformation geometry_;      // of the frame being tracked
-  const DepthImage* depth_ = nullptr;  // of the frame being tracked
+  static constexpr std::size_t kNoFrame = static_cast<std::size_t>(-1);
+  std::vector<FramePyramid> ring_;        // the frames still needed (claim_slot)
+  std::vector<RgbImage> colors_;          // their colours (photometric refinement), same slots
+  std::vector<std::size_t> slot_frames_;  // the frame each slot holds (kNoFrame: none yet)
+  GeometricInformation geometry_;         // of the frame being tracked
+  const DepthImage* depth_ = nullptr;     // of the frame being tracked
   const RgbImage* color_ = nullptr;
   std::vector<Eigen::Isometry3d> poses_;
   std::vector<OdometryFrame> frames_;
