@@ -21,6 +21,24 @@ int report_error(const std::string& message) {
   return 1;
 }
 
+// `demo`: its --backend defaults to $KARTOGRAF_BACKEND; backend_option tells whether it was given.
+CLI::App* add_demo_subcommand(CLI::App& app, kartograf::cli::DemoOptions& options,
+                              CLI::Option*& backend_option) {
+  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
+    options.backend = env_backend;
+    options.backend_source = "KARTOGRAF_BACKEND";
+  }
+  CLI::App* demo = app.add_subcommand("demo",
+                                      "Render a frame of the synthetic world, back-project, "
+                                      "estimate normals, write pictures and a PLY");
+  demo->add_option("--out", options.out_dir, "Output directory")->capture_default_str();
+  backend_option =
+      demo->add_option("--backend", options.backend,
+                       "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)");
+  demo->add_flag("--force", options.force, "Replace the files of an earlier run");
+  return demo;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -34,19 +52,8 @@ int main(int argc, char** argv) {
   CLI::App* devices = app.add_subcommand("devices", "List compute backends and their devices");
 
   kartograf::cli::DemoOptions demo_options;
-  // The environment supplies the default backend; --backend overrides it.
-  if (const char* env_backend = std::getenv("KARTOGRAF_BACKEND"); env_backend && *env_backend) {
-    demo_options.backend = env_backend;
-    demo_options.backend_source = "KARTOGRAF_BACKEND";
-  }
-  CLI::App* demo = app.add_subcommand("demo",
-                                      "Render a frame of the synthetic world, back-project, "
-                                      "estimate normals, write pictures and a PLY");
-  demo->add_option("--out", demo_options.out_dir, "Output directory")->capture_default_str();
-  CLI::Option* backend_option =
-      demo->add_option("--backend", demo_options.backend,
-                       "auto|cpu|vulkan|opencl (default: $KARTOGRAF_BACKEND, else auto)");
-  demo->add_flag("--force", demo_options.force, "Replace the files of an earlier run");
+  CLI::Option* backend_option = nullptr;
+  CLI::App* demo = add_demo_subcommand(app, demo_options, backend_option);
 
   kartograf::cli::EvalOptions eval_options;
   CLI::App* eval = kartograf::cli::add_eval_command(app, eval_options);

@@ -5,6 +5,7 @@
 // same way (for `kartograf eval traj`). Wiring only.
 #include <cstdio>
 #include <filesystem>
+#include <optional>
 #include <ostream>
 #include <string>
 
@@ -48,6 +49,119 @@ Json loop_closure_json(const mapping::LoopClosureRecord& record) {
   return json;
 }
 
+// What the summary and stats.json say beyond the result itself.
+struct SlamFigures {
+  std::optional<eval::AteResult> slam_ate, odometry_ate;
+  std::size_t accepted = 0, pruned = 0;
+  Json loops = Json::array();
+};
+
+SlamFigures slam_figures(const OpenedRun& run, const mapping::SlamResult& result) {
+  SlamFigures f;
+  f.slam_ate = absolute_trajectory_error(*run.source, result.poses);
+  f.odometry_ate = absolute_trajectory_error(*run.source, result.odometry.poses);
+  for (const auto& record : result.loop_closures) {
+    f.accepted += record.closure.report.accepted();
+    f.pruned += record.pruned;
+    f.loops.push_back(loop_closure_json(record));
+  }
+  return f;
+}
+
+Json slam_stats_json(const SlamOptions& o, const OpenedRun& run, const compute::Context& context,
+                     const mapping::SlamParams& params, const mapping::SlamResult& result,
+                     const SlamFigures& f) {
+  const mapping::SlamTimings& t = result.timing;
+  Json json;
+  json["sequence"] = o.run.sequence.string();
+  json["layout"] = io::to_string(run.opened.detected.layout);
+  json["input"] = input_json(run.opened);
+  json["frames"] = result.poses.size();
+  json["method"] = o.run.method;
+  json["backend"] = compute::to_string(context.backend());
+  json["device"] = context.device_info().name;
+  json["reestimate_interval"] = params.odometry.reestimate_interval;
+  json["odometry_ate_rmse_m"] = f.odometry_ate ? Json(f.odometry_ate->translation_m.rmse) : Json();
+  json["slam_ate_rmse_m"] = f.slam_ate ? Json(f.slam_ate->translation_m.rmse) : Json();
+  json["timing_s"] = {{"total", t.total_seconds},
+                      {"odometry", t.odometry_seconds},
+                      {"loop_closure", t.loop_closure_seconds},
+                      {"optimisation", t.optimisation_seconds},
+                      {"map", t.map_seconds},
+                      {"loading", t.load_seconds}};
+  json["loop_closure"] = {{"enabled", params.loop_closure},
+                          {"candidates", result.loop_candidates},
+                          {"accepted", f.accepted},
+                          {"pruned", f.pruned},
+                          {"closures", f.loops}};
+  json["pose_graph"] = {{"nodes", result.poses.size()},
+                        {"edges", result.graph_edges},
+                        {"optimisations", result.graph_optimisations},
+                        {"iterations", result.final_graph.iterations},
+                        {"initial_cost", result.final_graph.initial_cost},
+                        {"final_cost", result.final_graph.final_cost},
+                        {"converged", result.final_graph.converged}};
+  json["map"] = {{"points", result.map.size()},
+                 {"voxels", result.map_voxels},
+                 {"voxel_size_m", params.map.voxel_size}};
+  json["odometry"] = frame_summary_json(result.odometry.frames);
+  Json per_frame = Json::array();
+  for (const auto& frame : result.odometry.frames) per_frame.push_back(frame_json(frame));
+  json["per_frame"] = std::move(per_frame);
+  return json;
+}
+
+// Writes the files into the staging folder; returns whether groundtruth.txt was among them.
+bool write_slam_files(const std::filesystem::path& dir, const OpenedRun& run,
+                      const mapping::SlamResult& result, bool build_map, const Json& stats) {
+  const bool has_timestamps = run.opened.detected.has_timestamps;
+  const std::vector<double>& timestamps = result.odometry.timestamps;
+  io::write_tum_trajectory(dir / "trajectory.txt",
+                           stamped_trajectory(result.poses, timestamps, has_timestamps));
+  io::write_tum_trajectory(dir / "odometry.txt",
+                           stamped_trajectory(result.odometry.poses, timestamps, has_timestamps));
+  const Trajectory truth = ground_truth_trajectory(*run.source, timestamps, has_timestamps);
+  if (!truth.empty()) io::write_tum_trajectory(dir / "groundtruth.txt", truth);
+  if (build_map) io::write_ply(dir / "map.ply", result.map);
+  io::write_top_view_png(dir / "top_view.png", result.map, result.poses);
+  io::write_text_file(dir / "stats.json", stats.dump(1) + "\n");
+  return !truth.empty();
+}
+
+void print_slam_summary(std::ostream& out, const SlamOptions& o, const OpenedRun& run,
+                        const Json& stats, const mapping::SlamResult& result, const SlamFigures& f,
+                        bool wrote_truth) {
+  const mapping::SlamTimings& t = result.timing;
+  const double frames = static_cast<double>(result.poses.size());
+  char line[256];
+  out << "slam: " << o.run.sequence.string() << " (" << io::to_string(run.opened.detected.layout)
+      << ", " << result.poses.size() << " frames), method " << o.run.method << ", backend "
+      << stats["backend"].get<std::string>() << " (" << stats["device"].get<std::string>() << ")\n";
+  out << "  " << io::describe_input(run.opened) << "\n";
+  out << "  " << frame_summary_line(stats["odometry"]) << "\n";
+  std::snprintf(line, sizeof(line),
+                "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",
+                f.accepted, result.loop_candidates, f.pruned);
+  out << line;
+  std::snprintf(line, sizeof(line), "  map_points %zu (voxel %.3f m)\n", result.map.size(),
+                o.voxel_size);
+  out << line;
+  if (f.odometry_ate && f.slam_ate) {
+    std::snprintf(line, sizeof(line), "  odometry_ate_rmse_m %.6f\n  slam_ate_rmse_m %.6f\n",
+                  f.odometry_ate->translation_m.rmse, f.slam_ate->translation_m.rmse);
+    out << line;
+  }
+  std::snprintf(line, sizeof(line),
+                "  seconds %.2f total: odometry %.2f, loop closure %.2f, pose graph %.2f, map "
+                "%.2f, file loading %.2f (prefetched); %.1f frames/s overall\n",
+                t.total_seconds, t.odometry_seconds, t.loop_closure_seconds, t.optimisation_seconds,
+                t.map_seconds, t.load_seconds,
+                t.total_seconds > 0 ? frames / t.total_seconds : 0.0);
+  out << line << "  wrote " << o.out_dir.string() << "/{trajectory.txt, odometry.txt, "
+      << (o.no_map ? "" : "map.ply, ") << "top_view.png, stats.json"
+      << (wrote_truth ? ", groundtruth.txt" : "") << "}\n";
+}
+
 }  // namespace
 
 CLI::App* add_slam_command(CLI::App& app, SlamOptions& o) {
@@ -76,7 +190,6 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   params.loop_closure = !o.no_loop_closure;
   params.build_map = !o.no_map;
   params.map.voxel_size = o.voxel_size;
-  const bool has_timestamps = run.opened.detected.has_timestamps;
 
   ProgressBar bar(err, o.run.progress);
   mapping::SlamObserver observer;
@@ -87,96 +200,15 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   const mapping::SlamResult result = mapping::run_slam(context, *run.source, params, observer);
   bar.finish();
 
-  const InterruptsDeferred writing;  // a signal waits for the files, then drops them
-  const std::filesystem::path& dir = folder.dir();
-  const std::vector<double>& timestamps = result.odometry.timestamps;
-  io::write_tum_trajectory(dir / "trajectory.txt",
-                           stamped_trajectory(result.poses, timestamps, has_timestamps));
-  io::write_tum_trajectory(dir / "odometry.txt",
-                           stamped_trajectory(result.odometry.poses, timestamps, has_timestamps));
-  const Trajectory truth = ground_truth_trajectory(*run.source, timestamps, has_timestamps);
-  if (!truth.empty()) io::write_tum_trajectory(dir / "groundtruth.txt", truth);
-  if (params.build_map) io::write_ply(dir / "map.ply", result.map);
-  io::write_top_view_png(dir / "top_view.png", result.map, result.poses);
-
-  const auto slam_ate = absolute_trajectory_error(*run.source, result.poses);
-  const auto odometry_ate = absolute_trajectory_error(*run.source, result.odometry.poses);
-  std::size_t accepted = 0, pruned = 0;
-  Json loops = Json::array();
-  for (const auto& record : result.loop_closures) {
-    accepted += record.closure.report.accepted();
-    pruned += record.pruned;
-    loops.push_back(loop_closure_json(record));
+  const SlamFigures figures = slam_figures(run, result);
+  const Json stats = slam_stats_json(o, run, context, params, result, figures);
+  bool wrote_truth = false;
+  {
+    const InterruptsDeferred writing;  // a signal waits for the files, then drops them
+    wrote_truth = write_slam_files(folder.dir(), run, result, params.build_map, stats);
+    folder.commit();
   }
-  const mapping::SlamTimings& t = result.timing;
-  const double frames = static_cast<double>(result.poses.size());
-
-  Json json;
-  json["sequence"] = o.run.sequence.string();
-  json["layout"] = io::to_string(run.opened.detected.layout);
-  json["input"] = input_json(run.opened);
-  json["frames"] = result.poses.size();
-  json["method"] = o.run.method;
-  json["backend"] = compute::to_string(context.backend());
-  json["device"] = context.device_info().name;
-  json["reestimate_interval"] = params.odometry.reestimate_interval;
-  json["odometry_ate_rmse_m"] = odometry_ate ? Json(odometry_ate->translation_m.rmse) : Json();
-  json["slam_ate_rmse_m"] = slam_ate ? Json(slam_ate->translation_m.rmse) : Json();
-  json["timing_s"] = {{"total", t.total_seconds},
-                      {"odometry", t.odometry_seconds},
-                      {"loop_closure", t.loop_closure_seconds},
-                      {"optimisation", t.optimisation_seconds},
-                      {"map", t.map_seconds},
-                      {"loading", t.load_seconds}};
-  json["loop_closure"] = {{"enabled", params.loop_closure},
-                          {"candidates", result.loop_candidates},
-                          {"accepted", accepted},
-                          {"pruned", pruned},
-                          {"closures", loops}};
-  json["pose_graph"] = {{"nodes", result.poses.size()},
-                        {"edges", result.graph_edges},
-                        {"optimisations", result.graph_optimisations},
-                        {"iterations", result.final_graph.iterations},
-                        {"initial_cost", result.final_graph.initial_cost},
-                        {"final_cost", result.final_graph.final_cost},
-                        {"converged", result.final_graph.converged}};
-  json["map"] = {{"points", result.map.size()},
-                 {"voxels", result.map_voxels},
-                 {"voxel_size_m", params.map.voxel_size}};
-  json["odometry"] = frame_summary_json(result.odometry.frames);
-  Json per_frame = Json::array();
-  for (const auto& f : result.odometry.frames) per_frame.push_back(frame_json(f));
-  json["per_frame"] = std::move(per_frame);
-  io::write_text_file(dir / "stats.json", json.dump(1) + "\n");
-  folder.commit();
-
-  char line[256];
-  out << "slam: " << o.run.sequence.string() << " (" << io::to_string(run.opened.detected.layout)
-      << ", " << result.poses.size() << " frames), method " << o.run.method << ", backend "
-      << compute::to_string(context.backend()) << " (" << context.device_info().name << ")\n";
-  out << "  " << io::describe_input(run.opened) << "\n";
-  out << "  " << frame_summary_line(json["odometry"]) << "\n";
-  std::snprintf(line, sizeof(line),
-                "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",
-                accepted, result.loop_candidates, pruned);
-  out << line;
-  std::snprintf(line, sizeof(line), "  map_points %zu (voxel %.3f m)\n", result.map.size(),
-                params.map.voxel_size);
-  out << line;
-  if (odometry_ate && slam_ate) {
-    std::snprintf(line, sizeof(line), "  odometry_ate_rmse_m %.6f\n  slam_ate_rmse_m %.6f\n",
-                  odometry_ate->translation_m.rmse, slam_ate->translation_m.rmse);
-    out << line;
-  }
-  std::snprintf(line, sizeof(line),
-                "  seconds %.2f total: odometry %.2f, loop closure %.2f, pose graph %.2f, map "
-                "%.2f, file loading %.2f (prefetched); %.1f frames/s overall\n",
-                t.total_seconds, t.odometry_seconds, t.loop_closure_seconds, t.optimisation_seconds,
-                t.map_seconds, t.load_seconds,
-                t.total_seconds > 0 ? frames / t.total_seconds : 0.0);
-  out << line << "  wrote " << o.out_dir.string() << "/{trajectory.txt, odometry.txt, "
-      << (params.build_map ? "map.ply, " : "") << "top_view.png, stats.json"
-      << (truth.empty() ? "" : ", groundtruth.txt") << "}\n";
+  print_slam_summary(out, o, run, stats, result, figures, wrote_truth);
   return 0;
 }
 

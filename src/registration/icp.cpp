@@ -67,8 +67,7 @@ Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& pose) {
 
 IcpEngine::IcpEngine(const compute::Context& context, IcpParams params,
                      std::unique_ptr<CorrespondenceFinder> finder)
-    : context_(&context),
-      params_(std::move(params)),
+    : params_(std::move(params)),
       finder_(finder ? std::move(finder) : std::make_unique<ProjectiveAssociation>(context)),
       reduction_(context) {
   validate(params_);

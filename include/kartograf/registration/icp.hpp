@@ -91,7 +91,6 @@ class IcpEngine {
                            const Eigen::Isometry3d& pose) const;
   AssociationParams gates_of(int level) const;
 
-  const compute::Context* context_;
   IcpParams params_;
   std::unique_ptr<CorrespondenceFinder> finder_;
   IcpReduction reduction_;

@@ -1,0 +1,15 @@
+// Fuzz target: depth and colour images as sequences store them (PNG, JPEG): the header checks,
+// truncation checks and size limits before OpenCV decodes them.
+#include "fuzz_input_file.hpp"
+#include "kartograf/io/image_io.hpp"
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  using kartograf::fuzz::read_as_file;
+  read_as_file("depth.png", data, size,
+               [](const auto& path) { kartograf::io::read_depth_png(path); });
+  read_as_file("color.png", data, size,
+               [](const auto& path) { kartograf::io::read_color_image(path); });
+  read_as_file("color.jpg", data, size,
+               [](const auto& path) { kartograf::io::read_color_image(path); });
+  return 0;
+}
