@@ -303,7 +303,9 @@ TEST_P(ColorGateTest, MatchesTheReferenceOnSevenScenesColours) {
   const auto count = static_cast<std::int32_t>(c.target_colors.size());
   for (std::int32_t i = 0; i < count; ++i) {
     c.source_colors.push_back(c.target_colors[i]);
-    c.index.push_back(i % 7 == 3 ? (i * 7919 + 100000) % count : std::min(i + 1, count - 1));
+    // 64-bit: i * 7919 overflows an int32 beyond i = 271,000 (UBSan).
+    const auto far = static_cast<std::int32_t>((std::int64_t{i} * 7919 + 100000) % count);
+    c.index.push_back(i % 7 == 3 ? far : std::min(i + 1, count - 1));
   }
   const GateReference expected = reference_gate(c);
   registration::ColorGateStatistics statistics;

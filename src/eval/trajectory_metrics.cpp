@@ -53,10 +53,12 @@ std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs(const MatchedPoses& p
   std::vector<double> times(n);
   for (std::size_t k = 0; k < n; ++k) {
     times[k] = poses.ground_truth[k].timestamp;
-    require(k == 0 || times[k] > times[k - 1],
-            "RPE: ground-truth timestamps must increase for a delta in seconds; pose " +
-                std::to_string(k) + " has t = " + std::to_string(times[k]) + " after " +
-                std::to_string(times[k - 1]));
+    // Not require(): its message would be built, reading times[k - 1], for k == 0 too.
+    if (k > 0 && !(times[k] > times[k - 1])) {
+      throw Error("RPE: ground-truth timestamps must increase for a delta in seconds; pose " +
+                  std::to_string(k) + " has t = " + std::to_string(times[k]) + " after " +
+                  std::to_string(times[k - 1]));
+    }
   }
   constexpr double kClockSlack = 1e-6;  // s; so that t_i + delta == t_last survives rounding
   for (std::size_t i = 0; i < n; ++i) {
