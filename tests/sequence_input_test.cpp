@@ -261,6 +261,18 @@ TEST_F(SequenceInput, TruncatedJpegAndPngAreErrorsNamingTheFile) {  // defect 12
   }
 }
 
+// Found by fuzzing (fuzz/fuzz_camera_argument, fuzz/fuzz_image): a --camera value too long to be
+// a path threw std::filesystem::filesystem_error; a PNM header declaring 6e49 pixels was cast to an
+// integer for the message (UBSan). Both are Errors that say what is wrong.
+TEST_F(SequenceInput, FuzzFindingsAreErrorsNotCrashes) {
+  EXPECT_ERROR_MENTIONS(io::parse_camera_argument(std::string(5000, 'x')), "--camera",
+                        "not a preset");
+  const fs::path huge = dir() / "huge.png";
+  testing::write_file(
+      huge, std::string("P6 60444444444444444444444444444444444444444444444444 2\n255\n"));
+  EXPECT_ERROR_MENTIONS(io::read_color_image(huge), "huge.png", "60444444");
+}
+
 TEST_F(SequenceInput, TumCameraFromTheFolderNameAPresetOrADefaultWithAWarning) {
   const io::OpenedSequence plain = io::open_sequence(tum_folder("plain"));
   EXPECT_EQ(plain.camera.source, "default");

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <system_error>
 #include <utility>
 
 #include "io/atomic_file.hpp"
@@ -99,7 +100,8 @@ Camera parse_camera_argument(const std::string& value) {
     return {*k, "option", "--camera " + value};
   }
   const std::filesystem::path path(value);
-  if (std::filesystem::is_regular_file(path)) {
+  std::error_code unreadable;  // e.g. a name too long for a path: not a file, not an exception
+  if (std::filesystem::is_regular_file(path, unreadable)) {
     const bool json = path.extension() == ".json";
     return {json ? read_camera_intrinsics_json(path) : read_camera_matrix_txt(path), "file",
             "file " + quoted(path)};

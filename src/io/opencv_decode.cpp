@@ -4,6 +4,7 @@
 #include <array>
 #include <cctype>
 #include <cstdint>
+#include <cstdio>
 #include <initializer_list>
 #include <string>
 #include <string_view>
@@ -155,9 +156,10 @@ cv::Mat decode_image(const std::filesystem::path& path, const std::string& name)
   require_complete(bytes, name);
   if (const std::optional<DeclaredImageSize> size = declared_image_size(bytes)) {
     // The decoded pixels, and the copy the readers make of them.
-    require_fits_in_memory(2.0 * size->width * size->height * size->bytes_per_pixel,
-                           name + " (" + std::to_string(std::uint64_t(size->width)) + "x" +
-                               std::to_string(std::uint64_t(size->height)) + " pixels)");
+    // Printed as doubles: a header can declare sizes beyond any integer type.
+    char pixels[96];
+    std::snprintf(pixels, sizeof(pixels), " (%.0fx%.0f pixels)", size->width, size->height);
+    require_fits_in_memory(2.0 * size->width * size->height * size->bytes_per_pixel, name + pixels);
   }
   cv::Mat image;
   try {
