@@ -1,5 +1,6 @@
-// Fuzz target: depth and colour images as sequences store them (PNG, JPEG): the header checks,
-// truncation checks and size limits before OpenCV decodes them.
+// Fuzz target: depth and colour images as sequences store them (PNG, JPEG; PNM too): the header
+// checks, truncation checks and size limits before OpenCV decodes them, and the refusal of the
+// other formats OpenCV would decode (BMP, TIFF, WebP, ...) whose size is not checked first.
 #include "fuzz_input_file.hpp"
 #include "kartograf/io/image_io.hpp"
 

@@ -1,4 +1,5 @@
-// The second pass of every two-pass reduction; see shaders/reduce_rows.comp.
+// The second pass of every two-pass reduction, one work-group per column; see
+// shaders/reduce_rows.comp.
 typedef struct {
   uint row_count;
   uint column_count;
@@ -6,11 +7,18 @@ typedef struct {
 
 __kernel void reduce_rows(__global const double* rows, __global double* result,
                           const ReduceRowsParams params) {
-  __local double shared_sums[KG_MAX_SUMS * KG_REDUCTION_GROUP];
-  double sums[KG_MAX_SUMS];
-  for (uint k = 0; k < KG_MAX_SUMS; ++k) sums[k] = 0.0;
-  for (uint row = get_local_id(0); row < params.row_count; row += KG_REDUCTION_GROUP) {
-    for (uint k = 0; k < params.column_count; ++k) sums[k] += rows[row * params.column_count + k];
+  __local double column_sums[KG_REDUCTION_GROUP];
+  const uint lane = get_local_id(0);
+  const uint column = get_group_id(0);
+  double sum = 0.0;
+  for (uint row = lane; row < params.row_count; row += KG_REDUCTION_GROUP) {
+    sum += rows[row * params.column_count + column];
   }
-  kg_store_group_sums(sums, params.column_count, shared_sums, result);
+  column_sums[lane] = sum;
+  barrier(CLK_LOCAL_MEM_FENCE);
+  for (uint stride = KG_REDUCTION_GROUP / 2; stride > 0; stride >>= 1) {
+    if (lane < stride) column_sums[lane] += column_sums[lane + stride];
+    barrier(CLK_LOCAL_MEM_FENCE);
+  }
+  if (lane == 0) result[column] = column_sums[0];
 }

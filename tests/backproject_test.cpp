@@ -4,7 +4,7 @@
 #include <string>
 
 #include "kartograf/geometry/backproject.hpp"
-#include "kartograf/io/image_io.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -92,7 +92,7 @@ TEST_P(BackprojectTest, MatchesDoubleReferenceOnSevenScenesFrames) {
   const geometry::DepthBackprojector projector(context(), k, range);
   compute::DeviceImage<Point4f> points(context(), k.width, k.height);
   for (const char* frame : {"frame-000000", "frame-000150", "frame-000299"}) {
-    const DepthImage depth = io::read_depth_png(frames / (std::string(frame) + ".depth.png"));
+    const DepthImage depth = testing::read_depth(frames / (std::string(frame) + ".depth.png"));
     projector.run(compute::DeviceImage<std::uint16_t>::from_host(context(), depth), points);
     const Comparison c = compare_with_reference(depth, k, range, points.to_image());
     EXPECT_EQ(c.mask_mismatches, 0u) << frame;

@@ -2,7 +2,9 @@
 # options and prints an ATE; TUM cameras (presets, the folder's name, numbers, files), depth
 # scale and frame range are used, printed and recorded; each input defect's repro is a clear
 # error (or, with --skip-bad-frames, frames left out and counted). Test sequences are built in
-# the build folder from the real data by symbolic links, never in the repository.
+# the build folder from the real data by symbolic links, never in the repository. The tests
+# source cli_fails_with.sh, which defines `fails_with [--regex] LOG PATTERN... -- COMMAND...`.
+set(fails_with_helper ${CMAKE_CURRENT_SOURCE_DIR}/cli_fails_with.sh)
 
 # slam (100 frames) and map (no options at all) on frames 300-599: an ATE printed, the camera
 # (camera-intrinsics.txt) and depth scale printed and recorded.
@@ -46,6 +48,7 @@ set_tests_properties(Cli.input_slam_on_7scenes_frames_300_to_599 Cli.input_map_o
 # --depth-scale; --first/--frames/--step; --frames -1 and an unknown camera are errors.
 add_test(NAME Cli.input_tum_cameras_depth_scale_and_frame_range
   COMMAND sh -c [=[
+. "$2"
 rm -rf "$1" && mkdir -p "$1" || exit 1
 "$0" synth --out "$1/synth" --frames 4 --trajectory handheld > /dev/null 2>&1 || { echo "FAIL: synth"; exit 1; }
 cp -r "$1/synth" "$1/tum" && rm "$1/tum/world.json" "$1/tum/camera_intrinsics.json" || exit 1
@@ -71,45 +74,40 @@ grep -q '"depth_scale_source": "--depth-scale"' "$1/scale.json" || { echo "FAIL:
 run step "$1/tum" --step 2
 grep -q "(tum, 2 frames)" "$1/step.log" || { echo "FAIL: --step"; exit 1; }
 for bad in "--frames -1" "--first -2" "--step 0" "--depth-scale 0"; do
-  if "$0" odometry "$1/tum" $bad --out "$1/bad.txt" 2> "$1/bad.err"; then echo "FAIL: $bad accepted"; exit 1; fi
-  grep -q -- "${bad%% *}" "$1/bad.err" || { cat "$1/bad.err"; echo "FAIL: $bad message"; exit 1; }
+  fails_with "$1/bad.err" "${bad%% *}" -- "$0" odometry "$1/tum" $bad --out "$1/bad.txt" || exit 1
 done
-if "$0" slam "$1/tum" --camera tum-fr9 --out "$1/bad" 2> "$1/bad.err"; then echo "FAIL: tum-fr9 accepted"; exit 1; fi
-grep -q "tum-fr9.*tum-fr1|tum-fr2|tum-fr3|kinect|7scenes" "$1/bad.err" || { cat "$1/bad.err"; exit 1; }
+fails_with --regex "$1/bad.err" "tum-fr9.*tum-fr1|tum-fr2|tum-fr3|kinect|7scenes" -- "$0" slam "$1/tum" --camera tum-fr9 --out "$1/bad" || exit 1
 exit 0
-]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-tum)
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-tum ${fails_with_helper})
 
 # Defect 1: colour frames of 16x12 in a 640x480 7-Scenes copy: an error naming the colour file and
 # both sizes (no heap over-read, no map); with --skip-bad-frames those frames are left out.
 # Defect 12: a 320x240 depth frame names the file and both sizes; a truncated JPEG is an error.
 add_test(NAME Cli.input_colour_and_depth_sizes_and_truncated_images
   COMMAND sh -c [=[
-DATA=$2; . "$3"
+DATA=$2; . "$3"; . "$4"
 rm -rf "$1" && mkdir -p "$1" || exit 1
 "$0" synth --out "$1/tiny" --frames 1 --width 16 --height 12 > /dev/null 2>&1 || exit 1
 "$0" synth --out "$1/qvga" --frames 1 --width 320 --height 240 > /dev/null 2>&1 || exit 1
 small=$(ls "$1"/tiny/rgb/*.png | head -1); qvga=$(ls "$1"/qvga/depth/*.png | head -1)
 kitchen_copy "$1/colour" 0 9
 for n in 2 3 4 5 6; do f="$1/colour/frame-00000$n.color.jpg"; rm "$f" && cp "$small" "$f"; done
-if "$0" slam "$1/colour" --frames 7 --out "$1/out" 2> "$1/err"; then echo "FAIL: small colour accepted"; exit 1; fi
-grep -q "colour image '.*frame-000002.color.jpg' is 16x12, its depth image '.*frame-000002.depth.png' is 640x480" "$1/err" || { cat "$1/err"; echo "FAIL: colour size message"; exit 1; }
+fails_with --regex "$1/err" "colour image '.*frame-000002.color.jpg' is 16x12, its depth image '.*frame-000002.depth.png' is 640x480" \
+  -- "$0" slam "$1/colour" --frames 7 --out "$1/out" || exit 1
 test -e "$1/out/map.ply" && { echo "FAIL: a map was written"; exit 1; }
 "$0" slam "$1/colour" --skip-bad-frames --out "$1/skip" > "$1/skip.log" 2> "$1/skip.err" || { cat "$1/skip.err"; echo "FAIL: --skip-bad-frames"; exit 1; }
 test "$(grep -c 'left out: colour image' "$1/skip.err")" = 5 && grep -q "(5 bad frames left out)" "$1/skip.err" || { cat "$1/skip.err"; echo "FAIL: skipped frames reported"; exit 1; }
 grep -q '"frames_skipped": 5' "$1/skip/stats.json" && grep -q "(7scenes, 5 frames)" "$1/skip.log" || { echo "FAIL: skipped frames counted"; exit 1; }
 kitchen_copy "$1/depth" 0 5
 rm "$1/depth/frame-000003.depth.png" && cp "$qvga" "$1/depth/frame-000003.depth.png"
-if "$0" slam "$1/depth" --out "$1/out2" 2> "$1/err"; then echo "FAIL: 320x240 depth accepted"; exit 1; fi
-grep -q "depth image '.*frame-000003.depth.png' is 320x240, the sequence's frames are 640x480" "$1/err" || { cat "$1/err"; echo "FAIL: depth size message"; exit 1; }
+fails_with --regex "$1/err" "depth image '.*frame-000003.depth.png' is 320x240, the sequence's frames are 640x480" \
+  -- "$0" slam "$1/depth" --out "$1/out2" || exit 1
 kitchen_copy "$1/cut" 0 5
 f="$1/cut/frame-000002.color.jpg"; head -c 20000 "$DATA/7scenes_redkitchen/frames/frame-000002.color.jpg" > "$1/part" && rm "$f" && mv "$1/part" "$f"
-if "$0" odometry "$1/cut" --out "$1/cut.txt" 2> "$1/err"; then echo "FAIL: truncated JPEG accepted"; exit 1; fi
-grep -q "frame-000002.color.jpg'*: truncated JPEG" "$1/err" || { cat "$1/err"; echo "FAIL: truncation message"; exit 1; }
+fails_with --regex "$1/err" "frame-000002.color.jpg'*: truncated JPEG" -- "$0" odometry "$1/cut" --out "$1/cut.txt" || exit 1
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-sizes ${KARTOGRAF_DATA_DIR}
-  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh)
-set_tests_properties(Cli.input_colour_and_depth_sizes_and_truncated_images PROPERTIES
-  ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
 
 # Defect 5: a missing depth file in the numbered run is an error naming it (not 15 of 30 frames
 # and exit 0); --skip-bad-frames leaves it out and counts it. Defect 6: a pose that is not a
@@ -118,44 +116,39 @@ set_tests_properties(Cli.input_colour_and_depth_sizes_and_truncated_images PROPE
 # range too.
 add_test(NAME Cli.input_missing_frames_bad_poses_and_short_trajectories
   COMMAND sh -c [=[
-DATA=$2; . "$3"
+DATA=$2; . "$3"; . "$4"
 rm -rf "$1" && mkdir -p "$1" || exit 1
 kitchen_copy "$1/seq" 0 29
 rm "$1/seq/frame-000015.depth.png"
-if "$0" odometry "$1/seq" --out "$1/a.txt" 2> "$1/err"; then echo "FAIL: missing depth accepted"; exit 1; fi
-grep -q "frame-000015.depth.png': no such file (frame 15 of the sequence; --skip-bad-frames" "$1/err" || { cat "$1/err"; echo "FAIL: missing depth message"; exit 1; }
+fails_with "$1/err" "frame-000015.depth.png': no such file (frame 15 of the sequence; --skip-bad-frames" \
+  -- "$0" odometry "$1/seq" --out "$1/a.txt" || exit 1
 "$0" odometry "$1/seq" --skip-bad-frames --out "$1/b.txt" --stats "$1/b.json" > "$1/b.log" 2> "$1/b.err" || { cat "$1/b.err"; exit 1; }
 grep -q "warning: frame 15 left out: '.*frame-000015.depth.png': no such file" "$1/b.err" && test "$(grep -vc '^#' "$1/b.txt")" = 29 || { cat "$1/b.err"; echo "FAIL: skip"; exit 1; }
 grep -q '"frames_skipped": 1' "$1/b.json" || { echo "FAIL: skipped frame not counted"; exit 1; }
 kitchen_copy "$1/poses" 0 5
 rm "$1/poses/frame-000002.pose.txt" && printf '0 0 0 0\n0 0 0 0\n0 0 0 0\n0 0 0 1\n' > "$1/poses/frame-000002.pose.txt"
-if "$0" slam "$1/poses" --out "$1/out" 2> "$1/err"; then echo "FAIL: zero pose accepted"; exit 1; fi
-grep -q "frame-000002.pose.txt': the pose's 3x3 block is not a rotation" "$1/err" || { cat "$1/err"; echo "FAIL: pose message"; exit 1; }
+fails_with "$1/err" "frame-000002.pose.txt': the pose's 3x3 block is not a rotation" -- "$0" slam "$1/poses" --out "$1/out" || exit 1
 kitchen_copy "$1/short" 0 5
 printf '0 0 0 0 0 0 0 1\n1 0 0 0 0 0 0 1\n2 0 0 0 0 0 0 1\n' > "$1/short.txt"
-if "$0" semantic "$1/short" --trajectory "$1/short.txt" --out "$1/sem" 2> "$1/err"; then echo "FAIL: short trajectory accepted"; exit 1; fi
-grep -q "short.txt' holds 3 poses, the sequence '.*short' has 6 frames" "$1/err" || { cat "$1/err"; echo "FAIL: short trajectory message"; exit 1; }
+fails_with --regex "$1/err" "short.txt' holds 3 poses, the sequence '.*short' has 6 frames" \
+  -- "$0" semantic "$1/short" --trajectory "$1/short.txt" --out "$1/sem" || exit 1
 printf '0 0 0 0 0 0 0 0\n' > "$1/zero.txt"
-if "$0" semantic "$1/short" --trajectory "$1/zero.txt" --out "$1/sem" 2> "$1/err"; then echo "FAIL: zero quaternion accepted"; exit 1; fi
-grep -q "zero.txt' line 1: quaternion norm" "$1/err" || { cat "$1/err"; echo "FAIL: zero quaternion message"; exit 1; }
+fails_with "$1/err" "zero.txt' line 1: quaternion norm" -- "$0" semantic "$1/short" --trajectory "$1/zero.txt" --out "$1/sem" || exit 1
 "$0" planes "$1/short" --first 2 --frames 1 --camera kinect --out "$1/planes" > /dev/null 2> "$1/planes.err" || { cat "$1/planes.err"; echo "FAIL: planes --camera"; exit 1; }
 grep -q '"fx": 525' "$1/planes/summary.json" && test -d "$1/planes/000002" || { cat "$1/planes/summary.json"; echo "FAIL: planes camera / range"; exit 1; }
 for command in odometry slam map semantic planes; do
-  if "$0" $command "$1/short" --frames -1 --out "$1/x" 2> "$1/err"; then echo "FAIL: $command --frames -1 accepted"; exit 1; fi
-  grep -q -- "--frames" "$1/err" || { cat "$1/err"; echo "FAIL: $command --frames -1 message"; exit 1; }
+  fails_with "$1/err" "--frames" -- "$0" $command "$1/short" --frames -1 --out "$1/x" || exit 1
 done
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-missing ${KARTOGRAF_DATA_DIR}
-  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh)
-set_tests_properties(Cli.input_missing_frames_bad_poses_and_short_trajectories PROPERTIES
-  ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
 
 # Defect 8: depth that is all zero, or read at a scale that puts it all beyond range (metres
 # stored as millimetres), is an error before the run naming the depth file, the scale and the
 # values, suggesting --depth-scale; for odometry, slam and map (not a gravity message).
 add_test(NAME Cli.input_unusable_depth_is_named_before_the_run
   COMMAND sh -c [=[
-DATA=$2; . "$3"
+DATA=$2; . "$3"; . "$4"
 rm -rf "$1" && mkdir -p "$1" || exit 1
 kitchen_copy "$1/zero" 0 5
 python3 - "$1/zero.png" <<'PY' || exit 1
@@ -169,14 +162,15 @@ open(sys.argv[1], "wb").write(png + chunk(b"IDAT", zlib.compress(raw)) + chunk(b
 PY
 for n in 0 1 2 3 4 5; do f="$1/zero/frame-00000$n.depth.png"; rm "$f" && cp "$1/zero.png" "$f"; done
 for command in odometry slam map; do
-  if "$0" $command "$1/zero" --out "$1/out-$command" 2> "$1/err"; then echo "FAIL: $command accepted zero depth"; exit 1; fi
-  grep -q "depth image '.*frame-000000.depth.png' (and the next 4 frames): no pixel within the usable depth range.*1000 units per metre (every depth value is 0.*--depth-scale" "$1/err" || { cat "$1/err"; echo "FAIL: $command zero depth message"; exit 1; }
+  fails_with --regex "$1/err" "depth image '.*frame-000000.depth.png' (and the next 4 frames): no pixel within the usable depth range.*1000 units per metre (every depth value is 0.*--depth-scale" \
+    -- "$0" $command "$1/zero" --out "$1/out-$command" || exit 1
 done
 kitchen_copy "$1/far" 0 5
-if "$0" slam "$1/far" --depth-scale 1 --out "$1/out" 2> "$1/err"; then echo "FAIL: depth beyond range accepted"; exit 1; fi
-grep -q "frame-000000.depth.png'.*at a depth scale of 1 units per metre (values [0-9]* to [0-9]*, i.e. .* m).*--depth-scale" "$1/err" || { cat "$1/err"; echo "FAIL: far depth message"; exit 1; }
+fails_with --regex "$1/err" "frame-000000.depth.png'.*at a depth scale of 1 units per metre (values [0-9]* to [0-9]*, i.e. .* m).*--depth-scale" \
+  -- "$0" slam "$1/far" --depth-scale 1 --out "$1/out" || exit 1
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth ${KARTOGRAF_DATA_DIR}
-  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh)
-set_tests_properties(Cli.input_unusable_depth_is_named_before_the_run PROPERTIES
-  ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
+set_tests_properties(Cli.input_colour_and_depth_sizes_and_truncated_images
+  Cli.input_missing_frames_bad_poses_and_short_trajectories
+  Cli.input_unusable_depth_is_named_before_the_run PROPERTIES ENVIRONMENT "${KARTOGRAF_TEST_ENV}")

@@ -2,9 +2,9 @@
 # keeps the tests small), KARTOGRAF_DEVICE works on every command, invalid option values are
 # errors rather than silent defaults. Included from tests/CMakeLists.txt.
 
-# Each test sources cli_limits_fails_with.sh (its $1), which defines
-# `fails_with LOG PATTERN... -- COMMAND...`.
-set(limits_helper ${CMAKE_CURRENT_SOURCE_DIR}/cli_limits_fails_with.sh)
+# Each test sources cli_fails_with.sh (its $1), which defines
+# `fails_with [--regex] LOG PATTERN... -- COMMAND...`.
+set(fails_with_helper ${CMAKE_CURRENT_SOURCE_DIR}/cli_fails_with.sh)
 
 # Defect 7: a map whose rooms would not fit is refused before segmenting (a 4000 x 4000 PGM, 16 MB,
 # under a 200 MB limit); an image whose header declares 20000 x 20000 pixels is refused before
@@ -26,7 +26,7 @@ fails_with "$1/zero.txt" "/dev/zero" "not a regular file" -- "$0" rooms "$1/zero
 ln -sf /dev/zero "$1/link.yaml"
 fails_with "$1/link.txt" "link.yaml" "not a regular file" -- "$0" rooms "$1/link.yaml" --out "$1/rooms" || exit 1
 test ! -e "$1/rooms" || { echo "FAIL: $1/rooms was created"; exit 1; }
-]=] $<TARGET_FILE:kartograf> ${limits_helper} ${CMAKE_BINARY_DIR}/cli-limits-maps)
+]=] $<TARGET_FILE:kartograf> ${fails_with_helper} ${CMAKE_BINARY_DIR}/cli-limits-maps)
 
 # Defect 11 and the semantic range image of defect 7: out-of-range, zero, negative, NaN and
 # infinite values are errors naming the option, never silently replaced by a default.
@@ -61,7 +61,7 @@ fails_with "$1/threshold.txt" "--threshold" -- "$0" eval planes "$3" "$3" --thre
 fails_with "$1/voxel.txt" "--voxel" -- "$0" slam "$1" --voxel nan --out "$1/v" || exit 1
 fails_with "$1/mres.txt" "--resolution" -- "$0" map "$1" --resolution nan --out "$1/m" || exit 1
 for dir in p r s y v m; do test ! -e "$1/$dir" || { echo "FAIL: $1/$dir was created"; exit 1; }; done
-]=] $<TARGET_FILE:kartograf> ${limits_helper} ${CMAKE_BINARY_DIR}/cli-limits-options ${KARTOGRAF_DATA_DIR}
+]=] $<TARGET_FILE:kartograf> ${fails_with_helper} ${CMAKE_BINARY_DIR}/cli-limits-options ${KARTOGRAF_DATA_DIR}
     ${KARTOGRAF_DATA_DIR}/tum_fr1_xyz_lists_only/groundtruth.txt)
 
 # Defect 9: KARTOGRAF_DEVICE picks the device on every command: a bad value or an index beyond
@@ -82,7 +82,7 @@ fails_with "$1/odometry.txt" "KARTOGRAF_DEVICE=7" \
 test ! -e "$1/p" && test ! -e "$1/r" && test ! -e "$1/t.txt" || { echo "FAIL: output left"; exit 1; }
 KARTOGRAF_DEVICE=0 "$0" planes "$pcd" --backend vulkan --out "$1/p" > "$1/ok.txt" 2>&1 || { cat "$1/ok.txt"; exit 1; }
 test -s "$1/p/planes.json" || { echo "FAIL: KARTOGRAF_DEVICE=0 planes wrote nothing"; exit 1; }
-]=] $<TARGET_FILE:kartograf> ${limits_helper} ${CMAKE_BINARY_DIR}/cli-limits-device ${KARTOGRAF_DATA_DIR})
+]=] $<TARGET_FILE:kartograf> ${fails_with_helper} ${CMAKE_BINARY_DIR}/cli-limits-device ${KARTOGRAF_DATA_DIR})
 set_tests_properties(Cli.limits_maps_too_large_for_memory_are_refused
   Cli.limits_invalid_option_values_are_errors Cli.limits_kartograf_device_on_every_command
   PROPERTIES ENVIRONMENT "${KARTOGRAF_TEST_ENV}")

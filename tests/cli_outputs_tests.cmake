@@ -1,7 +1,9 @@
 # Outputs all or nothing (issue 20, Deliver 3; defects 2, 4, 10, 12): every command checks its
 # output before computing, writes into a staging folder beside it and moves the whole set in at
 # the end; interrupts, full disks and errors leave the previous set whole; --force replaces only an
-# earlier run's folder. tests/kill_test.sh is the kill test.
+# earlier run's folder. tests/kill_test.sh is the kill test; tests that a command is refused
+# source cli_fails_with.sh, which defines `fails_with [--regex] LOG PATTERN... -- COMMAND...`.
+set(fails_with_helper ${CMAKE_CURRENT_SOURCE_DIR}/cli_fails_with.sh)
 
 # SIGINT, SIGTERM and SIGHUP at 20 moments each (computing, writing, moving in, after the end).
 add_test(NAME Cli.outputs_kill_test_map_at_20_moments_per_signal
@@ -42,12 +44,12 @@ set_tests_properties(Cli.outputs_disk_full_keeps_the_previous_set PROPERTIES ENV
 # someone else's files are refused before any computing, naming the path and the problem.
 add_test(NAME Cli.outputs_refused_before_computing
   COMMAND bash -c [=[
+. "$2"
 rm -rf "$1" && mkdir -p "$1" && cd "$1" || exit 1
 "$0" synth --out seq --frames 4 --width 320 --height 240 > /dev/null 2>&1 || { echo "FAIL: synth"; exit 1; }
-refused() {  # refused PATTERN COMMAND...: fails with a message matching PATTERN
+refused() {  # refused PATTERN COMMAND...: fails with PATTERN (a fixed string) on its stderr
   local pattern=$1; shift
-  "$0" "$@" --no-progress > out.log 2> err.log && { echo "FAIL: accepted: $*"; return 1; }
-  grep -q -- "$pattern" err.log || { echo "FAIL: $*:"; cat err.log; return 1; }
+  fails_with err.log "$pattern" -- "$0" "$@" --no-progress
 }
 run="--backend cpu --no-progress"
 "$0" odometry seq --out traj.txt --stats stats.json $run > /dev/null 2>&1 || { echo "FAIL: odometry"; exit 1; }
@@ -82,7 +84,7 @@ fi
 leftovers=$(find . -name '.*kartograf-staging*')
 [ -z "$leftovers" ] || { echo "FAIL: left $leftovers"; exit 1; }
 exit 0
-]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-outputs-refused)
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-outputs-refused ${fails_with_helper})
 set_tests_properties(Cli.outputs_refused_before_computing PROPERTIES ENVIRONMENT
   "${KARTOGRAF_TEST_ENV}")
 

@@ -11,10 +11,10 @@
 #include <string>
 #include <thread>
 
-#include "kartograf/io/image_io.hpp"
 #include "kartograf/registration/color_gate.hpp"
 #include "kartograf/registration/frame_pyramid.hpp"
 #include "kartograf/registration/hsi.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -296,8 +296,8 @@ TEST_P(ColorGateTest, MatchesTheIntegerReferenceExactlyUnderIlluminationChange) 
 
 TEST_P(ColorGateTest, MatchesTheReferenceOnSevenScenesColours) {
   // Pixel (u, v) paired with its right neighbour (mostly alike), every 7th with a far pixel.
-  const RgbImage image = io::read_color_image(testing::data_dir() / "7scenes_redkitchen" /
-                                              "frames" / "frame-000100.color.jpg");
+  const RgbImage image = testing::read_color(testing::data_dir() / "7scenes_redkitchen" / "frames" /
+                                             "frame-000100.color.jpg");
   GateCase c;
   for (const Rgb8& pixel : image.pixels()) c.target_colors.push_back(pack_rgb(pixel));
   const auto count = static_cast<std::int32_t>(c.target_colors.size());

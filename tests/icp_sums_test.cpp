@@ -6,11 +6,11 @@
 
 #include <Eigen/Geometry>
 
+#include "kartograf/core/pose.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/normals.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/sequence.hpp"
 #include "kartograf/registration/icp_sums.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -200,7 +200,7 @@ Eigen::Isometry3d read_pose(const std::filesystem::path& path) {
     for (int c = 0; c < 4; ++c) in >> m(r, c);
   }
   EXPECT_FALSE(in.fail()) << path;
-  return io::orthonormalized_pose(m);
+  return orthonormalized_pose(m);
 }
 
 TEST_P(IcpSumsTest, MatchesReferenceOnSevenScenesFramePair) {
@@ -210,9 +210,9 @@ TEST_P(IcpSumsTest, MatchesReferenceOnSevenScenesFramePair) {
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   const PinholeIntrinsics k = PinholeIntrinsics::kinect_7scenes();
   const PointImage source =
-      geometry::backproject(cpu, io::read_depth_png(frames / "frame-000000.depth.png"), k);
+      geometry::backproject(cpu, testing::read_depth(frames / "frame-000000.depth.png"), k);
   const PointImage target =
-      geometry::backproject(cpu, io::read_depth_png(frames / "frame-000010.depth.png"), k);
+      geometry::backproject(cpu, testing::read_depth(frames / "frame-000010.depth.png"), k);
   const NormalImage normals = geometry::estimate_normals(cpu, target);
   HostPairs h;
   h.source.assign(source.pixels().begin(), source.pixels().end());

@@ -12,10 +12,10 @@
 #include <string>
 #include <vector>
 
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "carved_map.hpp"
 #include "kartograf/rooms/laser_features.hpp"
 #include "kartograf/rooms/laser_scan_device.hpp"
-#include "room_test_maps.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -183,8 +183,8 @@ TEST_P(LaserScanDeviceTest, LargeGridsAndChainedCalls) {
 // office_e (plain): every 7th free cell, 360 beams, 50 m: identical to the reference, and on the
 // device backends to the CPU backend's buffer.
 TEST_P(LaserScanDeviceTest, RealIpaMapMatchesTheReference) {
-  const OccupancyGrid map =
-      io::read_png_map(testing::data_dir() / "ipa_room_maps" / "test_maps" / "office_e.png", 0.05);
+  const OccupancyGrid map = testing::read_occupancy_map(
+      testing::data_dir() / "ipa_room_maps" / "test_maps" / "office_e.png", 0.05);
   const rooms::LaserScanner scanner(map);
   const std::vector<ScanCell> cells = free_cells(map, 7);
   ASSERT_GT(cells.size(), 2000u);

@@ -9,7 +9,7 @@
 
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/normals.hpp"
-#include "kartograf/io/image_io.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -119,7 +119,7 @@ TEST_P(NormalsTest, MatchesReferenceOnSevenScenesFrames) {
   const compute::Context cpu = compute::Context::cpu();
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   for (const char* frame : {"frame-000000", "frame-000299"}) {
-    const DepthImage depth = io::read_depth_png(frames / (std::string(frame) + ".depth.png"));
+    const DepthImage depth = testing::read_depth(frames / (std::string(frame) + ".depth.png"));
     const PointImage points = geometry::backproject(cpu, depth, PinholeIntrinsics::kinect_7scenes());
     const NormalImage normals = geometry::estimate_normals(context(), points);
     const Comparison c = compare(points, reference_normals(points, 0.05f), normals);

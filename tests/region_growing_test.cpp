@@ -14,11 +14,11 @@
 
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/segment_moments.hpp"
-#include "kartograf/io/image_io.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
 #include "kartograf/segmentation/region_growing.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
+#include "real_data.hpp"
 #include "rgbd_test_sequence.hpp"
 #include "test_support.hpp"
 
@@ -429,8 +429,8 @@ TEST_P(RegionGrowerTest, SameAsTheReferenceOnSyntheticAndRealFrames) {
       {15.0f, 0.02f, 16}, "synthetic frame");
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   expect_same_as_reference(
-      segmentation::to_lab_codes(io::read_color_image(frames / "frame-000100.color.jpg")),
-      geometry::backproject(cpu, io::read_depth_png(frames / "frame-000100.depth.png"),
+      segmentation::to_lab_codes(testing::read_color(frames / "frame-000100.color.jpg")),
+      geometry::backproject(cpu, testing::read_depth(frames / "frame-000100.depth.png"),
                             PinholeIntrinsics::kinect_7scenes()),
       {15.0f, 0.02f, 16}, "7-Scenes frame 100");
 }

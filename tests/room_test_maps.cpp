@@ -10,11 +10,6 @@ namespace kartograf::testing {
 
 namespace {
 
-void fill(Image<CellState>& cells, const CellRect& r, CellState state) {
-  for (int y = r.y0; y < r.y1; ++y)
-    for (int x = r.x0; x < r.x1; ++x) cells(x, y) = state;
-}
-
 void fill(LabelImage& labels, const CellRect& r, Label label) {
   for (int y = r.y0; y < r.y1; ++y)
     for (int x = r.x0; x < r.x1; ++x) labels(x, y) = label;
@@ -23,15 +18,6 @@ void fill(LabelImage& labels, const CellRect& r, Label label) {
 constexpr int kRoom = 120, kWall = 2, kDoor = 18;
 
 }  // namespace
-
-OccupancyGrid carve_map(int width, int height, std::initializer_list<CellRect> free_cells,
-                        double resolution) {
-  OccupancyGrid map;
-  map.resolution = resolution;
-  map.cells = Image<CellState>(width, height, CellState::occupied);
-  for (const CellRect& r : free_cells) fill(map.cells, r, CellState::free);
-  return map;
-}
 
 OccupancyGrid rooms_in_a_row(int rooms, LabelImage* truth) {
   const int width = kWall + rooms * (kRoom + kWall), height = kRoom + 2 * kWall;

@@ -5,21 +5,13 @@
 #include <initializer_list>
 #include <string>
 
+#include "carved_map.hpp"
 #include "kartograf/core/label_image.hpp"
 #include "kartograf/core/occupancy_grid.hpp"
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/rooms/room_segmentation.hpp"
 
 namespace kartograf::testing {
-
-// Cells [x0, x1) x [y0, y1).
-struct CellRect {
-  int x0, y0, x1, y1;
-};
-
-// An occupied map of width x height cells at `resolution` with the rectangles set free.
-OccupancyGrid carve_map(int width, int height, std::initializer_list<CellRect> free_cells,
-                        double resolution = 0.05);
 
 // Rooms (6 x 6 m at 0.05 m/cell: 120 x 120 cells; two of them exceed the methods' largest room)
 // in a row, walls 2 cells thick, each pair joined by a doorway 18 cells (0.9 m) wide and a wall

@@ -8,7 +8,7 @@
 
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/segment_moments.hpp"
-#include "kartograf/io/image_io.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -93,7 +93,8 @@ TEST_P(SegmentMomentsTest, MatchesReferenceAndCpuBitForBitOnSevenScenes) {
   const compute::Context cpu = compute::Context::cpu();
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   const PinholeIntrinsics k = PinholeIntrinsics::kinect_7scenes();
-  const PointImage image = geometry::backproject(cpu, io::read_depth_png(frames / "frame-000100.depth.png"), k);
+  const PointImage image =
+      geometry::backproject(cpu, testing::read_depth(frames / "frame-000100.depth.png"), k);
   std::vector<Point4f> points(image.pixels().begin(), image.pixels().end());
   std::vector<std::uint32_t> labels(points.size());
   const int tiles_x = (k.width + 19) / 20;

@@ -5,8 +5,11 @@
 // are not rotations (6), unusable depth (8), depth of another size and truncated images (12).
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
@@ -271,6 +274,56 @@ TEST_F(SequenceInput, FuzzFindingsAreErrorsNotCrashes) {
   testing::write_file(
       huge, std::string("P6 60444444444444444444444444444444444444444444444444 2\n255\n"));
   EXPECT_ERROR_MENTIONS(io::read_color_image(huge), "huge.png", "60444444");
+}
+
+// A BMP file (BITMAPINFOHEADER, 24-bit) declaring width x height, with 8 bytes of pixels: a whole
+// image for 2x1 (one row padded to 8 bytes).
+std::string bmp(std::uint32_t width, std::uint32_t height) {
+  const auto le32 = [](std::uint32_t v) {
+    return std::string{char(v & 0xff), char((v >> 8) & 0xff), char((v >> 16) & 0xff),
+                       char(v >> 24)};
+  };
+  std::string file = "BM" + le32(54 + 8) + le32(0) + le32(54);
+  file += le32(40) + le32(width) + le32(height) + std::string{1, 0, 24, 0} + le32(0) + le32(8);
+  file += le32(2835) + le32(2835) + le32(0) + le32(0);
+  return file + std::string(8, char(200));
+}
+
+// Fuzz finding (image, 10-minute run): 32 bytes of a WebP lossless bitstream declare 12545 x
+// 13313 pixels, which OpenCV decoded for over 10 s under ASan; BMP, TIFF, ... headers can do the
+// same. Only PNG, JPEG and PNM images are read: their declared size is checked before decoding.
+TEST_F(SequenceInput, ImagesWhoseSizeIsNotCheckedBeforeDecodingAreRefused) {
+  const std::string webp_timeout(
+      "\x2f\x00\x31\x00\x0d\xc8\x88\x88\x88\x88\x88\x88\x70\x68\x69\x6e"
+      "\x69\x00\x88\x2f\x88\x88\x88\x00\x88\x88\x88\x88\x88\x88\x88\x88",
+      32);
+  const std::vector<std::pair<std::string, std::string>> files = {
+      {"webp.png", webp_timeout}, {"small.bmp", bmp(2, 1)}, {"huge.bmp", bmp(30000, 30000)}};
+  for (const auto& [name, bytes] : files) {
+    testing::write_file(dir() / name, bytes);
+    EXPECT_ERROR_MENTIONS(io::read_color_image(dir() / name), "colour image", name,
+                          "PNG, JPEG or PNM", "convert");
+    EXPECT_ERROR_MENTIONS(io::read_depth_png(dir() / name), "depth image", name,
+                          "PNG, JPEG or PNM");
+  }
+  // PBM and PAM are PNM too: read, with their declared size checked first.
+  testing::write_file(dir() / "depth.pam",
+                      std::string("P7\nWIDTH 2\nHEIGHT 1\nDEPTH 1\nMAXVAL 65535\n"
+                                  "TUPLTYPE GRAYSCALE\nENDHDR\n\x03\xe8\x07\xd0"));  // 1000, 2000
+  const DepthImage depth = io::read_depth_png(dir() / "depth.pam");
+  ASSERT_EQ(depth.width(), 2);
+  EXPECT_EQ(depth(0, 0), 1000);
+  EXPECT_EQ(depth(1, 0), 2000);
+  testing::write_file(dir() / "huge.pam",
+                      "P7\nWIDTH 90000000\nHEIGHT 90000000\nDEPTH 3\nMAXVAL 255\nENDHDR\n");
+  EXPECT_ERROR_MENTIONS(io::read_color_image(dir() / "huge.pam"), "huge.pam",
+                        "90000000x90000000 pixels");
+  testing::write_file(dir() / "twice.pam",  // which WIDTH would OpenCV take?
+                      "P7\nWIDTH 1\nWIDTH 90000\nHEIGHT 1\nDEPTH 1\nMAXVAL 255\nENDHDR\n\x01");
+  EXPECT_ERROR_MENTIONS(io::read_depth_png(dir() / "twice.pam"), "twice.pam", "PNG, JPEG or PNM");
+  testing::write_file(dir() / "huge.pbm", "P4 90000000 90000000\n\xff");
+  EXPECT_ERROR_MENTIONS(io::read_depth_png(dir() / "huge.pbm"), "huge.pbm",
+                        "90000000x90000000 pixels");
 }
 
 TEST_F(SequenceInput, TumCameraFromTheFolderNameAPresetOrADefaultWithAWarning) {

@@ -10,7 +10,7 @@
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/normals.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
-#include "kartograf/io/image_io.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -178,9 +178,9 @@ TEST_P(VoxelDownsampleTest, MatchesReferenceOnSevenScenesFrame) {
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   const PinholeIntrinsics k = PinholeIntrinsics::kinect_7scenes();
   const PointImage points =
-      geometry::backproject(cpu, io::read_depth_png(frames / "frame-000100.depth.png"), k);
+      geometry::backproject(cpu, testing::read_depth(frames / "frame-000100.depth.png"), k);
   const NormalImage normals = geometry::estimate_normals(cpu, points);
-  const RgbImage colors = io::read_color_image(frames / "frame-000100.color.jpg");
+  const RgbImage colors = testing::read_color(frames / "frame-000100.color.jpg");
   HostCloud in{{points.pixels().begin(), points.pixels().end()},
                {normals.pixels().begin(), normals.pixels().end()},
                {}};

@@ -11,12 +11,12 @@
 #include <Eigen/Geometry>
 
 #include "kartograf/geometry/backproject.hpp"
-#include "kartograf/io/image_io.hpp"
 #include "kartograf/registration/color_gate.hpp"
 #include "kartograf/registration/frame_pyramid.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
 #include "kartograf/registration/voxel_hash_correspondences.hpp"
+#include "real_data.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -224,7 +224,7 @@ TEST_P(NearestNeighborTest, FindersAgreeOnSevenScenesFrames) {
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   const PinholeIntrinsics k = PinholeIntrinsics::kinect_7scenes();
   const auto load = [&](const char* name) {
-    const PointImage image = geometry::backproject(cpu, io::read_depth_png(frames / name), k);
+    const PointImage image = geometry::backproject(cpu, testing::read_depth(frames / name), k);
     return std::vector<Point4f>(image.pixels().begin(), image.pixels().end());
   };
   HostClouds host;

@@ -22,7 +22,8 @@ void print_device(std::ostream& out, const compute::DeviceInfo& device, int usab
       << "      api:            " << device.api_version << "\n"
       << "      driver:         " << device.driver << "\n"
       << "      memory:         " << memory_mib(device.memory_bytes) << "\n"
-      << "      unified memory: " << (device.unified_memory ? "yes" : "no") << "\n";
+      << "      unified memory: " << (device.unified_memory ? "yes" : "no") << "\n"
+      << "      limits:         " << compute::describe(device.limits) << "\n";
   if (!device.usable) out << "      not usable:     " << device.unusable_reason << "\n";
 }
 

@@ -67,9 +67,32 @@ DeviceInfo cpu_device_info() {
                      std::to_string(EIGEN_MAJOR_VERSION) + "." + std::to_string(EIGEN_MINOR_VERSION);
   info.driver = "reference implementation";
   info.unified_memory = true;
+  info.limits.compute_units = std::thread::hardware_concurrency();
+  info.limits.fp64 = true;
+  info.limits.int64 = true;
+  info.limits.int64_atomics = true;
   return info;
 }
 }  // namespace detail
+
+std::string describe(const DeviceLimits& limits) {
+  std::string text;
+  const auto add = [&](const std::string& part) { text += (text.empty() ? "" : ", ") + part; };
+  const auto yes_no = [](bool value) { return std::string(value ? "yes" : "no"); };
+  if (limits.compute_units) add("compute units " + std::to_string(limits.compute_units));
+  if (limits.max_workgroup_invocations) {
+    add("work-group " + std::to_string(limits.max_workgroup_invocations));
+  }
+  if (limits.shared_memory_bytes) add("shared " + std::to_string(limits.shared_memory_bytes / 1024) + " KiB");
+  if (limits.max_buffer_bytes) {
+    add("max buffer " + std::to_string(limits.max_buffer_bytes / (1024 * 1024)) + " MiB");
+  }
+  add("subgroup " + (limits.subgroup_size ? std::to_string(limits.subgroup_size) : std::string("none")));
+  add("fp64 " + yes_no(limits.fp64));
+  add("int64 atomics " + yes_no(limits.int64_atomics));
+  add("device timestamps " + yes_no(limits.device_timestamps));
+  return text;
+}
 
 std::vector<BackendStatus> probe_backends() {
   BackendStatus cpu;

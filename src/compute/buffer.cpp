@@ -68,6 +68,18 @@ void RawBuffer::fill_zero() {
   }
 }
 
+void RawBuffer::copy_from(const RawBuffer& source, std::size_t bytes) {
+  check_range(0, bytes, "copy target");
+  source.check_range(0, bytes, "copy source");
+  require(source.device_ == device_, "buffer copy: the source belongs to another context");
+  if (bytes == 0) return;
+  if (device_) {
+    device_->copy(*source.device_buffer_, 0, *device_buffer_, 0, bytes);
+  } else {
+    std::memcpy(host_.data(), source.host_.data(), bytes);
+  }
+}
+
 std::byte* RawBuffer::host_data() {
   require(!device_, "RawBuffer::host_data: the buffer lives on a device, not on the host");
   return host_.data();

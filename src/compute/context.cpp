@@ -135,5 +135,8 @@ std::uint64_t Context::validation_errors() const {
   return device_ ? device_->validation_errors() : 0;
 }
 bool Context::validation_active() const { return device_ && device_->validation_active(); }
+std::vector<DeviceTiming> Context::take_device_timings() const {
+  return device_ ? device_->take_device_timings() : std::vector<DeviceTiming>{};
+}
 
 }  // namespace kartograf::compute

@@ -35,11 +35,16 @@ class Device {
   // buffers: null entries are absent optional inputs (bind a placeholder).
   virtual void dispatch(const KernelSpec& kernel, std::span<DeviceBuffer* const> buffers,
                         std::span<const std::byte> params, GroupCount groups) = 0;
+  // Copies bytes between two buffers of this device, in order with the other commands.
+  virtual void copy(const DeviceBuffer& source, std::size_t source_offset, DeviceBuffer& target,
+                    std::size_t target_offset, std::size_t bytes) = 0;
   virtual void finish() = 0;
   virtual void build_all_kernels() = 0;
 
   virtual std::uint64_t validation_errors() const { return 0; }
   virtual bool validation_active() const { return false; }
+  // Completed commands' device times (ContextOptions::profile); waits for pending commands.
+  virtual std::vector<DeviceTiming> take_device_timings() = 0;
 };
 
 DeviceInfo cpu_device_info();

@@ -8,6 +8,7 @@
 #include <initializer_list>
 #include <string>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <opencv2/imgcodecs.hpp>
@@ -38,24 +39,70 @@ std::optional<DeclaredImageSize> png_size(std::span<const std::uint8_t> bytes) {
                            static_cast<double>(channels * (bit_depth == 16 ? 2 : 1))};
 }
 
-// Binary and ASCII PGM (P2, P5) and PPM (P3, P6): magic, width, height, maxval; comments allowed.
+// Skips whitespace and '#' comments (to the end of their line) in a PNM header.
+std::size_t skip_pnm_space(std::span<const std::uint8_t> bytes, std::size_t at) {
+  while (at < bytes.size() && (std::isspace(bytes[at]) || bytes[at] == '#')) {
+    if (bytes[at] == '#') {
+      while (at < bytes.size() && bytes[at] != '\n') ++at;
+    } else {
+      ++at;
+    }
+  }
+  return at;
+}
+
+// A decimal number at `at` (after skip_pnm_space), as a double: a header can declare sizes beyond
+// any integer type. Nothing when no digit is there.
+std::optional<double> pnm_number(std::span<const std::uint8_t> bytes, std::size_t& at) {
+  if (at >= bytes.size() || !std::isdigit(bytes[at])) return std::nullopt;
+  double number = 0;
+  while (at < bytes.size() && std::isdigit(bytes[at])) number = number * 10 + (bytes[at++] - '0');
+  return number;
+}
+
+// PAM (P7): "WIDTH w", "HEIGHT h", "DEPTH d", "MAXVAL m" lines up to "ENDHDR". A field given
+// twice, or without its number, is nothing: which one OpenCV would use is not ours to guess.
+std::optional<DeclaredImageSize> pam_size(std::span<const std::uint8_t> bytes) {
+  std::optional<double> width, height, depth, maxval;
+  std::size_t at = 2;
+  while ((at = skip_pnm_space(bytes, at)) < bytes.size()) {
+    std::string key;
+    while (at < bytes.size() && std::isalpha(bytes[at])) key += static_cast<char>(bytes[at++]);
+    if (key == "ENDHDR") {
+      if (!width || !height) return std::nullopt;
+      return DeclaredImageSize{*width, *height,
+                               depth.value_or(1.0) * (maxval.value_or(255.0) > 255 ? 2.0 : 1.0)};
+    }
+    const std::array<std::pair<const char*, std::optional<double>*>, 4> fields = {
+        {{"WIDTH", &width}, {"HEIGHT", &height}, {"DEPTH", &depth}, {"MAXVAL", &maxval}}};
+    for (const auto& [field_name, field] : fields) {
+      if (key != field_name) continue;
+      if (field->has_value()) return std::nullopt;
+      at = skip_pnm_space(bytes, at);
+      *field = pnm_number(bytes, at);
+      if (!field->has_value()) return std::nullopt;
+    }
+    while (at < bytes.size() && bytes[at] != '\n') ++at;  // the rest of the line (TUPLTYPE ...)
+  }
+  return std::nullopt;
+}
+
+// PBM (P1, P4: width, height), PGM (P2, P5) and PPM (P3, P6: width, height, maxval), comments
+// allowed, and PAM (P7).
 std::optional<DeclaredImageSize> pnm_size(std::span<const std::uint8_t> bytes) {
   if (bytes.size() < 3 || bytes[0] != 'P' ||
-      std::string_view("2356").find(bytes[1]) == std::string_view::npos) {
+      std::string_view("1234567").find(bytes[1]) == std::string_view::npos) {
     return std::nullopt;
   }
-  std::array<double, 3> numbers{};
+  if (bytes[1] == '7') return pam_size(bytes);
+  const bool bitmap = bytes[1] == '1' || bytes[1] == '4';
+  std::array<double, 3> numbers{0, 0, 255};  // a bitmap has no maxval: one byte per pixel
   std::size_t at = 2;
-  for (double& number : numbers) {
-    while (at < bytes.size() && (std::isspace(bytes[at]) || bytes[at] == '#')) {
-      if (bytes[at] == '#') {
-        while (at < bytes.size() && bytes[at] != '\n') ++at;
-      } else {
-        ++at;
-      }
-    }
-    if (at >= bytes.size() || !std::isdigit(bytes[at])) return std::nullopt;
-    while (at < bytes.size() && std::isdigit(bytes[at])) number = number * 10 + (bytes[at++] - '0');
+  for (std::size_t i = 0; i < (bitmap ? 2u : 3u); ++i) {
+    at = skip_pnm_space(bytes, at);
+    const std::optional<double> number = pnm_number(bytes, at);
+    if (!number) return std::nullopt;
+    numbers[i] = *number;
   }
   const int channels = bytes[1] == '3' || bytes[1] == '6' ? 3 : 1;
   return DeclaredImageSize{numbers[0], numbers[1], channels * (numbers[2] > 255 ? 2.0 : 1.0)};
@@ -154,13 +201,20 @@ cv::Mat decode_image(const std::filesystem::path& path, const std::string& name)
   const std::vector<std::uint8_t> bytes = read_file_bytes(path, name);
   if (bytes.empty()) throw Error(name + ": file is empty");
   require_complete(bytes, name);
-  if (const std::optional<DeclaredImageSize> size = declared_image_size(bytes)) {
-    // The decoded pixels, and the copy the readers make of them.
-    // Printed as doubles: a header can declare sizes beyond any integer type.
-    char pixels[96];
-    std::snprintf(pixels, sizeof(pixels), " (%.0fx%.0f pixels)", size->width, size->height);
-    require_fits_in_memory(2.0 * size->width * size->height * size->bytes_per_pixel, name + pixels);
+  // Only formats whose size is known before decoding: OpenCV also decodes BMP, TIFF, WebP, Sun
+  // raster, ... whose header Kartograf does not read, and a few bytes of those can declare an
+  // image that takes seconds and gigabytes to decode (a 32-byte WebP: 12545x13313 pixels).
+  const std::optional<DeclaredImageSize> size = declared_image_size(bytes);
+  if (!size) {
+    throw Error(name + ": cannot decode: not a PNG, JPEG or PNM (PBM, PGM, PPM, PAM) file with " +
+                "a complete header; Kartograf reads images only in these formats, whose size " +
+                "it checks before decoding (convert others, such as BMP, TIFF or WebP, to PNG)");
   }
+  // The decoded pixels, and the copy the readers make of them.
+  // Printed as doubles: a header can declare sizes beyond any integer type.
+  char pixels[96];
+  std::snprintf(pixels, sizeof(pixels), " (%.0fx%.0f pixels)", size->width, size->height);
+  require_fits_in_memory(2.0 * size->width * size->height * size->bytes_per_pixel, name + pixels);
   cv::Mat image;
   try {
     image = cv::imdecode(bytes, cv::IMREAD_UNCHANGED);

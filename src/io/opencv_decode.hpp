@@ -15,8 +15,9 @@
 
 namespace kartograf::io::detail {
 
-// The size an image file declares in its header (PNG, PGM/PPM, JPEG; others: nothing), read
-// before decoding so that a small file announcing a huge image is refused before it allocates.
+// The size an image file declares in its header (PNG, PBM/PGM/PPM/PAM, JPEG; others: nothing),
+// read before decoding so that a small file announcing a huge image is refused before it
+// allocates.
 struct DeclaredImageSize {
   double width = 0, height = 0;
   double bytes_per_pixel = 1;  // decoded: channels x bytes per sample
@@ -25,9 +26,10 @@ std::optional<DeclaredImageSize> declared_image_size(std::span<const std::uint8_
 
 // Exactly what the file stores: IMREAD_UNCHANGED keeps the bit depth, every channel and the
 // stored pixel order (no EXIF rotation). Throws Error starting with `name` (what the file is and
-// its quoted path, e.g. "label image 'a.png'") when the file cannot be read, is empty or cannot
-// be decoded, or when the size its header declares would not fit in memory
-// (core/memory_budget.hpp).
+// its quoted path, e.g. "label image 'a.png'") when the file cannot be read, is empty, is not in
+// a format whose size declared_image_size reads (BMP, TIFF, WebP, ... are refused: OpenCV would
+// decode them before their size is known), cannot be decoded, or when the size its header
+// declares would not fit in memory (core/memory_budget.hpp).
 cv::Mat decode_image(const std::filesystem::path& path, const std::string& name);
 
 // How messages name a bit depth (CV_16U: "16-bit") and an image's pixels ("8-bit 3-channel").

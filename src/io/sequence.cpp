@@ -50,17 +50,6 @@ Eigen::Matrix4d matrix_from(const std::vector<double>& values, std::size_t offse
 
 }  // namespace
 
-Eigen::Isometry3d orthonormalized_pose(const Eigen::Matrix4d& matrix) {
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(matrix.topLeftCorner<3, 3>(),
-                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
-  Eigen::Matrix3d rotation = svd.matrixU() * svd.matrixV().transpose();
-  require(rotation.determinant() > 0, "pose matrix is a reflection, not a rotation");
-  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
-  pose.linear() = rotation;
-  pose.translation() = matrix.topRightCorner<3, 1>();
-  return pose;
-}
-
 Eigen::Isometry3d rotation_pose(const Eigen::Matrix4d& matrix, const std::string& where) {
   require(matrix.allFinite(), where + ": the pose matrix has a value that is not finite");
   const Eigen::Matrix3d r = matrix.topLeftCorner<3, 3>();

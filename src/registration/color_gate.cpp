@@ -6,6 +6,7 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
+#include "registration/row_reduction.hpp"
 
 namespace kartograf::registration {
 
@@ -15,7 +16,6 @@ constexpr std::uint32_t kGroupSize = 64;  // KG_REDUCTION_GROUP in shaders/commo
 constexpr std::size_t kSumCount = 4;      // pairs, sum dS, hue pairs, sum dH
 constexpr compute::KernelSpec kDifferencesKernel{"color_gate_differences", kGroupSize};
 constexpr compute::KernelSpec kApplyKernel{"color_gate_apply", 64};
-constexpr compute::KernelSpec kReduceRowsKernel{"reduce_rows", kGroupSize};
 
 struct DifferenceParams {  // layout of shaders/color_gate_differences.comp and
                            // kernels/color_gate.cl
@@ -28,11 +28,6 @@ struct ApplyParams {  // layout of shaders/color_gate_apply.comp and kernels/col
   std::uint32_t use_hue;
   std::uint32_t use_saturation;
   float mean_factor;
-};
-
-struct ReduceRowsParams {  // layout of shaders/reduce_rows.comp and kernels/reduce_rows.cl
-  std::uint32_t row_count;
-  std::uint32_t column_count;
 };
 
 using Sums = std::array<double, kSumCount>;
@@ -140,8 +135,7 @@ void ColorGate::apply(const compute::Buffer<std::uint32_t>& source_colors,
                     {source_colors, target_colors, target_index, table_, differences_, partials_},
                     DifferenceParams{count, static_cast<std::uint32_t>(target_colors.size())},
                     {groups, 1});
-  compute::dispatch(*context_, kReduceRowsKernel, {partials_, sums_},
-                    ReduceRowsParams{groups, static_cast<std::uint32_t>(kSumCount)}, {1, 1});
+  reduce_rows(*context_, partials_, sums_, groups, static_cast<std::uint32_t>(kSumCount));
   compute::dispatch(*context_, kApplyKernel, {differences_, sums_, target_index, rejected_},
                     apply_params, {compute::groups_for(count, kApplyKernel.local_x), 1});
 }

@@ -5,9 +5,8 @@
 #include <numbers>
 #include <string>
 
-#include <opencv2/imgproc.hpp>
-
 #include "kartograf/core/error.hpp"
+#include "kartograf/geometry/distance_transform.hpp"
 #include "rooms/laser_beam.hpp"
 
 namespace kartograf::rooms {
@@ -106,22 +105,20 @@ LaserScanner::LaserScanner(const OccupancyGrid& map, const LaserScanParams& para
   max_steps_ = static_cast<int>(
       std::clamp(std::ceil(params.max_range_m / resolution_), 1.0, double{1 << 24}));
   // Free space with a border of non-free cells, so that the grid's edge stops rays like a wall.
-  cv::Mat free(height_ + 2, width_ + 2, CV_8UC1, cv::Scalar(0));
+  Image<std::uint8_t> free(width_ + 2, height_ + 2, 0);
   for (int y = 0; y < height_; ++y) {
     for (int x = 0; x < width_; ++x)
-      free.at<std::uint8_t>(y + 1, x + 1) = map.cells(x, y) == CellState::free ? 255 : 0;
+      free(x + 1, y + 1) = map.cells(x, y) == CellState::free ? 255 : 0;
   }
-  cv::Mat distance;
-  cv::distanceTransform(free, distance, cv::DIST_L2, cv::DIST_MASK_PRECISE, CV_32F);
+  const Image<float> distance = geometry::distance_to_zero(free);
   // A skip of s steps moves a sample by s |direction| <= s (1 + 1.1e-5) cells (rounded directions);
   // from within 0.71 cells of a free cell centre at distance d >= s + 1.5 from every non-free
   // centre, the sample's cell centre stays closer than d while s * 1.1e-5 < 0.085: s <= 4096.
   constexpr int kMaxSkip = 4096;
   skips_ = Image<std::int32_t>(width_ + 2, height_ + 2);
   for (int y = 0; y < height_ + 2; ++y) {
-    const float* row = distance.ptr<float>(y);
     for (int x = 0; x < width_ + 2; ++x) {
-      const float d = row[x];
+      const float d = distance(x, y);
       skips_(x, y) = d <= 0 ? 0 : std::clamp(static_cast<int>(d - 1.5f), 1, kMaxSkip);
     }
   }

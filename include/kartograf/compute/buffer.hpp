@@ -31,6 +31,9 @@ class RawBuffer {
   void write(std::size_t offset, const void* source, std::size_t bytes);
   void read(std::size_t offset, void* destination, std::size_t bytes) const;
   void fill_zero();
+  // Copies `bytes` of `source` (a buffer of the same context) to this buffer's offset 0, on the
+  // device and in order with the dispatches: no round trip through the host.
+  void copy_from(const RawBuffer& source, std::size_t bytes);
 
   bool on_host() const { return device_ == nullptr; }
   std::byte* host_data();  // CPU backend only

@@ -5,10 +5,17 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "kartograf/compute/backend.hpp"
 
 namespace kartograf::compute {
+
+// One device command as the device timed it (ContextOptions::profile).
+struct DeviceTiming {
+  std::string command;  // the kernel's name, or "upload", "download", "copy", "fill"
+  double milliseconds = 0;
+};
 
 namespace detail {
 class Device;
@@ -24,6 +31,9 @@ struct ContextOptions {
   // Vulkan only: enable VK_LAYER_KHRONOS_validation with synchronization validation, and count
   // every error it reports (see Context::validation_errors). Ignored when the layer is missing.
   bool vulkan_validation = false;
+  // Time every device command (kernels, copies, fills) on the device: Vulkan timestamp queries,
+  // OpenCL profiling events. Costs a little per command; for benchmarks. Ignored on the CPU.
+  bool profile = false;
 
   // KARTOGRAF_BACKEND=auto|cpu|vulkan|opencl, KARTOGRAF_DEVICE=<index>,
   // KARTOGRAF_VULKAN_VALIDATION=1.
@@ -57,6 +67,9 @@ class Context {
   // Vulkan with validation on: messages of severity error so far. Zero elsewhere.
   std::uint64_t validation_errors() const;
   bool validation_active() const;
+  // With ContextOptions::profile: every command completed since the last call, in issue order
+  // (waits for what is pending). Empty on the CPU backend or without profiling.
+  std::vector<DeviceTiming> take_device_timings() const;
 
   // For operations' device paths (see compute/kernel.hpp). Null on the CPU backend.
   detail::Device* device() const { return device_.get(); }

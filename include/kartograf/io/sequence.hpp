@@ -13,6 +13,7 @@
 #include "kartograf/core/color.hpp"
 #include "kartograf/core/intrinsics.hpp"
 #include "kartograf/core/point_image.hpp"
+#include "kartograf/core/pose.hpp"
 #include "kartograf/core/trajectory.hpp"
 
 namespace kartograf::io {
@@ -67,8 +68,9 @@ std::unique_ptr<Sequence> open_seven_scenes(const std::filesystem::path& folder)
 // errors name the file and line.
 Trajectory read_redwood_log(const std::filesystem::path& path);
 
-// The nearest rotation (SVD) of a 3x3 block, and the pose made of it and a translation.
-Eigen::Isometry3d orthonormalized_pose(const Eigen::Matrix4d& matrix);
+// The nearest rotation (SVD) of a 3x3 block: in core (kartograf/core/pose.hpp), so that code
+// without io (the device tests) uses the same one.
+using kartograf::orthonormalized_pose;
 
 // A ground-truth pose as data sets store it: accepted when its 3x3 block is a rotation up to
 // kPoseRotationTolerance (||R^T R - I|| under it, det > 0; 7-Scenes' files are ~4e-4 off) and its

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <cstdlib>
+#include <deque>
 #include <map>
 #include <mutex>
 #include <string>
@@ -26,7 +27,8 @@ namespace {
   X(clCreateBuffer) X(clReleaseMemObject) X(clEnqueueWriteBuffer) X(clEnqueueReadBuffer)       \
   X(clEnqueueFillBuffer) X(clCreateProgramWithSource) X(clBuildProgram)                        \
   X(clGetProgramBuildInfo) X(clReleaseProgram) X(clCreateKernel) X(clCreateKernelsInProgram)   \
-  X(clReleaseKernel) X(clSetKernelArg) X(clEnqueueNDRangeKernel) X(clFinish) X(clFlush)
+  X(clReleaseKernel) X(clSetKernelArg) X(clEnqueueNDRangeKernel) X(clFinish) X(clFlush)       \
+  X(clEnqueueCopyBuffer) X(clGetEventProfilingInfo) X(clReleaseEvent)
 
 struct OpenclApi {
 #define KARTOGRAF_CL_MEMBER(name) decltype(&::name) name = nullptr;
@@ -135,6 +137,25 @@ T device_value(cl_device_id device, cl_device_info param) {
   return value;
 }
 
+// Limits and optional features for `kartograf devices` and the benchmarks' reports.
+DeviceLimits read_limits(cl_device_id id, const std::string& extensions) {
+  DeviceLimits limits;
+  limits.compute_units = device_value<cl_uint>(id, CL_DEVICE_MAX_COMPUTE_UNITS);
+  limits.max_workgroup_invocations =
+      static_cast<std::uint32_t>(device_value<size_t>(id, CL_DEVICE_MAX_WORK_GROUP_SIZE));
+  limits.shared_memory_bytes = device_value<cl_ulong>(id, CL_DEVICE_LOCAL_MEM_SIZE);
+  limits.max_buffer_bytes = device_value<cl_ulong>(id, CL_DEVICE_MAX_MEM_ALLOC_SIZE);
+  const auto has = [&](const char* name) { return extensions.find(name) != std::string::npos; };
+  limits.fp64 = has("cl_khr_fp64");
+  limits.int64 = true;  // long is core OpenCL C
+  limits.int64_atomics = has("cl_khr_int64_base_atomics");
+  // OpenCL 1.2 has no subgroups; NVIDIA tells its warp size (CL_DEVICE_WARP_SIZE_NV).
+  constexpr cl_device_info kWarpSizeNv = 0x4003;
+  if (has("cl_nv_device_attribute_query")) limits.subgroup_size = device_value<cl_uint>(id, kWarpSizeNv);
+  limits.device_timestamps = true;  // profiling events are core OpenCL
+  return limits;
+}
+
 struct FoundDevice {
   cl_device_id id = nullptr;
   DeviceInfo info;
@@ -191,6 +212,7 @@ Enumeration enumerate_devices() {
         info.type = DeviceType::other;
       }
       const std::string extensions = device_string(id, CL_DEVICE_EXTENSIONS);
+      info.limits = read_limits(id, extensions);
       for (const char* needed : {"cl_khr_fp64", "cl_khr_int64_base_atomics"}) {
         if (extensions.find(needed) == std::string::npos) {
           info.usable = false;
@@ -228,12 +250,13 @@ cl_mem memory_of(const DeviceBuffer& buffer) {
 
 class OpenclDevice final : public Device {
  public:
-  OpenclDevice(cl_device_id id, DeviceInfo info) : id_(id), info_(std::move(info)) {
+  OpenclDevice(cl_device_id id, DeviceInfo info, bool profile)
+      : id_(id), info_(std::move(info)), profile_(profile) {
     const OpenclApi& cl = opencl_api();
     cl_int status = CL_SUCCESS;
     context_ = cl.clCreateContext(nullptr, 1, &id_, nullptr, nullptr, &status);
     check(status, "clCreateContext on " + info_.name);
-    queue_ = cl.clCreateCommandQueue(context_, id_, 0, &status);
+    queue_ = cl.clCreateCommandQueue(context_, id_, profile ? CL_QUEUE_PROFILING_ENABLE : 0, &status);
     check(status, "clCreateCommandQueue on " + info_.name);
     placeholder_ = create_buffer(16);
   }
@@ -241,6 +264,9 @@ class OpenclDevice final : public Device {
   ~OpenclDevice() override {
     const OpenclApi& cl = opencl_api();
     cl.clFinish(queue_);
+    for (const auto& [name, event] : pending_) {
+      if (event) cl.clReleaseEvent(event);
+    }
     placeholder_.reset();
     for (auto& [name, kernel] : kernels_) cl.clReleaseKernel(kernel);
     if (program_) cl.clReleaseProgram(program_);
@@ -260,22 +286,38 @@ class OpenclDevice final : public Device {
   void write(DeviceBuffer& buffer, std::size_t offset, const void* source,
              std::size_t bytes) override {
     check(opencl_api().clEnqueueWriteBuffer(queue_, memory_of(buffer), CL_TRUE, offset, bytes,
-                                            source, 0, nullptr, nullptr),
+                                            source, 0, nullptr, event_for("upload")),
           "clEnqueueWriteBuffer");
   }
 
   void read(const DeviceBuffer& buffer, std::size_t offset, void* destination,
             std::size_t bytes) override {
     check(opencl_api().clEnqueueReadBuffer(queue_, memory_of(buffer), CL_TRUE, offset, bytes,
-                                           destination, 0, nullptr, nullptr),
+                                           destination, 0, nullptr, event_for("download")),
           "clEnqueueReadBuffer");
   }
 
   void fill_zero(DeviceBuffer& buffer, std::size_t offset, std::size_t bytes) override {
     const cl_uint zero = 0;
     check(opencl_api().clEnqueueFillBuffer(queue_, memory_of(buffer), &zero, sizeof(zero), offset,
-                                           bytes, 0, nullptr, nullptr),
+                                           bytes, 0, nullptr, event_for("fill")),
           "clEnqueueFillBuffer");
+  }
+
+  void copy(const DeviceBuffer& source, std::size_t source_offset, DeviceBuffer& target,
+            std::size_t target_offset, std::size_t bytes) override {
+    check(opencl_api().clEnqueueCopyBuffer(queue_, memory_of(source), memory_of(target),
+                                           source_offset, target_offset, bytes, 0, nullptr,
+                                           event_for("copy")),
+          "clEnqueueCopyBuffer");
+  }
+
+  std::vector<DeviceTiming> take_device_timings() override {
+    finish();
+    collect_timings();
+    std::vector<DeviceTiming> result;
+    result.swap(completed_);
+    return result;
   }
 
   void dispatch(const KernelSpec& spec, std::span<DeviceBuffer* const> buffers,
@@ -297,7 +339,8 @@ class OpenclDevice final : public Device {
     // PoCL has no non-uniform work-groups: the global size is a whole number of groups.
     const size_t local[2] = {spec.local_x, spec.local_y};
     const size_t global[2] = {size_t{groups.x} * spec.local_x, size_t{groups.y} * spec.local_y};
-    check(cl.clEnqueueNDRangeKernel(queue_, kernel, 2, nullptr, global, local, 0, nullptr, nullptr),
+    check(cl.clEnqueueNDRangeKernel(queue_, kernel, 2, nullptr, global, local, 0, nullptr,
+                                    event_for(spec.name)),
           name + ": clEnqueueNDRangeKernel");
   }
 
@@ -315,6 +358,35 @@ class OpenclDevice final : public Device {
   }
 
  private:
+  // With profiling, the event of the next command (named for the report); else none. Long runs
+  // are collected on the way, so the number of live events stays bounded.
+  cl_event* event_for(std::string_view command) {
+    if (!profile_) return nullptr;
+    if (pending_.size() >= kMaxPendingEvents) {
+      finish();
+      collect_timings();
+    }
+    pending_.emplace_back(std::string(command), nullptr);
+    return &pending_.back().second;
+  }
+
+  // After clFinish: the pending commands' device times, in issue order.
+  void collect_timings() {
+    const OpenclApi& cl = opencl_api();
+    for (const auto& [name, event] : pending_) {
+      if (!event) continue;  // its enqueue failed (and threw)
+      cl_ulong start = 0, end = 0;
+      check(cl.clGetEventProfilingInfo(event, CL_PROFILING_COMMAND_START, sizeof(start), &start,
+                                       nullptr),
+            "clGetEventProfilingInfo");
+      check(cl.clGetEventProfilingInfo(event, CL_PROFILING_COMMAND_END, sizeof(end), &end, nullptr),
+            "clGetEventProfilingInfo");
+      cl.clReleaseEvent(event);
+      completed_.push_back({name, static_cast<double>(end - start) * 1e-6});
+    }
+    pending_.clear();
+  }
+
   void build_program() {
     std::lock_guard lock(build_mutex_);
     if (program_) return;
@@ -358,6 +430,10 @@ class OpenclDevice final : public Device {
   std::mutex build_mutex_;
   std::map<std::string, cl_kernel, std::less<>> kernels_;
   std::unique_ptr<DeviceBuffer> placeholder_;
+  static constexpr std::size_t kMaxPendingEvents = 4096;
+  bool profile_ = false;
+  std::deque<std::pair<std::string, cl_event>> pending_;  // deque: event_for's pointers stay valid
+  std::vector<DeviceTiming> completed_;
 };
 
 }  // namespace
@@ -394,7 +470,7 @@ std::shared_ptr<Device> create_opencl_device(const ContextOptions& options) {
   std::vector<const DeviceInfo*> infos;
   for (const FoundDevice* device : usable) infos.push_back(&device->info);
   const std::size_t index = choose_device(infos, options, "OpenCL");
-  return std::make_shared<OpenclDevice>(usable[index]->id, usable[index]->info);
+  return std::make_shared<OpenclDevice>(usable[index]->id, usable[index]->info, options.profile);
 }
 
 }  // namespace kartograf::compute::detail

@@ -2,6 +2,7 @@
 
 #include <cstdio>
 #include <cstring>
+#include <mutex>
 #include <vector>
 
 #include "compute/dynamic_library.hpp"
@@ -103,7 +104,22 @@ void vk_check(VkResult result, const std::string& what) {
   if (result != VK_SUCCESS) throw Error("Vulkan: " + what + " failed: " + vk_result_name(result));
 }
 
+// One instance per validation setting for the whole process, never destroyed: the loader unloads
+// the driver with the last instance, and loading NVIDIA's driver again and again exhausts glibc's
+// static TLS ("libnvidia-tls.so: cannot allocate memory in static TLS block" after ~30 contexts,
+// seen on an H100); it also saves the driver's start-up per context. Kept past static destruction
+// (a leak by design): the loader library it calls into stays loaded until the process ends.
+// A failure is not kept, so a later call tries again.
 std::shared_ptr<VulkanInstance> VulkanInstance::create(bool want_validation) {
+  static std::mutex mutex;
+  static auto* instances = new std::shared_ptr<VulkanInstance>[2];
+  std::lock_guard lock(mutex);
+  std::shared_ptr<VulkanInstance>& slot = instances[want_validation ? 1 : 0];
+  if (!slot) slot = create_new(want_validation);
+  return slot;
+}
+
+std::shared_ptr<VulkanInstance> VulkanInstance::create_new(bool want_validation) {
   const GlobalApi& api = global_api();
   if (!api.error.empty()) throw Error(api.error);
 

@@ -37,7 +37,8 @@ namespace kartograf::compute::detail {
   X(vkCmdBindDescriptorSets) X(vkCmdPushConstants) X(vkCmdDispatch)                         \
   X(vkCmdPipelineBarrier) X(vkCmdCopyBuffer) X(vkCmdFillBuffer) X(vkQueueSubmit)            \
   X(vkCreateFence) X(vkDestroyFence) X(vkWaitForFences) X(vkResetFences)                    \
-  X(vkDeviceWaitIdle)
+  X(vkDeviceWaitIdle) X(vkCreateQueryPool) X(vkDestroyQueryPool) X(vkGetQueryPoolResults)     \
+  X(vkCmdResetQueryPool) X(vkCmdWriteTimestamp) X(vkCmdUpdateBuffer)
 
 #define KARTOGRAF_VK_MEMBER(name) PFN_##name name = nullptr;
 
@@ -49,9 +50,13 @@ struct VulkanInstance {
   bool validation = false;
   std::atomic<std::uint64_t> validation_errors{0};
 
-  // Throws Error with the reason when there is no loader, no driver, or instance creation fails.
+  // The process's instance for this validation setting (made on first use). Throws Error with the
+  // reason when there is no loader, no driver, or instance creation fails.
   static std::shared_ptr<VulkanInstance> create(bool want_validation);
   ~VulkanInstance();
+
+ private:
+  static std::shared_ptr<VulkanInstance> create_new(bool want_validation);
 };
 
 struct VulkanDeviceApi {

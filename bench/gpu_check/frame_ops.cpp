@@ -1,0 +1,148 @@
+#include "frame_ops.hpp"
+
+#include "kartograf/compute/buffer.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/geometry/normals.hpp"
+#include "kartograf/geometry/segment_moments.hpp"
+#include "kartograf/geometry/subsample.hpp"
+#include "kartograf/geometry/voxel_downsample.hpp"
+#include "kartograf/registration/frame_pyramid.hpp"
+#include "kartograf/registration/icp.hpp"
+#include "kartograf/registration/icp_sums.hpp"
+#include "kartograf/registration/projective_association.hpp"
+
+namespace kartograf::gpu_check {
+
+struct Workspace {
+  Workspace(const compute::Context& context, const FrameSet& frames)
+      : context(context),
+        frames(frames),
+        projector(context, frames.camera, geometry::DepthRange{}),
+        depth(context, frames.camera.width, frames.camera.height),
+        points(context, frames.camera.width, frames.camera.height),
+        normals(context, frames.camera.width, frames.camera.height),
+        pyramids{registration::FramePyramid(context, frames.camera),
+                 registration::FramePyramid(context, frames.camera)},
+        reduction(context),
+        association(context),
+        engine(context),
+        moments(context),
+        downsampler(context) {}
+
+  const RgbdFrame& next_frame() { return frames.frames[next++ % frames.frames.size()]; }
+  registration::FramePyramid& reference() { return pyramids[reference_index]; }
+  registration::FramePyramid& current() { return pyramids[1 - reference_index]; }
+  registration::Correspondences pairs();  // current level 0 -> reference level 0, associated
+
+  const compute::Context& context;
+  const FrameSet& frames;
+  std::size_t next = 0;
+  geometry::DepthBackprojector projector;
+  compute::DeviceImage<std::uint16_t> depth;
+  compute::DeviceImage<Point4f> points, normals;
+  registration::FramePyramid pyramids[2];
+  int reference_index = 0;
+  registration::IcpReduction reduction;
+  registration::ProjectiveAssociation association;
+  registration::CorrespondenceBuffers association_out;
+  registration::Correspondences associated;  // pairs() of the set-up, for the sums alone
+  registration::IcpEngine engine;
+  compute::Buffer<std::uint32_t> labels;  // 16x16 tiles: one segment per tile
+  std::uint32_t label_count = 0;
+  geometry::SegmentMomentReducer moments;
+  geometry::VoxelDownsampler downsampler;
+  geometry::DeviceCloud cloud;  // level 0 of the current pyramid as an unorganized cloud
+};
+
+namespace {
+
+// The true relative pose is unknown here; a small motion keeps the association realistic.
+const Eigen::Isometry3d kSmallMotion =
+    Eigen::Translation3d(0.01, -0.005, 0.0) * Eigen::AngleAxisd(0.01, Eigen::Vector3d::UnitY());
+
+compute::Buffer<std::uint32_t> tile_labels(const compute::Context& context, int width, int height,
+                                           std::uint32_t& count) {
+  const int tiles_x = (width + 15) / 16;
+  std::vector<std::uint32_t> labels(static_cast<std::size_t>(width) * height);
+  for (int v = 0; v < height; ++v) {
+    for (int u = 0; u < width; ++u) labels[v * width + u] = (v / 16) * tiles_x + u / 16;
+  }
+  count = static_cast<std::uint32_t>(tiles_x * ((height + 15) / 16));
+  return compute::Buffer<std::uint32_t>::from_host(context, labels);
+}
+
+void build_current(Workspace& w) {
+  w.depth.upload(w.next_frame().depth);
+  w.current().build(w.projector, w.depth);
+}
+
+}  // namespace
+
+registration::Correspondences Workspace::pairs() {
+  const registration::CloudView source = current().level(0).view();
+  const registration::CloudView target = reference().level(0).view();
+  association.find(source, target, kSmallMotion, registration::AssociationParams{},
+                   association_out);
+  registration::Correspondences result;
+  result.source = source.points;
+  result.target = target.points;
+  result.target_normals = target.normals;
+  result.correspondences = &association_out.target_index;
+  result.source_to_target = kSmallMotion;
+  result.max_distance = 0.1;
+  return result;
+}
+
+std::shared_ptr<Workspace> make_workspace(const compute::Context& context, const FrameSet& frames) {
+  auto w = std::make_shared<Workspace>(context, frames);
+  w->labels = tile_labels(context, frames.camera.width, frames.camera.height, w->label_count);
+  w->depth.upload(w->next_frame().depth);
+  w->reference().build(w->projector, w->depth);
+  build_current(*w);
+  w->projector.run(w->depth, w->points);
+  geometry::estimate_normals(context, w->points, w->normals);
+  const compute::Buffer<Point4f>& level0 = w->current().level(0).points.buffer();
+  w->cloud.points = compute::Buffer<Point4f>(context, level0.size());
+  w->cloud.points.raw().copy_from(level0.raw(), level0.raw().size_bytes());
+  w->associated = w->pairs();
+  context.finish();
+  return w;
+}
+
+const std::vector<Operation>& frame_operations() {
+  static const std::vector<Operation> list = {
+      {"upload depth", 0, [](Workspace& w) { w.depth.upload(w.next_frame().depth); }},
+      {"backproject", 2 + 16, [](Workspace& w) { w.projector.run(w.depth, w.points); }},
+      {"normals", 16 + 16,
+       [](Workspace& w) { geometry::estimate_normals(w.context, w.points, w.normals); }},
+      {"pyramid (normals + 2 levels)", 52, [](Workspace& w) { w.current().build(); }},
+      {"backproject + normals + pyramid", 70,
+       [](Workspace& w) { w.current().build(w.projector, w.depth); }},
+      {"projective association", 16 + 16 + 4, [](Workspace& w) { w.pairs(); }},
+      {"point-to-plane sums", 16 + 16 + 16 + 4,
+       [](Workspace& w) { w.reduction.point_to_plane(w.associated, Eigen::Vector3d(0, 0, 2)); }},
+      {"point-to-point sums", 16 + 16 + 4,
+       [](Workspace& w) { w.reduction.point_to_point(w.associated, Eigen::Vector3d(0, 0, 2)); }},
+      {"ICP align (3 levels)", 0, [](Workspace& w) { w.engine.align(w.current(), w.reference()); }},
+      {"frame-to-frame odometry", 0,
+       [](Workspace& w) {
+         build_current(w);
+         w.engine.align(w.current(), w.reference());
+         w.reference_index = 1 - w.reference_index;
+       }},
+      {"segment moments", 16 + 4,
+       [](Workspace& w) {
+         geometry::SegmentMomentParams params;
+         params.label_count = w.label_count;
+         params.origin = Eigen::Vector3f(0, 0, 2);
+         w.moments.run(w.points.buffer(), w.labels, params);
+       }},
+      {"subsample 1 in 4", 16 + 4,
+       [](Workspace& w) { geometry::subsample(w.context, w.cloud, 4); }},
+      {"voxel downsample 5 cm", 0,
+       [](Workspace& w) { w.downsampler.run(w.cloud, geometry::VoxelDownsampleParams{}); }},
+  };
+  return list;
+}
+
+}  // namespace kartograf::gpu_check
