@@ -8,6 +8,7 @@
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/registration/odometry.hpp"
+#include "kartograf/rooms/laser_scan_device.hpp"
 
 namespace kartograf::gpu_check {
 
@@ -16,6 +17,7 @@ Inputs load_inputs(const std::filesystem::path& data_dir, int frames) {
   inputs.vga = seven_scenes(data_dir, frames);
   inputs.hd = enlarged(inputs.vga, 1280, 720);
   inputs.random = random_frames(inputs.vga.camera, 4, 20261126);
+  inputs.map = office_map(data_dir);
   return inputs;
 }
 
@@ -73,6 +75,35 @@ void measure_operations(const compute::Context& context, const Inputs& inputs,
       results.operations.push_back(std::move(row));
     }
   }
+}
+
+// The feature-based room segmentation's ray casting: 360 beams from every 7th free cell of
+// office_e.
+void measure_laser_scan(const compute::Context& context, const OccupancyGrid& map,
+                        const Repetitions& repetitions, Results& results, std::ostream& log) {
+  const rooms::LaserScanner scanner(map);
+  rooms::DeviceLaserScanner device(context, scanner);
+  std::vector<rooms::ScanCell> cells;
+  int free_seen = 0;
+  for (int row = 0; row < map.height(); ++row) {
+    for (int col = 0; col < map.width(); ++col) {
+      if (map.cells(col, row) == CellState::free && free_seen++ % 7 == 0)
+        cells.push_back({col, row});
+    }
+  }
+  compute::Buffer<std::int32_t> steps;
+  const Samples samples = measure(context, repetitions, [&] { device.scan_steps(cells, steps); });
+  Operation op{
+      "laser scan " + std::to_string((cells.size() + 500) / 1000) + "k cells x 360", 0, {}};
+  FrameSet set;
+  set.name = "office_e";
+  set.camera.width = map.width();
+  set.camera.height = map.height();
+  OperationResult row = summarize(op, set, samples);
+  row.backend = std::string(compute::to_string(context.backend()));
+  log << "  " << row.backend << " office_e " << op.name << ": " << row.wall_ms << " ms wall, "
+      << row.device_ms << " ms device\n";
+  results.operations.push_back(std::move(row));
 }
 
 std::vector<Eigen::Isometry3d> track_sequence(const compute::Context& context, const FrameSet& set,
@@ -155,6 +186,7 @@ bool run_backend(compute::BackendKind kind, const Inputs& inputs, const Repetiti
     context->build_all_kernels();
     measure_copy(*context, repetitions, backend);
     measure_operations(*context, inputs, repetitions, results, log);
+    measure_laser_scan(*context, inputs.map, repetitions, results, log);
     measure_sequence(*context, inputs, reference, results);
   } catch (const Error& error) {
     backend.error = error.what();

@@ -16,9 +16,10 @@
 namespace kartograf::gpu_check {
 
 struct Inputs {
-  FrameSet vga;     // 7-Scenes, 640x480
-  FrameSet hd;      // the same frames enlarged to 1280x720
-  FrameSet random;  // random depth and colour, 640x480
+  FrameSet vga;       // 7-Scenes, 640x480
+  FrameSet hd;        // the same frames enlarged to 1280x720
+  FrameSet random;    // random depth and colour, 640x480
+  OccupancyGrid map;  // office_e, for the laser scans
 };
 
 Inputs load_inputs(const std::filesystem::path& data_dir, int frames);

@@ -6,10 +6,14 @@
 #include "kartograf/geometry/segment_moments.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
+#include "kartograf/registration/color_gate.hpp"
 #include "kartograf/registration/frame_pyramid.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/icp_sums.hpp"
 #include "kartograf/registration/projective_association.hpp"
+#include "kartograf/registration/voxel_hash_correspondences.hpp"
+#include "kartograf/segmentation/lab_color.hpp"
+#include "kartograf/segmentation/region_growing.hpp"
 
 namespace kartograf::gpu_check {
 
@@ -27,7 +31,10 @@ struct Workspace {
         association(context),
         engine(context),
         moments(context),
-        downsampler(context) {}
+        downsampler(context),
+        gate(context),
+        hash(context),
+        grower(context) {}
 
   const RgbdFrame& next_frame() { return frames.frames[next++ % frames.frames.size()]; }
   registration::FramePyramid& reference() { return pyramids[reference_index]; }
@@ -52,6 +59,14 @@ struct Workspace {
   geometry::SegmentMomentReducer moments;
   geometry::VoxelDownsampler downsampler;
   geometry::DeviceCloud cloud;  // level 0 of the current pyramid as an unorganized cloud
+  registration::ColorGate gate;
+  compute::Buffer<std::uint32_t> current_colors, reference_colors;  // packed, frames 1 and 0
+  compute::Buffer<std::int32_t> gated;  // a copy of the association's pairs, gated in place
+  registration::VoxelHashCorrespondences hash;
+  registration::CorrespondenceBuffers hash_out;
+  segmentation::RegionGrower grower;
+  segmentation::LabCodeImage lab;          // of frame 1
+  compute::Buffer<Point4f> frame1_points;  // frame 1 back-projected, for the region growing
 };
 
 namespace {
@@ -69,6 +84,34 @@ compute::Buffer<std::uint32_t> tile_labels(const compute::Context& context, int 
   }
   count = static_cast<std::uint32_t>(tiles_x * ((height + 15) / 16));
   return compute::Buffer<std::uint32_t>::from_host(context, labels);
+}
+
+compute::Buffer<std::uint32_t> packed_colors(const compute::Context& context, const RgbImage& rgb) {
+  std::vector<std::uint32_t> packed(rgb.size());
+  for (std::size_t i = 0; i < rgb.size(); ++i) packed[i] = pack_rgb(rgb.data()[i]);
+  return compute::Buffer<std::uint32_t>::from_host(context, packed);
+}
+
+// The view without its camera: an unorganized cloud, the voxel-hash finder's input.
+registration::CloudView unorganized(const registration::CloudView& view) {
+  registration::CloudView result = view;
+  result.camera.reset();
+  return result;
+}
+
+void gate_colours(Workspace& w) {
+  w.gated.raw().copy_from(w.association_out.target_index.raw(),
+                          w.association_out.target_index.raw().size_bytes());
+  w.gate.apply(w.current_colors, w.reference_colors, w.gated);
+}
+
+void voxel_hash_nearest(Workspace& w) {
+  const registration::CloudView target = unorganized(w.reference().level(0).view());
+  w.hash.prepare(target, 0);
+  registration::AssociationParams params;
+  params.max_distance = 0.05;
+  params.subsample = 4;
+  w.hash.find(unorganized(w.current().level(0).view()), target, kSmallMotion, params, w.hash_out);
 }
 
 void build_current(Workspace& w) {
@@ -105,6 +148,12 @@ std::shared_ptr<Workspace> make_workspace(const compute::Context& context, const
   w->cloud.points = compute::Buffer<Point4f>(context, level0.size());
   w->cloud.points.raw().copy_from(level0.raw(), level0.raw().size_bytes());
   w->associated = w->pairs();
+  w->reference_colors = packed_colors(context, frames.frames[0].color);
+  w->current_colors = packed_colors(context, frames.frames[1 % frames.frames.size()].color);
+  w->gated = compute::Buffer<std::int32_t>(context, w->association_out.target_index.size());
+  w->lab = segmentation::to_lab_codes(frames.frames[1 % frames.frames.size()].color);
+  w->frame1_points = compute::Buffer<Point4f>(context, w->points.size());
+  w->frame1_points.raw().copy_from(w->points.buffer().raw(), w->points.buffer().raw().size_bytes());
   context.finish();
   return w;
 }
@@ -141,6 +190,12 @@ const std::vector<Operation>& frame_operations() {
        [](Workspace& w) { geometry::subsample(w.context, w.cloud, 4); }},
       {"voxel downsample 5 cm", 0,
        [](Workspace& w) { w.downsampler.run(w.cloud, geometry::VoxelDownsampleParams{}); }},
+      {"colour gate (HSI)", 0, gate_colours},
+      {"voxel-hash build + nearest", 0, voxel_hash_nearest},
+      {"region growing (Lab)", 0,
+       [](Workspace& w) {
+         w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});
+       }},
   };
   return list;
 }

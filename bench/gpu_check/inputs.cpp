@@ -23,6 +23,14 @@ FrameSet seven_scenes(const std::filesystem::path& data_dir, int count) {
   return set;
 }
 
+OccupancyGrid office_map(const std::filesystem::path& data_dir) {
+  OccupancyGrid map;
+  map.cells =
+      testing::raw::read_occupancy(data_dir / "ipa_room_maps" / "test_maps" / "office_e.png.raw");
+  map.resolution = 0.05;
+  return map;
+}
+
 namespace {
 template <class Pixel>
 Image<Pixel> nearest(const Image<Pixel>& image, int width, int height) {

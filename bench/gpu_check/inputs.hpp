@@ -9,6 +9,7 @@
 
 #include "kartograf/core/color.hpp"
 #include "kartograf/core/intrinsics.hpp"
+#include "kartograf/core/occupancy_grid.hpp"
 #include "kartograf/core/point_image.hpp"
 
 namespace kartograf::gpu_check {
@@ -27,6 +28,10 @@ struct FrameSet {
 // The first `count` frames of DATA/7scenes_redkitchen/frames (frame-NNNNNN.depth.png.raw and
 // .color.jpg.raw); throws Error naming a missing file.
 FrameSet seven_scenes(const std::filesystem::path& data_dir, int count);
+
+// The ipa room map office_e (DATA/ipa_room_maps/test_maps/office_e.png.raw), 5 cm cells: the
+// laser-scan ray casting's input.
+OccupancyGrid office_map(const std::filesystem::path& data_dir);
 
 // Every frame scaled by nearest neighbour to width x height, the camera scaled with it.
 FrameSet enlarged(const FrameSet& frames, int width, int height);

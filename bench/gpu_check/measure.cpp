@@ -5,6 +5,11 @@
 
 namespace kartograf::gpu_check {
 
+namespace {
+constexpr double kSlowCallMs = 20.0;
+constexpr int kSlowCallRepetitions = 5;
+}  // namespace
+
 double median(std::vector<double> values) {
   if (values.empty()) return 0;
   const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
@@ -15,12 +20,19 @@ double median(std::vector<double> values) {
 
 Samples measure(const compute::Context& context, const Repetitions& repetitions,
                 const std::function<void()>& call) {
-  for (int i = 0; i < repetitions.warm_up; ++i) call();
+  Repetitions counts = repetitions;
+  const auto first = std::chrono::steady_clock::now();
+  call();
+  context.finish();
+  const double first_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - first).count();
+  if (first_ms > kSlowCallMs) counts = {1, std::min(repetitions.timed, kSlowCallRepetitions)};
+  for (int i = 1; i < counts.warm_up; ++i) call();
   context.finish();
   context.take_device_timings();  // the warm-up's
   Samples samples;
   const bool timestamps = context.device_info().limits.device_timestamps && !context.is_cpu();
-  for (int i = 0; i < repetitions.timed; ++i) {
+  for (int i = 0; i < counts.timed; ++i) {
     const auto start = std::chrono::steady_clock::now();
     call();
     context.finish();
