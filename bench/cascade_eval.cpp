@@ -1,6 +1,6 @@
-// Issue 7 experiment (methods.md M2 step 4): the stairs cascade on held-out synthetic views (seeds
-// from 1000000, never used in training): recall at IoU >= 0.5 and false positives per image, before
-// and after the metric size check.
+// Issue 7 experiment (docs/methods.md M2 step 4): the stairs cascade on held-out synthetic views
+// (seeds from 1000000, never used in training): recall at IoU >= 0.5 and false positives per image,
+// before and after the metric size check.
 //   kartograf_cascade_eval models/semantic/stairs_cascade.yml.gz [object views] [empty views]
 //       [min_neighbors]
 #include <chrono>

@@ -1,4 +1,4 @@
-// kartograf_m1_planar_icp: the M1 paper's registration experiment (methods.md M1 steps 5-8) on
+// kartograf_m1_planar_icp: the M1 paper's registration experiment (docs/methods.md M1 steps 5-8) on
 // real frames. Frames f0, f0 + gap, f0 + 2 gap, ... of a sequence are registered frame to frame
 // and chained twice:
 //   planar     plane extraction (segmentation/plane_extraction.hpp), N points drawn on each plane

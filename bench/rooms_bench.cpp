@@ -1,4 +1,4 @@
-// Room segmentation of the ipa_room_segmentation benchmark maps (methods.md M4), CPU:
+// Room segmentation of the ipa_room_segmentation benchmark maps (docs/methods.md M4), CPU:
 //   rooms/<method>/<map>_<variant>: rooms::segment_rooms on the map in memory (reading the PNG is
 //   outside the timing), median of 3 repetitions; counter rooms = rooms found.
 // Maps: $KARTOGRAF_DATA_DIR/ipa_room_maps/test_maps (default ../shared/data), every map with a

@@ -1,4 +1,4 @@
-// Plane extraction (methods.md M1 steps 2-4) at 640x480:
+// Plane extraction (docs/methods.md M1 steps 2-4) at 640x480:
 //   plane_extraction/<backend>/640x480: PlaneExtractor::extract with its defaults (Lab codes,
 //       tiled growing, moments, merging, pixel refinement, output), cycling through 8 frames of
 //       the synthetic robot tour; counters: the median stage times of the last run [ms], planes;

@@ -1,5 +1,5 @@
-// Issue 7 experiment (methods.md M2): the semantic grid of the synthetic world against its floor
-// plan, and "go to the door" paths checked against the true doors and obstacles.
+// Issue 7 experiment (docs/methods.md M2): the semantic grid of the synthetic world against its
+// floor plan, and "go to the door" paths checked against the true doors and obstacles.
 //   kartograf_semantic_world_eval [seed=5] [frames=300] [step=3] [width=320] [noise 0/1=1] [outdir]
 //       [survey 0/1=0]
 // TOUR_SURVEY=1 in the environment: the tour itself is a survey (TourOptions::survey);

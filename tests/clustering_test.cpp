@@ -1,4 +1,4 @@
-// The clustering baselines of methods.md M1 step 7: features (normalisation, geometric weight,
+// The clustering baselines of docs/methods.md M1 step 7: features (normalisation, geometric weight,
 // stride, pixel bookkeeping), K-Means, SOM and Fuzzy C-Means on synthetic blobs with known
 // clusters, their objectives and determinism, bad input, and a real 7-Scenes frame.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// The HSI table and the colour gate (methods.md M3 step 3) on every backend.
+// The HSI table and the colour gate (docs/methods.md M3 step 3) on every backend.
 // Stated tolerances: the table agrees with an independent formula (H = atan2(sqrt(3)(G-B),
 // 2R-G-B)) within its quantisation (|dH| <= 180/255 deg, |dS| <= 0.5/255) for all 2^24 colours;
 // gate decisions equal the quantised all-integer reference exactly (0 mismatches) on every

@@ -1,4 +1,4 @@
-// Plane fits from segment moments, merging, and the plane extraction pipeline (methods.md M1
+// Plane fits from segment moments, merging, and the plane extraction pipeline (docs/methods.md M1
 // steps 2-4): exact synthetic planes, hand-built merges, acceptance on rendered synthetic frames
 // with exact plane ids, determinism, and bad input (the PCL mOSD table-top frames, read through
 // kartograf_io: plane_extraction_mosd_test.cpp).

@@ -166,7 +166,7 @@ CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
   CLI::App* command = app.add_subcommand(
       "planes",
       "Planes of an organized PCD, an RGB-D frame (depth PNG + --color) or a sequence folder "
-      "(methods.md M1: Lab region growing, plane fits, merging)");
+      "(docs/methods.md M1: Lab region growing, plane fits, merging)");
   command->add_option("INPUT", o.input, "Organized PCD with colour, depth PNG, or sequence folder")
       ->required();
   command->add_option("--out", o.out_dir, "Output folder")->required();

@@ -142,7 +142,7 @@ std::string fixed(double value, int digits) {
 
 CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& o) {
   CLI::App* command = app.add_subcommand(
-      "rooms", "Room segmentation of a 2-D occupancy map (PNG or ROS YAML; methods.md M4)");
+      "rooms", "Room segmentation of a 2-D occupancy map (PNG or ROS YAML; docs/methods.md M4)");
   command->add_option("MAP", o.map, "Map: ipa-style PNG (free = white) or ROS map YAML")
       ->required();
   command->add_option("--out", o.out_dir, "Output folder")->required();

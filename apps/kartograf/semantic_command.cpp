@@ -1,9 +1,10 @@
-// `kartograf semantic INPUT --out DIR [--goto door|wall]`: the metric-semantic map (methods.md M2)
-// of one organized scan (PCD) or of an RGB-D sequence folder with camera poses (its ground truth,
-// or --trajectory, e.g. a SLAM run's trajectory.txt): per-pixel labels and the normals image (of
-// the scan, or of a sequence's first labelled frame), the hybrid grid (semantic.png with a legend,
-// semantic.json), a ROS costmap and occupancy map, and a path to the nearest door or along the
-// nearest wall from the sensor. Wiring only: the method lives in semantic/, the files in io/.
+// `kartograf semantic INPUT --out DIR [--goto door|wall]`: the metric-semantic map
+// (docs/methods.md M2) of one organized scan (PCD) or of an RGB-D sequence folder with camera poses
+// (its ground truth, or --trajectory, e.g. a SLAM run's trajectory.txt): per-pixel labels and the
+// normals image (of the scan, or of a sequence's first labelled frame), the hybrid grid
+// (semantic.png with a legend, semantic.json), a ROS costmap and occupancy map, and a path to the
+// nearest door or along the nearest wall from the sensor. Wiring only: the method lives in
+// semantic/, the files in io/.
 #include <cmath>
 #include <filesystem>
 #include <map>
@@ -319,7 +320,7 @@ CLI::App* add_semantic_command(CLI::App& app, SemanticOptions& o) {
   CLI::App* command = app.add_subcommand(
       "semantic",
       "Metric-semantic grid map of an organized scan or an RGB-D sequence: floor, walls, "
-      "ceiling, doors, traversability, and a path (methods.md M2)");
+      "ceiling, doors, traversability, and a path (docs/methods.md M2)");
   command
       ->add_option("INPUT", o.input,
                    "Organized PCD (a 3-D laser scan or a depth frame), an unorganized map (PCD "

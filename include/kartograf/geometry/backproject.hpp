@@ -1,7 +1,7 @@
 #pragma once
-// Depth back-projection (methods.md M1 eq. 1-2): a 16-bit depth image becomes an organized cloud
-// of float4 points (x, y, z, 1) in the camera frame, all-NaN where the depth is 0 or outside the
-// range. Every coordinate is d * k with k rounded once from double, so each is within
+// Depth back-projection (docs/methods.md M1 step 1): a 16-bit depth image becomes an organized
+// cloud of float4 points (x, y, z, 1) in the camera frame, all-NaN where the depth is 0 or outside
+// the range. Every coordinate is d * k with k rounded once from double, so each is within
 // 1.2e-7 * |coordinate| of the exact value (<= 1e-6 m up to 8 m) on every backend.
 #include <cstdint>
 #include <vector>

@@ -1,5 +1,5 @@
 #pragma once
-// Normals of an organized point image from its 4-neighbours (methods.md M2 step 1).
+// Normals of an organized point image from its 4-neighbours (docs/methods.md M2 step 1).
 //
 // Rules, identical on every backend: a neighbour is usable when it is valid and its depth differs
 // from the centre's by at most max_depth_jump * z_centre (evaluated in float). The horizontal

@@ -1,6 +1,6 @@
 #pragma once
 // Per-label moments of an organized or unorganized cloud (count, sum p, sum p p^T), the input of
-// the per-segment plane fits of methods.md M1 step 3, for up to 65,536 labels in one pass.
+// the per-segment plane fits of docs/methods.md M1 step 3, for up to 65,536 labels in one pass.
 //
 // Every point adds its terms, relative to `origin`, as 64-bit fixed-point integers with atomic
 // adds: integer sums are exact and order-independent, so every backend returns bit-identical

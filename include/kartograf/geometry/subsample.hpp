@@ -1,6 +1,6 @@
 #pragma once
 // Unorganized clouds on a device (points with optional normals and colours), and their uniform
-// 1-in-k subsampling (methods.md M3 step 1: the paper keeps 1 point in 10).
+// 1-in-k subsampling (docs/methods.md M3 step 1: the paper keeps 1 point in 10).
 //
 // Subsampling keeps points 0, k, 2k, ... (ceil(n / k) points, in order, invalid ones included):
 // the selection of registration::is_selected() for an unorganized cloud. A copy: exact on every

@@ -1,6 +1,6 @@
 #pragma once
-// The files of a semantic grid map (methods.md M2): semantic.json (the grid's geometry, the class
-// traversability weights, every object with its contour and metric description, and planned
+// The files of a semantic grid map (docs/methods.md M2): semantic.json (the grid's geometry, the
+// class traversability weights, every object with its contour and metric description, and planned
 // paths) and a ROS map_server costmap pair in raw mode (0 free .. 254 lethal, 255 unknown). Each
 // file is written whole under a temporary name and renamed: an error leaves no partial file.
 #include <cstdint>

@@ -1,6 +1,6 @@
 #pragma once
 // The map: every frame's points, moved by its pose into the world, fused into one coloured cloud
-// with normals on a voxel grid (methods.md M3 "mapping": the union of the aligned clouds, here
+// with normals on a voxel grid (docs/methods.md M3 step 5: the union of the aligned clouds, here
 // voxel-downsampled so that it does not grow with the number of frames).
 //
 // Each voxel (the grid of geometry/voxel_downsample.hpp: floor(p / voxel_size), a 2^20-cell range

@@ -1,6 +1,6 @@
 #pragma once
-// The planes of a whole map, pooled from the planes extracted in many views (methods.md M1 on each
-// view, segmentation/plane_extraction.hpp): a view's plane joins a map plane with the same
+// The planes of a whole map, pooled from the planes extracted in many views (docs/methods.md M1 on
+// each view, segmentation/plane_extraction.hpp): a view's plane joins a map plane with the same
 // orientation and offset whose points it touches, else it starts one. Map planes keep their
 // points' moments (for a total-least-squares fit of everything they gathered), a thinned copy of
 // the points (for their extent) and the votes of the points' semantic classes.

@@ -1,7 +1,7 @@
 #pragma once
-// The RGB-D SLAM pipeline (methods.md M3 and the paper's future work): odometry with the paper's
-// k-back drift reduction, loop closure between keyframes, a pose graph over every frame, and a
-// fused map. Wiring only: the parts are registration/odometry.hpp, mapping/loop_closure.hpp,
+// The RGB-D SLAM pipeline (docs/methods.md M3 and the paper's future work): odometry with the
+// paper's k-back drift reduction, loop closure between keyframes, a pose graph over every frame,
+// and a fused map. Wiring only: the parts are registration/odometry.hpp, mapping/loop_closure.hpp,
 // mapping/pose_graph.hpp and mapping/map_fusion.hpp; frames come through a FrameSource, read one
 // ahead on a second thread.
 //

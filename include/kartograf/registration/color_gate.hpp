@@ -1,5 +1,5 @@
 #pragma once
-// Pair rejection by colour (methods.md M3 step 3): compare the hue and saturation (hsi.hpp) of
+// Pair rejection by colour (docs/methods.md M3 step 3): compare the hue and saturation (hsi.hpp) of
 // the two points of every correspondence, and reject the pairs whose difference exceeds the mean
 // difference over all pairs. Illumination-robust: intensity is ignored.
 //

@@ -1,6 +1,6 @@
 #pragma once
-// Hue and saturation of the HSI colour model (methods.md M3 step 3; paper eq. 1-3), exactly and
-// through the paper's lookup table of all 2^24 RGB values. Intensity is not used: H and S stay
+// Hue and saturation of the HSI colour model (docs/methods.md M3 step 3; paper eq. 1-3), exactly
+// and through the paper's lookup table of all 2^24 RGB values. Intensity is not used: H and S stay
 // stable when the illumination changes, which is why the colour gate (color_gate.hpp) uses them.
 //
 // Formulas, for 8-bit R, G, B:

@@ -1,5 +1,5 @@
 #pragma once
-// The ICP engine (methods.md M3): one coarse-to-fine loop whose parts are swapped, not copied.
+// The ICP engine (docs/methods.md M3): one coarse-to-fine loop whose parts are swapped, not copied.
 //
 //   correspondences  a CorrespondenceFinder (correspondence_finder.hpp); default: projective
 //                    association for organized frames (projective_association.hpp)

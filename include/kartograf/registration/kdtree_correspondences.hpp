@@ -1,9 +1,9 @@
 #pragma once
-// Nearest-neighbour correspondences for unorganized clouds with a k-d tree (methods.md M3 step 2;
-// the paper used ANN, this uses nanoflann): the tree is built once per target cloud on the host
-// and queried with the moved source points. CPU only; on a device context the finder downloads
-// the clouds and uploads the correspondences (voxel_hash_correspondences.hpp searches on the
-// device).
+// Nearest-neighbour correspondences for unorganized clouds with a k-d tree
+// (docs/methods.md M3 step 2; the paper used ANN, this uses nanoflann): the tree is built once per
+// target cloud on the host and queried with the moved source points. CPU only; on a device context
+// the finder downloads the clouds and uploads the correspondences (voxel_hash_correspondences.hpp
+// searches on the device).
 //
 // Rules, shared with VoxelHashCorrespondences (identical results): for source point i,
 // not is_selected(i, source width or 0, subsample) -> kNotSelected; an invalid p (or, with the

@@ -1,5 +1,5 @@
 #pragma once
-// Frame-to-frame RGB-D odometry (methods.md M3 "localisation") with the M3 paper's drift
+// Frame-to-frame RGB-D odometry (docs/methods.md M3 steps 1-4, 6) with the M3 paper's drift
 // reduction, degeneracy handling, motion-model fallbacks and keyframe selection.
 //
 // Each new frame n becomes a FramePyramid and is registered by the ICP engine against frame n-1,

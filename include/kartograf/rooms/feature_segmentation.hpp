@@ -1,5 +1,5 @@
 #pragma once
-// Feature-based room segmentation (methods.md M4 step 4; R. Bormann et al., ICRA 2016, after
+// Feature-based room segmentation (docs/methods.md M4 step 4; R. Bormann et al., ICRA 2016, after
 // O. Martinez Mozos et al.): an AdaBoost classifier labels the free cells room or hallway from the
 // features of a laser scan simulated there (laser_features.hpp); every connected region of
 // same-label cells whose area lies within the limits becomes a room, and the rooms grow over the

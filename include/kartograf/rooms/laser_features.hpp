@@ -1,7 +1,7 @@
 #pragma once
 // Simulated laser scans in an occupancy grid and the geometric scan features of O. Martinez Mozos
 // et al. ("Supervised semantic labeling of places using information extracted from sensor data",
-// RAS 2007) that the feature-based room segmentation classifies (methods.md M4 step 4; the
+// RAS 2007) that the feature-based room segmentation classifies (docs/methods.md M4 step 4; the
 // reference, ipa_room_segmentation's features.cpp, computes 23 of them; we add 4 more that are
 // cheap: compactness, shortest and longest beam, offset of the scan area's centroid).
 //

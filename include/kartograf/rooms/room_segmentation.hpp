@@ -1,5 +1,5 @@
 #pragma once
-// Room segmentation of 2-D occupancy maps (methods.md M4): what every method returns, and the
+// Room segmentation of 2-D occupancy maps (docs/methods.md M4): what every method returns, and the
 // steps they share. A method labels the map's free cells with rooms 1..n (0: no room, e.g. walls,
 // unknown space, free cells no room reaches); describe_rooms() measures the rooms.
 #include <chrono>

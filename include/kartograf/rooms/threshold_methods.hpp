@@ -1,5 +1,5 @@
 #pragma once
-// The two threshold-sweep methods of the room segmentation survey (methods.md M4 steps 1-2;
+// The two threshold-sweep methods of the room segmentation survey (docs/methods.md M4 steps 1-2;
 // R. Bormann et al., ICRA 2016), each followed by growing the rooms over the rest of the free
 // space (grow_rooms).
 //

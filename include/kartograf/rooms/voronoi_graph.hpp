@@ -1,8 +1,8 @@
 #pragma once
-// The generalised Voronoi graph of a map's free space and its critical lines (methods.md M4 step 3;
-// R. Bormann et al., "Room Segmentation: Survey, Implementation, and Analysis", ICRA 2016, and
-// ipa_room_segmentation's VoronoiSegmentation). Shared by the Voronoi segmentation and the
-// Voronoi random field method.
+// The generalised Voronoi graph of a map's free space and its critical lines
+// (docs/methods.md M4 step 3; R. Bormann et al., "Room Segmentation: Survey, Implementation, and
+// Analysis", ICRA 2016, and ipa_room_segmentation's VoronoiSegmentation). Shared by the Voronoi
+// segmentation and the Voronoi random field method.
 //
 // 1. Clearance: the exact Euclidean distance of every free cell to the nearest cell that is not
 //    free (cells outside the map count as obstacles), with that nearest obstacle cell.

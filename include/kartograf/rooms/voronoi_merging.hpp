@@ -1,5 +1,5 @@
 #pragma once
-// The merging heuristics of the Voronoi segmentation (methods.md M4 step 3; R. Bormann et al.,
+// The merging heuristics of the Voronoi segmentation (docs/methods.md M4 step 3; R. Bormann et al.,
 // ICRA 2016, and ipa_room_segmentation's AbstractVoronoiSegmentation::mergeRooms, whose exact
 // conditions these are).
 //

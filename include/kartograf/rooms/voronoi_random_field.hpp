@@ -1,9 +1,9 @@
 #pragma once
-// Voronoi random field room segmentation (methods.md M4 step 5; S. Friedman, H. Pasula, D. Fox,
-// "Voronoi Random Fields: Extracting the Topological Structure of Indoor Environments via Place
-// Labeling", IJCAI 2007; ipa_room_segmentation's VoronoiRandomFieldSegmentation, which the survey
-// reports never finishing). A conditional random field over points of the Voronoi graph labels
-// each point room, hallway or doorway; the doorways cut the free space into rooms.
+// Voronoi random field room segmentation (docs/methods.md M4 step 5; S. Friedman, H. Pasula,
+// D. Fox, "Voronoi Random Fields: Extracting the Topological Structure of Indoor Environments via
+// Place Labeling", IJCAI 2007; ipa_room_segmentation's VoronoiRandomFieldSegmentation, which the
+// survey reports never finishing). A conditional random field over points of the Voronoi graph
+// labels each point room, hallway or doorway; the doorways cut the free space into rooms.
 //
 // 1. Nodes (vrf_node_graph): the pruned Voronoi graph of the map without furniture
 //    (voronoi_graph.hpp, furniture.hpp). Its branch points, end points and critical points (all

@@ -1,5 +1,5 @@
 #pragma once
-// The Voronoi graph room segmentation of the survey (methods.md M4 step 3; R. Bormann et al.,
+// The Voronoi graph room segmentation of the survey (docs/methods.md M4 step 3; R. Bormann et al.,
 // ICRA 2016; ipa_room_segmentation's VoronoiSegmentation):
 // 1. the pruned generalised Voronoi graph of the free space and its critical lines
 //    (voronoi_graph.hpp);

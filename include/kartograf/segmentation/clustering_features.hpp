@@ -1,6 +1,6 @@
 #pragma once
-// The clustering baselines of methods.md M1 step 7 (K-Means, SOM, Fuzzy C-Means) all cluster the
-// same 6-D per-pixel features (x, y, z, R, G, B): each column min-max normalised to [0, 1] over
+// The clustering baselines of docs/methods.md M1 step 7 (K-Means, SOM, Fuzzy C-Means) all cluster
+// the same 6-D per-pixel features (x, y, z, R, G, B): each column min-max normalised to [0, 1] over
 // the frame's valid pixels, the geometric columns then multiplied by a constant weight so that
 // position counts more than colour (the paper: "a constant weight greater than one"). This header
 // builds those features, holds what every method returns, and turns a result into a label image.

@@ -1,7 +1,7 @@
 #pragma once
-// Fuzzy C-Means segmentation baseline (methods.md M1 step 7): alternating membership and centre
-// updates on the 6-D clustering features from k-means++ seeds, hard labels by largest membership
-// (which is the nearest centre).
+// Fuzzy C-Means segmentation baseline (docs/methods.md M1 step 7): alternating membership and
+// centre updates on the 6-D clustering features from k-means++ seeds, hard labels by largest
+// membership (which is the nearest centre).
 #include <cstdint>
 
 #include "kartograf/segmentation/clustering_features.hpp"

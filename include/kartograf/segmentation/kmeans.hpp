@@ -1,5 +1,5 @@
 #pragma once
-// K-Means segmentation baseline (methods.md M1 step 7): Lloyd iterations on the 6-D clustering
+// K-Means segmentation baseline (docs/methods.md M1 step 7): Lloyd iterations on the 6-D clustering
 // features from k-means++ seeds drawn with a seeded generator, so a run is reproducible.
 #include <cstdint>
 

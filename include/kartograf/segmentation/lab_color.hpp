@@ -1,5 +1,5 @@
 #pragma once
-// CIE-Lab colour (D65 white, sRGB input): the colour space in which methods.md M1 step 2 grows
+// CIE-Lab colour (D65 white, sRGB input): the colour space in which docs/methods.md M1 step 2 grows
 // regions, because Euclidean distance there roughly follows perceived colour difference.
 #include <array>
 #include <cstdint>

@@ -1,5 +1,5 @@
 #pragma once
-// Plane extraction from one organized RGB-D frame, methods.md M1 steps 2-4: Lab region growing
+// Plane extraction from one organized RGB-D frame, docs/methods.md M1 steps 2-4: Lab region growing
 // (over-segmentation), per-segment moments on the context's backend and plane fits, merging of
 // neighbouring segments, and the output planes with a per-pixel plane id image.
 #include <cstdint>
@@ -72,11 +72,11 @@ struct PlaneSet {
   PlaneExtractionTimings timings;
 };
 
-// One plane per segment of any segmentation (e.g. the clustering baselines of methods.md M1 step
-// 7): the total-least-squares fit of its points (fit_plane); segments without a valid fit or with
-// fewer than min_pixels points get no plane. Plane ids follow the segment order; the label image
-// gives each pixel its segment's plane (0: none). Throws Error on a size mismatch or a label >=
-// segment_count.
+// One plane per segment of any segmentation (e.g. the clustering baselines of
+// docs/methods.md M1 step 7): the total-least-squares fit of its points (fit_plane); segments
+// without a valid fit or with fewer than min_pixels points get no plane. Plane ids follow the
+// segment order; the label image gives each pixel its segment's plane (0: none). Throws Error on a
+// size mismatch or a label >= segment_count.
 PlaneSet fit_segment_planes(const PointImage& points, const SegmentLabelImage& segments,
                             std::uint32_t segment_count, std::uint64_t min_pixels = 3);
 

@@ -1,8 +1,8 @@
 #pragma once
-// Plane fits per segment from its moments (methods.md M1 step 3). The default is the total-least-
-// squares plane (through the centroid, normal = eigenvector of the covariance with the smallest
-// eigenvalue), which handles every orientation; the paper's eq. 6 (z = A x + B y + C, singular
-// for planes parallel to the z axis) is kept as an option. The moments are accumulated by
+// Plane fits per segment from its moments (docs/methods.md M1 step 3). The default is the
+// total-least-squares plane (through the centroid, normal = eigenvector of the covariance with the
+// smallest eigenvalue), which handles every orientation; the paper's eq. 6 (z = A x + B y + C,
+// singular for planes parallel to the z axis) is kept as an option. The moments are accumulated by
 // geometry::SegmentMomentReducer, so on Vulkan/OpenCL they are summed on the device.
 #include <cstdint>
 #include <span>

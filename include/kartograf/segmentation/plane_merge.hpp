@@ -1,8 +1,8 @@
 #pragma once
-// Merging neighbouring segments into planes (methods.md M1 step 4). Like the paper, merging grows
-// over segments with a stack: the largest unmerged segment that may seed a plane starts one, and
-// its neighbours join while they pass the tests against the plane merged so far, which is re-fitted
-// from the summed moments (moments are additive) as it grows. The tests:
+// Merging neighbouring segments into planes (docs/methods.md M1 step 4). Like the paper, merging
+// grows over segments with a stack: the largest unmerged segment that may seed a plane starts one,
+// and its neighbours join while they pass the tests against the plane merged so far, which is
+// re-fitted from the summed moments (moments are additive) as it grows. The tests:
 //  - normal angle (the paper's): for segments large enough to have a normal, the angle to the
 //    merged plane's normal is below max_normal_angle_deg, widened by the normal's uncertainty
 //    (normal_uncertainty_deg: a narrow strip, or a slanted far surface that the sensor's depth

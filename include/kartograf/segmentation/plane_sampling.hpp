@@ -1,6 +1,6 @@
 #pragma once
-// Point generation on extracted planes (methods.md M1 step 5, the paper's eq. 8-10): every pixel
-// of a plane is projected onto it, P' = P - (n . P + offset) n (eq. 8-9 with |n| = 1), and
+// Point generation on extracted planes (docs/methods.md M1 step 5, the paper's eq. 8-10): every
+// pixel of a plane is projected onto it, P' = P - (n . P + offset) n (eq. 8-9 with |n| = 1), and
 // points_per_plane of them (all when fewer) are drawn at random without replacement. ICP on these
 // few points per plane (M1 step 6) replaces ICP on every point of the frame.
 #include <cstddef>

@@ -1,5 +1,5 @@
 #pragma once
-// Over-segmentation by region growing in CIE-Lab, methods.md M1 step 2: pixels are scanned in
+// Over-segmentation by region growing in CIE-Lab, docs/methods.md M1 step 2: pixels are scanned in
 // order; each unlabelled valid pixel seeds a segment grown with an explicit stack over
 // 8-neighbours, accepting a pixel while its Lab distance to the segment's running mean colour
 // (paper eq. 5) stays under a threshold.

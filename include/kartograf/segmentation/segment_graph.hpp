@@ -1,7 +1,7 @@
 #pragma once
-// The neighbourhood of segments that plane merging walks (methods.md M1 step 4): which segments
-// touch (some pixel of one among the 8 neighbours of a pixel of the other), or, as the M1 paper
-// tests it, whose bounding rectangles overlap.
+// The neighbourhood of segments that plane merging walks (docs/methods.md M1 step 4): which
+// segments touch (some pixel of one among the 8 neighbours of a pixel of the other), or, as the M1
+// paper tests it, whose bounding rectangles overlap.
 #include <cstdint>
 #include <span>
 #include <vector>

@@ -1,8 +1,8 @@
 #pragma once
-// Self-Organizing Map segmentation baseline (methods.md M1 step 7; the paper gives the number of
-// neurons, 30/60/90): k nodes on a 1-D or 2-D grid trained online on the 6-D clustering features,
-// the learning rate and the Gaussian neighbourhood radius decaying geometrically over the epochs;
-// each feature is then labelled with its best-matching node.
+// Self-Organizing Map segmentation baseline (docs/methods.md M1 step 7; the paper gives the number
+// of neurons, 30/60/90): k nodes on a 1-D or 2-D grid trained online on the 6-D clustering
+// features, the learning rate and the Gaussian neighbourhood radius decaying geometrically over the
+// epochs; each feature is then labelled with its best-matching node.
 #include <cstdint>
 
 #include "kartograf/segmentation/clustering_features.hpp"

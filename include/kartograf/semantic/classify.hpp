@@ -1,6 +1,7 @@
 #pragma once
-// Rule-based classification of regions into floor, wall, ceiling, door or unknown (methods.md M2
-// step 3), and the whole pipeline from an organized point image to a SemanticImage.
+// Rule-based classification of regions into floor, wall, ceiling, door or unknown
+// (docs/methods.md M2 step 3), and the whole pipeline from an organized point image to a
+// SemanticImage.
 //
 // Rules (defaults are the paper's values where it gives them):
 //  - floor: horizontal, facing up, within floor_tolerance of the floor height (the lowest large

@@ -1,5 +1,5 @@
 #pragma once
-// Gravity ("up") estimated from the data (methods.md M2 step 3), not assumed from the sensor's
+// Gravity ("up") estimated from the data (docs/methods.md M2 step 3), not assumed from the sensor's
 // mounting, so that it works for RGB-D frames (camera y roughly down) and for laser scans in any
 // frame.
 //

@@ -1,7 +1,7 @@
 #pragma once
-// Ground texture classes for outdoor traversability (methods.md M2 step 5): a patch of coloured
-// ground points is pavement (flat, uniform colour: preferred), grass (bumpy by a few cm, green,
-// textured: traversable but avoided) or inaccessible (steep, steps, rubble, obstacles).
+// Ground texture classes for outdoor traversability (docs/methods.md M2 step 5): a patch of
+// coloured ground points is pavement (flat, uniform colour: preferred), grass (bumpy by a few cm,
+// green, textured: traversable but avoided) or inaccessible (steep, steps, rubble, obstacles).
 //
 // Gravity is known: z is up. The features are height statistics after removing the patch's
 // best-fit plane, the plane's slope, CIE-Lab colour statistics, colour uniformity and green-ness
@@ -27,8 +27,8 @@ inline constexpr int kGroundClassCount = 3;
 
 std::string_view to_string(GroundClass ground);
 
-// Traversability weight in [0, 1] per class (methods.md M2: pavement 1.0, grass avoided 0.5,
-// inaccessible 0.0).
+// Traversability weight in [0, 1] per class (docs/methods.md M2 step 5: pavement 1.0, grass avoided
+// 0.5, inaccessible 0.0).
 double default_traversability(GroundClass ground);
 
 // The feature vector, in this order (units in brackets).

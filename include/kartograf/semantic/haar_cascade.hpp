@@ -1,8 +1,8 @@
 #pragma once
 // Object detection on the grey normals image with a boosted cascade of Haar-like features
-// (methods.md M2 step 4; P. Viola, M. Jones, "Rapid Object Detection using a Boosted Cascade of
-// Simple Features", CVPR 2001). Debian's OpenCV ships the detector but not opencv_traincascade, so
-// Kartograf has its own: features on integral images, stages of gentle-AdaBoost decision stumps
+// (docs/methods.md M2 step 4; P. Viola, M. Jones, "Rapid Object Detection using a Boosted Cascade
+// of Simple Features", CVPR 2001). Debian's OpenCV ships the detector but not opencv_traincascade,
+// so Kartograf has its own: features on integral images, stages of gentle-AdaBoost decision stumps
 // (cascade_training.hpp), a sliding-window multi-scale detector, clustering of overlapping
 // windows, and a metric size check of each detection on the organized points under it.
 //

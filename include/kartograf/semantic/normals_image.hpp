@@ -1,7 +1,7 @@
 #pragma once
-// The normals image of method M2 (methods.md M2 step 1): the normal of every pixel of an organized
-// point image (an RGB-D frame back-projected, or an organized laser scan) stored as an RGB raster,
-// one colour channel per normal component.
+// The normals image of method M2 (docs/methods.md M2 step 1): the normal of every pixel of an
+// organized point image (an RGB-D frame back-projected, or an organized laser scan) stored as an
+// RGB raster, one colour channel per normal component.
 //
 // Normals come from geometry::estimate_normals, so they run on every backend. Two things make the
 // same call work for laser scans, whose frame has z up rather than z along the view:
@@ -66,7 +66,7 @@ enum class NormalEncoding : std::uint8_t {
 RgbImage normals_to_rgb(const NormalImage& normals, NormalEncoding encoding);
 
 // Grey (ITU-R BT.601 luma, rounded) of an encoded normals image: the input of cascade detection
-// (methods.md M2 step 4).
+// (docs/methods.md M2 step 4).
 GrayImage normals_rgb_to_gray(const RgbImage& normals_rgb);
 
 }  // namespace kartograf::semantic

@@ -1,6 +1,6 @@
 #pragma once
-// Segmentation of an organized point image into smooth surface regions (methods.md M2 step 2) and
-// their 3-D measurements.
+// Segmentation of an organized point image into smooth surface regions (docs/methods.md M2 step 2)
+// and their 3-D measurements.
 //
 // Region growing (flood fill, 4-neighbours, seeds in raster order): a pixel joins the region of a
 // neighbour (the nearest pixel with a point in each of the 4 directions, across at most

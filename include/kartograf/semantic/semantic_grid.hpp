@@ -1,7 +1,7 @@
 #pragma once
-// The hybrid metric-semantic grid of method M2 (methods.md; Siemiatkowska et al.): a 2-D grid in
-// which every cell holds the objects over it (label, outline in metres, height range, area) and a
-// traversability weight in [0, 1] (floor 1, obstacles 0, doors 0.7: "slow near doors").
+// The hybrid metric-semantic grid of method M2 (docs/methods.md M2; Siemiatkowska et al.): a 2-D
+// grid in which every cell holds the objects over it (label, outline in metres, height range, area)
+// and a traversability weight in [0, 1] (floor 1, obstacles 0, doors 0.7: "slow near doors").
 //
 // Input: labelled 3-D points in a gravity-aligned world frame (metres, z up), e.g. frames
 // back-projected with their pose and per-pixel classes, plus optional object detections. A cell

@@ -1,5 +1,5 @@
 #pragma once
-// Synthetic training and test views for the Haar cascade (methods.md M2 step 4): a room corner
+// Synthetic training and test views for the Haar cascade (docs/methods.md M2 step 4): a room corner
 // (floor, back wall, side walls, ceiling) with random furniture-like boxes and, optionally, a
 // flight of 3-5 steps against the back wall, ray cast (synth::RayCaster) by a pinhole camera at a
 // random place, height, yaw and pitch, with range noise; then the grey normals image
