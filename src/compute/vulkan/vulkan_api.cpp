@@ -119,6 +119,22 @@ std::shared_ptr<VulkanInstance> VulkanInstance::create(bool want_validation) {
   return slot;
 }
 
+namespace {
+// Warnings and errors of every kind go to on_validation_message, which counts the errors of `owner`.
+VkDebugUtilsMessengerCreateInfoEXT messenger_create_info(VulkanInstance* owner) {
+  VkDebugUtilsMessengerCreateInfoEXT info{};
+  info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
+  info.messageSeverity =
+      VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT | VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
+  info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
+                     VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
+  info.pfnUserCallback = on_validation_message;
+  info.pUserData = owner;
+  return info;
+}
+}  // namespace
+
 std::shared_ptr<VulkanInstance> VulkanInstance::create_new(bool want_validation) {
   const GlobalApi& api = global_api();
   if (!api.error.empty()) throw Error(api.error);
@@ -155,15 +171,7 @@ std::shared_ptr<VulkanInstance> VulkanInstance::create_new(bool want_validation)
   validation_features.enabledValidationFeatureCount = 1;
   validation_features.pEnabledValidationFeatures = enables;
 
-  VkDebugUtilsMessengerCreateInfoEXT messenger_info{};
-  messenger_info.sType = VK_STRUCTURE_TYPE_DEBUG_UTILS_MESSENGER_CREATE_INFO_EXT;
-  messenger_info.messageSeverity = VK_DEBUG_UTILS_MESSAGE_SEVERITY_WARNING_BIT_EXT |
-                                   VK_DEBUG_UTILS_MESSAGE_SEVERITY_ERROR_BIT_EXT;
-  messenger_info.messageType = VK_DEBUG_UTILS_MESSAGE_TYPE_GENERAL_BIT_EXT |
-                               VK_DEBUG_UTILS_MESSAGE_TYPE_VALIDATION_BIT_EXT |
-                               VK_DEBUG_UTILS_MESSAGE_TYPE_PERFORMANCE_BIT_EXT;
-  messenger_info.pfnUserCallback = on_validation_message;
-  messenger_info.pUserData = result.get();
+  VkDebugUtilsMessengerCreateInfoEXT messenger_info = messenger_create_info(result.get());
   if (features) messenger_info.pNext = &validation_features;
 
   VkInstanceCreateInfo info{};
