@@ -157,6 +157,32 @@ void fill_colours(const std::vector<Eigen::Vector4d>& sums, std::vector<Eigen::V
   }
 }
 
+// Each chunk of tiles numbered its segments from 0: shift them by the segments of the chunks before,
+// so that the labels are those of one sequential scan. Returns the segment count.
+std::uint32_t number_chunks_in_scan_order(const std::uint32_t* chunk_counts, std::uint32_t* labels,
+                                          int width, int height, int tile, std::size_t tile_count) {
+  const int tiles_x = (width + tile - 1) / tile;
+  std::uint32_t total = 0;
+  for (std::size_t chunk = 0; chunk < compute::detail::kCpuChunks; ++chunk) {
+    const std::uint32_t offset = total;
+    total += chunk_counts[chunk];
+    if (offset == 0 || chunk_counts[chunk] == 0) continue;
+    const std::size_t begin = tile_count * chunk / compute::detail::kCpuChunks;
+    const std::size_t end = tile_count * (chunk + 1) / compute::detail::kCpuChunks;
+    for (std::size_t t = begin; t < end; ++t) {
+      const int x0 = static_cast<int>(t % tiles_x) * tile;
+      const int y0 = static_cast<int>(t / tiles_x) * tile;
+      for (int y = y0; y < std::min(height, y0 + tile); ++y) {
+        std::uint32_t* row = labels + static_cast<std::size_t>(y) * width;
+        for (int x = x0; x < std::min(width, x0 + tile); ++x) {
+          if (row[x] != kNoLabel) row[x] += offset;
+        }
+      }
+    }
+  }
+  return total;
+}
+
 std::uint32_t grow_on_host(const LabCode* lab, const Point4f* points, int width, int height,
                            const RegionGrowingParams& params, std::uint32_t* labels,
                            SegmentStatistics* statistics, const Eigen::Vector3d* moments_origin) {
@@ -177,8 +203,7 @@ std::uint32_t grow_on_host(const LabCode* lab, const Point4f* points, int width,
   const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * tiles_y;
   // (T n)^2 < 2^63 for T <= 64000 codes and n <= 4096 pixels.
   const bool narrow = static_cast<std::int64_t>(tile) * tile <= 4096;
-  // Contiguous runs of tiles per chunk, numbered from 0 within the chunk; then shifted by the
-  // segments of the chunks before (so the labels are those of one sequential scan).
+  // Contiguous runs of tiles per chunk, numbered from 0 within the chunk (then put in scan order).
   std::uint32_t chunk_counts[compute::detail::kCpuChunks] = {};
   GrowOutput chunk_outputs[compute::detail::kCpuChunks];
   compute::detail::for_each_chunk(
@@ -210,24 +235,8 @@ std::uint32_t grow_on_host(const LabCode* lab, const Point4f* points, int width,
         }
         chunk_counts[chunk] = count;
       });
-  std::uint32_t total = 0;
-  for (std::size_t chunk = 0; chunk < compute::detail::kCpuChunks; ++chunk) {
-    const std::uint32_t offset = total;
-    total += chunk_counts[chunk];
-    if (offset == 0 || chunk_counts[chunk] == 0) continue;
-    const std::size_t begin = tile_count * chunk / compute::detail::kCpuChunks;
-    const std::size_t end = tile_count * (chunk + 1) / compute::detail::kCpuChunks;
-    for (std::size_t t = begin; t < end; ++t) {
-      const int x0 = static_cast<int>(t % tiles_x) * tile;
-      const int y0 = static_cast<int>(t / tiles_x) * tile;
-      for (int y = y0; y < std::min(height, y0 + tile); ++y) {
-        std::uint32_t* row = labels + static_cast<std::size_t>(y) * width;
-        for (int x = x0; x < std::min(width, x0 + tile); ++x) {
-          if (row[x] != kNoLabel) row[x] += offset;
-        }
-      }
-    }
-  }
+  const std::uint32_t total =
+      number_chunks_in_scan_order(chunk_counts, labels, width, height, tile, tile_count);
   if (statistics) {
     std::vector<Eigen::Vector4d> sums;
     sums.reserve(total);
