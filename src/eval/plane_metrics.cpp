@@ -28,6 +28,54 @@ void check_normals(const PlaneNormals& normals, const char* side) {
   }
 }
 
+enum class Side { ground_truth, predicted };
+
+// Over-segmentations (whole = the ground truth) or under-segmentations (whole = the prediction):
+// remaining regions of `whole` that two or more remaining regions of the other side fill, each
+// lying (T of it) inside, together T of the whole. Marks them and their parts done; returns how
+// many there are. Cells are sorted by ground-truth region.
+int count_split_regions(const LabelOverlap& overlap, Side whole, double t,
+                        std::vector<bool>& gt_done, std::vector<bool>& predicted_done) {
+  const bool gt_whole = whole == Side::ground_truth;
+  const auto& wholes = gt_whole ? overlap.ground_truth : overlap.predicted;
+  const auto& parts = gt_whole ? overlap.predicted : overlap.ground_truth;
+  std::vector<bool>& whole_done = gt_whole ? gt_done : predicted_done;
+  std::vector<bool>& part_done = gt_whole ? predicted_done : gt_done;
+  const auto whole_of = [&](const LabelOverlap::Cell& c) {
+    return gt_whole ? c.ground_truth : c.predicted;
+  };
+  const auto part_of = [&](const LabelOverlap::Cell& c) {
+    return gt_whole ? c.predicted : c.ground_truth;
+  };
+  const auto contains_t_of = [t](std::int64_t part, std::int64_t all) {
+    return static_cast<double>(part) >= t * static_cast<double>(all);
+  };
+  std::vector<std::int64_t> inside_sum(wholes.size(), 0);
+  std::vector<int> inside_count(wholes.size(), 0);
+  for (const LabelOverlap::Cell& cell : overlap.cells) {
+    if (whole_done[whole_of(cell)] || part_done[part_of(cell)]) continue;
+    if (!contains_t_of(cell.pixels, parts[part_of(cell)].pixels)) continue;
+    inside_sum[whole_of(cell)] += cell.pixels;
+    ++inside_count[whole_of(cell)];
+  }
+  std::vector<bool> split(wholes.size(), false);
+  for (std::size_t w = 0; w < wholes.size(); ++w) {
+    split[w] =
+        !whole_done[w] && inside_count[w] >= 2 && contains_t_of(inside_sum[w], wholes[w].pixels);
+  }
+  for (const LabelOverlap::Cell& cell : overlap.cells) {
+    if (!split[whole_of(cell)] || part_done[part_of(cell)]) continue;
+    if (contains_t_of(cell.pixels, parts[part_of(cell)].pixels)) part_done[part_of(cell)] = true;
+  }
+  int count = 0;
+  for (std::size_t w = 0; w < wholes.size(); ++w) {
+    if (!split[w]) continue;
+    whole_done[w] = true;
+    ++count;
+  }
+  return count;
+}
+
 }  // namespace
 
 SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
@@ -59,59 +107,10 @@ SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
   }
   result.correct = static_cast<int>(result.correct_pairs.size());
 
-  // Over-segmentations: per remaining ground-truth region, the remaining predicted regions that
-  // lie (T of them) inside it; cells are sorted by ground-truth region, so each is one run.
-  std::vector<std::int64_t> inside_sum(m_count, 0);
-  std::vector<int> inside_count(m_count, 0);
-  for (const LabelOverlap::Cell& cell : overlap.cells) {
-    if (gt_done[cell.ground_truth] || predicted_done[cell.predicted]) continue;
-    if (!contains_t_of(cell.pixels, overlap.predicted[cell.predicted].pixels)) continue;
-    inside_sum[cell.ground_truth] += cell.pixels;
-    ++inside_count[cell.ground_truth];
-  }
-  std::vector<bool> over(m_count, false);
-  for (std::size_t m = 0; m < m_count; ++m) {
-    over[m] = !gt_done[m] && inside_count[m] >= 2 &&
-              contains_t_of(inside_sum[m], overlap.ground_truth[m].pixels);
-  }
-  for (const LabelOverlap::Cell& cell : overlap.cells) {
-    if (!over[cell.ground_truth] || predicted_done[cell.predicted]) continue;
-    if (contains_t_of(cell.pixels, overlap.predicted[cell.predicted].pixels)) {
-      predicted_done[cell.predicted] = true;
-    }
-  }
-  for (std::size_t m = 0; m < m_count; ++m) {
-    if (!over[m]) continue;
-    gt_done[m] = true;
-    ++result.over_segmented;
-  }
-
-  // Under-segmentations: per remaining predicted region, the remaining ground-truth regions that
-  // lie (T of them) inside it.
-  std::vector<std::int64_t> covered_sum(n_count, 0);
-  std::vector<int> covered_count(n_count, 0);
-  for (const LabelOverlap::Cell& cell : overlap.cells) {
-    if (gt_done[cell.ground_truth] || predicted_done[cell.predicted]) continue;
-    if (!contains_t_of(cell.pixels, overlap.ground_truth[cell.ground_truth].pixels)) continue;
-    covered_sum[cell.predicted] += cell.pixels;
-    ++covered_count[cell.predicted];
-  }
-  std::vector<bool> under(n_count, false);
-  for (std::size_t n = 0; n < n_count; ++n) {
-    under[n] = !predicted_done[n] && covered_count[n] >= 2 &&
-               contains_t_of(covered_sum[n], overlap.predicted[n].pixels);
-  }
-  for (const LabelOverlap::Cell& cell : overlap.cells) {
-    if (!under[cell.predicted] || gt_done[cell.ground_truth]) continue;
-    if (contains_t_of(cell.pixels, overlap.ground_truth[cell.ground_truth].pixels)) {
-      gt_done[cell.ground_truth] = true;
-    }
-  }
-  for (std::size_t n = 0; n < n_count; ++n) {
-    if (!under[n]) continue;
-    predicted_done[n] = true;
-    ++result.under_segmented;
-  }
+  result.over_segmented =
+      count_split_regions(overlap, Side::ground_truth, t, gt_done, predicted_done);
+  result.under_segmented =
+      count_split_regions(overlap, Side::predicted, t, gt_done, predicted_done);
 
   result.missed = static_cast<int>(std::count(gt_done.begin(), gt_done.end(), false));
   result.noise = static_cast<int>(std::count(predicted_done.begin(), predicted_done.end(), false));
