@@ -227,14 +227,12 @@ VrfTrainingMap vrf_training_map(std::string name, const Image<std::uint8_t>& dra
   return result;
 }
 
-VrfModel VrfModel::train(const std::vector<VrfTrainingMap>& maps, const VrfTrainingParams& params) {
-  require(params.folds >= 1 && static_cast<int>(maps.size()) >= params.folds,
-          "VRF training: needs at least `folds` (" + std::to_string(params.folds) +
-              ") training maps, got " + std::to_string(maps.size()));
-  require(params.weak_count >= 1 && params.max_depth >= 1 && params.sample_stride >= 1,
-          "VRF training: weak_count, max_depth and sample_stride must be >= 1");
-  Samples samples;
-  std::vector<FieldSample> fields;
+namespace {
+// The classifiers' samples (every sample_stride-th node of each map with its room-type label) and
+// each map's sparse field (the nodes and edges the random field is fitted on). Throws Error for a
+// bad map, labels of another size, or a class no map has a sample of.
+void collect_training_data(const std::vector<VrfTrainingMap>& maps, const VrfTrainingParams& params,
+                           Samples& samples, std::vector<FieldSample>& fields) {
   for (std::size_t m = 0; m < maps.size(); ++m) {
     const VrfTrainingMap& training = maps[m];
     check_map(training.map, "VRF training map " + training.name);
@@ -265,6 +263,18 @@ VrfModel VrfModel::train(const std::vector<VrfTrainingMap>& maps, const VrfTrain
             std::string("VRF training: no ") + kClassifierNames[static_cast<std::size_t>(c)] +
                 " sample in the maps");
   }
+}
+}  // namespace
+
+VrfModel VrfModel::train(const std::vector<VrfTrainingMap>& maps, const VrfTrainingParams& params) {
+  require(params.folds >= 1 && static_cast<int>(maps.size()) >= params.folds,
+          "VRF training: needs at least `folds` (" + std::to_string(params.folds) +
+              ") training maps, got " + std::to_string(maps.size()));
+  require(params.weak_count >= 1 && params.max_depth >= 1 && params.sample_stride >= 1,
+          "VRF training: weak_count, max_depth and sample_stride must be >= 1");
+  Samples samples;
+  std::vector<FieldSample> fields;
+  collect_training_data(maps, params, samples, fields);
 
   auto model = std::make_shared<Model>();
   const auto train_all = [&](const std::vector<std::size_t>& rows) {
