@@ -16,15 +16,10 @@ std::uint32_t find(std::vector<std::uint32_t>& parent, std::uint32_t i) {
   return i;
 }
 
-}  // namespace
-
-ComponentTree build_component_tree(const Image<std::int32_t>& levels) {
-  const int width = levels.width(), height = levels.height();
+// The pixels of level > 0 by decreasing level, in scan order within a level (a counting sort).
+// Throws Error for a level >= 65536.
+std::vector<std::uint32_t> pixels_by_decreasing_level(const Image<std::int32_t>& levels) {
   const std::size_t n = levels.size();
-  ComponentTree tree;
-  tree.width = width;
-  tree.node_of.assign(n, -1);
-  // Pixels by decreasing level (counting sort).
   int top = 0;
   for (const std::int32_t l : levels.pixels()) {
     require(l < 65536, "component tree: a level is >= 65536");
@@ -44,6 +39,18 @@ ComponentTree build_component_tree(const Image<std::int32_t>& levels) {
     const std::int32_t l = levels.data()[i];
     if (l > 0) order[fill[static_cast<std::size_t>(l)]++] = static_cast<std::uint32_t>(i);
   }
+  return order;
+}
+
+}  // namespace
+
+ComponentTree build_component_tree(const Image<std::int32_t>& levels) {
+  const int width = levels.width(), height = levels.height();
+  const std::size_t n = levels.size();
+  ComponentTree tree;
+  tree.width = width;
+  tree.node_of.assign(n, -1);
+  const std::vector<std::uint32_t> order = pixels_by_decreasing_level(levels);
 
   std::vector<std::uint32_t> parent(n), size(n, 0);
   std::vector<std::int32_t> node_of_root(n, -1);  // the root's current component node
