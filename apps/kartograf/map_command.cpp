@@ -117,10 +117,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
 
   ProgressBar bar(err, o.run.progress);
   pipeline::MapPipelineObserver observer;
-  observer.slam.on_frame = [&](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
-  observer.slam.on_progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
-    bar.update(stage, done, total);
-  };
+  observer.slam = slam_progress_observer(err, bar);
   int stage_number = 0;
   observer.on_stage = [&](std::string_view stage) {
     bar.finish();

@@ -38,11 +38,7 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
   const bool has_timestamps = run.opened.detected.has_timestamps;
 
   ProgressBar bar(err, o.run.progress);
-  mapping::SlamObserver observer;
-  observer.on_frame = [&](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
-  observer.on_progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
-    bar.update(stage, done, total);
-  };
+  const mapping::SlamObserver observer = slam_progress_observer(err, bar);
   const mapping::OdometryRun result = mapping::run_odometry(context, *run.source, params, observer);
   bar.finish();
 

@@ -188,6 +188,15 @@ void warn_about(std::ostream& err, ProgressBar& bar, const registration::Odometr
   }
 }
 
+mapping::SlamObserver slam_progress_observer(std::ostream& err, ProgressBar& bar) {
+  mapping::SlamObserver observer;
+  observer.on_frame = [&err, &bar](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
+  observer.on_progress = [&bar](std::string_view stage, std::size_t done, std::size_t total) {
+    bar.update(stage, done, total);
+  };
+  return observer;
+}
+
 Trajectory stamped_trajectory(const std::vector<Eigen::Isometry3d>& poses,
                               const std::vector<double>& timestamps, bool has_timestamps) {
   Trajectory trajectory;

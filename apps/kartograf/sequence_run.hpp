@@ -21,6 +21,7 @@
 #include "kartograf/core/trajectory.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/mapping/slam.hpp"
 #include "kartograf/registration/odometry.hpp"
 
 namespace kartograf::cli {
@@ -75,6 +76,9 @@ class ProgressBar {
 
 // A warning line on `err` for each rejected registration or fallback of a frame.
 void warn_about(std::ostream& err, ProgressBar& bar, const registration::OdometryFrame& frame);
+
+// What odometry, slam and map report while tracking: warn_about per frame, progress on `bar`.
+mapping::SlamObserver slam_progress_observer(std::ostream& err, ProgressBar& bar);
 
 // Timestamps: the sequence's, or the frame number where it has none (7-Scenes).
 Trajectory stamped_trajectory(const std::vector<Eigen::Isometry3d>& poses,

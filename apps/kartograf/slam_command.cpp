@@ -192,11 +192,7 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   params.map.voxel_size = o.voxel_size;
 
   ProgressBar bar(err, o.run.progress);
-  mapping::SlamObserver observer;
-  observer.on_frame = [&](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
-  observer.on_progress = [&](std::string_view stage, std::size_t done, std::size_t total) {
-    bar.update(stage, done, total);
-  };
+  const mapping::SlamObserver observer = slam_progress_observer(err, bar);
   const mapping::SlamResult result = mapping::run_slam(context, *run.source, params, observer);
   bar.finish();
 
