@@ -35,8 +35,8 @@ std::vector<compute::BackendKind> backends_to_run() {
   return kinds;
 }
 
-compute::ContextOptions context_options(compute::BackendKind backend) {
-  compute::ContextOptions options;
+compute::ContextParams context_options(compute::BackendKind backend) {
+  compute::ContextParams options;
   options.backend = compute::choice_of(backend);
   return options;
 }

@@ -18,7 +18,7 @@ namespace kartograf::bench {
 std::vector<compute::BackendKind> backends_to_run();
 
 // Options for a context on exactly `backend` (no validation layer: these are timings).
-compute::ContextOptions context_options(compute::BackendKind backend);
+compute::ContextParams context_options(compute::BackendKind backend);
 
 // "<operation>/<backend>/<size>", e.g. "normals/vulkan/640x480": the name of every case, so that
 // --benchmark_filter selects the same way in every binary.

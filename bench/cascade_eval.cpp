@@ -11,10 +11,12 @@
 
 #include "kartograf/compute/context.hpp"
 #include "kartograf/semantic/haar_cascade.hpp"
-#include "kartograf/semantic/synthetic_stairs.hpp"
+#include "kartograf/semantic/object_detector.hpp"
+#include "kartograf/training/synthetic_stairs.hpp"
 
 using namespace kartograf;
 using namespace kartograf::semantic;
+using namespace kartograf::training;
 
 int main(int argc, char** argv) {
   const std::string model = argv[1];

@@ -142,7 +142,7 @@ void steady_state(benchmark::State& state, BackendKind backend, const Operation&
 void cold_start(benchmark::State& state, BackendKind backend, const Operation& operation, int width,
                 int height) {
   state.SetItemsProcessed(static_cast<std::int64_t>(width) * height);
-  const compute::ContextOptions options = bench::context_options(backend);
+  const compute::ContextParams options = bench::context_options(backend);
   for (auto _ : state) {
     state.PauseTiming();
     auto context = std::make_unique<compute::Context>(options);

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "bench_support.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/laser_scan_device.hpp"
 
 namespace kartograf {

@@ -39,7 +39,7 @@
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/normals.hpp"
 #include "kartograf/geometry/subsample.hpp"
-#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
 #include "kartograf/segmentation/clustering_features.hpp"

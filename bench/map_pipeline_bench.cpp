@@ -10,7 +10,8 @@
 #include <string>
 
 #include "bench_support.hpp"
-#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
 
 namespace kartograf {
@@ -31,7 +32,7 @@ void map_pipeline(benchmark::State& state, compute::BackendKind backend) {
   const compute::Context context = compute::Context(bench::context_options(backend));
   pipeline::MapPipelineResult result;
   for (auto _ : state) {
-    const io::SequenceFrameSource source(*opened.sequence, 300);
+    const pipeline::SequenceFrameSource source(*opened.sequence, 300);
     result = pipeline::run_map_pipeline(context, source);
   }
   state.counters["frames"] = static_cast<double>(result.poses.size());

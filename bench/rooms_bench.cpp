@@ -12,8 +12,9 @@
 #include <iostream>
 #include <string>
 
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/room_io.hpp"
+#include "kartograf/compute/context.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/outputs/room_io.hpp"
 #include "kartograf/rooms/room_methods.hpp"
 
 namespace kartograf {
@@ -35,7 +36,9 @@ void register_cases() {
                                    [map, method](benchmark::State& state) {
                                      std::size_t found = 0;
                                      for (auto _ : state)
-                                       found = rooms::segment_rooms(*map, method).records.size();
+                                       found = rooms::segment_rooms(compute::Context::cpu(), *map,
+                                                                    method)
+                                                   .records.size();
                                      state.counters["rooms"] = static_cast<double>(found);
                                    })
           ->Unit(benchmark::kMillisecond)

@@ -44,7 +44,7 @@ BENCHMARK(robot_tour_bench)->Name("robot_tour/300")->Unit(benchmark::kMillisecon
 // Arguments: noise (0 none, 1 kinect), threads (0 = all cores). Frames cycle through the tour.
 void render_bench(benchmark::State& state) {
   const NoiseModel noise = state.range(0) ? NoiseModel::kinect() : NoiseModel::none();
-  const RenderOptions options{static_cast<int>(state.range(1))};
+  const RenderParams options{static_cast<int>(state.range(1))};
   std::size_t frame = 0;
   for (auto _ : state) {
     const StampedPose& pose = scene().tour[frame % scene().tour.size()];
@@ -87,7 +87,7 @@ BENCHMARK(floor_plan_bench)->Name("floor_plan/0.05m")->Unit(benchmark::kMillisec
 
 void laser_scan_bench(benchmark::State& state) {
   const RayCaster caster(scene().world);
-  LaserScanOptions options;
+  LidarScanParams options;
   options.threads = 1;
   const Eigen::Isometry3d pose = default_scan_pose(scene().world);
   for (auto _ : state) benchmark::DoNotOptimize(scan_laser(caster, pose, options, 1));

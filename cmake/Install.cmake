@@ -1,14 +1,17 @@
 # `cmake --install`: headers, the static libraries, the CLI, the trained models and a package
-# configuration, so that another project can say find_package(kartograf) and link kartograf::io
-# (everything) or a lower layer (kartograf::compute: core, compute and the algorithms on Eigen).
+# configuration, so that another project can say find_package(kartograf) and link kartograf::outputs
+# (everything) or a lower layer (kartograf::algorithms: core, compute and the algorithms on Eigen).
 include(CMakePackageConfigHelpers)
 
 set(KARTOGRAF_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/kartograf)
-foreach(library compute rooms semantic pipeline io)
+set(KARTOGRAF_LAYERS core compute geometry segmentation registration mapping eval synth rooms_scan
+    algorithms rooms semantic formats pipeline outputs)
+foreach(library ${KARTOGRAF_LAYERS})
   set_target_properties(kartograf_${library} PROPERTIES EXPORT_NAME ${library})
   add_library(kartograf::${library} ALIAS kartograf_${library})
 endforeach()
-install(TARGETS kartograf_compute kartograf_rooms kartograf_semantic kartograf_pipeline kartograf_io
+list(TRANSFORM KARTOGRAF_LAYERS PREPEND kartograf_ OUTPUT_VARIABLE kartograf_layer_targets)
+install(TARGETS ${kartograf_layer_targets}
         EXPORT kartografTargets
         ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}
         INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/camera_intrinsics.hpp"
+#include "kartograf/formats/camera_intrinsics.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 2) return 0;

@@ -1,6 +1,6 @@
 // Fuzz target: camera_intrinsics.json (Open3D's PinholeCameraIntrinsic).
 #include "fuzz_input_file.hpp"
-#include "kartograf/io/sequence.hpp"
+#include "kartograf/formats/sequence.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   kartograf::fuzz::read_as_file("camera_intrinsics.json", data, size, [](const auto& path) {

@@ -2,7 +2,7 @@
 // checks, truncation checks and size limits before OpenCV decodes them, and the refusal of the
 // other formats OpenCV would decode (BMP, TIFF, WebP, ...) whose size is not checked first.
 #include "fuzz_input_file.hpp"
-#include "kartograf/io/image_io.hpp"
+#include "kartograf/formats/image_io.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using kartograf::fuzz::read_as_file;

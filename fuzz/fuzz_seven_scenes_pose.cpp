@@ -3,8 +3,8 @@
 #include <filesystem>
 
 #include "fuzz_input_file.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
 
 namespace {
 
@@ -28,7 +28,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   const auto written = kartograf::fuzz::write_input("pose.txt", data, size);
   std::filesystem::rename(written, folder / "frame-000007.pose.txt");
   try {
-    kartograf::io::SequenceOptions options;
+    kartograf::io::SequenceParams options;
     options.camera = "16,16,8,6";
     const kartograf::io::OpenedSequence opened = kartograf::io::open_sequence(folder, options);
     opened.sequence->frame(0);

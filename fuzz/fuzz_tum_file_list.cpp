@@ -1,6 +1,6 @@
 // Fuzz target: TUM frame lists (rgb.txt / depth.txt: timestamp filename).
 #include "fuzz_input_file.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/tum.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   kartograf::fuzz::read_as_file("rgb.txt", data, size,

@@ -3,8 +3,7 @@
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 
 #define KG_INVALID_POINT ((float4)(NAN, NAN, NAN, NAN))
-#define KG_REDUCTION_GROUP 64
-#define KG_MAX_SUMS 32
+#include "kernels/reduce_rows/reduce_rows.h"  // KG_REDUCTION_GROUP, KG_MAX_SUMS
 
 inline bool kg_is_valid_point(float4 p) { return !isnan(p.x); }
 

@@ -6,8 +6,3 @@
 #define kInvalidPoint vec4(kNaN)
 
 bool is_valid_point(vec4 p) { return !isnan(p.x); }
-
-// Work-group size of the reductions (must equal kReductionGroupSize in src/compute/reduction.hpp).
-#define KG_REDUCTION_GROUP 64
-// The most sums one reduction row carries (point-to-plane needs 29).
-#define KG_MAX_SUMS 32

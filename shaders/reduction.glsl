@@ -2,6 +2,7 @@
 // `sums`; the work-group adds those in shared memory (a fixed-order tree, so results do not vary
 // from run to run) and writes one row of `sum_count` doubles per work-group to `partials`.
 // The including shader declares `partials` (a double[] buffer) before including this file.
+#include "kernels/reduce_rows/reduce_rows.h"  // KG_REDUCTION_GROUP, KG_MAX_SUMS
 shared double shared_sums[KG_MAX_SUMS][KG_REDUCTION_GROUP];
 
 void store_group_sums(double sums[KG_MAX_SUMS], uint sum_count) {

@@ -14,7 +14,7 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/segment_moments.hpp"
-#include "kartograf/io/image_io.hpp"
+#include "kartograf/formats/image_io.hpp"
 #include "kartograf/segmentation/clustering_features.hpp"
 #include "kartograf/segmentation/fuzzy_cmeans.hpp"
 #include "kartograf/segmentation/kmeans.hpp"

@@ -1,5 +1,5 @@
 // Device-side copies, recycled device buffers, device limits and the device timings that
-// kartograf_gpu_check reports (ContextOptions::profile), on every backend.
+// kartograf_gpu_check reports (ContextParams::profile), on every backend.
 #include <algorithm>
 #include <numeric>
 #include <set>
@@ -76,7 +76,7 @@ TEST_P(DeviceRuntimeTest, ReportsLimitsItsKernelsNeed) {
 }
 
 TEST_P(DeviceRuntimeTest, ProfilingTimesEveryCommandOnTheDevice) {
-  compute::ContextOptions options;
+  compute::ContextParams options;
   options.backend = compute::choice_of(GetParam());
   options.vulkan_validation = true;
   options.profile = true;

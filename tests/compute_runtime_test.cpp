@@ -59,17 +59,82 @@ TEST_P(ComputeRuntimeTest, OutOfRangeAccessIsAnError) {
   EXPECT_THROW(buffer.download(one, 4), Error);
 }
 
-TEST_P(ComputeRuntimeTest, DispatchNeedsADevice) {
-  if (GetParam() != compute::BackendKind::cpu) {
-    // An unknown kernel name is a clear error, not a crash.
-    const std::uint32_t params[1] = {0};
-    EXPECT_THROW(compute::dispatch(context(), compute::KernelSpec{"no_such_kernel", 64}, {}, params, {1, 1}),
-                 Error);
-  } else {
-    const std::uint32_t params[1] = {0};
-    EXPECT_THROW(compute::dispatch(context(), compute::KernelSpec{"backproject", 16, 16}, {}, params, {1, 1}),
-                 Error);
+TEST_P(ComputeRuntimeTest, HostViewReadsTheValuesWithoutCopyingHostMemory) {
+  const std::vector<float> values = {1.5f, -2.0f, 3.25f, 7.0f};
+  const auto buffer = compute::Buffer<float>::from_host(context(), values);
+  const compute::HostView<float> view = compute::read_on_host(buffer);
+  EXPECT_EQ(std::vector<float>(view.begin(), view.end()), values);
+  ASSERT_EQ(view.size(), values.size());
+  EXPECT_EQ(view[2], 3.25f);
+  // Free where the buffer is host memory: the view is the storage itself.
+  if (buffer.raw().on_host()) {
+    EXPECT_EQ(view.data(), buffer.host_span().data());
   }
+  EXPECT_TRUE(compute::read_on_host(compute::Buffer<float>{}).empty());
+}
+
+TEST_P(ComputeRuntimeTest, HostWriteViewUploadsOnCommitAndDestruction) {
+  auto buffer =
+      compute::Buffer<std::uint32_t>::from_host(context(), std::vector<std::uint32_t>{1, 2, 3});
+  {
+    compute::HostWriteView<std::uint32_t> view = compute::write_on_host(buffer);
+    EXPECT_EQ(view[1], 2u);  // starts from the current values
+    view[1] = 20;
+  }
+  EXPECT_EQ(buffer.to_vector(), (std::vector<std::uint32_t>{1, 20, 3}));
+  {
+    auto view = compute::write_on_host(buffer, compute::HostWriteStart::overwrite_all);
+    for (std::size_t i = 0; i < view.size(); ++i) view[i] = static_cast<std::uint32_t>(10 * i);
+    view.commit();
+    EXPECT_EQ(buffer.to_vector(), (std::vector<std::uint32_t>{0, 10, 20}));
+  }
+  EXPECT_EQ(buffer.to_vector(), (std::vector<std::uint32_t>{0, 10, 20}));
+}
+
+TEST_P(ComputeRuntimeTest, HostWriteViewDoesNotUploadWhileAnErrorUnwinds) {
+  auto buffer = compute::Buffer<std::uint32_t>::from_host(context(), std::vector<std::uint32_t>{5});
+  try {
+    auto view = compute::write_on_host(buffer);
+    view[0] = 6;
+    throw Error("step failed");
+  } catch (const Error&) {
+  }
+  // Host memory is written in place; a device buffer keeps its values.
+  EXPECT_EQ(buffer.to_vector()[0], buffer.raw().on_host() ? 6u : 5u);
+}
+
+TEST_P(ComputeRuntimeTest, UnknownKernelsAndWrongParameterBlocksAreErrors) {
+  // Every backend, the CPU included, dispatches by name: an unknown one is a clear error.
+  const std::uint32_t params[1] = {0};
+  EXPECT_ERROR_MENTIONS(
+      compute::dispatch(context(), compute::KernelSpec{"no_such_kernel", 64}, {}, params, {1, 1}),
+      "no_such_kernel");
+  if (GetParam() == compute::BackendKind::cpu) {
+    // The CPU wrapper checks the block against the rule's struct (5 words for backproject).
+    EXPECT_ERROR_MENTIONS(compute::dispatch(context(), compute::KernelSpec{"backproject", 16, 16},
+                                            {}, params, {1, 1}),
+                          "backproject", "parameter block of 4 bytes");
+  }
+}
+
+TEST_P(ComputeRuntimeTest, ReferOrUploadHoldsTheValuesAndCopiesNothingOnTheHost) {
+  std::vector<std::uint32_t> values = {4, 8, 15, 16, 23};
+  compute::Buffer<std::uint32_t> buffer(context(), 2);
+  buffer.refer_or_upload(context(), values);
+  ASSERT_EQ(buffer.size(), values.size());
+  EXPECT_EQ(buffer.to_vector(), values);
+  if (GetParam() == compute::BackendKind::cpu) {
+    // A view of the caller's memory: later changes show, nothing was copied.
+    EXPECT_EQ(buffer.host_span().data(), values.data());
+    values[0] = 42;
+    EXPECT_EQ(buffer.to_vector()[0], 42u);
+  } else {
+    EXPECT_FALSE(buffer.raw().on_host());
+  }
+  // Another call replaces the values (a new view, or an upload at the new size).
+  const std::vector<std::uint32_t> again = {1, 2, 3};
+  buffer.refer_or_upload(context(), again);
+  EXPECT_EQ(buffer.to_vector(), again);
 }
 
 KARTOGRAF_INSTANTIATE_BACKEND_TESTS(ComputeRuntimeTest);
@@ -88,13 +153,13 @@ TEST(BackendSelection, EnvironmentPicksTheBackend) {
   EXPECT_THROW(compute::Context::from_environment(), Error);
   unsetenv("KARTOGRAF_BACKEND");
   setenv("KARTOGRAF_DEVICE", "x", 1);
-  EXPECT_THROW(compute::ContextOptions::from_environment(), Error);
+  EXPECT_THROW(compute::ContextParams::from_environment(), Error);
   unsetenv("KARTOGRAF_DEVICE");
 }
 
 TEST(BackendSelection, AutomaticTakesAGpuOrTheCpu) {
   // CPU-hosted drivers (lavapipe, PoCL) are never chosen automatically.
-  const compute::Context context{compute::ContextOptions{}};
+  const compute::Context context{compute::ContextParams{}};
   if (context.backend() == compute::BackendKind::cpu) {
     for (const auto& status : compute::probe_backends()) {
       for (const auto& device : status.devices) {

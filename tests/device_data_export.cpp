@@ -3,8 +3,8 @@
 #include <cstdio>
 #include <string>
 
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "raw_image_file.hpp"
 
 namespace kartograf::testing {

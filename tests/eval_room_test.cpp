@@ -4,9 +4,9 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/eval/connected_components.hpp"
+#include "kartograf/core/connected_components.hpp"
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "label_image_builders.hpp"
 #include "test_support.hpp"
 
@@ -83,7 +83,7 @@ TEST(EvalRooms, RegionsOfAHundredPixelsOrLessAreIgnoredLikeIpa) {
   EXPECT_EQ(scores.segments, 2);
   EXPECT_DOUBLE_EQ(scores.room_recall[0], 200.0 / 300.0);
   EXPECT_DOUBLE_EQ(scores.precision_mean, 1);
-  eval::RoomEvaluationOptions keep_all;
+  eval::RoomEvaluationParams keep_all;
   keep_all.min_region_pixels = 1;
   EXPECT_EQ(eval::evaluate_room_segmentation(two_rooms(), segmentation, keep_all).segments, 3);
 }
@@ -113,19 +113,19 @@ TEST(EvalConnectedComponents, NumbersRegionsInRasterOrderAndDropsSpecks) {
   for (int y = 0; y < 5; ++y) {
     for (int x = 0; x < 5; ++x) mask(x, y) = rows[y][x] != '.';
   }
-  const LabelImage four = eval::label_connected_components(mask, {eval::Connectivity::four, 2});
+  const LabelImage four = label_connected_components(mask, {Connectivity::four, 2});
   EXPECT_EQ(four(0, 0), 1);  // a
   EXPECT_EQ(four(4, 0), 2);  // d
   EXPECT_EQ(four(2, 2), 3);  // b
   EXPECT_EQ(four(3, 4), 3);
   EXPECT_EQ(four(0, 4), 0);  // c: a speck of 1 < 2 pixels
   EXPECT_EQ(four(2, 0), 0);  // background
-  const LabelImage eight = eval::label_connected_components(mask, {eval::Connectivity::eight, 1});
+  const LabelImage eight = label_connected_components(mask, {Connectivity::eight, 1});
   EXPECT_EQ(eight(0, 0), 1);  // a and b joined through the diagonal, d stays apart
   EXPECT_EQ(eight(2, 2), 1);
   EXPECT_EQ(eight(4, 0), 2);
   EXPECT_EQ(eight(0, 4), 3);  // c kept with min_pixels 1
-  EXPECT_THROW(eval::label_connected_components(mask, {eval::Connectivity::four, 0}), Error);
+  EXPECT_THROW(label_connected_components(mask, {Connectivity::four, 0}), Error);
 }
 
 TEST(EvalRooms, RealGroundTruthAgainstItselfScoresOne) {
@@ -141,8 +141,8 @@ TEST(EvalRooms, RealGroundTruthAgainstItselfScoresOne) {
   EXPECT_DOUBLE_EQ(self.precision_total, 1);
   EXPECT_DOUBLE_EQ(self.mcc, 1);
 
-  io::RoomGroundTruthOptions ipa_flood_fill;
-  ipa_flood_fill.connectivity = eval::Connectivity::eight;
+  io::RoomGroundTruthParams ipa_flood_fill;
+  ipa_flood_fill.connectivity = Connectivity::eight;
   const LabelImage eight =
       io::read_room_ground_truth_png(maps / "lab_ipa_gt_segmentation.png", ipa_flood_fill);
   const auto merged = eval::evaluate_room_segmentation(rooms, eight);

@@ -9,7 +9,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {

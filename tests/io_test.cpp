@@ -25,8 +25,8 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/point_cloud.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/ply.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/ply.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -167,13 +167,10 @@ int paeth(int a, int b, int c) {
   return pb <= pc ? b : c;
 }
 
-// Decodes a non-interlaced 8- or 16-bit PNG, checking every chunk's CRC.
-::testing::AssertionResult decode_png(const std::vector<std::uint8_t>& file, DecodedPng& png) {
-  if (!zlib().loaded()) return ::testing::AssertionFailure() << "libz.so.1 not found";
-  if (file.size() < 8 || !std::equal(kPngSignature.begin(), kPngSignature.end(), file.begin())) {
-    return ::testing::AssertionFailure() << "no PNG signature";
-  }
-  std::vector<std::uint8_t> compressed;
+// Reads the chunks after the signature, checking each one's CRC: the header into png, the image
+// data appended to compressed.
+::testing::AssertionResult read_png_chunks(const std::vector<std::uint8_t>& file, DecodedPng& png,
+                                           std::vector<std::uint8_t>& compressed) {
   bool saw_header = false;
   bool saw_end = false;
   std::size_t at = 8;
@@ -208,14 +205,13 @@ int paeth(int a, int b, int c) {
     at += 12 + length;
   }
   if (!saw_header) return ::testing::AssertionFailure() << "no IHDR";
-  const std::size_t bpp = static_cast<std::size_t>(png.channels * png.bit_depth / 8);
+  return ::testing::AssertionSuccess();
+}
+
+// Undoes the rows' filters: raw holds each row's filter byte and filtered bytes.
+::testing::AssertionResult unfilter_rows(const std::vector<std::uint8_t>& raw, std::size_t bpp,
+                                         DecodedPng& png) {
   const std::size_t stride = static_cast<std::size_t>(png.width) * bpp;
-  std::vector<std::uint8_t> raw(static_cast<std::size_t>(png.height) * (stride + 1));
-  unsigned long raw_size = raw.size();
-  if (zlib().uncompress(raw.data(), &raw_size, compressed.data(), compressed.size()) != 0 ||
-      raw_size != raw.size()) {
-    return ::testing::AssertionFailure() << "IDAT does not inflate to " << raw.size() << " bytes";
-  }
   png.rows.assign(static_cast<std::size_t>(png.height) * stride, 0);
   for (std::size_t y = 0; y < static_cast<std::size_t>(png.height); ++y) {
     const std::uint8_t filter = raw[y * (stride + 1)];
@@ -249,6 +245,25 @@ int paeth(int a, int b, int c) {
     }
   }
   return ::testing::AssertionSuccess();
+}
+
+// Decodes a non-interlaced 8- or 16-bit PNG, checking every chunk's CRC.
+::testing::AssertionResult decode_png(const std::vector<std::uint8_t>& file, DecodedPng& png) {
+  if (!zlib().loaded()) return ::testing::AssertionFailure() << "libz.so.1 not found";
+  if (file.size() < 8 || !std::equal(kPngSignature.begin(), kPngSignature.end(), file.begin())) {
+    return ::testing::AssertionFailure() << "no PNG signature";
+  }
+  std::vector<std::uint8_t> compressed;
+  if (::testing::AssertionResult read = read_png_chunks(file, png, compressed); !read) return read;
+  const std::size_t bpp = static_cast<std::size_t>(png.channels * png.bit_depth / 8);
+  const std::size_t stride = static_cast<std::size_t>(png.width) * bpp;
+  std::vector<std::uint8_t> raw(static_cast<std::size_t>(png.height) * (stride + 1));
+  unsigned long raw_size = raw.size();
+  if (zlib().uncompress(raw.data(), &raw_size, compressed.data(), compressed.size()) != 0 ||
+      raw_size != raw.size()) {
+    return ::testing::AssertionFailure() << "IDAT does not inflate to " << raw.size() << " bytes";
+  }
+  return unfilter_rows(raw, bpp, png);
 }
 
 void append_chunk(std::vector<std::uint8_t>& png, const char* type,

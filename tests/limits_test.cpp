@@ -12,10 +12,10 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/formats/pcd.hpp"
+#include "kartograf/formats/ply.hpp"
 #include "kartograf/geometry/range_image.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/pcd.hpp"
-#include "kartograf/io/ply.hpp"
 #include "kartograf/registration/odometry.hpp"
 #include "kartograf/rooms/room_methods.hpp"
 #include "kartograf/semantic/classify.hpp"
@@ -169,7 +169,7 @@ TEST(MemoryBudget, LabellingRoomsAndOdometryAreCheckedBeforeAllocating) {
   map.resolution = 0.05;
   map.cells = Image<CellState>(1000, 1000, CellState::free);
   for (const rooms::RoomMethod method : rooms::all_room_methods()) {
-    EXPECT_ERROR_MENTIONS(rooms::segment_rooms(map, method),
+    EXPECT_ERROR_MENTIONS(rooms::segment_rooms(compute::Context::cpu(), map, method),
                           "room segmentation (" + rooms::to_string(method) + ") of a 1000 x 1000",
                           "needs about");
   }
@@ -181,11 +181,11 @@ TEST(MemoryBudget, LabellingRoomsAndOdometryAreCheckedBeforeAllocating) {
 TEST(DeviceEnvironment, IndexMustNameAnExistingDevice) {
   for (const char* bad : {"abc", "-1", "1.5", " 1", "99999999999"}) {
     const ScopedEnvironment device("KARTOGRAF_DEVICE", bad);
-    compute::ContextOptions options;
+    compute::ContextParams options;
     EXPECT_ERROR_MENTIONS(options.read_device_environment(), "KARTOGRAF_DEVICE", bad);
   }
   const ScopedEnvironment device("KARTOGRAF_DEVICE", "9");
-  compute::ContextOptions options;
+  compute::ContextParams options;
   options.backend = compute::BackendChoice::cpu;
   options.read_device_environment();
   EXPECT_EQ(options.device_index, 9);
@@ -199,7 +199,7 @@ TEST(DeviceEnvironment, IndexBeyondTheBackendsDevicesIsAnError) {
   for (const compute::BackendKind kind : testing::backends_under_test()) {
     if (kind == compute::BackendKind::cpu) continue;
     SCOPED_TRACE(compute::to_string(kind));
-    compute::ContextOptions options;
+    compute::ContextParams options;
     options.backend = kind == compute::BackendKind::vulkan ? compute::BackendChoice::vulkan
                                                            : compute::BackendChoice::opencl;
     options.device_index = 0;

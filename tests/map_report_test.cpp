@@ -10,11 +10,11 @@
 
 #include <gtest/gtest.h>
 
-#include "io/html_text.hpp"
-#include "io/map_report_html.hpp"
-#include "io/report_svg.hpp"
-#include "kartograf/io/map_outputs.hpp"
-#include "kartograf/io/top_view.hpp"
+#include "outputs/html_text.hpp"
+#include "outputs/map_report_html.hpp"
+#include "outputs/report_svg.hpp"
+#include "kartograf/outputs/map_outputs.hpp"
+#include "kartograf/formats/top_view.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
 
 namespace kartograf {
@@ -300,7 +300,7 @@ TEST(MapReportHtml, The3dViewKeepsAtMostMaxPointsWithTheirColours) {
   }
   EXPECT_EQ(scene["estimated"].size(), 60u);
   EXPECT_EQ(scene["truth"].size(), 57u);  // 19 frames with a true pose
-  EXPECT_DOUBLE_EQ(scene["ceiling_z"].get<double>(), 1.2 + io::TopViewOptions{}.ceiling_clearance);
+  EXPECT_DOUBLE_EQ(scene["ceiling_z"].get<double>(), 1.2 + io::TopViewParams{}.ceiling_clearance);
 }
 
 }  // namespace

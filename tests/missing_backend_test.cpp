@@ -34,7 +34,7 @@ TEST(MissingBackend, IsReportedWithItsReasonAndOthersStillWork) {
       EXPECT_TRUE(status.available) << status.reason;
     }
   }
-  compute::ContextOptions options;
+  compute::ContextParams options;
   options.backend = kind;
   try {
     compute::Context context(options);
@@ -43,7 +43,7 @@ TEST(MissingBackend, IsReportedWithItsReasonAndOthersStillWork) {
     EXPECT_NE(std::string(error.what()).find(expected_reason), std::string::npos) << error.what();
   }
   // Automatic selection still starts.
-  EXPECT_NO_THROW(compute::Context{compute::ContextOptions{}});
+  EXPECT_NO_THROW(compute::Context{compute::ContextParams{}});
 }
 
 }  // namespace

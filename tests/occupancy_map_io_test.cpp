@@ -11,8 +11,8 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {

@@ -17,8 +17,8 @@
 #include <utility>
 #include <vector>
 
-#include "kartograf/io/pcd.hpp"
-#include "kartograf/io/ply.hpp"
+#include "kartograf/formats/pcd.hpp"
+#include "kartograf/formats/ply.hpp"
 
 namespace kartograf {
 namespace {

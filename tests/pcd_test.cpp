@@ -21,8 +21,8 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/pcd.hpp"
-#include "kartograf/io/ply.hpp"
+#include "kartograf/formats/pcd.hpp"
+#include "kartograf/formats/ply.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {

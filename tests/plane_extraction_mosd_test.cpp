@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "kartograf/io/pcd.hpp"
+#include "kartograf/formats/pcd.hpp"
 #include "kartograf/segmentation/plane_extraction.hpp"
 #include "test_support.hpp"
 

@@ -7,7 +7,7 @@
 
 #include <Eigen/Geometry>
 
-#include "kartograf/io/plane_io.hpp"
+#include "kartograf/outputs/plane_io.hpp"
 #include "kartograf/segmentation/plane_extraction.hpp"
 #include "test_support.hpp"
 

@@ -108,7 +108,7 @@ TEST(RangeImage, RejectsBadParametersAndPoses) {
 TEST(RangeImage, LabelsAMapOfTwoMergedScans) {
   const synth::World world = synth::make_building(5);
   const synth::RayCaster caster(world);
-  synth::LaserScanOptions options;
+  synth::LidarScanParams options;
   options.columns = 361;
   options.lines = 161;
   options.threads = 2;

@@ -1,7 +1,7 @@
 // The real data of the device tests as kartograf_tests reads it: the original files, through
 // kartograf_io.
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "real_data.hpp"
 
 namespace kartograf::testing {

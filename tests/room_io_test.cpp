@@ -1,7 +1,8 @@
 // Room segmentations on disk (io/room_io.hpp): rooms.json, the picture, benchmark folders.
 #include <nlohmann/json.hpp>
 
-#include "kartograf/io/room_io.hpp"
+#include "kartograf/compute/context.hpp"
+#include "kartograf/outputs/room_io.hpp"
 #include "kartograf/rooms/room_methods.hpp"
 #include "room_test_maps.hpp"
 #include "test_support.hpp"
@@ -14,7 +15,8 @@ using RoomIo = testing::TempDirTest;
 TEST_F(RoomIo, RoomsJsonHoldsEveryRoomWithItsGeometry) {
   OccupancyGrid map = testing::rooms_in_a_row(2);
   map.origin = Eigen::Vector3d(10, 20, 0);
-  const auto rooms = rooms::segment_rooms(map, rooms::RoomMethod::distance);
+  const auto rooms =
+      rooms::segment_rooms(compute::Context::cpu(), map, rooms::RoomMethod::distance);
   io::write_rooms_json(dir() / "rooms.json", rooms, map, "two rooms", R"({"method": "distance"})");
   const auto json = nlohmann::json::parse(testing::read_text(dir() / "rooms.json"));
   EXPECT_EQ(json["format"], "kartograf-rooms");
@@ -36,7 +38,8 @@ TEST_F(RoomIo, RoomsJsonHoldsEveryRoomWithItsGeometry) {
 
 TEST_F(RoomIo, OverlayColoursRoomsAndDrawsWallsBlack) {
   const OccupancyGrid map = testing::rooms_in_a_row(2);
-  const auto rooms = rooms::segment_rooms(map, rooms::RoomMethod::morphological);
+  const auto rooms =
+      rooms::segment_rooms(compute::Context::cpu(), map, rooms::RoomMethod::morphological);
   const RgbImage picture = io::room_overlay(map, rooms.rooms);
   EXPECT_EQ(picture(0, 0), (Rgb8{0, 0, 0}));
   EXPECT_NE(picture(10, 10), picture(200, 10));

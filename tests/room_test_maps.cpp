@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/room_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/outputs/room_io.hpp"
 #include "test_support.hpp"
 
 namespace kartograf::testing {

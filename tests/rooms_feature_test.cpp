@@ -8,8 +8,9 @@
 #include <random>
 #include <vector>
 
+#include "kartograf/compute/context.hpp"
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/feature_segmentation.hpp"
 #include "kartograf/rooms/laser_features.hpp"
 #include "room_test_maps.hpp"
@@ -207,8 +208,9 @@ TEST(RoomClassifier, ClearErrors) {
       rooms::RoomClassifier::train(std::vector<float>(26, 1.f), std::vector<int>{1}),
       "26 features for 1 labels");
   const rooms::RoomClassifier empty;
-  EXPECT_ERROR_MENTIONS(rooms::segment_feature_based(testing::rooms_in_a_row(2), empty),
-                        "classifier is empty");
+  EXPECT_ERROR_MENTIONS(
+      rooms::segment_feature_based(compute::Context::cpu(), testing::rooms_in_a_row(2), empty),
+      "classifier is empty");
   EXPECT_ERROR_MENTIONS(empty.save(temp_path("empty.yml")), "empty model");
 }
 
@@ -227,9 +229,10 @@ TEST(FeatureSegmentation, LearnsAndSegmentsRoomsOffACorridor) {
   rooms::ClassifierTrainingParams params;
   params.weak_count = 40;
   params.sample_stride = 2;
-  const rooms::RoomClassifier classifier = rooms::train_room_classifier({training}, params);
+  const rooms::RoomClassifier classifier =
+      rooms::train_room_classifier(compute::Context::cpu(), {training}, params);
 
-  const Image<PlaceClass> places = rooms::classify_places(map, classifier);
+  const Image<PlaceClass> places = rooms::classify_places(compute::Context::cpu(), map, classifier);
   int labelled = 0, right = 0;
   for (std::size_t i = 0; i < places.size(); ++i) {
     if (training.places.data()[i] == PlaceClass::none) continue;
@@ -238,7 +241,8 @@ TEST(FeatureSegmentation, LearnsAndSegmentsRoomsOffACorridor) {
   }
   EXPECT_GT(right, 0.97 * labelled) << right << " of " << labelled;
 
-  const rooms::RoomSegmentation result = rooms::segment_feature_based(map, classifier);
+  const rooms::RoomSegmentation result =
+      rooms::segment_feature_based(compute::Context::cpu(), map, classifier);
   EXPECT_EQ(result.method, "feature");
   EXPECT_EQ(result.records.size(), 5u);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
@@ -259,21 +263,26 @@ TEST(FeatureSegmentation, TrainingMapsFromDrawings) {
   EXPECT_EQ(t.places(3, 0), PlaceClass::none);
   EXPECT_ERROR_MENTIONS(rooms::room_training_map("drawing", white, drawn, PlaceClass::room),
                         "drawing", "white cell outside");
-  EXPECT_ERROR_MENTIONS(rooms::train_room_classifier({}), "no training maps");
+  EXPECT_ERROR_MENTIONS(rooms::train_room_classifier(compute::Context::cpu(), {}),
+                        "no training maps");
 }
 
 TEST(FeatureSegmentation, RejectsBadInput) {
   const rooms::RoomClassifier classifier = rooms::RoomClassifier::load(shipped_model());
-  EXPECT_ERROR_MENTIONS(rooms::segment_feature_based(testing::carve_map(5, 5, {}), classifier),
+  EXPECT_ERROR_MENTIONS(rooms::segment_feature_based(compute::Context::cpu(),
+                                                     testing::carve_map(5, 5, {}), classifier),
                         "feature-based room segmentation");
   rooms::FeatureSegmentationParams params;
   params.region_area = {2.0, 1.0};
   EXPECT_ERROR_MENTIONS(
-      rooms::segment_feature_based(testing::rooms_in_a_row(2), classifier, params), "area limits");
+      rooms::segment_feature_based(compute::Context::cpu(), testing::rooms_in_a_row(2), classifier,
+                                   params),
+      "area limits");
   params = {};
   params.sample_stride = 0;
   EXPECT_ERROR_MENTIONS(
-      rooms::segment_feature_based(testing::rooms_in_a_row(2), classifier, params),
+      rooms::segment_feature_based(compute::Context::cpu(), testing::rooms_in_a_row(2), classifier,
+                                   params),
       "sample_stride");
 }
 
@@ -282,7 +291,7 @@ TEST(FeatureSegmentation, RejectsBadInput) {
 TEST(FeatureSegmentation, RealIpaMap) {
   const rooms::RoomClassifier classifier = rooms::RoomClassifier::load(shipped_model());
   const auto scores = testing::benchmark_map_scores("office_c", [&](const OccupancyGrid& map) {
-    return rooms::segment_feature_based(map, classifier);
+    return rooms::segment_feature_based(compute::Context::cpu(), map, classifier);
   });
   EXPECT_GT(scores.recall_mean, 0.96);     // measured 0.990
   EXPECT_GT(scores.precision_mean, 0.95);  // measured 0.976

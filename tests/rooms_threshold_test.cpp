@@ -4,9 +4,10 @@
 #include <algorithm>
 #include <set>
 
+#include "kartograf/compute/context.hpp"
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/room_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/outputs/room_io.hpp"
 #include "kartograf/rooms/component_tree.hpp"
 #include "kartograf/rooms/furniture.hpp"
 #include "kartograf/rooms/room_methods.hpp"
@@ -19,8 +20,8 @@ namespace {
 
 using rooms::RoomMethod;
 
-rooms::RoomMethodOptions area_limits(double min_m2, double max_m2) {
-  rooms::RoomMethodOptions options;
+rooms::RoomMethodParams area_limits(double min_m2, double max_m2) {
+  rooms::RoomMethodParams options;
   options.room_area = rooms::AreaLimits{min_m2, max_m2};
   return options;
 }
@@ -30,7 +31,8 @@ class ThresholdMethods : public ::testing::TestWithParam<RoomMethod> {};
 TEST_P(ThresholdMethods, SplitRoomsInARowAtTheirDoorways) {
   LabelImage truth;
   const OccupancyGrid map = testing::rooms_in_a_row(3, &truth);
-  const rooms::RoomSegmentation result = rooms::segment_rooms(map, GetParam());
+  const rooms::RoomSegmentation result =
+      rooms::segment_rooms(compute::Context::cpu(), map, GetParam());
   ASSERT_EQ(result.records.size(), 3u);
   testing::expect_free_space_covered(map, result.rooms);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
@@ -55,7 +57,8 @@ TEST_P(ThresholdMethods, SplitRoomsInARowAtTheirDoorways) {
 TEST_P(ThresholdMethods, FindRoomsOffACorridor) {
   LabelImage truth;
   const OccupancyGrid map = testing::rooms_off_a_corridor(4, &truth);
-  const rooms::RoomSegmentation result = rooms::segment_rooms(map, GetParam());
+  const rooms::RoomSegmentation result =
+      rooms::segment_rooms(compute::Context::cpu(), map, GetParam());
   testing::expect_free_space_covered(map, result.rooms);
   const auto scores = eval::evaluate_room_segmentation(truth, result.rooms);
   EXPECT_EQ(scores.segments, 5);
@@ -65,23 +68,27 @@ TEST_P(ThresholdMethods, FindRoomsOffACorridor) {
 
 TEST_P(ThresholdMethods, RejectBadMaps) {
   OccupancyGrid empty;
-  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(empty, GetParam()), "empty");
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(compute::Context::cpu(), empty, GetParam()), "empty");
   OccupancyGrid walls = testing::carve_map(10, 10, {});
-  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(walls, GetParam()), "no free cell");
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(compute::Context::cpu(), walls, GetParam()),
+                        "no free cell");
   OccupancyGrid bad_resolution = testing::rooms_in_a_row(1);
   bad_resolution.resolution = 0;
-  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(bad_resolution, GetParam()), "resolution", "> 0");
-  EXPECT_ERROR_MENTIONS(
-      rooms::segment_rooms(testing::rooms_in_a_row(1), GetParam(), area_limits(5, 2)),
-      "area limits");
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(compute::Context::cpu(), bad_resolution, GetParam()),
+                        "resolution", "> 0");
+  EXPECT_ERROR_MENTIONS(rooms::segment_rooms(compute::Context::cpu(), testing::rooms_in_a_row(1),
+                                             GetParam(), area_limits(5, 2)),
+                        "area limits");
 }
 
 TEST_P(ThresholdMethods, AreaLimitsDecideWhatIsARoom) {
   // Two 36 m^2 rooms: with rooms of 40-100 m^2 only both together are one; with the default
   // limits (at most 47 m^2 morphological, 163 m^2 distance) the sweeps find each.
   const OccupancyGrid map = testing::rooms_in_a_row(2);
-  EXPECT_EQ(rooms::segment_rooms(map, GetParam(), area_limits(40, 100)).records.size(), 1u);
-  EXPECT_EQ(rooms::segment_rooms(map, GetParam()).records.size(), 2u);
+  EXPECT_EQ(rooms::segment_rooms(compute::Context::cpu(), map, GetParam(), area_limits(40, 100))
+                .records.size(),
+            1u);
+  EXPECT_EQ(rooms::segment_rooms(compute::Context::cpu(), map, GetParam()).records.size(), 2u);
 }
 
 INSTANTIATE_TEST_SUITE_P(Rooms, ThresholdMethods,
@@ -270,9 +277,10 @@ TEST(ThresholdMethodsOnRealMaps, MatchOrBeatTheReference) {
                                   {RoomMethod::distance, "furnitures", 0.761, 0.884}};
   for (const Reference& reference : references) {
     const std::string name = rooms::to_string(reference.method);
-    const testing::BenchmarkMeans means = testing::benchmark_means(
-        name, reference.variant,
-        [&](const OccupancyGrid& map) { return rooms::segment_rooms(map, reference.method); });
+    const testing::BenchmarkMeans means =
+        testing::benchmark_means(name, reference.variant, [&](const OccupancyGrid& map) {
+          return rooms::segment_rooms(compute::Context::cpu(), map, reference.method);
+        });
     ASSERT_EQ(means.maps, 10);
     EXPECT_GE(means.recall, reference.recall) << name << " " << reference.variant;
     EXPECT_GE(means.precision, reference.precision) << name << " " << reference.variant;

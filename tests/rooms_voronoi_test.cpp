@@ -6,7 +6,7 @@
 #include <random>
 
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/voronoi_segmentation.hpp"
 #include "room_test_maps.hpp"
 #include "test_support.hpp"

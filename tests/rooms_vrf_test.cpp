@@ -11,7 +11,7 @@
 #include <unistd.h>
 
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/voronoi_random_field.hpp"
 #include "room_test_maps.hpp"
 #include "test_support.hpp"

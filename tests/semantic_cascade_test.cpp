@@ -14,10 +14,15 @@
 #include "kartograf/semantic/cascade_training.hpp"
 #include "kartograf/semantic/haar_cascade.hpp"
 #include "kartograf/semantic/object_detector.hpp"
-#include "kartograf/semantic/synthetic_stairs.hpp"
+#include "kartograf/training/synthetic_stairs.hpp"
 
 namespace kartograf::semantic {
 namespace {
+
+using training::render_stairs_view;
+using training::stairs_positives;
+using training::StairsView;
+using training::StairsViewParams;
 
 GrayImage random_image(int width, int height, std::uint64_t seed) {
   std::mt19937_64 rng(seed);
@@ -239,7 +244,7 @@ TEST(SemanticCascade, MetricSizeOfADetection) {
 
 TEST(SemanticCascade, SyntheticStairsViewsAndPositives) {
   const compute::Context context = compute::Context::cpu();
-  StairsViewOptions options;
+  StairsViewParams options;
   options.width = 160, options.height = 120, options.focal = 125;
   const StairsView view = render_stairs_view(context, 3, true, options);
   ASSERT_TRUE(view.object.has_value());
@@ -266,7 +271,7 @@ TEST(SemanticCascade, ShippedStairsDetectorPlacesStairsOnTheMap) {
   const compute::Context context = compute::Context::cpu();
   const ObjectDetector detector = ObjectDetector::stairs();
   EXPECT_EQ(detector.object_class(), "stairs");
-  StairsViewOptions options;
+  StairsViewParams options;
   options.width = 640, options.height = 480, options.focal = 500;
   int found = 0;
   for (std::uint64_t seed = 2000000; seed < 2000006; ++seed) {
@@ -329,7 +334,7 @@ TEST(SemanticCascade, BadInputThrows) {
   EXPECT_THROW(measure_detection(wall_points(2.0), {90, 0, 20, 20, 0, 1}), Error);
   EXPECT_THROW(verify_metric_size({}, wall_points(2.0), SizeLimits{1, 0.5, 0, 1}), Error);
   EXPECT_THROW(load_cascade("/nonexistent/kartograf_cascade.yml.gz"), Error);
-  EXPECT_THROW(render_stairs_view(compute::Context::cpu(), 1, true, StairsViewOptions{.width = 5}),
+  EXPECT_THROW(render_stairs_view(compute::Context::cpu(), 1, true, StairsViewParams{.width = 5}),
                Error);
 }
 

@@ -172,7 +172,7 @@ TEST(SemanticGrid, UnclassifiedOutlinesThatEncloseFloorBlockIt) {
   EXPECT_EQ(at(1.1, 1.1), std::pair(C::unknown, 0.0f));
   EXPECT_EQ(at(3.2, 0.9), std::pair(C::floor, 1.0f));  // inside the L's corner
   EXPECT_EQ(at(3.0, 2.5), std::pair(C::floor, 1.0f));
-  SemanticGridOptions off;
+  SemanticGridParams off;
   off.max_furniture_fill_area = 0;
   const SemanticGrid unfilled = build_semantic_grid(s.points, s.labels, off);
   const Eigen::Vector2i under = unfilled.cell_of({1.6, 1.4});
@@ -239,7 +239,7 @@ TEST_F(SemanticGridRoom, DetectionsAddObjectsAndWeights) {
 TEST_F(SemanticGridRoom, BadInputIsRejected) {
   std::vector<SemanticClass> short_labels(scene.labels.begin(), scene.labels.end() - 1);
   EXPECT_ERROR_MENTIONS(build_semantic_grid(scene.points, short_labels), "points", "labels");
-  SemanticGridOptions options;
+  SemanticGridParams options;
   options.weights.by_class[static_cast<int>(SemanticClass::door)] = 1.5f;
   EXPECT_ERROR_MENTIONS(build_semantic_grid(scene.points, scene.labels, options), "door", "[0, 1]");
   const std::vector<Eigen::Vector3d> none(3, Eigen::Vector3d::Constant(std::nan("")));
@@ -383,7 +383,7 @@ TEST_F(SemanticGridRoom, UnreachableGoalsAndBlockedStartsFailClearly) {
   EXPECT_ERROR_MENTIONS(plan_path(grid, {0.8, 0.7}, {3.0, 1.5}), "start", "obstacle");
   EXPECT_ERROR_MENTIONS(plan_path(grid, {-5.0, 1.5}, {3.0, 1.5}), "start", "outside the map");
   // A robot too wide for the 0.9 m door cannot reach the hall.
-  PlannerOptions wide;
+  PlannerParams wide;
   wide.robot_radius = 0.5;
   EXPECT_ERROR_MENTIONS(plan_path(grid, {2.0, 1.5}, {2.0, 3.75}, wide), "goal unreachable");
   // ... nor come within 0.35 m of its centre once 0.6 m from the jambs.
@@ -393,7 +393,7 @@ TEST_F(SemanticGridRoom, UnreachableGoalsAndBlockedStartsFailClearly) {
 }
 
 TEST_F(SemanticGridRoom, QueriesGoToTheDoorAndAlongTheWall) {
-  const PlannerOptions options;  // robot radius 0.2 m
+  const PlannerParams options;  // robot radius 0.2 m
   const PlannedPath door_path = plan_to_nearest_door(grid, {3.0, 1.0}, {}, options);
   const SemanticObject& door = grid.object(door_path.target_object);
   EXPECT_EQ(door.kind, ObjectKind::doorway);

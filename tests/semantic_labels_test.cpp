@@ -390,7 +390,7 @@ INSTANTIATE_TEST_SUITE_P(Backends, SemanticLabels,
 TEST(SemanticLaserScan, ArbitraryFrame) {
   const synth::World world = synth::make_building(5);
   const synth::RayCaster caster(world);
-  synth::LaserScanOptions options;
+  synth::LidarScanParams options;
   options.columns = 181;  // 1 degree steps keep the test small
   options.lines = 101;
   options.threads = 2;

@@ -7,9 +7,10 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/sequence_detect.hpp"
-#include "kartograf/io/synthetic_dataset.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
+#include "kartograf/outputs/synthetic_dataset.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -68,7 +69,7 @@ TEST_F(SequenceDetect, ExplainsWhatItLookedFor) {
 }
 
 TEST_F(SequenceDetect, OpensASyntheticFolderAsAFrameSourceWithGroundTruth) {
-  io::SyntheticDatasetOptions options;
+  io::SyntheticDatasetParams options;
   options.frames = 3;
   options.intrinsics = {80, 60, 65.625, 66.0, 39.5, 29.75};
   options.laser.lines = 11;
@@ -77,9 +78,9 @@ TEST_F(SequenceDetect, OpensASyntheticFolderAsAFrameSourceWithGroundTruth) {
   EXPECT_EQ(opened.detected.layout, io::SequenceLayout::synthetic);
   ASSERT_EQ(opened.sequence->size(), 3u);
 
-  const io::SequenceFrameSource all(*opened.sequence);
+  const pipeline::SequenceFrameSource all(*opened.sequence);
   EXPECT_EQ(all.size(), 3u);
-  const io::SequenceFrameSource limited(*opened.sequence, 2);
+  const pipeline::SequenceFrameSource limited(*opened.sequence, 2);
   EXPECT_EQ(limited.size(), 2u);
   EXPECT_EQ(limited.camera().width, 80);
   EXPECT_DOUBLE_EQ(limited.depth_units_per_metre(), 5000.0);
@@ -104,7 +105,7 @@ TEST(SequenceDetectRealData, Detects7ScenesRedKitchen) {
   EXPECT_FALSE(opened.detected.has_timestamps);
   EXPECT_EQ(opened.sequence->size(), 300u);
   EXPECT_DOUBLE_EQ(opened.sequence->intrinsics().fx, 585.0);
-  const io::SequenceFrameSource source(*opened.sequence, 1);
+  const pipeline::SequenceFrameSource source(*opened.sequence, 1);
   const registration::RgbdImages frame = source.frame(0);
   EXPECT_EQ(frame.depth.width(), 640);
   ASSERT_TRUE(source.ground_truth().at(0).has_value());

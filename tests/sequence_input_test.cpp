@@ -13,9 +13,10 @@
 
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/camera_intrinsics.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/formats/camera_intrinsics.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/mapping/slam.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "rgbd_test_sequence.hpp"
@@ -116,7 +117,7 @@ TEST_F(SequenceInput, MissingDepthInTheNumberedRunIsAnErrorNamingItUnlessSkipped
   fs::remove(folder / frame_name(15, ".depth.png"));
   EXPECT_ERROR_MENTIONS(io::open_sequence(folder), "frame-000015.depth.png", "no such file",
                         "--skip-bad-frames");
-  io::SequenceOptions skip;
+  io::SequenceParams skip;
   skip.skip_bad_frames = true;
   const io::OpenedSequence opened = io::open_sequence(folder, skip);
   EXPECT_EQ(opened.sequence->size(), 29u);
@@ -153,7 +154,7 @@ TEST_F(SequenceInput, ColourSmallerThanDepthIsAnErrorNamingTheFileAndBothSizes) 
   fs::copy_file(dir() / "small.png", folder / frame_name(2, ".color.jpg"));  // PNG bytes, .jpg name
   const io::OpenedSequence opened = io::open_sequence(folder);
   EXPECT_ERROR_MENTIONS(opened.sequence->frame(2), "frame-000002.color.jpg", "16x12", "640x480");
-  io::SequenceOptions skip;
+  io::SequenceParams skip;
   skip.skip_bad_frames = true;
   EXPECT_EQ(io::open_sequence(folder, skip).sequence->size(), 4u);
 }
@@ -233,18 +234,18 @@ TEST_F(SequenceInput, UnusableDepthIsFoundBeforeARun) {  // defect 8
                   DepthImage(640, 480, std::uint16_t(0)));
   const io::OpenedSequence zeros = io::open_sequence(zero);
   range.units_per_metre = zeros.sequence->depth_units_per_metre();
-  EXPECT_ERROR_MENTIONS(io::check_depth_usable(*zeros.sequence, range), "depth/0.png",
+  EXPECT_ERROR_MENTIONS(pipeline::check_depth_usable(*zeros.sequence, range), "depth/0.png",
                         "every depth value is 0", "--depth-scale", "5000 units per metre");
 
   const fs::path far = tum_folder("far", 2);  // 1.5 m stored x1000: 7500 at 5 units per metre
-  io::SequenceOptions millimetres_as_metres;
+  io::SequenceParams millimetres_as_metres;
   millimetres_as_metres.depth_units_per_metre = 5;
   const io::OpenedSequence wrong = io::open_sequence(far, millimetres_as_metres);
   range.units_per_metre = 5;
-  EXPECT_ERROR_MENTIONS(io::check_depth_usable(*wrong.sequence, range), "depth/0.png",
+  EXPECT_ERROR_MENTIONS(pipeline::check_depth_usable(*wrong.sequence, range), "depth/0.png",
                         "values 7500 to 7500", "--depth-scale");
   range.units_per_metre = 5000;
-  EXPECT_NO_THROW(io::check_depth_usable(*io::open_sequence(far).sequence, range));
+  EXPECT_NO_THROW(pipeline::check_depth_usable(*io::open_sequence(far).sequence, range));
 }
 
 TEST_F(SequenceInput, TruncatedJpegAndPngAreErrorsNamingTheFile) {  // defect 12
@@ -339,7 +340,7 @@ TEST_F(SequenceInput, TumCameraFromTheFolderNameAPresetOrADefaultWithAWarning) {
   EXPECT_DOUBLE_EQ(fr2.sequence->intrinsics().cy, 249.7);
   EXPECT_TRUE(fr2.warnings.empty());
 
-  io::SequenceOptions fr3;
+  io::SequenceParams fr3;
   fr3.camera = "tum-fr3";
   const io::OpenedSequence given = io::open_sequence(dir() / "plain", fr3);
   EXPECT_DOUBLE_EQ(given.sequence->intrinsics().fx, 535.4);
@@ -355,7 +356,7 @@ TEST_F(SequenceInput, TumCameraFromTheFolderNameAPresetOrADefaultWithAWarning) {
 
 TEST_F(SequenceInput, CameraAsNumbersOrFileAndPresetsScaledToTheFrames) {
   const fs::path folder = tum_folder("cam");
-  io::SequenceOptions numbers;
+  io::SequenceParams numbers;
   numbers.camera = "500,501,320.5,240.5";
   const io::OpenedSequence a = io::open_sequence(folder, numbers);
   EXPECT_DOUBLE_EQ(a.sequence->intrinsics().fy, 501.0);
@@ -363,7 +364,7 @@ TEST_F(SequenceInput, CameraAsNumbersOrFileAndPresetsScaledToTheFrames) {
   EXPECT_EQ(a.camera.source, "option");
 
   std::ofstream(dir() / "K.txt") << "600 0 310\n0 610 230\n0 0 1\n";
-  io::SequenceOptions file;
+  io::SequenceParams file;
   file.camera = (dir() / "K.txt").string();
   const io::OpenedSequence b = io::open_sequence(folder, file);
   EXPECT_DOUBLE_EQ(b.sequence->intrinsics().fy, 610.0);
@@ -386,7 +387,7 @@ TEST_F(SequenceInput, CameraAsNumbersOrFileAndPresetsScaledToTheFrames) {
 
 TEST_F(SequenceInput, DepthScaleAndFrameRange) {
   const fs::path folder = kitchen_copy("range", 0, 9);
-  io::SequenceOptions o;
+  io::SequenceParams o;
   o.depth_units_per_metre = 500;
   o.first = 2;
   o.count = 3;

@@ -3,8 +3,8 @@
 #include <fstream>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/sequence.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/sequence.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {

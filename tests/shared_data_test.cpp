@@ -23,11 +23,11 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/pcd.hpp"
-#include "kartograf/io/ply.hpp"
-#include "kartograf/io/sequence.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/formats/pcd.hpp"
+#include "kartograf/formats/ply.hpp"
+#include "kartograf/formats/sequence.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {

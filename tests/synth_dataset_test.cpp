@@ -11,11 +11,11 @@
 #include <nlohmann/json.hpp>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/pcd.hpp"
-#include "kartograf/io/sequence.hpp"
-#include "kartograf/io/synthetic_dataset.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/formats/pcd.hpp"
+#include "kartograf/formats/sequence.hpp"
+#include "kartograf/outputs/synthetic_dataset.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {
@@ -23,8 +23,8 @@ namespace {
 
 namespace fs = std::filesystem;
 
-io::SyntheticDatasetOptions small_options() {
-  io::SyntheticDatasetOptions o;
+io::SyntheticDatasetParams small_options() {
+  io::SyntheticDatasetParams o;
   o.frames = 4;
   o.intrinsics = {80, 60, 65.625, 66.0, 39.5, 29.75};
   o.laser.lines = 41;
@@ -54,7 +54,7 @@ void expect_intrinsics(const PinholeIntrinsics& actual, const PinholeIntrinsics&
 class SynthDataset : public testing::TempDirTest {};
 
 TEST_F(SynthDataset, OpensAsTumSequenceWithIntrinsicsAndPoses) {
-  const io::SyntheticDatasetOptions options = small_options();
+  const io::SyntheticDatasetParams options = small_options();
   const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(dir() / "set", options);
   const auto sequence = io::open_tum_sequence(dir() / "set");
   ASSERT_EQ(sequence->size(), 4u);
@@ -74,9 +74,9 @@ TEST_F(SynthDataset, OpensAsTumSequenceWithIntrinsicsAndPoses) {
 }
 
 TEST_F(SynthDataset, ByteIdenticalAcrossRunsAndThreadCounts) {
-  io::SyntheticDatasetOptions a = small_options();
+  io::SyntheticDatasetParams a = small_options();
   a.threads = 1;
-  io::SyntheticDatasetOptions b = small_options();
+  io::SyntheticDatasetParams b = small_options();
   b.threads = 3;
   io::write_synthetic_dataset(dir() / "a", a);
   io::write_synthetic_dataset(dir() / "b", b);
@@ -88,7 +88,7 @@ TEST_F(SynthDataset, ByteIdenticalAcrossRunsAndThreadCounts) {
     ASSERT_TRUE(files_b.count(name)) << name;
     EXPECT_TRUE(files_b.at(name) == content) << name << " differs";
   }
-  io::SyntheticDatasetOptions c = small_options();
+  io::SyntheticDatasetParams c = small_options();
   c.seed = 2;
   io::write_synthetic_dataset(dir() / "c", c);
   EXPECT_NE(testing::read_text(dir() / "a" / "world.json"),
@@ -96,7 +96,7 @@ TEST_F(SynthDataset, ByteIdenticalAcrossRunsAndThreadCounts) {
 }
 
 TEST_F(SynthDataset, RefusesANonEmptyFolderUnlessForced) {
-  io::SyntheticDatasetOptions options = small_options();
+  io::SyntheticDatasetParams options = small_options();
   options.frames = 1;
   io::write_synthetic_dataset(dir() / "set", options);
   EXPECT_ERROR_MENTIONS(io::write_synthetic_dataset(dir() / "set", options), "--force");
@@ -109,7 +109,7 @@ TEST_F(SynthDataset, RefusesANonEmptyFolderUnlessForced) {
 // frames 0: a robot tour takes the frames it needs to keep its per-frame limits; a hand-held
 // sequence has no such count.
 TEST_F(SynthDataset, ZeroFramesMeansTheTourOwnCount) {
-  io::SyntheticDatasetOptions options = small_options();
+  io::SyntheticDatasetParams options = small_options();
   options.intrinsics = {16, 12, 13.125, 13.125, 7.5, 5.5};
   options.frames = 0;
   const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(dir() / "tour", options);
@@ -124,7 +124,7 @@ TEST_F(SynthDataset, ZeroFramesMeansTheTourOwnCount) {
 }
 
 TEST_F(SynthDataset, GroundTruthFilesAgreeWithWorldJson) {
-  io::SyntheticDatasetOptions options = small_options();
+  io::SyntheticDatasetParams options = small_options();
   options.frames = 2;
   options.trajectory = io::SyntheticTrajectory::handheld;
   const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(dir() / "set", options);
@@ -205,7 +205,7 @@ TEST_F(SynthDataset, CameraIntrinsicsJsonRoundTripAndErrors) {
 
   // open_tum_sequence prefers an explicit argument over the file.
   const io::SyntheticDatasetSummary summary = io::write_synthetic_dataset(dir() / "set", [] {
-    io::SyntheticDatasetOptions o = small_options();
+    io::SyntheticDatasetParams o = small_options();
     o.frames = 1;
     return o;
   }());

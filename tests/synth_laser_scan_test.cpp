@@ -11,7 +11,7 @@ namespace kartograf::synth {
 namespace {
 
 TEST(SynthLaserScan, LayoutLikeTheDlutScans) {
-  const LaserScanOptions o;
+  const LidarScanParams o;
   EXPECT_EQ(o.columns, 361);
   const Eigen::Vector3d forward = laser_beam_direction(o, 180, 80);  // azimuth 0, elevation 20
   EXPECT_NEAR(forward.y(), 0.0, 1e-12);
@@ -27,7 +27,7 @@ TEST(SynthLaserScan, PointsLieOnTheirSurfaces) {
   const RayCaster caster(w);
   const Eigen::Isometry3d pose = default_scan_pose(w);
   EXPECT_NEAR(pose.translation().z(), 0.8, 1e-12);
-  LaserScanOptions exact;
+  LidarScanParams exact;
   exact.range_sigma = 0;
   const LaserScan scan = scan_laser(caster, pose, exact, 1);
   ASSERT_EQ(scan.points.width(), 361);
@@ -47,7 +47,7 @@ TEST(SynthLaserScan, PointsLieOnTheirSurfaces) {
   EXPECT_GT(valid, 0.9 * scan.points.size());
 
   // Noisy: the range error along each beam has the configured sigma (10 % tolerance).
-  const LaserScan noisy = scan_laser(caster, pose, LaserScanOptions{}, 2);
+  const LaserScan noisy = scan_laser(caster, pose, LidarScanParams{}, 2);
   double sum = 0, sum2 = 0;
   int n = 0;
   for (int row = 0; row < noisy.points.height(); ++row) {

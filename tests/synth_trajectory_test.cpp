@@ -34,7 +34,7 @@ TEST(SynthTrajectory, RobotTourVisitsEveryRoomAndClosesTheLoopWithinLimits) {
   for (std::uint64_t seed = 1; seed <= 8; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const World w = make_building(seed);
-    const TourOptions options;
+    const TourParams options;
     ASSERT_LE(tour_frames_needed(w, options), 300) << "the default building fits a 300-frame tour";
     const Trajectory t = robot_tour(w, 300, options);
     ASSERT_EQ(t.size(), 300u);
@@ -78,7 +78,7 @@ TEST(SynthTrajectory, SurveyTurnsAllTheWayRoundInPlaceInEveryRoom) {
   for (std::uint64_t seed = 1; seed <= 3; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const World w = make_building(seed);
-    TourOptions options;
+    TourParams options;
     options.survey = true;
     options.pitch_deg = 20;
     const int frames = tour_frames_needed(w, options);
@@ -123,7 +123,7 @@ TEST(SynthTrajectory, ShortToursStillLoopAndOptionsAreChecked) {
   ASSERT_EQ(t.size(), 20u);
   EXPECT_LT((t.back().pose.translation() - t.front().pose.translation()).norm(), 1e-9);
   EXPECT_THROW(robot_tour(w, 1), Error);
-  TourOptions bad;
+  TourParams bad;
   bad.max_step = 0;
   EXPECT_THROW(robot_tour(w, 10, bad), Error);
 }

@@ -45,98 +45,115 @@ bool in_range(double value, double lo, double hi) {
   return value >= lo - kEps && value <= hi + kEps;
 }
 
+// Room sizes in range, the corridor's width, and no two rooms closer than a wall.
+void expect_rooms_in_range(const World& w) {
+  const BuildingParams& o = w.options;
+  for (const Room& r : w.rooms) {
+    EXPECT_EQ(r.id, &r - w.rooms.data() + 1);
+    if (r.kind == RoomKind::corridor) {
+      EXPECT_TRUE(in_range(r.rect.size().y(), o.min_corridor_width, o.max_corridor_width));
+    } else {
+      EXPECT_TRUE(in_range(r.rect.size().x(), 3.0, 6.0)) << r.name;
+      EXPECT_TRUE(in_range(r.rect.size().y(), 3.0, 6.0)) << r.name;
+    }
+    for (const Room& other : w.rooms) {
+      if (&other != &r) {
+        EXPECT_FALSE(r.rect.overlaps(other.rect.expanded(w.wall_thickness - 1e-6)));
+      }
+    }
+  }
+}
+
+// Doorways: sizes in range, spanning exactly one wall between the two rooms they join; the
+// building connected, and every room with a doorway to the corridor.
+void expect_doorways_connect_rooms(const World& w) {
+  std::vector<std::set<Label>> neighbours(w.rooms.size() + 1);
+  for (const Doorway& d : w.doorways) {
+    EXPECT_TRUE(in_range(d.width, 0.8, 1.0));
+    EXPECT_TRUE(in_range(d.height, 2.0, 2.1));
+    EXPECT_NEAR(d.opening.size()[1 - d.passage_axis], d.width, kEps);
+    EXPECT_NEAR(d.opening.size()[d.passage_axis], w.wall_thickness, kEps);
+    for (Label id : d.rooms) {
+      const Rect2& r = w.room(id).rect;
+      const int a = d.passage_axis;
+      EXPECT_TRUE(std::fabs(r.min[a] - d.opening.max[a]) < kEps ||
+                  std::fabs(r.max[a] - d.opening.min[a]) < kEps);
+      EXPECT_GE(d.opening.min[1 - a], r.min[1 - a] + 0.3);  // not in a corner
+      EXPECT_LE(d.opening.max[1 - a], r.max[1 - a] - 0.3);
+    }
+    neighbours[d.rooms[0]].insert(d.rooms[1]);
+    neighbours[d.rooms[1]].insert(d.rooms[0]);
+  }
+  const Label corridor = w.rooms.back().id;
+  std::set<Label> seen = {corridor};
+  std::queue<Label> queue;
+  queue.push(corridor);
+  while (!queue.empty()) {
+    for (Label n : neighbours[queue.front()]) {
+      if (seen.insert(n).second) queue.push(n);
+    }
+    queue.pop();
+  }
+  EXPECT_EQ(seen.size(), w.rooms.size());
+  for (const Room& r : w.rooms) {
+    if (r.kind == RoomKind::room) {
+      EXPECT_TRUE(neighbours[r.id].count(corridor)) << r.name;
+    }
+  }
+}
+
+// Furniture: inside its room, clear of doorways and of the robot's route.
+void expect_furniture_clear(const World& w) {
+  const std::vector<Eigen::Vector2d> route = route_path(w).sample(0.02);
+  EXPECT_GE(w.furniture.size(), 4u);
+  for (const Furniture& f : w.furniture) {
+    const Rect2& room = w.room(f.room).rect;
+    EXPECT_TRUE(room.contains(f.footprint.min) && room.contains(f.footprint.max));
+    for (const Doorway& d : w.doorways) {
+      Rect2 zone = d.opening;
+      zone.min[d.passage_axis] -= 0.6;
+      zone.max[d.passage_axis] += 0.6;
+      EXPECT_FALSE(zone.overlaps(f.footprint))
+          << "furniture " << f.id << " blocks doorway " << d.id;
+    }
+    for (const Eigen::Vector2d& p : route) ASSERT_GE(f.footprint.distance(p), 0.45 - kEps);
+  }
+}
+
+// Solids are proper boxes, and no wall stands in a doorway below its lintel.
+void expect_solids_proper(const World& w) {
+  for (const Solid& solid : w.solids) {
+    EXPECT_GT((solid.box.max - solid.box.min).minCoeff(), 0.009);
+    if (solid.kind != SolidKind::wall) continue;
+    for (const Doorway& d : w.doorways) {
+      if (solid.box.min.z() < d.height) {
+        EXPECT_FALSE(solid.box.footprint().overlaps(d.opening)) << d.id;
+      }
+    }
+  }
+}
+
+// At least one dark surface (dropped returns).
+bool has_dark_surface(const World& w) {
+  bool dark = false;
+  for (const Plane& p : w.planes) {
+    if (p.material >= 0 && luminance(w.materials[p.material].color_a) < 0.08) dark = true;
+  }
+  return dark;
+}
+
 TEST(SynthWorld, BuildingInvariantsAcrossSeeds) {
   for (std::uint64_t seed = 1; seed <= 25; ++seed) {
     SCOPED_TRACE("seed " + std::to_string(seed));
     const World w = make_building(seed);
-    const BuildingOptions& o = w.options;
     ASSERT_EQ(w.rooms.size(), 5u);  // 4 rooms and the corridor
     EXPECT_TRUE(in_range(w.height, 2.5, 3.0));
     EXPECT_TRUE(in_range(w.wall_thickness, 0.1, 0.2));
-    for (const Room& r : w.rooms) {
-      EXPECT_EQ(r.id, &r - w.rooms.data() + 1);
-      if (r.kind == RoomKind::corridor) {
-        EXPECT_TRUE(in_range(r.rect.size().y(), o.min_corridor_width, o.max_corridor_width));
-      } else {
-        EXPECT_TRUE(in_range(r.rect.size().x(), 3.0, 6.0)) << r.name;
-        EXPECT_TRUE(in_range(r.rect.size().y(), 3.0, 6.0)) << r.name;
-      }
-      for (const Room& other : w.rooms) {
-        if (&other != &r) {
-          EXPECT_FALSE(r.rect.overlaps(other.rect.expanded(w.wall_thickness - 1e-6)));
-        }
-      }
-    }
-
-    // Doorways: sizes in range, spanning exactly one wall between the two rooms they join.
-    std::vector<std::set<Label>> neighbours(w.rooms.size() + 1);
-    for (const Doorway& d : w.doorways) {
-      EXPECT_TRUE(in_range(d.width, 0.8, 1.0));
-      EXPECT_TRUE(in_range(d.height, 2.0, 2.1));
-      EXPECT_NEAR(d.opening.size()[1 - d.passage_axis], d.width, kEps);
-      EXPECT_NEAR(d.opening.size()[d.passage_axis], w.wall_thickness, kEps);
-      for (Label id : d.rooms) {
-        const Rect2& r = w.room(id).rect;
-        const int a = d.passage_axis;
-        EXPECT_TRUE(std::fabs(r.min[a] - d.opening.max[a]) < kEps ||
-                    std::fabs(r.max[a] - d.opening.min[a]) < kEps);
-        EXPECT_GE(d.opening.min[1 - a], r.min[1 - a] + 0.3);  // not in a corner
-        EXPECT_LE(d.opening.max[1 - a], r.max[1 - a] - 0.3);
-      }
-      neighbours[d.rooms[0]].insert(d.rooms[1]);
-      neighbours[d.rooms[1]].insert(d.rooms[0]);
-    }
-    // Connected, and every room has a doorway to the corridor.
-    const Label corridor = w.rooms.back().id;
-    std::set<Label> seen = {corridor};
-    std::queue<Label> queue;
-    queue.push(corridor);
-    while (!queue.empty()) {
-      for (Label n : neighbours[queue.front()]) {
-        if (seen.insert(n).second) queue.push(n);
-      }
-      queue.pop();
-    }
-    EXPECT_EQ(seen.size(), w.rooms.size());
-    for (const Room& r : w.rooms) {
-      if (r.kind == RoomKind::room) {
-        EXPECT_TRUE(neighbours[r.id].count(corridor)) << r.name;
-      }
-    }
-
-    // Furniture: inside its room, clear of doorways and of the robot's route.
-    const std::vector<Eigen::Vector2d> route = route_path(w).sample(0.02);
-    EXPECT_GE(w.furniture.size(), 4u);
-    for (const Furniture& f : w.furniture) {
-      const Rect2& room = w.room(f.room).rect;
-      EXPECT_TRUE(room.contains(f.footprint.min) && room.contains(f.footprint.max));
-      for (const Doorway& d : w.doorways) {
-        Rect2 zone = d.opening;
-        zone.min[d.passage_axis] -= 0.6;
-        zone.max[d.passage_axis] += 0.6;
-        EXPECT_FALSE(zone.overlaps(f.footprint))
-            << "furniture " << f.id << " blocks doorway " << d.id;
-      }
-      for (const Eigen::Vector2d& p : route) ASSERT_GE(f.footprint.distance(p), 0.45 - kEps);
-    }
-
-    // Solids are proper boxes, and no wall stands in a doorway below its lintel.
-    for (const Solid& solid : w.solids) {
-      EXPECT_GT((solid.box.max - solid.box.min).minCoeff(), 0.009);
-      if (solid.kind != SolidKind::wall) continue;
-      for (const Doorway& d : w.doorways) {
-        if (solid.box.min.z() < d.height) {
-          EXPECT_FALSE(solid.box.footprint().overlaps(d.opening)) << d.id;
-        }
-      }
-    }
-
-    // At least one dark surface (dropped returns).
-    bool dark = false;
-    for (const Plane& p : w.planes) {
-      if (p.material >= 0 && luminance(w.materials[p.material].color_a) < 0.08) dark = true;
-    }
-    EXPECT_TRUE(dark);
+    expect_rooms_in_range(w);
+    expect_doorways_connect_rooms(w);
+    ASSERT_NO_FATAL_FAILURE(expect_furniture_clear(w));
+    expect_solids_proper(w);
+    EXPECT_TRUE(has_dark_surface(w));
   }
 }
 
@@ -228,7 +245,7 @@ TEST(SynthWorld, WallPlaneLookup) {
 }
 
 TEST(SynthWorld, RejectsBadOptions) {
-  BuildingOptions o;
+  BuildingParams o;
   o.room_count = 0;
   EXPECT_THROW(make_building(1, o), Error);
   o = {};
@@ -241,7 +258,7 @@ TEST(SynthWorld, RejectsBadOptions) {
 
 TEST(SynthWorld, OtherRoomCountsStillConnectAndLoop) {
   for (int rooms : {1, 2, 3, 5, 6}) {
-    BuildingOptions o;
+    BuildingParams o;
     o.room_count = rooms;
     const World w = make_building(11, o);
     EXPECT_EQ(w.rooms.size(), static_cast<std::size_t>(rooms + 1));

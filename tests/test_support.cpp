@@ -30,7 +30,7 @@ std::vector<compute::BackendKind> backends_under_test() {
 }
 
 compute::Context make_context(compute::BackendKind kind) {
-  compute::ContextOptions options;
+  compute::ContextParams options;
   options.backend = compute::choice_of(kind);
   options.vulkan_validation = true;
   return compute::Context(options);

@@ -4,7 +4,7 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "test_support.hpp"
 
 namespace kartograf {

@@ -18,7 +18,7 @@
 
 #include "kartograf/compute/context.hpp"
 #include "kartograf/semantic/cascade_training.hpp"
-#include "kartograf/semantic/synthetic_stairs.hpp"
+#include "kartograf/training/synthetic_stairs.hpp"
 
 using namespace kartograf;
 
@@ -42,9 +42,9 @@ int main(int argc, char** argv) {
     std::vector<GrayImage> positives;
     std::vector<semantic::TrainingBackground> backgrounds;
     for (int i = 0; i < object_views; ++i) {
-      const semantic::StairsView view =
-          semantic::render_stairs_view(context, static_cast<std::uint64_t>(1 + i), true);
-      for (GrayImage& p : semantic::stairs_positives(view, per_view, 20, rng)) {
+      const training::StairsView view =
+          training::render_stairs_view(context, static_cast<std::uint64_t>(1 + i), true);
+      for (GrayImage& p : training::stairs_positives(view, per_view, 20, rng)) {
         positives.push_back(std::move(p));
       }
       // The view itself gives hard negatives: parts of the stairs, neighbouring scales.
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     }
     for (int i = 0; i < background_views; ++i) {
       backgrounds.push_back(
-          {semantic::render_stairs_view(context, static_cast<std::uint64_t>(100001 + i), false)
+          {training::render_stairs_view(context, static_cast<std::uint64_t>(100001 + i), false)
                .gray,
            {}});
     }

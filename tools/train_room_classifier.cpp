@@ -15,8 +15,9 @@
 #include <string>
 #include <vector>
 
+#include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/feature_segmentation.hpp"
 
 namespace fs = std::filesystem;
@@ -58,7 +59,8 @@ int main(int argc, char** argv) {
   try {
     const auto start = std::chrono::steady_clock::now();
     const std::vector<rooms::RoomTrainingMap> maps = read_training_maps(argv[1]);
-    const rooms::RoomClassifier classifier = rooms::train_room_classifier(maps);
+    const rooms::RoomClassifier classifier =
+        rooms::train_room_classifier(compute::Context::cpu(), maps);
     const fs::path output = argv[2];
     if (output.has_parent_path()) fs::create_directories(output.parent_path());
     classifier.save(output);

@@ -20,7 +20,7 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/voronoi_random_field.hpp"
 
 namespace fs = std::filesystem;

@@ -17,7 +17,7 @@ void add_backend_option(CLI::App& command, std::string& backend, std::string& so
 }
 
 compute::Context backend_context(const std::string& backend, const std::string& source) {
-  compute::ContextOptions options;
+  compute::ContextParams options;
   options.backend = compute::parse_backend_choice(backend, source);
   options.read_device_environment();  // KARTOGRAF_DEVICE on every command, not only `demo`
   return compute::Context(options);

@@ -58,7 +58,7 @@ struct SynthOptions {
   int room = 0;                      // handheld: room id, 0 = the largest
   double look_around_deg = 30.0;     // robot: the yaw sweep inside each room
   double pitch_deg = 12.0;           // robot: the camera's downward pitch
-  bool survey = false;               // robot: a full turn in every room (TourOptions::survey)
+  bool survey = false;               // robot: a full turn in every room (TourParams::survey)
   PinholeIntrinsics intrinsics{640, 480, 525.0, 525.0, 319.5, 239.5};
   bool intrinsics_given = false;  // any of --fx --fy --cx --cy; else scaled to --width/--height
   bool no_noise = false;
@@ -69,7 +69,7 @@ CLI::App* add_synth_command(CLI::App& app, SynthOptions& options);
 int run_synth_command(const SynthOptions& options, std::ostream& out, std::ostream& err);
 
 // How every command that takes a sequence folder reads it (sequence_run.hpp:
-// add_sequence_input_options; io::SequenceOptions).
+// add_sequence_input_options; io::SequenceParams).
 struct SequenceInputOptions {
   std::string camera;                           // --camera; empty: the folder's
   double depth_scale = 0;                       // --depth-scale [units per metre]; 0: the layout's

@@ -18,8 +18,8 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/normals.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/ply.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/ply.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "output_transaction.hpp"
@@ -99,7 +99,7 @@ std::string percent_of(std::size_t part, std::size_t whole) {
 }  // namespace
 
 int run_demo_command(const DemoOptions& options, std::ostream& out) {
-  compute::ContextOptions context_options = compute::ContextOptions::from_environment();
+  compute::ContextParams context_options = compute::ContextParams::from_environment();
   context_options.backend = compute::parse_backend_choice(options.backend, options.backend_source);
   OutputFolder folder("demo", options.out_dir, options.force,
                       {"depth.png", "depth_color.png", "normals.png", "cloud.ply"});

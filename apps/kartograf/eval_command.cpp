@@ -19,8 +19,8 @@
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/eval/semantic_metrics.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "option_checks.hpp"
 
 namespace kartograf::cli {

@@ -10,8 +10,8 @@
 
 #include "commands.hpp"
 #include "interrupts.hpp"
-#include "kartograf/io/map_outputs.hpp"
-#include "kartograf/io/synthetic_dataset.hpp"
+#include "kartograf/outputs/map_outputs.hpp"
+#include "kartograf/outputs/synthetic_dataset.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
 #include "option_checks.hpp"
@@ -113,7 +113,6 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   params.label_width = o.label_width;
   params.grid.resolution = o.resolution;
   params.room_method = rooms::parse_room_method(o.room_method);
-  params.rooms.context = &context;
 
   ProgressBar bar(err, o.run.progress);
   pipeline::MapPipelineObserver observer;

@@ -8,8 +8,8 @@
 
 #include "commands.hpp"
 #include "interrupts.hpp"
-#include "kartograf/io/text_file.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/text_file.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "kartograf/mapping/slam.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"

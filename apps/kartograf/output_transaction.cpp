@@ -14,7 +14,7 @@
 
 #include "interrupts.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/text_file.hpp"
+#include "kartograf/formats/text_file.hpp"
 
 namespace kartograf::cli {
 

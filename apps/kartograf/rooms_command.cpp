@@ -25,10 +25,10 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/room_io.hpp"
-#include "kartograf/io/text_file.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/formats/text_file.hpp"
+#include "kartograf/outputs/room_io.hpp"
 #include "kartograf/rooms/room_methods.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
@@ -66,8 +66,8 @@ OccupancyGrid read_map(const fs::path& path, double resolution, int free_thresho
   return io::read_png_map(path, resolution, free_threshold);
 }
 
-rooms::RoomMethodOptions method_options(const RoomsOptions& o) {
-  rooms::RoomMethodOptions options;
+rooms::RoomMethodParams method_options(const RoomsOptions& o) {
+  rooms::RoomMethodParams options;
   if (o.min_area_m2 >= 0 || o.max_area_m2 >= 0) {
     require(o.min_area_m2 >= 0 && o.max_area_m2 > o.min_area_m2,
             "rooms: --min-area and --max-area go together, with 0 <= min < max");
@@ -79,8 +79,10 @@ rooms::RoomMethodOptions method_options(const RoomsOptions& o) {
 }
 
 // The backend of the feature method's laser scans, made only when that method runs.
-std::optional<compute::Context> scan_context(const RoomsOptions& o, bool needed) {
-  if (!needed) return std::nullopt;
+// The backend the feature method's laser scans run on; the other methods run on the host, so they
+// take the CPU context and never open a device.
+compute::Context scan_context(const RoomsOptions& o, bool needed) {
+  if (!needed) return compute::Context::cpu();
   return backend_context(o.backend, o.backend_source);
 }
 
@@ -154,13 +156,11 @@ CLI::App* add_rooms_command(CLI::App& app, RoomsOptions& o) {
 
 int run_rooms_command(const RoomsOptions& o, bool resolution_given, std::ostream& out) {
   const rooms::RoomMethod method = rooms::parse_room_method(o.method);
-  rooms::RoomMethodOptions options = method_options(o);
-  const std::optional<compute::Context> context =
-      scan_context(o, method == rooms::RoomMethod::feature);
-  if (context) options.context = &*context;
+  rooms::RoomMethodParams options = method_options(o);
+  const compute::Context context = scan_context(o, method == rooms::RoomMethod::feature);
   const OccupancyGrid map = read_map(o.map, o.resolution, o.free_threshold, resolution_given);
   OutputFolder folder("rooms", o.out_dir, o.force, {"rooms.png", "rooms_color.png", "rooms.json"});
-  const rooms::RoomSegmentation result = rooms::segment_rooms(map, method, options);
+  const rooms::RoomSegmentation result = rooms::segment_rooms(context, map, method, options);
   const InterruptsDeferred writing;  // a signal waits for the files, then drops them
   const fs::path& dir = folder.dir();
   // Everything is computed before the first file is written; each write is atomic.
@@ -200,11 +200,10 @@ int run_rooms_eval_command(const RoomsEvalOptions& o, std::ostream& out, std::os
   std::vector<rooms::RoomMethod> methods;
   for (const std::string& name : o.methods) methods.push_back(rooms::parse_room_method(name));
   if (methods.empty()) methods = rooms::all_room_methods();
-  rooms::RoomMethodOptions options = method_options(o.map);
-  const std::optional<compute::Context> context =
+  rooms::RoomMethodParams options = method_options(o.map);
+  const compute::Context context =
       scan_context(o.map, std::find(methods.begin(), methods.end(), rooms::RoomMethod::feature) !=
                               methods.end());
-  if (context) options.context = &*context;
   std::vector<io::RoomMapCase> cases = io::find_room_maps(o.folder);
   if (!o.only.empty()) {
     std::erase_if(
@@ -226,7 +225,7 @@ int run_rooms_eval_command(const RoomsEvalOptions& o, std::ostream& out, std::os
       if (truth == truths.end())
         truth = truths.emplace(c.name, io::read_room_ground_truth_png(c.ground_truth)).first;
       const OccupancyGrid map = io::read_png_map(c.map, o.map.resolution, o.map.free_threshold);
-      const rooms::RoomSegmentation result = rooms::segment_rooms(map, method, options);
+      const rooms::RoomSegmentation result = rooms::segment_rooms(context, map, method, options);
       const eval::RoomSegmentationScores s =
           eval::evaluate_room_segmentation(truth->second, result.rooms);
       groups[c.variant].add(s, result.seconds);

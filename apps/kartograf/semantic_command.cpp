@@ -23,13 +23,13 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/geometry/range_image.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/occupancy_map_io.hpp"
-#include "kartograf/io/pcd.hpp"
-#include "kartograf/io/ply.hpp"
-#include "kartograf/io/semantic_map_io.hpp"
-#include "kartograf/io/sequence_detect.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/formats/pcd.hpp"
+#include "kartograf/formats/ply.hpp"
+#include "kartograf/outputs/semantic_map_io.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "kartograf/semantic/classify.hpp"
 #include "kartograf/semantic/labelled_views.hpp"
 #include "kartograf/semantic/normals_image.hpp"
@@ -376,7 +376,7 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
   const std::vector<semantic::ObjectDetection> detections =
       place_detections(labelled, o.detect, err);
   const semantic::SemanticLabelling& labelling = labelled.view;
-  semantic::SemanticGridOptions grid_options;
+  semantic::SemanticGridParams grid_options;
   grid_options.resolution = o.resolution;
   const semantic::SemanticGrid grid = semantic::build_semantic_grid(
       labelled.pooled.points(), labelled.pooled.labels(), grid_options, detections);

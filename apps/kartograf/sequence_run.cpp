@@ -7,6 +7,7 @@
 #include <iostream>
 
 #include "backend_option.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/core/error.hpp"
 #include "option_checks.hpp"
 
@@ -57,8 +58,8 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
 }
 
-io::SequenceOptions sequence_options(const SequenceInputOptions& o) {
-  io::SequenceOptions options;
+io::SequenceParams sequence_options(const SequenceInputOptions& o) {
+  io::SequenceParams options;
   options.camera = o.camera;
   if (o.depth_scale > 0) options.depth_units_per_metre = o.depth_scale;
   options.first = o.first;
@@ -120,8 +121,8 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
   run.opened = open_input(options.sequence, options.input, err);
   geometry::DepthRange range = odometry_params(options).depth_range;
   range.units_per_metre = run.opened.sequence->depth_units_per_metre();
-  io::check_depth_usable(*run.opened.sequence, range);
-  run.source = std::make_unique<io::SequenceFrameSource>(*run.opened.sequence);
+  pipeline::check_depth_usable(*run.opened.sequence, range);
+  run.source = std::make_unique<pipeline::SequenceFrameSource>(*run.opened.sequence);
   return run;
 }
 
@@ -206,7 +207,7 @@ Trajectory stamped_trajectory(const std::vector<Eigen::Isometry3d>& poses,
   return trajectory;
 }
 
-Trajectory ground_truth_trajectory(const io::SequenceFrameSource& source,
+Trajectory ground_truth_trajectory(const pipeline::SequenceFrameSource& source,
                                    const std::vector<double>& timestamps, bool has_timestamps) {
   Trajectory trajectory;
   const auto& truth = source.ground_truth();
@@ -219,7 +220,7 @@ Trajectory ground_truth_trajectory(const io::SequenceFrameSource& source,
 }
 
 std::optional<eval::AteResult> absolute_trajectory_error(
-    const io::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses) {
+    const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses) {
   const eval::MatchedPoses matched = eval::match_frames(source.ground_truth(), poses);
   if (matched.size() < 3) return std::nullopt;
   return eval::compute_ate(matched, eval::Alignment::se3);

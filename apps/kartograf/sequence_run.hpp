@@ -20,7 +20,8 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/trajectory.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
-#include "kartograf/io/sequence_detect.hpp"
+#include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/mapping/slam.hpp"
 #include "kartograf/registration/odometry.hpp"
 
@@ -38,7 +39,7 @@ void add_sequence_input_options(CLI::App& command, SequenceInputOptions& options
 // Registers SEQUENCE, the input options, --method, --backend, --reestimate-every, --no-progress.
 void add_sequence_run_options(CLI::App& command, SequenceRunOptions& options);
 
-io::SequenceOptions sequence_options(const SequenceInputOptions& options);
+io::SequenceParams sequence_options(const SequenceInputOptions& options);
 // Opens a sequence folder as the options say; on err: warnings (a camera assumed), each frame left
 // out, and one line with the frame count, the camera and the depth scale.
 io::OpenedSequence open_input(const std::filesystem::path& folder,
@@ -52,7 +53,7 @@ compute::Context make_run_context(const SequenceRunOptions& options);
 // The opened sequence and the pipeline's view of it.
 struct OpenedRun {
   io::OpenedSequence opened;
-  std::unique_ptr<io::SequenceFrameSource> source;
+  std::unique_ptr<pipeline::SequenceFrameSource> source;
 };
 // open_input, then the first frames' depth checked against the odometry's depth range.
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err);
@@ -84,11 +85,11 @@ mapping::SlamObserver slam_progress_observer(std::ostream& err, ProgressBar& bar
 Trajectory stamped_trajectory(const std::vector<Eigen::Isometry3d>& poses,
                               const std::vector<double>& timestamps, bool has_timestamps);
 // The ground truth of the frames that have one, stamped like the estimate.
-Trajectory ground_truth_trajectory(const io::SequenceFrameSource& source,
+Trajectory ground_truth_trajectory(const pipeline::SequenceFrameSource& source,
                                    const std::vector<double>& timestamps, bool has_timestamps);
 // ATE (SE(3) alignment) of the estimate's frames that have ground truth; empty without any.
 std::optional<eval::AteResult> absolute_trajectory_error(
-    const io::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
+    const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
 
 Json report_json(const registration::RegistrationReport& report);
 Json frame_json(const registration::OdometryFrame& frame);

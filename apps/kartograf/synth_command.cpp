@@ -12,7 +12,7 @@
 #include "commands.hpp"
 #include "interrupts.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/synthetic_dataset.hpp"
+#include "kartograf/outputs/synthetic_dataset.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
 
@@ -88,7 +88,7 @@ int run_synth_command(const SynthOptions& o, std::ostream& out, std::ostream& er
                        "camera_intrinsics.json", "world.json", "floor_plan.yaml", "floor_plan.pgm",
                        "floor_plan.png", "floor_plan_gt_segmentation.png", "rooms.png",
                        "semantic_grid.png", "laser_scan.pcd", "preview.png"});
-  io::SyntheticDatasetOptions options;
+  io::SyntheticDatasetParams options;
   options.seed = o.seed;
   options.frames = o.survey && !o.frames_given ? 0 : o.frames;
   options.trajectory = o.trajectory == "handheld" ? io::SyntheticTrajectory::handheld

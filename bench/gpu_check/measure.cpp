@@ -31,7 +31,7 @@ Samples measure(const compute::Context& context, const Repetitions& repetitions,
   context.finish();
   context.take_device_timings();  // the warm-up's
   Samples samples;
-  const bool timestamps = context.device_info().limits.device_timestamps && !context.is_cpu();
+  const bool timestamps = context.device_info().limits.device_timestamps;
   for (int i = 0; i < counts.timed; ++i) {
     const auto start = std::chrono::steady_clock::now();
     call();

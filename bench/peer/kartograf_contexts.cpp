@@ -5,7 +5,7 @@
 namespace kartograf::peer {
 
 ContextPtr make_context(compute::BackendChoice backend) {
-  compute::ContextOptions options;
+  compute::ContextParams options;
   options.backend = backend;
   return std::make_shared<const compute::Context>(options);
 }

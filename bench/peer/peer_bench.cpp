@@ -33,7 +33,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
-#include "kartograf/io/tum.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "peer_methods.hpp"
 #include "peer_report.hpp"
 #include "peer_timing.hpp"
@@ -127,7 +127,7 @@ std::vector<ChainOutcome> run_chain(const Dataset& dataset, const Options& optio
   for (Tracker& tracker : trackers) {
     const eval::MatchedPoses matched{ground_truth, tracker.trajectory};
     const eval::TrajectoryEvaluation evaluation =
-        eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeOptions{});
+        eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeParams{});
     outcomes.push_back({dataset.name, tracker.name, tracker.threads, dataset.size(),
                         1000 * median(tracker.seconds), evaluation.ate.translation_m.rmse,
                         1000 * evaluation.rpe.translation_m.rmse, evaluation.rpe.rotation_deg.rmse,

@@ -8,7 +8,7 @@
 #include "kartograf/geometry/normals.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
-#include "kartograf/io/synthetic_dataset.hpp"
+#include "kartograf/outputs/synthetic_dataset.hpp"
 
 namespace kartograf::peer {
 namespace {
@@ -63,7 +63,7 @@ Dataset open_synthetic_dataset(const std::filesystem::path& folder) {
 }
 
 void write_synthetic_sequence(const std::filesystem::path& folder, int frames) {
-  io::SyntheticDatasetOptions options;
+  io::SyntheticDatasetParams options;
   options.frames = frames;
   options.trajectory = io::SyntheticTrajectory::handheld;
   options.force = true;

@@ -17,7 +17,7 @@
 #include "kartograf/core/point_cloud.hpp"
 #include "kartograf/core/point_image.hpp"
 #include "kartograf/geometry/backproject.hpp"
-#include "kartograf/io/sequence.hpp"
+#include "kartograf/formats/sequence.hpp"
 
 namespace kartograf::peer {
 

@@ -17,8 +17,8 @@
 #include <ostream>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/io/image_io.hpp"
-#include "kartograf/io/plane_io.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/outputs/plane_io.hpp"
 #include "peer_report.hpp"
 #include "plane_methods.hpp"
 #include "plane_report.hpp"

@@ -5,7 +5,7 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
-#include "kartograf/io/pcd.hpp"
+#include "kartograf/formats/pcd.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "kartograf/synth/world.hpp"

@@ -7,9 +7,10 @@
 #include <exception>
 
 #include <kartograf/compute/context.hpp>
-#include <kartograf/io/map_outputs.hpp>
-#include <kartograf/io/sequence_detect.hpp>
+#include <kartograf/outputs/map_outputs.hpp>
+#include <kartograf/formats/sequence_detect.hpp>
 #include <kartograf/pipeline/map_pipeline.hpp>
+#include <kartograf/pipeline/sequence_frame_source.hpp>
 
 int main(int argc, char** argv) {
   if (argc != 3) {
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   try {
     using namespace kartograf;
     const io::OpenedSequence opened = io::open_sequence(argv[1]);  // TUM, 7-Scenes, synthetic
-    const io::SequenceFrameSource frames(*opened.sequence);
+    const pipeline::SequenceFrameSource frames(*opened.sequence);
     const compute::Context context = compute::Context::cpu();  // or a Vulkan / OpenCL device
 
     pipeline::MapPipelineParams params;

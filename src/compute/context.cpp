@@ -3,6 +3,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "compute/cpu/cpu_device.hpp"
 #include "compute/device.hpp"
 #include "kartograf/core/error.hpp"
 
@@ -22,15 +23,22 @@ std::optional<int> best_gpu(const BackendStatus& status) {
     if (device.usable) usable.push_back(&device);
   }
   if (usable.empty()) return std::nullopt;
-  const std::size_t index = detail::choose_device(usable, ContextOptions{}, to_string(status.backend));
+  const std::size_t index = detail::choose_device(usable, ContextParams{}, to_string(status.backend));
   if (!usable[index]->is_gpu()) return std::nullopt;
   return static_cast<int>(index);
+}
+
+// The CPU backend has one device; an index other than 0 is an Error.
+std::shared_ptr<detail::Device> cpu_device(const ContextParams& options) {
+  auto device = detail::create_cpu_device();
+  detail::choose_device({&device->info()}, options, "cpu");
+  return device;
 }
 
 }  // namespace
 
 namespace detail {
-std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextOptions& options,
+std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextParams& options,
                           std::string_view backend) {
   if (options.device_index) {
     if (*options.device_index < 0 || *options.device_index >= static_cast<int>(usable.size())) {
@@ -54,8 +62,8 @@ std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const Co
 }
 }  // namespace detail
 
-ContextOptions ContextOptions::from_environment() {
-  ContextOptions options;
+ContextParams ContextParams::from_environment() {
+  ContextParams options;
   if (const char* backend = env("KARTOGRAF_BACKEND")) {
     options.backend = parse_backend_choice(backend, "KARTOGRAF_BACKEND");
   }
@@ -63,7 +71,7 @@ ContextOptions ContextOptions::from_environment() {
   return options;
 }
 
-void ContextOptions::read_device_environment() {
+void ContextParams::read_device_environment() {
   if (const char* index = env("KARTOGRAF_DEVICE")) {
     const std::string text = index;
     // Digits only (no sign, blanks or suffix), and few enough to be an int.
@@ -79,12 +87,10 @@ void ContextOptions::read_device_environment() {
   }
 }
 
-Context::Context() : cpu_info_(detail::cpu_device_info()) {}
-
-Context::Context(const ContextOptions& options) : Context() {
+Context::Context(const ContextParams& options) {
   switch (options.backend) {
     case BackendChoice::cpu:
-      detail::choose_device({&cpu_info_}, options, "cpu");  // checks device_index
+      device_ = cpu_device(options);
       break;
     case BackendChoice::vulkan:
       device_ = detail::create_vulkan_device(options);
@@ -96,7 +102,7 @@ Context::Context(const ContextOptions& options) : Context() {
       // CPU-hosted drivers (lavapipe, PoCL) are for correctness, not speed: only a GPU beats the
       // CPU reference, so automatic takes a GPU or nothing.
       // A device index given applies to the backend taken.
-      ContextOptions chosen = options;
+      ContextParams chosen = options;
       if (auto index = best_gpu(detail::probe_vulkan())) {
         chosen.device_index = options.device_index.value_or(*index);
         device_ = detail::create_vulkan_device(chosen);
@@ -104,16 +110,16 @@ Context::Context(const ContextOptions& options) : Context() {
         chosen.device_index = options.device_index.value_or(*cl_index);
         device_ = detail::create_opencl_device(chosen);
       } else {
-        detail::choose_device({&cpu_info_}, options, "cpu");
+        device_ = cpu_device(options);
       }
       break;
     }
   }
 }
 
-Context Context::from_environment() { return Context(ContextOptions::from_environment()); }
+Context Context::from_environment() { return Context(ContextParams::from_environment()); }
 Context Context::cpu() {
-  ContextOptions options;
+  ContextParams options;
   options.backend = BackendChoice::cpu;
   return Context(options);
 }
@@ -122,21 +128,20 @@ Context::Context(Context&&) noexcept = default;
 Context& Context::operator=(Context&&) noexcept = default;
 Context::~Context() = default;
 
-BackendKind Context::backend() const { return device_ ? device_->info().backend : BackendKind::cpu; }
-const DeviceInfo& Context::device_info() const { return device_ ? device_->info() : cpu_info_; }
+// A moved-from Context has no device; using one is a programming error the accessors report.
+detail::Device& Context::checked_device() const {
+  require(device_ != nullptr, "compute context: used after it was moved from");
+  return *device_;
+}
 
-void Context::finish() const {
-  if (device_) device_->finish();
-}
-void Context::build_all_kernels() const {
-  if (device_) device_->build_all_kernels();
-}
-std::uint64_t Context::validation_errors() const {
-  return device_ ? device_->validation_errors() : 0;
-}
-bool Context::validation_active() const { return device_ && device_->validation_active(); }
+BackendKind Context::backend() const { return checked_device().info().backend; }
+const DeviceInfo& Context::device_info() const { return checked_device().info(); }
+void Context::finish() const { checked_device().finish(); }
+void Context::build_all_kernels() const { checked_device().build_all_kernels(); }
+std::uint64_t Context::validation_errors() const { return checked_device().validation_errors(); }
+bool Context::validation_active() const { return checked_device().validation_active(); }
 std::vector<DeviceTiming> Context::take_device_timings() const {
-  return device_ ? device_->take_device_timings() : std::vector<DeviceTiming>{};
+  return checked_device().take_device_timings();
 }
 
 }  // namespace kartograf::compute

@@ -1,5 +1,5 @@
 #pragma once
-// The interface a GPU backend (Vulkan, OpenCL) implements. Operations never see it directly: they
+// The interface every backend implements: the CPU (compute/cpu), Vulkan and OpenCL. Operations never see it directly: they
 // go through compute/kernel.hpp and compute/buffer.hpp.
 #include <cstddef>
 #include <cstdint>
@@ -38,12 +38,17 @@ class Device {
   // Copies bytes between two buffers of this device, in order with the other commands.
   virtual void copy(const DeviceBuffer& source, std::size_t source_offset, DeviceBuffer& target,
                     std::size_t target_offset, std::size_t bytes) = 0;
+  // The buffer's bytes when they live in host memory (the CPU backend), else null.
+  virtual std::byte* host_pointer(DeviceBuffer&) const { return nullptr; }
+  // A buffer that is a view of `bytes` of host memory the caller keeps alive; null where buffers
+  // are not host memory (then the caller uploads).
+  virtual std::unique_ptr<DeviceBuffer> view_host(std::byte*, std::size_t) { return nullptr; }
   virtual void finish() = 0;
   virtual void build_all_kernels() = 0;
 
   virtual std::uint64_t validation_errors() const { return 0; }
   virtual bool validation_active() const { return false; }
-  // Completed commands' device times (ContextOptions::profile); waits for pending commands.
+  // Completed commands' device times (ContextParams::profile); waits for pending commands.
   virtual std::vector<DeviceTiming> take_device_timings() = 0;
 };
 
@@ -51,12 +56,12 @@ DeviceInfo cpu_device_info();
 
 // Which of a backend's usable devices a context takes: options.device_index if given (checked),
 // else a discrete GPU, else an integrated GPU, else the first.
-std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextOptions& options,
+std::size_t choose_device(const std::vector<const DeviceInfo*>& usable, const ContextParams& options,
                           std::string_view backend);
 
 // Each throws Error naming why the backend or the requested device cannot be used.
-std::shared_ptr<Device> create_vulkan_device(const ContextOptions& options);
-std::shared_ptr<Device> create_opencl_device(const ContextOptions& options);
+std::shared_ptr<Device> create_vulkan_device(const ContextParams& options);
+std::shared_ptr<Device> create_opencl_device(const ContextParams& options);
 BackendStatus probe_vulkan();
 BackendStatus probe_opencl();
 

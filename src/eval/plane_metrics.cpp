@@ -80,7 +80,7 @@ int count_split_regions(const LabelOverlap& overlap, Side whole, double t,
 
 SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
                                           const LabelImage& predicted,
-                                          const SegCompOptions& options) {
+                                          const SegCompParams& options) {
   const double t = options.threshold;
   require(
       t > 0.5 && t <= 1.0,
@@ -119,7 +119,7 @@ SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
 
 SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
                                           const LabelImage& predicted,
-                                          const SegCompOptions& options,
+                                          const SegCompParams& options,
                                           const PlaneNormals& ground_truth_normals,
                                           const PlaneNormals& predicted_normals) {
   check_normals(ground_truth_normals, "ground-truth");

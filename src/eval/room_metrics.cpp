@@ -98,7 +98,7 @@ void compute_mcc(const LabelOverlap& overlap, RoomSegmentationScores& scores) {
 
 RoomSegmentationScores evaluate_room_segmentation(const LabelImage& ground_truth,
                                                   const LabelImage& segmentation,
-                                                  const RoomEvaluationOptions& options) {
+                                                  const RoomEvaluationParams& options) {
   require(options.min_region_pixels >= 1, std::string(kWhat) +
                                               ": min_region_pixels must be >= 1, got " +
                                               std::to_string(options.min_region_pixels));

@@ -22,7 +22,7 @@ int class_index(SemanticClass c, const char* side, std::size_t pixel, int width)
 
 SemanticScores evaluate_semantic_segmentation(const SemanticImage& ground_truth,
                                               const SemanticImage& predicted,
-                                              const SemanticEvaluationOptions& options) {
+                                              const SemanticEvaluationParams& options) {
   require(ground_truth.width() == predicted.width() && ground_truth.height() == predicted.height(),
           std::string(kWhat) + ": the ground truth is " + std::to_string(ground_truth.width()) +
               "x" + std::to_string(ground_truth.height()) + " but the prediction is " +

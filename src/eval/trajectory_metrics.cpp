@@ -36,7 +36,7 @@ double rotation_angle_deg(const Eigen::Matrix3d& r) {
 
 // The (i, j) pairs delta apart, as documented in the header.
 std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs(const MatchedPoses& poses,
-                                                           const RpeOptions& options) {
+                                                           const RpeParams& options) {
   const std::size_t n = poses.size();
   std::vector<std::pair<std::size_t, std::size_t>> pairs;
   if (options.unit == DeltaUnit::frames) {
@@ -179,7 +179,7 @@ AteResult compute_ate(const MatchedPoses& poses, Alignment alignment) {
   return result;
 }
 
-RpeResult compute_rpe(const MatchedPoses& poses, const RpeOptions& options) {
+RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options) {
   require_matched(poses, "RPE");
   const auto pairs = rpe_pairs(poses, options);
   require(!pairs.empty(), "RPE: no pose pair is " + std::to_string(options.delta) +
@@ -200,7 +200,7 @@ RpeResult compute_rpe(const MatchedPoses& poses, const RpeOptions& options) {
 }
 
 TrajectoryEvaluation evaluate_trajectory(const MatchedPoses& poses, Alignment alignment,
-                                         const RpeOptions& rpe_options) {
+                                         const RpeParams& rpe_options) {
   TrajectoryEvaluation evaluation;
   evaluation.ate = compute_ate(poses, alignment);
   MatchedPoses aligned{poses.ground_truth,

@@ -4,20 +4,14 @@
 #include <limits>
 
 #include "kartograf/compute/kernel.hpp"
+#include "kernels/backproject/backproject.h"
 
 namespace kartograf::geometry {
 
 namespace {
 
-constexpr compute::KernelSpec kBackprojectKernel{"backproject", 16, 16};
-
-struct BackprojectParams {  // layout of shaders/backproject.comp and kernels/backproject.cl
-  std::uint32_t width;
-  std::uint32_t height;
-  std::uint32_t min_units;
-  std::uint32_t max_units;
-  float metres_per_unit;
-};
+constexpr compute::KernelSpec kBackprojectKernel{"backproject", KG_BACKPROJECT_LOCAL_X,
+                                                 KG_BACKPROJECT_LOCAL_Y};
 
 // The smallest raw value d with d / units >= metres, evaluated exactly as the reference does.
 std::uint32_t first_unit_at_least(double metres, double units) {
@@ -25,27 +19,6 @@ std::uint32_t first_unit_at_least(double metres, double units) {
   while (d > 0 && (d - 1) / units >= metres) d -= 1;
   while (d / units < metres) d += 1;
   return static_cast<std::uint32_t>(std::min(d, 65536.0));
-}
-
-void backproject_cpu(const std::uint16_t* depth, int width, int height, const float* factors,
-                     float metres_per_unit, std::uint32_t min_units, std::uint32_t max_units,
-                     Point4f* points) {
-  const float nan = std::numeric_limits<float>::quiet_NaN();
-  for (int y = 0; y < height; ++y) {
-    const float row_factor = factors[width + y];
-    const std::uint16_t* depth_row = depth + static_cast<std::size_t>(y) * width;
-    float* out = points[static_cast<std::size_t>(y) * width].data();
-    for (int x = 0; x < width; ++x) {
-      const std::uint32_t d = depth_row[x];
-      const bool valid = d != 0 && d >= min_units && d <= max_units;
-      const float z = static_cast<float>(d);
-      // Branch-free so that the loop vectorizes.
-      out[4 * x + 0] = valid ? z * factors[x] : nan;
-      out[4 * x + 1] = valid ? z * row_factor : nan;
-      out[4 * x + 2] = valid ? z * metres_per_unit : nan;
-      out[4 * x + 3] = valid ? 1.0f : nan;
-    }
-  }
 }
 
 }  // namespace
@@ -77,7 +50,7 @@ DepthBackprojector::DepthBackprojector(const compute::Context& context,
     factors_[intrinsics.width + y] =
         static_cast<float>((y - intrinsics.cy) / intrinsics.fy * metres_per_unit);
   }
-  if (!context.is_cpu()) device_factors_ = compute::Buffer<float>::from_host(context, factors_);
+  device_factors_ = compute::Buffer<float>::from_host(context, factors_);
 }
 
 void DepthBackprojector::run(const compute::DeviceImage<std::uint16_t>& depth,
@@ -91,12 +64,7 @@ void DepthBackprojector::run(const compute::DeviceImage<std::uint16_t>& depth,
   if (points.width() != width || points.height() != height) {
     points = compute::DeviceImage<Point4f>(*context_, width, height);
   }
-  if (context_->is_cpu()) {
-    backproject_cpu(depth.buffer().host_span().data(), width, height, factors_.data(),
-                    metres_per_unit_, min_units_, max_units_, points.buffer().host_span().data());
-    return;
-  }
-  const BackprojectParams params{static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height),
+  const kernels::BackprojectParams params{static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height),
                                  min_units_, max_units_, metres_per_unit_};
   compute::dispatch(*context_, kBackprojectKernel, {depth.buffer(), device_factors_, points.buffer()},
                     params,

@@ -6,24 +6,15 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
+#include "kernels/segment_moments/segment_moments_cpu.hpp"
 
 namespace kartograf::geometry {
 
 namespace {
 
-constexpr compute::KernelSpec kSegmentMomentsKernel{"segment_moments", 256};
-constexpr std::size_t kValuesPerLabel = 10;
-
-struct SegmentMomentKernelParams {  // layout of shaders/segment_moments.comp and the .cl kernel
-  std::uint32_t point_count;
-  std::uint32_t label_count;
-  float origin_x;
-  float origin_y;
-  float origin_z;
-  float max_offset;
-  float first_scale;
-  float second_scale;
-};
+constexpr compute::KernelSpec kSegmentMomentsKernel{"segment_moments", KG_SEGMENT_MOMENTS_LOCAL_X};
+constexpr std::size_t kValuesPerLabel = KG_SEGMENT_MOMENT_VALUES;
+static_assert(std::tuple_size_v<FixedPointMoments::Sums> == kValuesPerLabel);
 
 // The largest power of two s with max_total * s < 2^62: no sum of up to `count` terms of
 // magnitude <= per_term can overflow int64.
@@ -33,24 +24,9 @@ float fixed_point_scale(double count, double per_term) {
 }
 
 struct Accumulation {
-  std::vector<FixedPointMoments::Sums> moments;  // per label
-  std::uint32_t points_too_far = 0;
-  std::uint32_t bad_labels = 0;
+  std::vector<std::int64_t> sums;  // kValuesPerLabel per label
+  std::uint32_t status[2] = {};    // indexed by KG_SEGMENT_MOMENTS_*
 };
-
-void accumulate_cpu(std::span<const Point4f> points, std::span<const std::uint32_t> labels,
-                    const FixedPointMoments& fixed, std::uint32_t label_count, Accumulation& out) {
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    const std::uint32_t label = labels[i];
-    const Point4f& p = points[i];
-    if (label == kNoLabel || !is_valid(p)) continue;
-    if (label >= label_count) {
-      ++out.bad_labels;
-      continue;
-    }
-    if (!fixed.add(p, out.moments[label])) ++out.points_too_far;
-  }
-}
 
 }  // namespace
 
@@ -67,9 +43,8 @@ Eigen::Matrix3d SegmentMomentSet::covariance(std::uint32_t label) const {
   return m.sum_outer / n - mean * mean.transpose();
 }
 
-SegmentMomentReducer::SegmentMomentReducer(const compute::Context& context) : context_(&context) {
-  if (!context.is_cpu()) status_ = compute::Buffer<std::uint32_t>(context, 2);
-}
+SegmentMomentReducer::SegmentMomentReducer(const compute::Context& context)
+    : context_(&context), status_(context, 2) {}
 
 SegmentMomentSet segment_moments(const compute::Context& context,
                                  const compute::Buffer<Point4f>& points,
@@ -94,9 +69,9 @@ void check_params(std::size_t point_count, std::size_t label_length,
           "segment moments: max_offset must be positive");
 }
 
-SegmentMomentKernelParams kernel_params_for(std::size_t point_count,
-                                            const SegmentMomentParams& params,
-                                            const FixedPointMoments& fixed) {
+kernels::SegmentMomentsParams kernel_params_for(std::size_t point_count,
+                                                const SegmentMomentParams& params,
+                                                const FixedPointMoments& fixed) {
   return {static_cast<std::uint32_t>(point_count),
           params.label_count,
           params.origin.x(),
@@ -110,28 +85,29 @@ SegmentMomentKernelParams kernel_params_for(std::size_t point_count,
 // Checks the counters and turns the fixed-point sums into moments.
 SegmentMomentSet finish(const Accumulation& accumulation, const SegmentMomentParams& params,
                         const FixedPointMoments& fixed) {
-  require(accumulation.bad_labels == 0,
-          "segment moments: " + std::to_string(accumulation.bad_labels) +
-              " pixels carry a label >= " + std::to_string(params.label_count) +
-              " (and not kNoLabel)");
-  require(accumulation.points_too_far == 0,
-          "segment moments: " + std::to_string(accumulation.points_too_far) +
-              " points lie farther than max_offset = " + std::to_string(params.max_offset) +
-              " m from the origin");
+  const std::uint32_t bad_labels = accumulation.status[KG_SEGMENT_MOMENTS_BAD_LABEL];
+  const std::uint32_t points_too_far = accumulation.status[KG_SEGMENT_MOMENTS_TOO_FAR];
+  require(bad_labels == 0, "segment moments: " + std::to_string(bad_labels) +
+                               " pixels carry a label >= " + std::to_string(params.label_count) +
+                               " (and not kNoLabel)");
+  require(points_too_far == 0, "segment moments: " + std::to_string(points_too_far) +
+                                   " points lie farther than max_offset = " +
+                                   std::to_string(params.max_offset) + " m from the origin");
   SegmentMomentSet result;
   result.origin = params.origin.cast<double>();
-  result.segments.reserve(accumulation.moments.size());
-  for (const FixedPointMoments::Sums& sums : accumulation.moments)
-    result.segments.push_back(fixed.moments(sums));
+  result.segments.resize(params.label_count);
+  FixedPointMoments::Sums sums;
+  for (std::size_t label = 0; label < params.label_count; ++label) {
+    std::copy_n(&accumulation.sums[label * kValuesPerLabel], kValuesPerLabel, sums.begin());
+    result.segments[label] = fixed.moments(sums);
+  }
   return result;
 }
 
 }  // namespace
 
 FixedPointMoments::FixedPointMoments(std::size_t point_count, const SegmentMomentParams& params)
-    : origin_(params.origin.cast<double>()),
-      bound_(params.max_offset),
-      first_scale_(fixed_point_scale(static_cast<double>(point_count), params.max_offset)),
+    : first_scale_(fixed_point_scale(static_cast<double>(point_count), params.max_offset)),
       second_scale_(fixed_point_scale(static_cast<double>(point_count),
                                       double{params.max_offset} * params.max_offset)) {}
 
@@ -152,8 +128,11 @@ SegmentMomentSet segment_moments(std::span<const Point4f> points,
   check_params(points.size(), labels.size(), params, std::numeric_limits<std::uint32_t>::max() - 1);
   const FixedPointMoments fixed(points.size(), params);
   Accumulation accumulation;
-  accumulation.moments.assign(params.label_count, FixedPointMoments::Sums{});
-  accumulate_cpu(points, labels, fixed, params.label_count, accumulation);
+  accumulation.sums.assign(std::size_t{params.label_count} * kValuesPerLabel, 0);
+  kernels::accumulate_segment_moments(reinterpret_cast<const kernels::float4*>(points.data()),
+                                      labels.data(),
+                                      kernel_params_for(points.size(), params, fixed),
+                                      accumulation.sums.data(), accumulation.status);
   return finish(accumulation, params, fixed);
 }
 
@@ -162,7 +141,6 @@ SegmentMomentSet SegmentMomentReducer::run(const compute::Buffer<Point4f>& point
                                            const SegmentMomentParams& params) {
   const compute::Context& context = *context_;
   check_params(points.size(), labels.size(), params, kMaxSegmentLabels);
-  if (context.is_cpu()) return segment_moments(points.host_span(), labels.host_span(), params);
   const FixedPointMoments fixed(points.size(), params);
   const std::size_t values = std::size_t{params.label_count} * kValuesPerLabel;
   if (moments_.size() < values) moments_ = compute::Buffer<std::int64_t>(context, values);
@@ -171,18 +149,10 @@ SegmentMomentSet SegmentMomentReducer::run(const compute::Buffer<Point4f>& point
   compute::dispatch(context, kSegmentMomentsKernel, {points, labels, moments_, status_},
                     kernel_params_for(points.size(), params, fixed),
                     {compute::groups_for(points.size(), kSegmentMomentsKernel.local_x), 1});
-  std::vector<std::int64_t> sums(values);
-  moments_.download(std::span<std::int64_t>(sums));
   Accumulation accumulation;
-  accumulation.moments.resize(params.label_count);
-  for (std::size_t label = 0; label < params.label_count; ++label) {
-    std::copy_n(&sums[label * kValuesPerLabel], kValuesPerLabel,
-                accumulation.moments[label].begin());
-  }
-  std::uint32_t counters[2] = {};
-  status_.download(counters);
-  accumulation.points_too_far = counters[0];
-  accumulation.bad_labels = counters[1];
+  accumulation.sums.resize(values);
+  moments_.download(std::span<std::int64_t>(accumulation.sums));
+  status_.download(accumulation.status);
   return finish(accumulation, params, fixed);
 }
 

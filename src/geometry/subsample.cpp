@@ -5,24 +5,13 @@
 
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/color.hpp"
+#include "kernels/subsample/subsample.h"
 
 namespace kartograf::geometry {
 
 namespace {
 
-constexpr compute::KernelSpec kSubsampleKernel{"subsample", 64};
-
-struct SubsampleParams {  // layout of shaders/subsample.comp and kernels/subsample.cl
-  std::uint32_t out_count;
-  std::uint32_t k;
-  std::uint32_t has_normals;
-  std::uint32_t has_colors;
-};
-
-template <class T>
-void copy_every_kth(std::span<const T> in, std::span<T> out, std::size_t k) {
-  for (std::size_t m = 0; m < out.size(); ++m) out[m] = in[m * k];
-}
+constexpr compute::KernelSpec kSubsampleKernel{"subsample", KG_SUBSAMPLE_LOCAL_X};
 
 }  // namespace
 
@@ -77,14 +66,6 @@ DeviceCloud subsample(const compute::Context& context, const DeviceCloud& cloud,
   if (cloud.has_normals()) out.normals = compute::Buffer<Point4f>(context, count);
   if (cloud.has_colors()) out.colors = compute::Buffer<std::uint32_t>(context, count);
   if (count == 0) return out;
-  if (context.is_cpu()) {
-    copy_every_kth(cloud.points.host_span(), out.points.host_span(), stride);
-    if (cloud.has_normals())
-      copy_every_kth(cloud.normals.host_span(), out.normals.host_span(), stride);
-    if (cloud.has_colors())
-      copy_every_kth(cloud.colors.host_span(), out.colors.host_span(), stride);
-    return out;
-  }
   const auto optional = [](const auto& buffer) {
     return buffer.empty() ? compute::BufferArg() : compute::BufferArg(buffer);
   };
@@ -92,8 +73,8 @@ DeviceCloud subsample(const compute::Context& context, const DeviceCloud& cloud,
       context, kSubsampleKernel,
       {cloud.points, optional(cloud.normals), optional(cloud.colors), out.points,
        optional(out.normals), optional(out.colors)},
-      SubsampleParams{static_cast<std::uint32_t>(count), static_cast<std::uint32_t>(k),
-                      cloud.has_normals() ? 1u : 0u, cloud.has_colors() ? 1u : 0u},
+      kernels::SubsampleParams{static_cast<std::uint32_t>(count), static_cast<std::uint32_t>(k),
+                               cloud.has_normals() ? 1u : 0u, cloud.has_colors() ? 1u : 0u},
       {compute::groups_for(count, kSubsampleKernel.local_x), 1});
   return out;
 }

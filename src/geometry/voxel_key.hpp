@@ -1,9 +1,7 @@
 #pragma once
-// Voxel keys and their open-addressing hash, shared by voxel downsampling and the voxel-hash
-// nearest-neighbour grid; the same arithmetic as shaders/voxel_hash.glsl and
-// kernels/voxel_common.cl. A voxel (kx, ky, kz) = floor(p * inverse_size), each in [-2^20, 2^20),
-// is stored as the 64-bit key 1 + (kx + 2^20) | (ky + 2^20) << 21 | (kz + 2^20) << 42, so 0 marks
-// an empty slot.
+// The voxel-key rule of kernels/voxel_hash/voxel_hash.h for host code that works in Eigen (the
+// host-built tables of registration/voxel_hash_correspondences.cpp and mapping/map_fusion.cpp),
+// and the sizing of those tables.
 #include <algorithm>
 #include <bit>
 #include <cmath>
@@ -11,36 +9,35 @@
 
 #include <Eigen/Core>
 
+#include "kernels/voxel_hash/voxel_hash.h"
+
 namespace kartograf::geometry::detail {
 
-inline constexpr double kVoxelLimit = 1048576.0;  // 2^20
-inline constexpr std::uint64_t kEmptyVoxelKey = 0;
+inline constexpr double kVoxelLimit = KG_VOXEL_LIMIT;
+inline constexpr std::uint64_t kEmptyVoxelKey = KG_EMPTY_VOXEL_KEY;
+
+inline kernels::double3 to_double3(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
 
 // floor(scaled) per axis; false when a coordinate is outside [-2^20, 2^20) or not finite.
 inline bool voxel_of(const Eigen::Vector3d& scaled, Eigen::Vector3d& voxel) {
-  voxel = Eigen::Vector3d(std::floor(scaled.x()), std::floor(scaled.y()), std::floor(scaled.z()));
-  return voxel.x() >= -kVoxelLimit && voxel.y() >= -kVoxelLimit && voxel.z() >= -kVoxelLimit &&
-         voxel.x() < kVoxelLimit && voxel.y() < kVoxelLimit && voxel.z() < kVoxelLimit;
+  const kernels::double3 floored = kernels::voxel_floor(to_double3(scaled));
+  voxel = Eigen::Vector3d(floored.x, floored.y, floored.z);
+  return kernels::voxel_in_range(floored);
 }
 
 inline std::uint64_t voxel_key(const Eigen::Vector3d& voxel) {
-  const auto biased = [](double k) {
-    return static_cast<std::uint64_t>(static_cast<std::int64_t>(k) + 1048576);
-  };
-  return 1 + (biased(voxel.x()) | biased(voxel.y()) << 21 | biased(voxel.z()) << 42);
+  return kernels::voxel_key(to_double3(voxel));
 }
 
 inline Eigen::Vector3d voxel_of_key(std::uint64_t key) {
-  const std::uint64_t biased = key - 1;
-  const auto axis = [&](int shift) {
-    return static_cast<double>(static_cast<std::int64_t>((biased >> shift) & 0x1fffff) - 1048576);
-  };
-  return {axis(0), axis(21), axis(42)};
+  const kernels::double3 voxel = kernels::voxel_of_key(key);
+  return {voxel.x, voxel.y, voxel.z};
 }
 
-// The first slot to probe (Fibonacci hashing); probing walks slot + 1, + 2, ... mod capacity.
 inline std::uint32_t voxel_slot(std::uint64_t key, unsigned capacity_log2) {
-  return static_cast<std::uint32_t>((key * 0x9e3779b97f4a7c15ull) >> (64 - capacity_log2));
+  return kernels::voxel_slot(key, capacity_log2);
 }
 
 // log2 of the table capacity for `entries` keys: a power of two >= 2 x entries (load <= 1/2,

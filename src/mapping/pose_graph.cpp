@@ -46,7 +46,7 @@ double total_cost(const PoseGraph& graph, double kernel) {
   return cost;
 }
 
-void validate(const PoseGraph& graph, const PoseGraphOptions& options) {
+void validate(const PoseGraph& graph, const PoseGraphParams& options) {
   require(!graph.poses.empty(), "pose graph: no nodes");
   require(options.fixed_node < graph.poses.size(),
           "pose graph: fixed node " + std::to_string(options.fixed_node) + " does not exist");
@@ -72,7 +72,7 @@ struct LinearSystem {
 };
 
 // Gauss-Newton system over all nodes but the fixed one (block index = node index, shifted).
-LinearSystem build_system(const PoseGraph& graph, const PoseGraphOptions& options, double kernel) {
+LinearSystem build_system(const PoseGraph& graph, const PoseGraphParams& options, double kernel) {
   const auto n = graph.poses.size();
   auto block_of = [&](std::size_t node) -> long {
     if (node == options.fixed_node) return -1;
@@ -127,7 +127,7 @@ std::vector<Eigen::Isometry3d> apply_step(const PoseGraph& graph, const Eigen::V
 }
 
 // Levenberg-Marquardt with Nielsen's damping update, at one loop-closure kernel width.
-PoseGraphSummary levenberg_marquardt(PoseGraph& graph, const PoseGraphOptions& options,
+PoseGraphSummary levenberg_marquardt(PoseGraph& graph, const PoseGraphParams& options,
                                      double kernel) {
   PoseGraphSummary summary;
   double cost = total_cost(graph, kernel);
@@ -191,7 +191,7 @@ PoseGraphSummary levenberg_marquardt(PoseGraph& graph, const PoseGraphOptions& o
 // Graduated non-convexity: a loop closure that disagrees with drifted odometry by many sigmas is
 // not an outlier yet. Start with a kernel wide enough to trust every edge, then narrow it by
 // quarters to the requested width, so that only edges the converged graph contradicts lose weight.
-PoseGraphSummary graduated_optimization(PoseGraph& graph, const PoseGraphOptions& options) {
+PoseGraphSummary graduated_optimization(PoseGraph& graph, const PoseGraphParams& options) {
   const double target = options.loop_closure_kernel;
   double widest_chi2 = 0;
   for (const auto& edge : graph.edges) {
@@ -218,7 +218,7 @@ double edge_chi2(const PoseGraph& graph, const PoseGraphEdge& edge) {
   return e.dot(edge.information * e);
 }
 
-PoseGraphSummary optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& options) {
+PoseGraphSummary optimize_pose_graph(PoseGraph& graph, const PoseGraphParams& options) {
   validate(graph, options);
   PoseGraphSummary summary = graduated_optimization(graph, options);
   if (options.prune_chi2 <= 0) return summary;

@@ -79,7 +79,7 @@ PoseGraphEdge edge_of(const registration::RelativePose& pose, bool loop_closure)
 // anchor), odometry-relative poses after it; loop closures kept for the graph.
 class GraphState {
  public:
-  GraphState(const PoseGraphOptions& options, const LoopConsistency& consistency)
+  GraphState(const PoseGraphParams& options, const LoopConsistency& consistency)
       : options_(options), consistency_(consistency) {}
 
   // Brings the estimate of frames after the anchor up to date with the odometry: the new frame,
@@ -179,7 +179,7 @@ class GraphState {
     }
     return worst;
   }
-  PoseGraphOptions options_;
+  PoseGraphParams options_;
   LoopConsistency consistency_;
   std::vector<Eigen::Isometry3d> estimate_;
   std::vector<ActiveLoop> loops_;
@@ -241,8 +241,8 @@ PointCloud fuse_map(const compute::Context& context, const FrameSource& source,
 
 }  // namespace
 
-PoseGraphOptions slam_graph_options() {
-  PoseGraphOptions options;
+PoseGraphParams slam_graph_options() {
+  PoseGraphParams options;
   options.loop_closure_kernel = 0;
   options.prune_chi2 = 0;
   return options;

@@ -54,7 +54,7 @@ MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth
         "trajectory, rooms, classes: fewer than 3 frames have a ground-truth pose");
     return out;
   }
-  out.trajectory = eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeOptions{});
+  out.trajectory = eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeParams{});
   out.frame_errors = frame_errors(matched, out.trajectory->ate);
   if (!truth.plan) {
     out.skipped.push_back("rooms, classes: no floor plan");

@@ -118,7 +118,8 @@ void connect_rooms_through_doorways(const semantic::SemanticGrid& grid,
 }
 
 // Stage 5: rooms on the occupancy grid (doorways closed if asked), then over what they enclose.
-void segment_rooms(const MapPipelineParams& params, MapPipelineResult& result) {
+void segment_rooms(const compute::Context& context, const MapPipelineParams& params,
+                   MapPipelineResult& result) {
   const semantic::SemanticGrid& grid = result.semantic;
   OccupancyGrid room_map = result.occupancy;
   if (params.rooms_end_at_doorways) {
@@ -128,7 +129,7 @@ void segment_rooms(const MapPipelineParams& params, MapPipelineResult& result) {
         room_map.cells(c.x(), c.y()) = CellState::occupied;
     }
   }
-  result.rooms = rooms::segment_rooms(room_map, params.room_method, params.rooms);
+  result.rooms = rooms::segment_rooms(context, room_map, params.room_method, params.rooms);
   if (params.rooms_take_enclosed) {
     // Walls and doors bound rooms; everything else (furniture, unclassified obstacles, floor no
     // room reached, cells never observed) may belong to the room around it.
@@ -240,7 +241,7 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   result.occupancy = semantic::to_occupancy_grid(result.semantic);
 
   clock.start("rooms");
-  segment_rooms(params, result);
+  segment_rooms(context, params, result);
   clock.stop();
   return result;
 }

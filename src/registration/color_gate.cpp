@@ -6,48 +6,21 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
+#include "kernels/color_gate/color_gate.h"
 #include "registration/row_reduction.hpp"
 
 namespace kartograf::registration {
 
 namespace {
 
-constexpr std::uint32_t kGroupSize = 64;  // KG_REDUCTION_GROUP in shaders/common.glsl
-constexpr std::size_t kSumCount = 4;      // pairs, sum dS, hue pairs, sum dH
-constexpr compute::KernelSpec kDifferencesKernel{"color_gate_differences", kGroupSize};
-constexpr compute::KernelSpec kApplyKernel{"color_gate_apply", 64};
-
-struct DifferenceParams {  // layout of shaders/color_gate_differences.comp and
-                           // kernels/color_gate.cl
-  std::uint32_t pair_count;
-  std::uint32_t target_count;
-};
-
-struct ApplyParams {  // layout of shaders/color_gate_apply.comp and kernels/color_gate.cl
-  std::uint32_t pair_count;
-  std::uint32_t use_hue;
-  std::uint32_t use_saturation;
-  float mean_factor;
-};
+constexpr std::size_t kSumCount = KG_COLOR_GATE_SUMS;  // pairs, sum dS, hue pairs, sum dH
+constexpr compute::KernelSpec kDifferencesKernel{"color_gate_differences",
+                                                 KG_COLOR_GATE_DIFFERENCES_LOCAL_X};
+constexpr compute::KernelSpec kApplyKernel{"color_gate_apply", KG_COLOR_GATE_APPLY_LOCAL_X};
+static_assert(KG_COLOR_GATE_NO_HUE == kNoHue && KG_COLOR_GATE_HUE_CODES == kHueCodes,
+              "the kernels' HSI codes are hsi.hpp's");
 
 using Sums = std::array<double, kSumCount>;
-
-// The kernels' packed per-pair record: bit 0 pair, bit 1 both hues, dH << 8, dS << 16.
-std::uint32_t pair_differences(HsiCode a, HsiCode b) {
-  const std::uint32_t ds = saturation_code_distance(saturation_code(a), saturation_code(b));
-  if (hue_code(a) == kNoHue || hue_code(b) == kNoHue) return 1u | ds << 16;
-  return 3u | hue_code_distance(hue_code(a), hue_code(b)) << 8 | ds << 16;
-}
-
-// The kernels' test, in the same double arithmetic.
-bool rejected(std::uint32_t d, const Sums& sums, const ApplyParams& params) {
-  const double factor = params.mean_factor;
-  const bool saturation_far =
-      params.use_saturation != 0 && static_cast<double>(d >> 16) * sums[0] > factor * sums[1];
-  const bool hue_far = params.use_hue != 0 && (d & 2u) != 0 &&
-                       static_cast<double>((d >> 8) & 0xffu) * sums[2] > factor * sums[3];
-  return saturation_far || hue_far;
-}
 
 ColorGateStatistics statistics_of(const Sums& sums, std::uint64_t rejected_count) {
   ColorGateStatistics s;
@@ -66,7 +39,6 @@ ColorGate::ColorGate(const compute::Context& context, ColorGateParams params)
   require(std::isfinite(params_.mean_factor) && params_.mean_factor > 0,
           "colour gate: mean_factor must be finite and > 0, got " +
               std::to_string(params_.mean_factor));
-  if (context.is_cpu()) return;
   sums_ = compute::Buffer<double>(context, kSumCount);
   rejected_ = compute::Buffer<std::uint32_t>(context, 1);
   sums_.fill_zero();  // statistics() before the first apply() reads zeros
@@ -83,39 +55,9 @@ void ColorGate::apply(const compute::Buffer<std::uint32_t>& source_colors,
       target_index.size() < (std::size_t{1} << 31) && target_colors.size() < (std::size_t{1} << 31),
       "colour gate: more than 2^31 points");
   const auto count = static_cast<std::uint32_t>(target_index.size());
-  const ApplyParams apply_params{count, params_.use_hue ? 1u : 0u, params_.use_saturation ? 1u : 0u,
-                                 static_cast<float>(params_.mean_factor)};
-  if (context_->is_cpu()) {
-    const std::span<const HsiCode> table = hsi_table();
-    const auto sources = source_colors.host_span();
-    const auto targets = target_colors.host_span();
-    const auto index = target_index.host_span();
-    if (differences_.size() < count)
-      differences_ = compute::Buffer<std::uint32_t>(*context_, count);
-    const auto differences = differences_.host_span().first(count);
-    Sums sums{};
-    for (std::size_t i = 0; i < count; ++i) {
-      const std::int32_t j = index[i];
-      differences[i] = 0;
-      if (j < 0 || static_cast<std::size_t>(j) >= targets.size()) continue;
-      const std::uint32_t d = pair_differences(
-          hsi_lookup(table, sources[i]), hsi_lookup(table, targets[static_cast<std::size_t>(j)]));
-      differences[i] = d;
-      sums[0] += 1.0;
-      sums[1] += d >> 16;
-      if ((d & 2u) == 0) continue;
-      sums[2] += 1.0;
-      sums[3] += (d >> 8) & 0xffu;
-    }
-    std::uint64_t rejected_count = 0;
-    for (std::size_t i = 0; i < count; ++i) {
-      if ((differences[i] & 1u) == 0 || !rejected(differences[i], sums, apply_params)) continue;
-      index[i] = kNoMatch;
-      ++rejected_count;
-    }
-    host_statistics_ = statistics_of(sums, rejected_count);
-    return;
-  }
+  const kernels::ColorGateApplyParams apply_params{count, params_.use_hue ? 1u : 0u,
+                                                   params_.use_saturation ? 1u : 0u,
+                                                   static_cast<float>(params_.mean_factor)};
 
   rejected_.fill_zero();
   if (count == 0) {
@@ -126,22 +68,22 @@ void ColorGate::apply(const compute::Buffer<std::uint32_t>& source_colors,
   if (differences_.size() < count) differences_ = compute::Buffer<std::uint32_t>(*context_, count);
   // Few work-groups on CPU-hosted drivers, where barriers are expensive; enough to fill a GPU.
   const std::uint32_t max_groups = context_->device_info().is_gpu() ? 1024 : 16;
-  const std::uint32_t groups =
-      std::max<std::uint32_t>(1, std::min(max_groups, compute::groups_for(count, kGroupSize)));
+  const std::uint32_t groups = std::max<std::uint32_t>(
+      1, std::min(max_groups, compute::groups_for(count, kReductionGroupSize)));
   if (partials_.size() < std::size_t{groups} * kSumCount) {
     partials_ = compute::Buffer<double>(*context_, std::size_t{max_groups} * kSumCount);
   }
-  compute::dispatch(*context_, kDifferencesKernel,
-                    {source_colors, target_colors, target_index, table_, differences_, partials_},
-                    DifferenceParams{count, static_cast<std::uint32_t>(target_colors.size())},
-                    {groups, 1});
+  compute::dispatch(
+      *context_, kDifferencesKernel,
+      {source_colors, target_colors, target_index, table_, differences_, partials_},
+      kernels::ColorGateDifferencesParams{count, static_cast<std::uint32_t>(target_colors.size())},
+      {groups, 1});
   reduce_rows(*context_, partials_, sums_, groups, static_cast<std::uint32_t>(kSumCount));
   compute::dispatch(*context_, kApplyKernel, {differences_, sums_, target_index, rejected_},
                     apply_params, {compute::groups_for(count, kApplyKernel.local_x), 1});
 }
 
 ColorGateStatistics ColorGate::statistics() const {
-  if (context_->is_cpu()) return host_statistics_;
   Sums sums{};
   sums_.download(sums);
   std::uint32_t rejected_count = 0;

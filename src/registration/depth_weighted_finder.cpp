@@ -30,19 +30,10 @@ void DepthWeightedFinder::prepare(const CloudView& target, int level) {
 void DepthWeightedFinder::write_weights(const CloudView& source, compute::Buffer<float>& weights) {
   const std::size_t count = source.size();
   if (weights.size() != count) weights = compute::Buffer<float>(*context_, count);
-  if (context_->is_cpu()) {
-    const auto points = source.points->host_span();
-    const auto out = weights.host_span();
-    for (std::size_t i = 0; i < count; ++i) out[i] = weight(points[i].z(), params_.reference_depth);
-    return;
-  }
-  host_points_.resize(count);
-  source.points->download(host_points_);
-  host_weights_.resize(count);
-  for (std::size_t i = 0; i < count; ++i) {
-    host_weights_[i] = weight(host_points_[i].z(), params_.reference_depth);
-  }
-  weights.upload(host_weights_);
+  // On the host (in place on the CPU backend): a few hundred thousand points once per level.
+  const auto points = compute::read_on_host(*source.points);
+  auto out = compute::write_on_host(weights, compute::HostWriteStart::overwrite_all);
+  for (std::size_t i = 0; i < count; ++i) out[i] = weight(points[i].z(), params_.reference_depth);
 }
 
 void DepthWeightedFinder::find(const CloudView& source, const CloudView& target,

@@ -4,88 +4,22 @@
 #include <string>
 
 #include "kartograf/compute/kernel.hpp"
+#include "kernels/pyramid_downsample/pyramid_downsample.h"
 
 namespace kartograf::registration {
 
 namespace {
 
-constexpr compute::KernelSpec kDownsampleKernel{"pyramid_downsample", 16, 16};
+constexpr compute::KernelSpec kDownsampleKernel{"pyramid_downsample", KG_PYRAMID_DOWNSAMPLE_LOCAL_X,
+                                                KG_PYRAMID_DOWNSAMPLE_LOCAL_Y};
 constexpr int kMinLevelSize = 8;
-
-struct DownsampleParams {  // layout of shaders/pyramid_downsample.comp and
-                           // kernels/pyramid_downsample.cl
-  std::uint32_t fine_width;
-  std::uint32_t coarse_width;
-  std::uint32_t coarse_height;
-  std::uint32_t has_colors;
-  float max_depth_jump;
-};
-
-// The kernels' reciprocals of 1..4 (multiplication rounds identically everywhere).
-constexpr float kInverseCount[5] = {0.0f, 1.0f, 0.5f, 0.333333343267f, 0.25f};
-
-void downsample_cpu(const PyramidLevel& fine, PyramidLevel& coarse, bool with_colors,
-                    float max_depth_jump) {
-  const Point4f* fine_points = fine.points.buffer().host_span().data();
-  const std::uint32_t* fine_colors =
-      with_colors ? fine.colors.buffer().host_span().data() : nullptr;
-  Point4f* coarse_points = coarse.points.buffer().host_span().data();
-  std::uint32_t* coarse_colors = with_colors ? coarse.colors.buffer().host_span().data() : nullptr;
-  const std::size_t fine_width = static_cast<std::size_t>(fine.camera.width);
-  const int width = coarse.camera.width;
-  for (int y = 0; y < coarse.camera.height; ++y) {
-    for (int x = 0; x < width; ++x) {
-      const std::size_t corner =
-          2 * static_cast<std::size_t>(y) * fine_width + 2 * static_cast<std::size_t>(x);
-      const std::size_t block[4] = {corner, corner + 1, corner + fine_width,
-                                    corner + fine_width + 1};
-      float z_min = 0.0f;
-      bool any = false;
-      for (std::size_t index : block) {
-        const Point4f& p = fine_points[index];
-        if (is_valid(p) && (!any || p.z() < z_min)) {
-          z_min = p.z();
-          any = true;
-        }
-      }
-      Point4f point = invalid_point();
-      std::uint32_t color = 0;
-      if (any) {
-        float sx = 0.0f, sy = 0.0f, sz = 0.0f;
-        std::uint32_t color_sum[3] = {0, 0, 0};
-        std::uint32_t count = 0;
-        for (std::size_t index : block) {
-          const Point4f& p = fine_points[index];
-          if (!is_valid(p) || !(p.z() - z_min <= max_depth_jump * z_min)) continue;
-          sx += p.x();
-          sy += p.y();
-          sz += p.z();
-          ++count;
-          if (with_colors) {
-            for (int c = 0; c < 3; ++c) color_sum[c] += (fine_colors[index] >> (8 * c)) & 0xffu;
-          }
-        }
-        point = Point4f(sx * kInverseCount[count], sy * kInverseCount[count],
-                        sz * kInverseCount[count], 1.0f);
-        for (int c = 0; c < 3; ++c) color |= ((color_sum[c] + count / 2) / count) << (8 * c);
-      }
-      const std::size_t index = static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + x;
-      coarse_points[index] = point;
-      if (with_colors) coarse_colors[index] = color;
-    }
-  }
-}
 
 void downsample(const compute::Context& context, const PyramidLevel& fine, PyramidLevel& coarse,
                 bool with_colors, float max_depth_jump) {
-  if (context.is_cpu()) {
-    downsample_cpu(fine, coarse, with_colors, max_depth_jump);
-    return;
-  }
-  const DownsampleParams params{static_cast<std::uint32_t>(fine.camera.width),
-                                static_cast<std::uint32_t>(coarse.camera.width),
-                                static_cast<std::uint32_t>(coarse.camera.height),
-                                with_colors ? 1u : 0u, max_depth_jump};
+  const kernels::PyramidDownsampleParams params{static_cast<std::uint32_t>(fine.camera.width),
+                                                static_cast<std::uint32_t>(coarse.camera.width),
+                                                static_cast<std::uint32_t>(coarse.camera.height),
+                                                with_colors ? 1u : 0u, max_depth_jump};
   const compute::BufferArg fine_colors =
       with_colors ? compute::BufferArg(fine.colors.buffer()) : compute::BufferArg();
   const compute::BufferArg coarse_colors =

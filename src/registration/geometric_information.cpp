@@ -14,24 +14,14 @@ namespace {
 
 // The cloud's points and normals on the host (in place on the CPU backend).
 struct HostCloud {
-  std::vector<Point4f> point_copy, normal_copy;
-  std::span<const Point4f> points, normals;
+  compute::HostView<Point4f> points;
+  compute::HostView<Point4f> normals;
 };
 
 HostCloud host_cloud(const CloudView& cloud) {
   require(cloud.points && cloud.normals && cloud.normals->size() == cloud.points->size(),
           "geometric information: the cloud needs points and one normal per point");
-  HostCloud host;
-  if (cloud.points->raw().on_host()) {
-    host.points = cloud.points->host_span();
-    host.normals = cloud.normals->host_span();
-    return host;
-  }
-  host.point_copy = cloud.points->to_vector();
-  host.normal_copy = cloud.normals->to_vector();
-  host.points = host.point_copy;
-  host.normals = host.normal_copy;
-  return host;
+  return {compute::read_on_host(*cloud.points), compute::read_on_host(*cloud.normals)};
 }
 
 // Balanced coordinates of analyse_degeneracy: rotations scaled by the length L.

@@ -110,13 +110,7 @@ KdTreeCorrespondences::KdTreeCorrespondences(const compute::Context& context, Kd
 
 void KdTreeCorrespondences::build(const CloudView& target) {
   require(target.points != nullptr, "k-d tree correspondences: target points are required");
-  if (context_->is_cpu()) {
-    tree_.emplace(target.points->host_span(), params_);
-  } else {
-    const std::vector<Point4f> points = target.points->to_vector();
-    tree_.emplace(points, params_);
-    target_normals_ = target.normals ? target.normals->to_vector() : std::vector<Point4f>();
-  }
+  tree_.emplace(compute::read_on_host(*target.points), params_);
   built_for_ = target.points;
 }
 
@@ -137,30 +131,12 @@ void KdTreeCorrespondences::find(const CloudView& source, const CloudView& targe
   }
   if (source.size() == 0) return;
 
-  std::span<const Point4f> source_points, source_normals, target_normals;
-  std::span<std::int32_t> result;
-  if (context_->is_cpu()) {
-    source_points = source.points->host_span();
-    if (query.use_normals) {
-      source_normals = source.normals->host_span();
-      target_normals = target.normals->host_span();
-    }
-    result = out.target_index.host_span();
-  } else {
-    source_points_.resize(source.size());
-    source.points->download(std::span(source_points_));
-    source_points = source_points_;
-    if (query.use_normals) {
-      source_normals_.resize(source.size());
-      source.normals->download(std::span(source_normals_));
-      source_normals = source_normals_;
-      require(target_normals_.size() == target.size(),
-              "k-d tree correspondences: the target had no normals when its tree was built");
-      target_normals = target_normals_;
-    }
-    result_.resize(source.size());
-    result = result_;
-  }
+  // A host-only search: the views are free on the CPU backend, copies from other devices.
+  const compute::Buffer<Point4f> absent;
+  const auto source_points = compute::read_on_host(*source.points);
+  const auto source_normals = compute::read_on_host(query.use_normals ? *source.normals : absent);
+  const auto target_normals = compute::read_on_host(query.use_normals ? *target.normals : absent);
+  auto result = compute::write_on_host(out.target_index, compute::HostWriteStart::overwrite_all);
   const auto width = source.camera ? static_cast<std::uint32_t>(source.camera->width) : 0u;
   const double max_distance_sq = query.max_distance_sq();
   detail::find_each(query, source_points, source_normals, target_normals, width,
@@ -168,7 +144,7 @@ void KdTreeCorrespondences::find(const CloudView& source, const CloudView& targe
                     [&](const Eigen::Vector3d& moved, const NormalGate* gate) {
                       return tree_->nearest(moved, max_distance_sq, gate);
                     });
-  if (!context_->is_cpu()) out.target_index.upload(result_);
+  result.commit();
 }
 
 }  // namespace kartograf::registration

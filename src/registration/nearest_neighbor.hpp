@@ -1,8 +1,7 @@
 #pragma once
-// The rules both nearest-neighbour finders (k-d tree, voxel-hash grid) share, in the arithmetic
-// of the voxel_hash_nearest kernels: moved points, squared distances in a fixed order (no
-// contraction, so every backend computes the same doubles), the normal gate, the tie-break, and
-// the per-source-point driver of the CPU paths.
+// The rules of kernels/voxel_hash_nearest/voxel_hash_nearest.h (moved points, squared distances,
+// the tie-break) for the k-d tree finder, which searches on the host, and the per-source-point
+// driver of its search.
 #include <array>
 #include <cmath>
 #include <numbers>
@@ -13,44 +12,46 @@
 
 #include "kartograf/registration/correspondence_finder.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
+#include "kernels/correspondence/selection.h"
+#include "kernels/voxel_hash_nearest/voxel_hash_nearest.h"
 #include "registration/association_checks.hpp"
 
 namespace kartograf::registration::detail {
 
-// What one find() needs besides the clouds; frame layout of shaders/voxel_hash_nearest.comp:
-// R (row-major), t, cell inverse (grid only), max distance^2, min normal cosine.
+inline kernels::float4 to_float4(const Point4f& p) {
+  return {p.x(), p.y(), p.z(), p.w()};
+}
+
+// What one find() needs besides the clouds; the frame as KG_NEAREST_FRAME_* lays it out (the cell
+// inverse is the grid's only).
 struct NearestQuery {
-  std::array<double, 15> frame{};
+  std::array<double, KG_NEAREST_FRAME_VALUES> frame{};
   bool use_normals = false;
 
-  double max_distance_sq() const { return frame[13]; }
-  double min_normal_cosine() const { return frame[14]; }
+  double max_distance_sq() const { return frame[KG_NEAREST_FRAME_MAX_DISTANCE_SQ]; }
+  double min_normal_cosine() const { return frame[KG_NEAREST_FRAME_MIN_COSINE]; }
 
   Eigen::Vector3d rotate(double x, double y, double z) const {
-    return {frame[0] * x + frame[1] * y + frame[2] * z, frame[3] * x + frame[4] * y + frame[5] * z,
-            frame[6] * x + frame[7] * y + frame[8] * z};
+    const kernels::double3 r = kernels::nearest_rotate(frame.data(), {x, y, z});
+    return {r.x, r.y, r.z};
   }
   Eigen::Vector3d move(const Point4f& p) const {
-    const Eigen::Vector3d r = rotate(p.x(), p.y(), p.z());
-    return {r.x() + frame[9], r.y() + frame[10], r.z() + frame[11]};
+    const kernels::double3 moved = kernels::nearest_move(frame.data(), to_float4(p));
+    return {moved.x, moved.y, moved.z};
   }
 };
 
 inline NearestQuery make_query(const Eigen::Isometry3d& pose, const AssociationParams& params) {
   NearestQuery query;
   for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) query.frame[3 * r + c] = pose.linear()(r, c);
-    query.frame[9 + r] = pose.translation()(r);
+    for (int c = 0; c < 3; ++c) query.frame[KG_NEAREST_FRAME_R + 3 * r + c] = pose.linear()(r, c);
+    query.frame[KG_NEAREST_FRAME_T + r] = pose.translation()(r);
   }
-  query.frame[13] = params.max_distance * params.max_distance;
-  query.frame[14] = std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0);
+  query.frame[KG_NEAREST_FRAME_MAX_DISTANCE_SQ] = params.max_distance * params.max_distance;
+  query.frame[KG_NEAREST_FRAME_MIN_COSINE] =
+      std::cos(params.max_normal_angle_deg * std::numbers::pi / 180.0);
   query.use_normals = params.max_normal_angle_deg < 180.0;
   return query;
-}
-
-inline double squared_distance(const Eigen::Vector3d& a, const Point4f& b) {
-  const double dx = a.x() - b.x(), dy = a.y() - b.y(), dz = a.z() - b.z();
-  return dx * dx + dy * dy + dz * dz;
 }
 
 // The best candidate so far: the smallest squared distance <= the bound, the lowest index among
@@ -58,7 +59,7 @@ inline double squared_distance(const Eigen::Vector3d& a, const Point4f& b) {
 struct Nearest {
   explicit Nearest(double max_distance_sq) : distance_sq(max_distance_sq) {}
   bool improves(std::int32_t j, double d) const {
-    return d < distance_sq || (d == distance_sq && (index < 0 || j < index));
+    return kernels::nearest_improves(d, j, {index, distance_sq});
   }
   void take(std::int32_t j, double d) {
     index = j;
@@ -84,7 +85,7 @@ void find_each(const NearestQuery& query, std::span<const Point4f> source,
                std::uint32_t width, std::uint32_t k, std::span<std::int32_t> out, Search&& search) {
   for (std::size_t i = 0; i < source.size(); ++i) {
     const auto index = static_cast<std::uint32_t>(i);
-    if (!is_selected(index, width, k)) {
+    if (!kernels::correspondence_selected(index, width, k)) {
       out[i] = kNotSelected;
       continue;
     }

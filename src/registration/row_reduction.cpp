@@ -6,12 +6,7 @@
 namespace kartograf::registration {
 
 namespace {
-constexpr compute::KernelSpec kReduceRowsKernel{"reduce_rows", kReductionGroupSize};
-
-struct ReduceRowsParams {  // layout of shaders/reduce_rows.comp and kernels/reduce_rows.cl
-  std::uint32_t row_count;
-  std::uint32_t column_count;
-};
+constexpr compute::KernelSpec kReduceRowsKernel{"reduce_rows", KG_REDUCE_ROWS_LOCAL_X};
 }  // namespace
 
 void reduce_rows(const compute::Context& context, const compute::Buffer<double>& rows,
@@ -21,7 +16,7 @@ void reduce_rows(const compute::Context& context, const compute::Buffer<double>&
           "reduce_rows: " + std::to_string(row_count) + " x " + std::to_string(column_count) +
               " sums do not fit the buffers");
   compute::dispatch(context, kReduceRowsKernel, {rows, result},
-                    ReduceRowsParams{row_count, column_count}, {column_count, 1});
+                    kernels::ReduceRowsParams{row_count, column_count}, {column_count, 1});
 }
 
 }  // namespace kartograf::registration

@@ -2,175 +2,129 @@
 
 #include <algorithm>
 #include <cmath>
+#include <span>
 #include <string>
+#include <tuple>
 #include <unordered_map>
 
 #include "geometry/voxel_key.hpp"
 #include "kartograf/compute/kernel.hpp"
+#include "kernels/voxel_hash_nearest/voxel_hash_nearest.h"
 #include "registration/nearest_neighbor.hpp"
 
 namespace kartograf::registration {
 
 namespace {
 
-constexpr compute::KernelSpec kNearestKernel{"voxel_hash_nearest", 64};
+constexpr compute::KernelSpec kNearestKernel{"voxel_hash_nearest", KG_VOXEL_HASH_NEAREST_LOCAL_X};
 constexpr double kCellMargin = 0x1p-20;  // cell edge = max_distance / (1 - 2^-20)
-constexpr double kGapMargin = 1e-9;      // cells: > the rounding of p * s for |p * s| < 2^21
-
-struct NearestKernelParams {  // layout of shaders/voxel_hash_nearest.comp and the .cl kernel
-  std::uint32_t source_count;
-  std::uint32_t source_width;
-  std::uint32_t subsample;
-  std::uint32_t capacity_log2;
-  std::uint32_t use_normals;
-};
-
-// The kernel's search, for one moved source point, over the host copy of the grid.
-struct HostGrid {
-  std::span<const std::uint64_t> keys;
-  std::span<const std::uint32_t> ranges;
-  std::span<const Point4f> points;
-  std::span<const std::uint32_t> indices;
-  unsigned capacity_log2;
-  double cell_inverse;
-
-  std::int32_t nearest(const Eigen::Vector3d& moved, double max_distance_sq,
-                       const NormalGate* gate) const {
-    const Eigen::Vector3d scaled = moved * cell_inverse;
-    const Eigen::Vector3d base(std::floor(scaled.x()), std::floor(scaled.y()),
-                               std::floor(scaled.z()));
-    const double bound = geometry::detail::kVoxelLimit + 1.0;
-    if (!(std::fabs(base.x()) <= bound && std::fabs(base.y()) <= bound &&
-          std::fabs(base.z()) <= bound)) {
-      return kNoMatch;
-    }
-    const Eigen::Vector3d fraction = scaled - base;  // the query's place in its cell, [0, 1]
-    const double cell_sq = 1.0 / (cell_inverse * cell_inverse);
-    const std::uint32_t mask = (std::uint32_t{1} << capacity_log2) - 1;
-    detail::Nearest best(max_distance_sq);
-    // The query's own cell first; then a cell is skipped when even its nearest face is farther
-    // than the best so far (gaps shrunk by 1e-9 cells against rounding, so none is lost).
-    constexpr int kOrder[3] = {0, -1, 1};
-    for (const int dz : kOrder) {
-      for (const int dy : kOrder) {
-        for (const int dx : kOrder) {
-          const Eigen::Vector3i offset(dx, dy, dz);
-          double gap_sq = 0;
-          for (int axis = 0; axis < 3; ++axis) {
-            if (offset(axis) == 0) continue;
-            const double gap = offset(axis) < 0 ? fraction(axis) : 1.0 - fraction(axis);
-            gap_sq += std::max(gap - kGapMargin, 0.0) * std::max(gap - kGapMargin, 0.0);
-          }
-          if (gap_sq * cell_sq > best.distance_sq) continue;
-          Eigen::Vector3d cell;
-          if (!geometry::detail::voxel_of(base + offset.cast<double>(), cell)) continue;
-          const std::uint64_t key = geometry::detail::voxel_key(cell);
-          std::uint32_t slot = geometry::detail::voxel_slot(key, capacity_log2);
-          while (keys[slot] != key && keys[slot] != geometry::detail::kEmptyVoxelKey)
-            slot = (slot + 1) & mask;
-          if (keys[slot] == geometry::detail::kEmptyVoxelKey) continue;
-          const std::uint32_t first = ranges[2 * slot], end = first + ranges[2 * slot + 1];
-          for (std::uint32_t m = first; m < end; ++m) {
-            const auto j = static_cast<std::int32_t>(indices[m]);
-            const double distance_sq = detail::squared_distance(moved, points[m]);
-            if (best.improves(j, distance_sq) && (!gate || gate->accepts(indices[m]))) {
-              best.take(j, distance_sq);
-            }
-          }
-        }
-      }
-    }
-    return best.index;
-  }
-};
+static_assert(KG_NEAREST_NO_MATCH == kNoMatch && KG_NEAREST_NOT_SELECTED == kNotSelected);
+static_assert(KG_NEAREST_FRAME_VALUES == std::tuple_size_v<decltype(detail::NearestQuery::frame)>);
 
 template <class T>
 void upload_resized(const compute::Context& context, compute::Buffer<T>& buffer,
-                    std::vector<T>& values) {
+                    std::span<const T> values) {
   if (buffer.size() != values.size()) buffer = compute::Buffer<T>(context, values.size());
   buffer.upload(values);
-  std::vector<T>().swap(values);  // the device holds the grid now
+}
+
+// The grid on the host: cells in the order of their first point, the points sorted by cell
+// (stable), and the table of cells (key -> first, count).
+struct HostGrid {
+  std::vector<std::uint64_t> keys;     // per slot: cell key, 0 = empty
+  std::vector<std::uint32_t> ranges;   // per slot: first, count (into the sorted points)
+  std::vector<Point4f> points;         // target points sorted by cell
+  std::vector<std::uint32_t> indices;  // their indices in the target
+  std::size_t cell_count = 0;
+  unsigned capacity_log2 = 0;
+};
+
+// The cell of every valid point (0xffffffff for invalid ones), the cells' keys in the order of
+// their first point, and how many points each has.
+struct CellsOfPoints {
+  std::vector<std::uint32_t> point_cells;
+  std::vector<std::uint64_t> keys;
+  std::vector<std::uint32_t> counts;
+};
+
+CellsOfPoints cells_of_points(std::span<const Point4f> points, double cell_inverse,
+                              double cell_size) {
+  CellsOfPoints cells;
+  cells.point_cells.assign(points.size(), 0xffffffffu);
+  std::unordered_map<std::uint64_t, std::uint32_t> cell_of_key;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (!is_valid(points[i])) continue;
+    Eigen::Vector3d cell;
+    require(geometry::detail::voxel_of(points[i].head<3>().cast<double>() * cell_inverse, cell),
+            "voxel-hash correspondences: target point " + std::to_string(i) +
+                " lies beyond 2^20 cells of " + std::to_string(cell_size) +
+                " m from the origin (or has NaN/Inf coordinates)");
+    const auto [entry, inserted] = cell_of_key.try_emplace(
+        geometry::detail::voxel_key(cell), static_cast<std::uint32_t>(cells.keys.size()));
+    if (inserted) {
+      cells.keys.push_back(entry->first);
+      cells.counts.push_back(0);
+    }
+    cells.point_cells[i] = entry->second;
+    ++cells.counts[entry->second];
+  }
+  return cells;
+}
+
+HostGrid build_grid(std::span<const Point4f> points, double cell_inverse, double cell_size) {
+  const CellsOfPoints cells = cells_of_points(points, cell_inverse, cell_size);
+  std::vector<std::uint32_t> starts(cells.counts.size());
+  std::uint32_t running = 0;
+  for (std::size_t c = 0; c < starts.size(); ++c) {
+    starts[c] = running;
+    running += cells.counts[c];
+  }
+  HostGrid grid;
+  std::vector<std::uint32_t> cursor = starts;
+  grid.points.assign(running, Point4f::Zero());
+  grid.indices.assign(running, 0);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    if (cells.point_cells[i] == 0xffffffffu) continue;
+    const std::uint32_t m = cursor[cells.point_cells[i]]++;
+    grid.points[m] = points[i];
+    grid.indices[m] = static_cast<std::uint32_t>(i);
+  }
+  grid.cell_count = cells.keys.size();
+  grid.capacity_log2 = geometry::detail::hash_capacity_log2(grid.cell_count);
+  grid.keys.assign(std::size_t{1} << grid.capacity_log2, geometry::detail::kEmptyVoxelKey);
+  grid.ranges.assign(std::size_t{2} << grid.capacity_log2, 0);
+  for (std::size_t c = 0; c < grid.cell_count; ++c) {
+    std::uint32_t slot = kernels::voxel_slot(cells.keys[c], grid.capacity_log2);
+    while (grid.keys[slot] != geometry::detail::kEmptyVoxelKey) {
+      slot = kernels::voxel_next_slot(slot, grid.capacity_log2);
+    }
+    grid.keys[slot] = cells.keys[c];
+    grid.ranges[2 * slot] = starts[c];
+    grid.ranges[2 * slot + 1] = cells.counts[c];
+  }
+  return grid;
 }
 
 }  // namespace
 
 VoxelHashCorrespondences::VoxelHashCorrespondences(const compute::Context& context)
-    : context_(&context) {
-  if (!context.is_cpu()) frame_ = compute::Buffer<double>(context, 15);
-}
+    : context_(&context), frame_(context, KG_NEAREST_FRAME_VALUES) {}
 
 void VoxelHashCorrespondences::prepare(const CloudView&, int) {
   stale_ = true;
 }
 
 void VoxelHashCorrespondences::build(const CloudView& target, double max_distance) {
-  std::vector<Point4f> downloaded;
-  std::span<const Point4f> points;
-  if (context_->is_cpu()) {
-    points = target.points->host_span();
-  } else {
-    downloaded = target.points->to_vector();
-    points = downloaded;
-  }
   cell_inverse_ = (1.0 - kCellMargin) / max_distance;
   cell_size_ = 1.0 / cell_inverse_;
-
-  // Cells in the order of their first point, then the points sorted by cell (stable).
-  std::unordered_map<std::uint64_t, std::uint32_t> cell_of_key;
-  std::vector<std::uint64_t> cell_keys;
-  std::vector<std::uint32_t> cell_starts;
-  std::vector<std::uint32_t> point_cells(points.size(), 0xffffffffu);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (!is_valid(points[i])) continue;
-    Eigen::Vector3d cell;
-    require(geometry::detail::voxel_of(points[i].head<3>().cast<double>() * cell_inverse_, cell),
-            "voxel-hash correspondences: target point " + std::to_string(i) +
-                " lies beyond 2^20 cells of " + std::to_string(cell_size_) +
-                " m from the origin (or has NaN/Inf coordinates)");
-    const auto [entry, inserted] = cell_of_key.try_emplace(
-        geometry::detail::voxel_key(cell), static_cast<std::uint32_t>(cell_keys.size()));
-    if (inserted) {
-      cell_keys.push_back(entry->first);
-      cell_starts.push_back(0);
-    }
-    point_cells[i] = entry->second;
-    ++cell_starts[entry->second];
-  }
-  std::uint32_t running = 0;
-  for (std::uint32_t& start : cell_starts) {
-    const std::uint32_t count = start;
-    start = running;
-    running += count;
-  }
-  std::vector<std::uint32_t> cursor = cell_starts;
-  host_points_.assign(running, Point4f::Zero());
-  host_indices_.assign(running, 0);
-  for (std::size_t i = 0; i < points.size(); ++i) {
-    if (point_cells[i] == 0xffffffffu) continue;
-    const std::uint32_t m = cursor[point_cells[i]]++;
-    host_points_[m] = points[i];
-    host_indices_[m] = static_cast<std::uint32_t>(i);
-  }
-
-  cell_count_ = cell_keys.size();
-  capacity_log2_ = geometry::detail::hash_capacity_log2(cell_count_);
-  const std::uint32_t mask = (std::uint32_t{1} << capacity_log2_) - 1;
-  host_keys_.assign(std::size_t{1} << capacity_log2_, geometry::detail::kEmptyVoxelKey);
-  host_ranges_.assign(std::size_t{2} << capacity_log2_, 0);
-  for (std::size_t c = 0; c < cell_count_; ++c) {
-    std::uint32_t slot = geometry::detail::voxel_slot(cell_keys[c], capacity_log2_);
-    while (host_keys_[slot] != geometry::detail::kEmptyVoxelKey) slot = (slot + 1) & mask;
-    host_keys_[slot] = cell_keys[c];
-    host_ranges_[2 * slot] = cell_starts[c];
-    host_ranges_[2 * slot + 1] =
-        (c + 1 < cell_count_ ? cell_starts[c + 1] : running) - cell_starts[c];
-  }
-  if (!context_->is_cpu()) {
-    upload_resized(*context_, keys_, host_keys_);
-    upload_resized(*context_, ranges_, host_ranges_);
-    upload_resized(*context_, points_, host_points_);
-    upload_resized(*context_, indices_, host_indices_);
-  }
+  const HostGrid grid =
+      build_grid(compute::read_on_host(*target.points), cell_inverse_, cell_size_);
+  cell_count_ = grid.cell_count;
+  capacity_log2_ = grid.capacity_log2;
+  upload_resized<std::uint64_t>(*context_, keys_, grid.keys);
+  upload_resized<std::uint32_t>(*context_, ranges_, grid.ranges);
+  upload_resized<Point4f>(*context_, points_, grid.points);
+  upload_resized<std::uint32_t>(*context_, indices_, grid.indices);
   built_for_ = target.points;
   built_distance_ = max_distance;
   stale_ = false;
@@ -186,37 +140,24 @@ void VoxelHashCorrespondences::find(const CloudView& source, const CloudView& ta
   if (stale_ || built_for_ != target.points || built_distance_ != params.max_distance) {
     build(target, params.max_distance);
   }
-  query.frame[12] = cell_inverse_;
+  query.frame[KG_NEAREST_FRAME_CELL_INVERSE] = cell_inverse_;
   if (out.target_index.size() != source.size()) {
     out.target_index = compute::Buffer<std::int32_t>(*context_, source.size());
   }
   if (source.size() == 0) return;
   const auto width = source.camera ? static_cast<std::uint32_t>(source.camera->width) : 0u;
-  const auto k = static_cast<std::uint32_t>(params.subsample);
-
-  if (context_->is_cpu()) {
-    const HostGrid grid{host_keys_,    host_ranges_,   host_points_,
-                        host_indices_, capacity_log2_, cell_inverse_};
-    const double max_distance_sq = query.max_distance_sq();
-    detail::find_each(query, source.points->host_span(),
-                      query.use_normals ? source.normals->host_span() : std::span<const Point4f>(),
-                      query.use_normals ? target.normals->host_span() : std::span<const Point4f>(),
-                      width, k, out.target_index.host_span(),
-                      [&](const Eigen::Vector3d& moved, const NormalGate* gate) {
-                        return grid.nearest(moved, max_distance_sq, gate);
-                      });
-    return;
-  }
   frame_.upload(query.frame);
   const auto optional = [&](const compute::Buffer<Point4f>* buffer) {
     return query.use_normals ? compute::BufferArg(*buffer) : compute::BufferArg();
   };
-  compute::dispatch(*context_, kNearestKernel,
-                    {*source.points, optional(source.normals), optional(target.normals), keys_,
-                     ranges_, points_, indices_, frame_, out.target_index},
-                    NearestKernelParams{static_cast<std::uint32_t>(source.size()), width, k,
-                                        capacity_log2_, query.use_normals ? 1u : 0u},
-                    {compute::groups_for(source.size(), kNearestKernel.local_x), 1});
+  compute::dispatch(
+      *context_, kNearestKernel,
+      {*source.points, optional(source.normals), optional(target.normals), keys_, ranges_, points_,
+       indices_, frame_, out.target_index},
+      kernels::VoxelHashNearestParams{static_cast<std::uint32_t>(source.size()), width,
+                                      static_cast<std::uint32_t>(params.subsample), capacity_log2_,
+                                      query.use_normals ? 1u : 0u},
+      {compute::groups_for(source.size(), kNearestKernel.local_x), 1});
 }
 
 }  // namespace kartograf::registration

@@ -15,8 +15,8 @@
 
 #include "compute/cpu_parallel.hpp"
 #include "kartograf/compute/context.hpp"
+#include "kartograf/core/connected_components.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/eval/connected_components.hpp"
 #include "kartograf/rooms/laser_scan_device.hpp"
 
 namespace kartograf::rooms {
@@ -37,39 +37,28 @@ using Cell = ScanCell;
 constexpr std::size_t kDeviceBatchCells = 16384;
 
 // The features of a scan at every cell, rows in the order of `cells`. The scans run on `context`
-// when it is a device backend (DeviceLaserScanner: the same scans, bit for bit), else with the
-// features on threads over chunks of cells (KARTOGRAF_CPU_THREADS, src/compute/cpu_parallel.hpp).
-std::vector<float> features_at(const LaserScanner& scanner, const std::vector<Cell>& cells,
-                               const LaserFeatureParams& params, const compute::Context* context) {
+// (DeviceLaserScanner: the same scans, bit for bit, on every backend) in batches; the features on
+// threads over chunks of cells (KARTOGRAF_CPU_THREADS, src/compute/cpu_parallel.hpp).
+std::vector<float> features_at(const compute::Context& context, const LaserScanner& scanner,
+                               const std::vector<Cell>& cells, const LaserFeatureParams& params) {
   const auto beams = static_cast<std::size_t>(scanner.beams());
   std::vector<float> features(cells.size() * kLaserFeatureCount);
-  const auto store = [&](std::size_t i, std::span<const double> ranges) {
-    const LaserFeatures f = laser_scan_features(ranges, params);
-    std::copy(f.begin(), f.end(),
-              features.begin() + static_cast<std::ptrdiff_t>(i * kLaserFeatureCount));
-  };
-  if (context && !context->is_cpu()) {
-    DeviceLaserScanner device(*context, scanner);
-    for (std::size_t begin = 0; begin < cells.size(); begin += kDeviceBatchCells) {
-      const std::size_t count = std::min(kDeviceBatchCells, cells.size() - begin);
-      const std::vector<double> ranges =
-          device.scan_ranges(std::span(cells).subspan(begin, count), count);
-      compute::detail::for_each_chunk(
-          count, count * beams, [&](std::size_t first, std::size_t last, std::size_t) {
-            for (std::size_t i = first; i < last; ++i)
-              store(begin + i, std::span(ranges).subspan(i * beams, beams));
-          });
-    }
-    return features;
+  DeviceLaserScanner device(context, scanner);
+  for (std::size_t begin = 0; begin < cells.size(); begin += kDeviceBatchCells) {
+    const std::size_t count = std::min(kDeviceBatchCells, cells.size() - begin);
+    const std::vector<double> ranges =
+        device.scan_ranges(std::span(cells).subspan(begin, count), count);
+    compute::detail::for_each_chunk(
+        count, count * beams, [&](std::size_t first, std::size_t last, std::size_t) {
+          for (std::size_t i = first; i < last; ++i) {
+            const LaserFeatures f =
+                laser_scan_features(std::span(ranges).subspan(i * beams, beams), params);
+            std::copy(
+                f.begin(), f.end(),
+                features.begin() + static_cast<std::ptrdiff_t>((begin + i) * kLaserFeatureCount));
+          }
+        });
   }
-  compute::detail::for_each_chunk(cells.size(), cells.size() * beams,
-                                  [&](std::size_t first, std::size_t last, std::size_t) {
-                                    std::vector<double> ranges(beams);
-                                    for (std::size_t i = first; i < last; ++i) {
-                                      scanner.scan(cells[i].col, cells[i].row, ranges);
-                                      store(i, ranges);
-                                    }
-                                  });
   return features;
 }
 
@@ -242,7 +231,8 @@ RoomTrainingMap room_training_map(const std::string& name, const OccupancyGrid& 
   return result;
 }
 
-RoomClassifier train_room_classifier(const std::vector<RoomTrainingMap>& maps,
+RoomClassifier train_room_classifier(const compute::Context& context,
+                                     const std::vector<RoomTrainingMap>& maps,
                                      const ClassifierTrainingParams& params) {
   require(!maps.empty(), "room classifier training: no training maps");
   require(params.sample_stride >= 1, "room classifier training: sample_stride must be >= 1");
@@ -265,7 +255,7 @@ RoomClassifier train_room_classifier(const std::vector<RoomTrainingMap>& maps,
         labels.push_back(place == PlaceClass::room ? 1 : -1);
       }
     }
-    const std::vector<float> map_features = features_at(scanner, cells, params.features, nullptr);
+    const std::vector<float> map_features = features_at(context, scanner, cells, params.features);
     features.insert(features.end(), map_features.begin(), map_features.end());
   }
   return RoomClassifier::train(features, labels, params.weak_count, params.max_depth);
@@ -273,9 +263,9 @@ RoomClassifier train_room_classifier(const std::vector<RoomTrainingMap>& maps,
 
 // ---- Segmentation ------------------------------------------------------------------------------
 
-Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                  const FeatureSegmentationParams& params,
-                                  const compute::Context* context) {
+Image<PlaceClass> classify_places(const compute::Context& context, const OccupancyGrid& map,
+                                  const RoomClassifier& classifier,
+                                  const FeatureSegmentationParams& params) {
   check_map(map, "feature-based room segmentation");
   require(!classifier.empty(), "feature-based room segmentation: the room classifier is empty");
   require(params.sample_stride >= 1, "feature-based room segmentation: sample_stride must be >= 1");
@@ -289,7 +279,7 @@ Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier
   }
   const LaserScanner scanner(map, params.scan);
   const std::vector<float> scores =
-      smoothed(cells, classifier.scores(features_at(scanner, cells, params.features, context)),
+      smoothed(cells, classifier.scores(features_at(context, scanner, cells, params.features)),
                params.sample_stride, params.smoothing_radius);
   // Classes as labels 1 (room) and 2 (hallway), grown over the free cells between the lattice's.
   LabelImage classes(width, height, 0);
@@ -310,21 +300,20 @@ std::filesystem::path default_room_classifier_path() {
   return models_dir() / "rooms" / "room_hallway_boost.yml.gz";
 }
 
-RoomSegmentation segment_feature_based(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                       const FeatureSegmentationParams& params,
-                                       const compute::Context* context) {
+RoomSegmentation segment_feature_based(const compute::Context& context, const OccupancyGrid& map,
+                                       const RoomClassifier& classifier,
+                                       const FeatureSegmentationParams& params) {
   const Clock::time_point start = Clock::now();
   check_map(map, "feature-based room segmentation");
   params.region_area.check("feature-based room segmentation");
-  const Image<PlaceClass> places = classify_places(map, classifier, params, context);
+  const Image<PlaceClass> places = classify_places(context, map, classifier, params);
   const int width = map.width(), height = map.height();
   const double cell_area = map.resolution * map.resolution;
   LabelImage rooms(width, height, 0);
   Label next = 0;
   for (const PlaceClass place : {PlaceClass::room, PlaceClass::hallway}) {
     const Image<std::uint8_t> mask = core_of(places, place, params.core_margin_m / map.resolution);
-    const LabelImage regions =
-        eval::label_connected_components(mask, {eval::Connectivity::eight, 1});
+    const LabelImage regions = label_connected_components(mask, {Connectivity::eight, 1});
     Label count = 0;
     for (const Label l : regions.pixels()) count = std::max(count, l);
     std::vector<int> cells(static_cast<std::size_t>(count) + 1, 0);

@@ -7,7 +7,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/distance_transform.hpp"
-#include "rooms/laser_beam.hpp"
+#include "kernels/laser_scan/laser_scan.h"
 
 namespace kartograf::rooms {
 
@@ -86,6 +86,136 @@ void unit_directions(std::size_t n, std::vector<double>& xs, std::vector<double>
   ys = sin_table;
 }
 
+void set(LaserFeatures& f, Feature which, double value) {
+  f[which] = static_cast<float>(value);
+}
+
+// Differences and ratios of consecutive beams (cyclic: the last beam is followed by the first).
+void set_consecutive_beam_features(std::span<const double> ranges, const LaserFeatureParams& params,
+                                   LaserFeatures& f) {
+  const std::size_t n = ranges.size();
+  const auto next = [&](std::size_t i) { return i + 1 < n ? ranges[i + 1] : ranges[0]; };
+  double sum_difference = 0, sum2_difference = 0, sum_clipped = 0, sum2_clipped = 0;
+  double sum_ratio = 0, sum2_ratio = 0;
+  int gap_count = 0, relative_gap_count = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const double a = ranges[i], b = next(i);
+    const double difference = std::abs(a - b);
+    const double clipped = std::abs(std::min(a, params.clip_m) - std::min(b, params.clip_m));
+    const double ratio = std::min(a, b) / std::max(a, b);
+    sum_difference += difference;
+    sum2_difference += difference * difference;
+    sum_clipped += clipped;
+    sum2_clipped += clipped * clipped;
+    sum_ratio += ratio;
+    sum2_ratio += ratio * ratio;
+    gap_count += difference > params.gap_m;
+    relative_gap_count += ratio < params.relative_gap;
+  }
+  const MeanStd difference = from_sums(sum_difference, sum2_difference, n);
+  const MeanStd clipped = from_sums(sum_clipped, sum2_clipped, n);
+  const MeanStd ratio = from_sums(sum_ratio, sum2_ratio, n);
+  set(f, mean_difference, difference.mean);
+  set(f, std_difference, difference.std);
+  set(f, mean_clipped_difference, clipped.mean);
+  set(f, std_clipped_difference, clipped.std);
+  set(f, gaps, gap_count);
+  set(f, mean_ratio, ratio.mean);
+  set(f, std_ratio, ratio.std);
+  set(f, relative_gaps, relative_gap_count);
+}
+
+// Beam lengths: their mean, spread, kurtosis and extremes.
+void set_beam_length_features(std::span<const double> ranges, LaserFeatures& f) {
+  const std::size_t n = ranges.size();
+  const MeanStd length = mean_std(n, [&](std::size_t i) { return ranges[i]; });
+  const auto [shortest, longest] = std::minmax_element(ranges.begin(), ranges.end());
+  double m4 = 0;
+  for (const double b : ranges) {
+    const double d2 = (b - length.mean) * (b - length.mean);
+    m4 += d2 * d2;
+  }
+  m4 /= static_cast<double>(n);
+  const double variance = length.std * length.std;
+  set(f, mean_beam, length.mean);
+  set(f, std_beam, length.std);
+  set(f, beam_kurtosis, variance > 1e-12 ? m4 / (variance * variance) - 3 : 0.0);
+  set(f, mean_beam_per_max, length.mean / *longest);
+  set(f, std_beam_per_max, length.std / *longest);
+  set(f, shortest_beam, *shortest);
+  set(f, longest_beam, *longest);
+}
+
+// The shortest beam and the shortest one at least a quarter turn away from it: in a corridor,
+// the two walls; their end points' distance is its width.
+void set_minima_features(std::span<const double> ranges, LaserFeatures& f) {
+  const std::size_t n = ranges.size();
+  const double step = 2 * std::numbers::pi / static_cast<double>(n);
+  // The first shortest beam, as std::minmax_element finds it.
+  const std::size_t first =
+      static_cast<std::size_t>(std::min_element(ranges.begin(), ranges.end()) - ranges.begin());
+  std::size_t second = first;
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t apart = std::min((i + n - first) % n, (first + n - i) % n);
+    if (4 * apart >= n && (second == first || ranges[i] < ranges[second])) second = i;
+  }
+  const std::size_t apart = std::min((second + n - first) % n, (first + n - second) % n);
+  const double angle = static_cast<double>(apart) * step;
+  const double b1 = ranges[first], b2 = ranges[second];
+  set(f, minima_distance,
+      std::sqrt(std::max(0.0, b1 * b1 + b2 * b2 - 2 * b1 * b2 * std::cos(angle))));
+  set(f, minima_angle, angle * 180 / std::numbers::pi);
+}
+
+// The polygon of the beams' end points: area, perimeter, centroid and second moments.
+void set_polygon_features(std::span<const double> ranges, LaserFeatures& f) {
+  const std::size_t n = ranges.size();
+  thread_local std::vector<double> xs, ys;
+  unit_directions(n, xs, ys);
+  for (std::size_t i = 0; i < n; ++i) {
+    xs[i] *= ranges[i];
+    ys[i] *= ranges[i];
+  }
+  double area2 = 0, perimeter = 0, cx6 = 0, cy6 = 0, ixx12 = 0, iyy12 = 0, ixy24 = 0;
+  double vx = 0, vy = 0;  // vertex mean
+  for (std::size_t i = 0; i < n; ++i) {
+    const std::size_t j = (i + 1) % n;
+    const double x0 = xs[i], y0 = ys[i], x1 = xs[j], y1 = ys[j];
+    const double cross = x0 * y1 - x1 * y0;
+    area2 += cross;
+    perimeter += norm(x1 - x0, y1 - y0);
+    cx6 += (x0 + x1) * cross;
+    cy6 += (y0 + y1) * cross;
+    ixx12 += (x0 * x0 + x0 * x1 + x1 * x1) * cross;
+    iyy12 += (y0 * y0 + y0 * y1 + y1 * y1) * cross;
+    ixy24 += (x0 * y1 + 2 * x0 * y0 + 2 * x1 * y1 + x1 * y0) * cross;
+    vx += x0;
+    vy += y0;
+  }
+  const double area = area2 / 2;  // > 0: the beams turn counter-clockwise
+  const double cx = cx6 / (6 * area), cy = cy6 / (6 * area);
+  const double sxx = ixx12 / (12 * area) - cx * cx, syy = iyy12 / (12 * area) - cy * cy;
+  const double sxy = ixy24 / (24 * area) - cx * cy;
+  // Eigenvalues of the area's covariance; a uniform ellipse with semi-axis a has variance a^2/4.
+  const double half_trace = (sxx + syy) / 2;
+  const double root = std::sqrt(std::max(0.0, (sxx - syy) * (sxx - syy) / 4 + sxy * sxy));
+  const double major = 2 * std::sqrt(std::max(0.0, half_trace + root));
+  const double minor = 2 * std::sqrt(std::max(0.0, half_trace - root));
+  vx /= static_cast<double>(n);
+  vy /= static_cast<double>(n);
+  const MeanStd centroid_distance =
+      mean_std(n, [&](std::size_t i) { return norm(xs[i] - vx, ys[i] - vy); });
+  set(f, polygon_area, area);
+  set(f, polygon_perimeter, perimeter);
+  set(f, area_per_perimeter, area / perimeter);
+  set(f, mean_centroid_distance, centroid_distance.mean);
+  set(f, std_centroid_distance, centroid_distance.std);
+  set(f, major_semi_axis, major);
+  set(f, minor_semi_axis, minor);
+  set(f, axis_ratio, major / std::max(minor, 1e-6));
+  set(f, compactness, 4 * std::numbers::pi * area / (perimeter * perimeter));
+  set(f, centroid_offset, norm(cx, cy));
+}
 }  // namespace
 
 LaserScanner::LaserScanner(const OccupancyGrid& map, const LaserScanParams& params)
@@ -141,10 +271,10 @@ void LaserScanner::scan_steps(int col, int row, std::span<std::int32_t> steps) c
   std::fill(steps.begin(), steps.end(), 0);
   if (col < 0 || row < 0 || col >= width_ || row >= height_) return;
   // The cell centre in the padded grid, 1/65536 cell units (a non-free cell stops at step 0).
-  const std::int32_t x0 = (col + 1) * 65536 + 32768, y0 = (row + 1) * 65536 + 32768;
+  const std::int32_t x0 = kernels::laser_cell_origin(col), y0 = kernels::laser_cell_origin(row);
   for (std::size_t k = 0; k < steps.size(); ++k) {
-    steps[k] = detail::trace_beam(skips_.data(), width_ + 2, x0, y0, directions_[2 * k],
-                                  directions_[2 * k + 1], max_steps_);
+    steps[k] = kernels::laser_trace_beam(skips_.data(), width_ + 2, x0, y0, directions_[2 * k],
+                                         directions_[2 * k + 1], max_steps_);
   }
 }
 
@@ -200,118 +330,10 @@ LaserFeatures laser_scan_features(std::span<const double> ranges,
                   std::to_string(b));
   }
   LaserFeatures f{};
-  const auto set = [&](Feature which, double value) { f[which] = static_cast<float>(value); };
-
-  // Differences and ratios of consecutive beams (cyclic: the last beam is followed by the first).
-  const auto next = [&](std::size_t i) { return i + 1 < n ? ranges[i + 1] : ranges[0]; };
-  double sum_difference = 0, sum2_difference = 0, sum_clipped = 0, sum2_clipped = 0;
-  double sum_ratio = 0, sum2_ratio = 0;
-  int gap_count = 0, relative_gap_count = 0;
-  for (std::size_t i = 0; i < n; ++i) {
-    const double a = ranges[i], b = next(i);
-    const double difference = std::abs(a - b);
-    const double clipped = std::abs(std::min(a, params.clip_m) - std::min(b, params.clip_m));
-    const double ratio = std::min(a, b) / std::max(a, b);
-    sum_difference += difference;
-    sum2_difference += difference * difference;
-    sum_clipped += clipped;
-    sum2_clipped += clipped * clipped;
-    sum_ratio += ratio;
-    sum2_ratio += ratio * ratio;
-    gap_count += difference > params.gap_m;
-    relative_gap_count += ratio < params.relative_gap;
-  }
-  const MeanStd difference = from_sums(sum_difference, sum2_difference, n);
-  const MeanStd clipped = from_sums(sum_clipped, sum2_clipped, n);
-  const MeanStd ratio = from_sums(sum_ratio, sum2_ratio, n);
-  set(mean_difference, difference.mean);
-  set(std_difference, difference.std);
-  set(mean_clipped_difference, clipped.mean);
-  set(std_clipped_difference, clipped.std);
-  set(gaps, gap_count);
-  set(mean_ratio, ratio.mean);
-  set(std_ratio, ratio.std);
-  set(relative_gaps, relative_gap_count);
-
-  // Beam lengths.
-  const MeanStd length = mean_std(n, [&](std::size_t i) { return ranges[i]; });
-  const auto [shortest, longest] = std::minmax_element(ranges.begin(), ranges.end());
-  double m4 = 0;
-  for (const double b : ranges) {
-    const double d2 = (b - length.mean) * (b - length.mean);
-    m4 += d2 * d2;
-  }
-  m4 /= static_cast<double>(n);
-  const double variance = length.std * length.std;
-  set(mean_beam, length.mean);
-  set(std_beam, length.std);
-  set(beam_kurtosis, variance > 1e-12 ? m4 / (variance * variance) - 3 : 0.0);
-  set(mean_beam_per_max, length.mean / *longest);
-  set(std_beam_per_max, length.std / *longest);
-  set(shortest_beam, *shortest);
-  set(longest_beam, *longest);
-
-  // The shortest beam and the shortest one at least a quarter turn away from it: in a corridor,
-  // the two walls; their end points' distance is its width.
-  const double step = 2 * std::numbers::pi / static_cast<double>(n);
-  const std::size_t first = static_cast<std::size_t>(shortest - ranges.begin());
-  std::size_t second = first;
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t apart = std::min((i + n - first) % n, (first + n - i) % n);
-    if (4 * apart >= n && (second == first || ranges[i] < ranges[second])) second = i;
-  }
-  const std::size_t apart = std::min((second + n - first) % n, (first + n - second) % n);
-  const double angle = static_cast<double>(apart) * step;
-  const double b1 = ranges[first], b2 = ranges[second];
-  set(minima_distance, std::sqrt(std::max(0.0, b1 * b1 + b2 * b2 - 2 * b1 * b2 * std::cos(angle))));
-  set(minima_angle, angle * 180 / std::numbers::pi);
-
-  // The polygon of the beams' end points: area, perimeter, centroid and second moments.
-  thread_local std::vector<double> xs, ys;
-  unit_directions(n, xs, ys);
-  for (std::size_t i = 0; i < n; ++i) {
-    xs[i] *= ranges[i];
-    ys[i] *= ranges[i];
-  }
-  double area2 = 0, perimeter = 0, cx6 = 0, cy6 = 0, ixx12 = 0, iyy12 = 0, ixy24 = 0;
-  double vx = 0, vy = 0;  // vertex mean
-  for (std::size_t i = 0; i < n; ++i) {
-    const std::size_t j = (i + 1) % n;
-    const double x0 = xs[i], y0 = ys[i], x1 = xs[j], y1 = ys[j];
-    const double cross = x0 * y1 - x1 * y0;
-    area2 += cross;
-    perimeter += norm(x1 - x0, y1 - y0);
-    cx6 += (x0 + x1) * cross;
-    cy6 += (y0 + y1) * cross;
-    ixx12 += (x0 * x0 + x0 * x1 + x1 * x1) * cross;
-    iyy12 += (y0 * y0 + y0 * y1 + y1 * y1) * cross;
-    ixy24 += (x0 * y1 + 2 * x0 * y0 + 2 * x1 * y1 + x1 * y0) * cross;
-    vx += x0;
-    vy += y0;
-  }
-  const double area = area2 / 2;  // > 0: the beams turn counter-clockwise
-  const double cx = cx6 / (6 * area), cy = cy6 / (6 * area);
-  const double sxx = ixx12 / (12 * area) - cx * cx, syy = iyy12 / (12 * area) - cy * cy;
-  const double sxy = ixy24 / (24 * area) - cx * cy;
-  // Eigenvalues of the area's covariance; a uniform ellipse with semi-axis a has variance a^2/4.
-  const double half_trace = (sxx + syy) / 2;
-  const double root = std::sqrt(std::max(0.0, (sxx - syy) * (sxx - syy) / 4 + sxy * sxy));
-  const double major = 2 * std::sqrt(std::max(0.0, half_trace + root));
-  const double minor = 2 * std::sqrt(std::max(0.0, half_trace - root));
-  vx /= static_cast<double>(n);
-  vy /= static_cast<double>(n);
-  const MeanStd centroid_distance =
-      mean_std(n, [&](std::size_t i) { return norm(xs[i] - vx, ys[i] - vy); });
-  set(polygon_area, area);
-  set(polygon_perimeter, perimeter);
-  set(area_per_perimeter, area / perimeter);
-  set(mean_centroid_distance, centroid_distance.mean);
-  set(std_centroid_distance, centroid_distance.std);
-  set(major_semi_axis, major);
-  set(minor_semi_axis, minor);
-  set(axis_ratio, major / std::max(minor, 1e-6));
-  set(compactness, 4 * std::numbers::pi * area / (perimeter * perimeter));
-  set(centroid_offset, norm(cx, cy));
+  set_consecutive_beam_features(ranges, params, f);
+  set_beam_length_features(ranges, f);
+  set_minima_features(ranges, f);
+  set_polygon_features(ranges, f);
   return f;
 }
 

@@ -4,47 +4,17 @@
 #include <limits>
 #include <string>
 
-#include "compute/cpu_parallel.hpp"
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
-#include "rooms/laser_beam.hpp"
+#include "kernels/laser_scan/laser_scan.h"
 
 namespace kartograf::rooms {
 
 namespace {
 
-constexpr compute::KernelSpec kLaserScanKernel{"laser_scan", 64, 1};
+constexpr compute::KernelSpec kLaserScanKernel{"laser_scan", KG_LASER_SCAN_LOCAL_X, 1};
 // Vulkan guarantees 65535 work-groups per dimension; larger grids fold into y.
 constexpr std::uint32_t kMaxGroupsX = 65535;
-
-struct LaserScanKernelParams {   // layout of shaders/laser_scan.comp and kernels/laser_scan.cl
-  std::uint32_t item_count;      // cell_count * items_per_cell
-  std::uint32_t items_per_cell;  // ceil(beams / beams_per_item)
-  std::uint32_t beams;
-  std::uint32_t beams_per_item;
-  std::int32_t map_width;
-  std::int32_t map_height;
-  std::int32_t max_steps;
-};
-
-// The CPU backend: LaserScanner's loop over host storage.
-void scan_cpu(std::span<const std::int32_t> skips, std::span<const std::int32_t> directions,
-              std::span<const ScanCell> cells, int map_width, int max_steps,
-              std::span<std::int32_t> steps) {
-  const std::size_t beams = directions.size() / 2;
-  compute::detail::for_each_chunk(
-      cells.size(), cells.size() * beams, [&](std::size_t begin, std::size_t end, std::size_t) {
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::int32_t x0 = (cells[i].col + 1) * 65536 + 32768;
-          const std::int32_t y0 = (cells[i].row + 1) * 65536 + 32768;
-          for (std::size_t k = 0; k < beams; ++k) {
-            steps[i * beams + k] =
-                detail::trace_beam(skips.data(), map_width + 2, x0, y0, directions[2 * k],
-                                   directions[2 * k + 1], max_steps);
-          }
-        }
-      });
-}
 
 }  // namespace
 
@@ -57,9 +27,9 @@ DeviceLaserScanner::DeviceLaserScanner(const compute::Context& context, const La
       resolution_(scanner.resolution()),
       skips_(compute::Buffer<std::int32_t>::from_host(context, scanner.skips().pixels())),
       directions_(compute::Buffer<std::int32_t>::from_host(context, scanner.directions())) {
-  // A loop over a cell's beams per work-item suits CPU-hosted drivers (fewer, longer items);
-  // a GPU wants one item per beam.
-  beams_per_item_ = context.is_cpu() || context.device_info().is_gpu() ? 1 : beams_;
+  // A loop over a cell's beams per work-item suits CPUs and CPU-hosted drivers (fewer, longer
+  // items); a GPU wants one item per beam.
+  beams_per_item_ = context.device_info().is_gpu() ? 1 : beams_;
 }
 
 void DeviceLaserScanner::set_beams_per_work_item(int beams_per_item) {
@@ -87,23 +57,18 @@ void DeviceLaserScanner::scan_steps(std::span<const ScanCell> cells,
   if (steps.size() != total) steps = compute::Buffer<std::int32_t>(*context_, total);
   if (cells.empty()) return;
 
-  if (context_->is_cpu()) {
-    scan_cpu(skips_.host_span(), directions_.host_span(), cells, map_width_, max_steps_,
-             steps.host_span());
-    return;
-  }
   if (cells_.size() < cells.size()) cells_ = compute::Buffer<ScanCell>(*context_, cells.size());
   cells_.upload(cells);
   const std::uint32_t items_per_cell =
       static_cast<std::uint32_t>((beams_ + beams_per_item_ - 1) / beams_per_item_);
   const std::size_t items = cells.size() * items_per_cell;
-  const LaserScanKernelParams params{static_cast<std::uint32_t>(items),
-                                     items_per_cell,
-                                     static_cast<std::uint32_t>(beams_),
-                                     static_cast<std::uint32_t>(beams_per_item_),
-                                     map_width_,
-                                     map_height_,
-                                     max_steps_};
+  const kernels::LaserScanParams params{static_cast<std::uint32_t>(items),
+                                        items_per_cell,
+                                        static_cast<std::uint32_t>(beams_),
+                                        static_cast<std::uint32_t>(beams_per_item_),
+                                        map_width_,
+                                        map_height_,
+                                        max_steps_};
   const std::uint32_t groups = compute::groups_for(items, kLaserScanKernel.local_x);
   const std::uint32_t groups_x = std::min(groups, kMaxGroupsX);
   const std::uint32_t groups_y = (groups + groups_x - 1) / groups_x;

@@ -12,7 +12,7 @@ namespace kartograf::rooms {
 namespace {
 
 template <class Params>
-Params with_options(Params params, const RoomMethodOptions& options) {
+Params with_options(Params params, const RoomMethodParams& options) {
   if (options.room_area) params.room_area = *options.room_area;
   params.furniture = options.furniture;
   return params;
@@ -72,8 +72,8 @@ RoomMethod parse_room_method(const std::string& name) {
   throw Error("unknown room segmentation method '" + name + "' (known: " + known + ")");
 }
 
-RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
-                               const RoomMethodOptions& options) {
+RoomSegmentation segment_rooms(const compute::Context& context, const OccupancyGrid& map,
+                               RoomMethod method, const RoomMethodParams& options) {
   require_fits_in_memory(bytes_per_cell(method) * static_cast<double>(map.cells.size()),
                          "room segmentation (" + to_string(method) + ") of a " +
                              std::to_string(map.width()) + " x " + std::to_string(map.height()) +
@@ -90,7 +90,7 @@ RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
       if (options.room_area) params.region_area = *options.room_area;
       const RoomClassifier classifier = RoomClassifier::load(
           options.model.empty() ? default_room_classifier_path() : options.model);
-      return segment_feature_based(map, classifier, params, options.context);
+      return segment_feature_based(context, map, classifier, params);
     }
     case RoomMethod::vrf: {
       const VrfModel model =

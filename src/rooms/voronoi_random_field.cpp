@@ -275,24 +275,19 @@ std::pair<cv::Point, cv::Point> doorway_line(const Eigen::Vector2i& point,
   return {cv::Point(a.x(), a.y()), cv::Point(b.x(), b.y())};
 }
 
-}  // namespace
-
-LabelImage vrf_rooms(const OccupancyGrid& work, const VrfLabelling& labelling,
-                     const VrfParams& params) {
-  const AreaLimits& room_area = params.room_area;
-  room_area.check("vrf_rooms");
-  const int width = work.width(), height = work.height();
-  const VrfNodeGraph& graph = labelling.graph;
-  const std::vector<PlaceLabel>& labels = labelling.inference.labels;
-  require(labels.size() == graph.nodes.size() && graph.voronoi.graph.width() == width &&
-              graph.voronoi.graph.height() == height,
-          "vrf_rooms: the labelling does not belong to the map");
-  Image<std::uint8_t> free_cells(width, height, 0);
+// 1 on the map's free cells, 0 elsewhere.
+Image<std::uint8_t> free_cell_mask(const OccupancyGrid& work) {
+  Image<std::uint8_t> free_cells(work.width(), work.height(), 0);
   for (std::size_t i = 0; i < free_cells.size(); ++i)
     free_cells.data()[i] = work.cells.data()[i] == CellState::free;
-  const NearestObstacles near = nearest_obstacles(free_cells);
+  return free_cells;
+}
 
-  // Cuts at the narrowest points near each connected run of doorway nodes.
+// The graph cells of each connected run of doorway nodes (indexed by a node of the run; the other
+// entries are empty).
+std::vector<std::vector<std::uint32_t>> doorway_runs(const VrfNodeGraph& graph,
+                                                     const std::vector<PlaceLabel>& labels,
+                                                     int width) {
   const std::size_t n = graph.nodes.size();
   const auto is_door = [&](std::size_t i) { return labels[i] == PlaceLabel::doorway; };
   Groups runs(n);
@@ -306,31 +301,44 @@ LabelImage vrf_rooms(const OccupancyGrid& work, const VrfLabelling& labelling,
       run_cells[runs.find(i)].push_back(
           static_cast<std::uint32_t>(graph.nodes[i].cell.y() * width + graph.nodes[i].cell.x()));
   }
-  cv::Mat open(height, width, CV_8UC1);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x) open.at<std::uint8_t>(y, x) = free_cells(x, y) ? 255 : 0;
-  std::vector<std::array<cv::Point, 3>> cuts;  // cut point, the two ends
-  GraphWalk walk(graph.voronoi.graph);
+  return run_cells;
+}
+
+// Where a run of doorway nodes is cut: the cells of the run's stretch of graph (its nodes' cells
+// and those within node_spacing steps) that are the narrowest within node_spacing steps, or else
+// the narrowest cell of the stretch.
+std::vector<std::uint32_t> narrowest_cells(const std::vector<std::uint32_t>& run,
+                                           const VrfNodeGraph& graph, GraphWalk& walk) {
   const Image<float>& clearance_of = graph.voronoi.clearance;
   const auto narrower = [&](std::uint32_t a,
                             std::uint32_t b) {  // a before b: less clearance, then index
     return clearance_of.data()[a] < clearance_of.data()[b] ||
            (clearance_of.data()[a] == clearance_of.data()[b] && a < b);
   };
-  for (const std::vector<std::uint32_t>& run : run_cells) {
+  const std::vector<std::uint32_t> stretch = walk.within(run, graph.node_spacing);
+  std::vector<std::uint32_t> points;
+  for (const std::uint32_t c : stretch) {
+    const std::vector<std::uint32_t> around = walk.within({c}, graph.node_spacing);
+    if (std::none_of(around.begin(), around.end(), [&](std::uint32_t o) { return narrower(o, c); }))
+      points.push_back(c);
+  }
+  if (points.empty()) points.push_back(*std::min_element(stretch.begin(), stretch.end(), narrower));
+  return points;
+}
+
+using DoorwayCut = std::array<cv::Point, 3>;  // cut point, the two ends
+
+// Cuts at the narrowest points near each connected run of doorway nodes, drawn as obstacle lines
+// into `open` (free cells 255).
+std::vector<DoorwayCut> cut_doorways(const VrfNodeGraph& graph,
+                                     const std::vector<PlaceLabel>& labels,
+                                     const NearestObstacles& near, cv::Mat& open) {
+  const int width = open.cols;
+  std::vector<DoorwayCut> cuts;
+  GraphWalk walk(graph.voronoi.graph);
+  for (const std::vector<std::uint32_t>& run : doorway_runs(graph, labels, width)) {
     if (run.empty()) continue;
-    // The run's stretch of graph: its nodes' cells and those within node_spacing steps.
-    const std::vector<std::uint32_t> stretch = walk.within(run, graph.node_spacing);
-    std::vector<std::uint32_t> points;
-    for (const std::uint32_t c : stretch) {
-      const std::vector<std::uint32_t> around = walk.within({c}, graph.node_spacing);
-      if (std::none_of(around.begin(), around.end(),
-                       [&](std::uint32_t o) { return narrower(o, c); }))
-        points.push_back(c);
-    }
-    if (points.empty())
-      points.push_back(*std::min_element(stretch.begin(), stretch.end(), narrower));
-    for (const std::uint32_t c : points) {
+    for (const std::uint32_t c : narrowest_cells(run, graph, walk)) {
       const Eigen::Vector2i p(static_cast<int>(c % static_cast<std::uint32_t>(width)),
                               static_cast<int>(c / static_cast<std::uint32_t>(width)));
       const auto [a, b] = doorway_line(p, near);
@@ -339,63 +347,81 @@ LabelImage vrf_rooms(const OccupancyGrid& work, const VrfLabelling& labelling,
       cv::line(open, cuts.back()[0], b, cv::Scalar(0), 1, cv::LINE_8);
     }
   }
-  cv::Mat parts;
-  const int count = cv::connectedComponents(open, parts, 4, CV_32S);
+  return cuts;
+}
 
-  // Votes of the room and hallway nodes of each region.
-  std::vector<int> room_votes(static_cast<std::size_t>(count), 0),
-      hallway_votes(room_votes.size(), 0);
-  for (std::size_t i = 0; i < n; ++i) {
-    const int region = parts.at<int>(graph.nodes[i].cell.y(), graph.nodes[i].cell.x());
-    if (region == 0) continue;
-    if (labels[i] == PlaceLabel::room) ++room_votes[static_cast<std::size_t>(region)];
-    if (labels[i] == PlaceLabel::hallway) ++hallway_votes[static_cast<std::size_t>(region)];
-  }
-  const auto hallway = [&](int region) {
+// The regions (connected free space between the cuts, 0: none) and their room and hallway votes:
+// the nodes of each label in them.
+struct Regions {
+  cv::Mat parts;
+  int count = 0;
+  std::vector<int> room_votes, hallway_votes;
+
+  int at(int x, int y) const { return parts.at<int>(y, x); }
+  bool hallway(int region) const {
     return hallway_votes[static_cast<std::size_t>(region)] >
            room_votes[static_cast<std::size_t>(region)];
-  };
-  // Hallway regions meeting across a cut are one hallway.
-  Groups merged(static_cast<std::size_t>(count));
+  }
+};
+
+Regions vote_regions(const cv::Mat& open, const VrfNodeGraph& graph,
+                     const std::vector<PlaceLabel>& labels) {
+  Regions regions;
+  regions.count = cv::connectedComponents(open, regions.parts, 4, CV_32S);
+  regions.room_votes.assign(static_cast<std::size_t>(regions.count), 0);
+  regions.hallway_votes.assign(regions.room_votes.size(), 0);
+  for (std::size_t i = 0; i < graph.nodes.size(); ++i) {
+    const int region = regions.at(graph.nodes[i].cell.x(), graph.nodes[i].cell.y());
+    if (region == 0) continue;
+    if (labels[i] == PlaceLabel::room) ++regions.room_votes[static_cast<std::size_t>(region)];
+    if (labels[i] == PlaceLabel::hallway) ++regions.hallway_votes[static_cast<std::size_t>(region)];
+  }
+  return regions;
+}
+
+// The regions within one cell of a cut's two lines (ascending, each once) that hold a node, and
+// every region there marked in cut_touches.
+std::vector<int> regions_along_cut(const DoorwayCut& cut, const cv::Mat& open,
+                                   const Regions& regions, std::vector<std::uint8_t>& cut_touches) {
   std::vector<int> touching;
-  std::vector<std::uint8_t> cut_touches(static_cast<std::size_t>(count), 0);
-  for (const auto& cut : cuts) {
-    touching.clear();
-    for (const cv::Point& end : {cut[1], cut[2]}) {
-      cv::LineIterator it(open, cut[0], end, 8);
-      for (int k = 0; k < it.count; ++k, ++it) {
-        const cv::Point c = it.pos();
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const int x = c.x + dx, y = c.y + dy;
-            if (x < 0 || y < 0 || x >= width || y >= height) continue;
-            const int region = parts.at<int>(y, x);
-            const auto r = static_cast<std::size_t>(region);
-            if (region == 0) continue;
-            cut_touches[r] = 1;
-            if (room_votes[r] + hallway_votes[r] > 0) touching.push_back(region);
-          }
+  for (const cv::Point& end : {cut[1], cut[2]}) {
+    cv::LineIterator it(open, cut[0], end, 8);
+    for (int k = 0; k < it.count; ++k, ++it) {
+      const cv::Point c = it.pos();
+      for (int dy = -1; dy <= 1; ++dy) {
+        for (int dx = -1; dx <= 1; ++dx) {
+          const int x = c.x + dx, y = c.y + dy;
+          if (x < 0 || y < 0 || x >= open.cols || y >= open.rows) continue;
+          const int region = regions.at(x, y);
+          const auto r = static_cast<std::size_t>(region);
+          if (region == 0) continue;
+          cut_touches[r] = 1;
+          if (regions.room_votes[r] + regions.hallway_votes[r] > 0) touching.push_back(region);
         }
       }
     }
-    std::sort(touching.begin(), touching.end());
-    touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
-    int first_hallway = 0;
-    for (const int region : touching) {
-      if (!hallway(region)) continue;
-      if (first_hallway == 0) first_hallway = region;
-      merged.join(static_cast<std::size_t>(region), static_cast<std::size_t>(first_hallway));
-    }
   }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  return touching;
+}
+
+// The rooms of the merged regions (0: none), numbered in region order: a region (or merged
+// hallway) with a room or hallway node, within the area limits.
+std::vector<Label> number_rooms(const OccupancyGrid& work, const AreaLimits& room_area,
+                                const Regions& regions,
+                                const std::vector<std::uint8_t>& cut_touches, Groups& merged) {
+  const int count = regions.count;
   std::vector<long> cells(static_cast<std::size_t>(count), 0), voters(cells.size(), 0);
-  for (int y = 0; y < height; ++y)
-    for (int x = 0; x < width; ++x)
-      ++cells[merged.find(static_cast<std::size_t>(parts.at<int>(y, x)))];
+  for (int y = 0; y < work.height(); ++y)
+    for (int x = 0; x < work.width(); ++x)
+      ++cells[merged.find(static_cast<std::size_t>(regions.at(x, y)))];
   for (int region = 1; region < count; ++region) {
     const auto r = static_cast<std::size_t>(region);
     // A piece of free space no cut touches and no node lies in (too narrow for the graph) is a
     // room of its own: nothing could grow into it.
-    voters[merged.find(r)] += room_votes[r] + hallway_votes[r] + (cut_touches[r] ? 0 : 1);
+    voters[merged.find(r)] +=
+        regions.room_votes[r] + regions.hallway_votes[r] + (cut_touches[r] ? 0 : 1);
   }
   const double cell_area = work.resolution * work.resolution;
   std::vector<Label> room_of(static_cast<std::size_t>(count), 0);
@@ -403,14 +429,48 @@ LabelImage vrf_rooms(const OccupancyGrid& work, const VrfLabelling& labelling,
   for (int region = 1; region < count; ++region) {
     const std::size_t root = merged.find(static_cast<std::size_t>(region));
     if (room_of[root] != 0 || next == 65535) continue;
-    // A region (or merged hallway) with a room or hallway node, within the area limits.
     if (voters[root] > 0 && room_area.contains(static_cast<double>(cells[root]) * cell_area))
       room_of[root] = ++next;
   }
+  return room_of;
+}
+
+}  // namespace
+
+LabelImage vrf_rooms(const OccupancyGrid& work, const VrfLabelling& labelling,
+                     const VrfParams& params) {
+  const AreaLimits& room_area = params.room_area;
+  room_area.check("vrf_rooms");
+  const int width = work.width(), height = work.height();
+  const VrfNodeGraph& graph = labelling.graph;
+  const std::vector<PlaceLabel>& labels = labelling.inference.labels;
+  require(labels.size() == graph.nodes.size() && graph.voronoi.graph.width() == width &&
+              graph.voronoi.graph.height() == height,
+          "vrf_rooms: the labelling does not belong to the map");
+  const Image<std::uint8_t> free_cells = free_cell_mask(work);
+  const NearestObstacles near = nearest_obstacles(free_cells);
+  cv::Mat open(height, width, CV_8UC1);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) open.at<std::uint8_t>(y, x) = free_cells(x, y) ? 255 : 0;
+  const std::vector<DoorwayCut> cuts = cut_doorways(graph, labels, near, open);
+  const Regions regions = vote_regions(open, graph, labels);
+
+  // Hallway regions meeting across a cut are one hallway.
+  Groups merged(static_cast<std::size_t>(regions.count));
+  std::vector<std::uint8_t> cut_touches(static_cast<std::size_t>(regions.count), 0);
+  for (const DoorwayCut& cut : cuts) {
+    int first_hallway = 0;
+    for (const int region : regions_along_cut(cut, open, regions, cut_touches)) {
+      if (!regions.hallway(region)) continue;
+      if (first_hallway == 0) first_hallway = region;
+      merged.join(static_cast<std::size_t>(region), static_cast<std::size_t>(first_hallway));
+    }
+  }
+  const std::vector<Label> room_of = number_rooms(work, room_area, regions, cut_touches, merged);
   LabelImage rooms(width, height, 0);
   for (int y = 0; y < height; ++y) {
     for (int x = 0; x < width; ++x) {
-      const int region = parts.at<int>(y, x);
+      const int region = regions.at(x, y);
       if (region != 0) rooms(x, y) = room_of[merged.find(static_cast<std::size_t>(region))];
     }
   }

@@ -253,17 +253,14 @@ void PlaneExtractionParams::validate() const {
 
 PlaneExtractor::PlaneExtractor(const compute::Context& context, const PinholeIntrinsics& intrinsics,
                                const PlaneExtractionParams& params)
-    : context_(&context),
-      intrinsics_(intrinsics),
-      params_(params),
-      grower_(context),
-      fitter_(context) {
+    : context_(&context), intrinsics_(intrinsics), params_(params), grower_(context) {
   intrinsics.validate("plane extraction");
   params.validate();
 }
 
-PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) {
-  const int width = intrinsics_.width, height = intrinsics_.height;
+namespace {
+
+void check_frame(const PointImage& points, const RgbImage& rgb, int width, int height) {
   require(!points.empty() && !rgb.empty(),
           "plane extraction: empty input (points " + size_text(points.width(), points.height()) +
               ", colour " + size_text(rgb.width(), rgb.height()) + ")");
@@ -273,84 +270,38 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
   require(rgb.width() == width && rgb.height() == height,
           "plane extraction: colour image is " + size_text(rgb.width(), rgb.height()) +
               " but the camera is " + size_text(width, height));
+}
 
-  PlaneSet result;
-  result.labels = LabelImage(width, height, kUnlabeled);
-  Clock::time_point clock = Clock::now();
-  to_lab_codes(rgb, lab_);
-  const LabCodeImage& lab = lab_;
-  result.timings.lab = elapsed_ms(clock);
-
-  // Segments and their moments: on the CPU backend summed as the segments grow, on a device
-  // with the labels left there for the moments and downloaded once.
-  Eigen::Vector3f origin;
-  float max_offset = 0;
-  if (!moment_frame(points, origin, max_offset)) return result;  // no valid point
-  const bool on_host = context_->is_cpu();
-  geometry::SegmentMomentSet moments;
-  if (on_host) {
-    moments.origin = origin.cast<double>();
-    result.segment_count =
-        grow_regions(lab, points, params_.growing, segments_, &statistics_, &moments.origin);
-    moments.segments = std::move(statistics_.moments);
-  } else {
-    if (points_.size() != points.size())
-      points_ = compute::Buffer<Point4f>(*context_, points.size());
-    points_.upload(points.pixels());
-    result.segment_count = grower_.grow(lab, points_, params_.growing, &statistics_.colours);
-  }
-  const SegmentLabelImage& segments = on_host ? segments_ : grower_.host_labels();
-  result.timings.growing = elapsed_ms(clock);
-  if (result.segment_count == 0) return result;
-  if (!on_host) {
-    moments = fitter_.moments(points_, grower_.labels(), segments.pixels(), result.segment_count,
-                              origin, max_offset);
-    result.timings.moments = elapsed_ms(clock);
-  }
-
-  MergedPlanes merged =
-      merge_segments(segments, moments, params_.merge, {statistics_.colours, &points});
-  result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
-  result.timings.merging = elapsed_ms(clock);
-
-  std::vector<std::uint32_t>& pixel_plane = pixel_plane_;
-  pixel_plane.assign(segments.size(), geometry::kNoLabel);
-  for (std::size_t i = 0; i < segments.size(); ++i) {
-    const std::uint32_t s = segments.data()[i];
-    if (s != geometry::kNoLabel) pixel_plane[i] = merged.segment_plane[s];
-  }
-  if (params_.refine_pixels) {
-    refine_border_pixels(segments, points, merged, params_.merge, pixel_plane);
-    flood_unassigned_pixels(points, merged.planes, params_.merge, params_.growing.max_depth_jump,
-                            pixel_plane, flood_queue_, flood_sources_);
-    plane_leftover_regions(points, params_, pixel_plane, merged.planes, flood_queue_);
-  }
-  result.timings.refinement = elapsed_ms(clock);
-  const std::size_t pixel_count = segments.size();
-  const Point4f* point = points.data();
-
-  // Output planes: valid, large enough, by decreasing size (then merge order), ids 1..n.
+// The output planes: valid, with at least min_pixels pixels, by decreasing size (then merge
+// order), ids 1..n (extents and counts to be measured); plane_label: each merged plane's id.
+void output_planes(const MergedPlanes& merged, const std::vector<std::uint32_t>& pixel_plane,
+                   std::uint64_t min_pixels, std::vector<Plane>& planes,
+                   std::vector<Label>& plane_label) {
   std::vector<std::uint64_t> pixels_of(merged.planes.size(), 0);
   for (const std::uint32_t m : pixel_plane) {
     if (m != geometry::kNoLabel) ++pixels_of[m];
   }
   std::vector<std::uint32_t> kept;
   for (std::uint32_t i = 0; i < merged.planes.size(); ++i) {
-    if (merged.planes[i].valid && pixels_of[i] >= params_.min_plane_pixels) kept.push_back(i);
+    if (merged.planes[i].valid && pixels_of[i] >= min_pixels) kept.push_back(i);
   }
   std::stable_sort(kept.begin(), kept.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return pixels_of[a] > pixels_of[b]; });
   kept.resize(std::min<std::size_t>(kept.size(), std::numeric_limits<Label>::max()));
-  std::vector<Label> plane_label(merged.planes.size(), kUnlabeled);
+  plane_label.assign(merged.planes.size(), kUnlabeled);
   for (std::size_t k = 0; k < kept.size(); ++k) {
     Plane plane = plane_record(static_cast<Label>(k + 1), merged.planes[kept[k]]);
     plane.extent_min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
     plane.extent_max = -plane.extent_min;
-    result.planes.push_back(plane);
+    planes.push_back(plane);
     plane_label[kept[k]] = plane.id;
   }
-  // Labels, extents, inlier counts and errors: per chunk, combined in chunk order (the same
-  // sums for any thread count).
+}
+
+// Labels, extents, inlier counts and errors of the output planes: per chunk, combined in chunk
+// order (the same sums for any thread count).
+void measure_planes(const PointImage& points, const std::vector<std::uint32_t>& pixel_plane,
+                    const std::vector<Label>& plane_label, PlaneSet& result) {
   struct PlaneSums {
     Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
     Eigen::Vector2d hi = -lo;
@@ -358,11 +309,13 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
     std::uint64_t count = 0;
   };
   std::array<std::vector<PlaneSums>, compute::detail::kCpuChunks> chunk_sums;
+  const Point4f* point = points.data();
   Label* out = result.labels.data();
+  const std::size_t pixel_count = pixel_plane.size();
   compute::detail::for_each_chunk(
       pixel_count, pixel_count, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
         std::vector<PlaneSums>& sums = chunk_sums[chunk];
-        sums.assign(kept.size(), PlaneSums{});
+        sums.assign(result.planes.size(), PlaneSums{});
         for (std::size_t i = begin; i < end; ++i) {
           if (pixel_plane[i] == geometry::kNoLabel) continue;
           const Label id = plane_label[pixel_plane[i]];
@@ -390,6 +343,66 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
     }
     plane.rms_error = std::sqrt(squared_error / static_cast<double>(plane.inlier_count));
   }
+}
+
+}  // namespace
+
+std::uint32_t PlaneExtractor::grow_segments(const PointImage& points,
+                                            geometry::SegmentMomentSet& moments) {
+  points_.refer_or_upload(*context_, points.pixels());  // no copy on the CPU backend
+  const std::uint32_t count =
+      grower_.grow(lab_, points_, params_.growing, &statistics_, &moments.origin);
+  if (segments_.width() != points.width() || segments_.height() != points.height())
+    segments_ = SegmentLabelImage(points.width(), points.height());
+  grower_.labels().download(segments_.pixels());
+  moments.segments = std::move(statistics_.moments);
+  return count;
+}
+
+void PlaneExtractor::assign_pixels(const PointImage& points, MergedPlanes& merged) {
+  const SegmentLabelImage& segments = segments_;
+  std::vector<std::uint32_t>& pixel_plane = pixel_plane_;
+  pixel_plane.assign(segments.size(), geometry::kNoLabel);
+  for (std::size_t i = 0; i < segments.size(); ++i) {
+    const std::uint32_t s = segments.data()[i];
+    if (s != geometry::kNoLabel) pixel_plane[i] = merged.segment_plane[s];
+  }
+  if (!params_.refine_pixels) return;
+  refine_border_pixels(segments, points, merged, params_.merge, pixel_plane);
+  flood_unassigned_pixels(points, merged.planes, params_.merge, params_.growing.max_depth_jump,
+                          pixel_plane, flood_queue_, flood_sources_);
+  plane_leftover_regions(points, params_, pixel_plane, merged.planes, flood_queue_);
+}
+
+PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) {
+  check_frame(points, rgb, intrinsics_.width, intrinsics_.height);
+  PlaneSet result;
+  result.labels = LabelImage(intrinsics_.width, intrinsics_.height, kUnlabeled);
+  Clock::time_point clock = Clock::now();
+  to_lab_codes(rgb, lab_);
+  result.timings.lab = elapsed_ms(clock);
+
+  // Segments with their colours and moments, summed as they grow.
+  Eigen::Vector3f origin;
+  float max_offset = 0;
+  if (!moment_frame(points, origin, max_offset)) return result;  // no valid point
+  geometry::SegmentMomentSet moments;
+  moments.origin = origin.cast<double>();
+  result.segment_count = grow_segments(points, moments);
+  result.timings.growing = elapsed_ms(clock);
+  if (result.segment_count == 0) return result;
+
+  MergedPlanes merged =
+      merge_segments(segments_, moments, params_.merge, {statistics_.colours, &points});
+  result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
+  result.timings.merging = elapsed_ms(clock);
+
+  assign_pixels(points, merged);
+  result.timings.refinement = elapsed_ms(clock);
+
+  std::vector<Label> plane_label;
+  output_planes(merged, pixel_plane_, params_.min_plane_pixels, result.planes, plane_label);
+  measure_planes(points, pixel_plane_, plane_label, result);
   result.timings.output = elapsed_ms(clock);
   return result;
 }

@@ -2,10 +2,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <string>
 
-#include "compute/cpu_parallel.hpp"
 #include "kartograf/compute/kernel.hpp"
+#include "kernels/region_grow/region_grow_cpu.hpp"
 
 namespace kartograf::segmentation {
 
@@ -13,239 +14,81 @@ namespace {
 
 using geometry::kNoLabel;
 
-constexpr int kNeighbourDx[8] = {-1, 0, 1, -1, 1, -1, 0, 1};
-constexpr int kNeighbourDy[8] = {-1, -1, -1, 0, 0, 1, 1, 1};
-
-constexpr compute::KernelSpec kTilesKernel{"region_grow_tiles", 64};  // one tile per work-item
-constexpr compute::KernelSpec kScanKernel{"region_grow_scan", 64};    // one work-group
-constexpr compute::KernelSpec kOffsetsKernel{"region_grow_offsets", 256};
-
-struct RegionGrowKernelParams {  // layout of shaders/region_grow.glsl and kernels/region_grow.cl
-  std::uint32_t width;
-  std::uint32_t height;
-  std::uint32_t tile_size;
-  std::uint32_t tiles_x;
-  std::uint32_t tile_count;
-  std::uint32_t padded_tile_count;  // a multiple of 64 (the scan's lanes)
-  std::uint32_t stack_stride;       // stack entries per tile: 8 tile_size^2 + 1
-  std::uint32_t threshold_code;     // the threshold in 1/64 Lab units
-  float depth_ratio;                // 0: no depth test
-};
+constexpr compute::KernelSpec kTilesKernel{"region_grow_tiles", KG_REGION_GROW_TILES_LOCAL_X};
+constexpr compute::KernelSpec kScanKernel{"region_grow_scan", KG_REGION_GROW_SCAN_LOCAL_X};
+constexpr compute::KernelSpec kOffsetsKernel{"region_grow_offsets", KG_REGION_GROW_OFFSETS_LOCAL_X};
+constexpr compute::KernelSpec kStatisticsKernel{"region_grow_statistics",
+                                                KG_REGION_GROW_STATISTICS_LOCAL_X};
+constexpr std::size_t kStatistics = KG_REGION_GROW_STATISTICS;
+static_assert(sizeof(LabCode) == sizeof(kernels::LabCode4) &&
+              sizeof(Point4f) == sizeof(kernels::float4));
 
 std::string size_text(int width, int height) {
   return std::to_string(width) + "x" + std::to_string(height);
 }
 
-// The threshold in Lab codes (1/64 units).
-std::int64_t threshold_code(float lab_threshold) {
-  return std::llround(static_cast<double>(lab_threshold) * kLabCodeScale);
+// The kernels' parameters. tile: the tile size in pixels (the whole image when not tiling);
+// moments_origin (rounded to float) only measuring.
+kernels::RegionGrowParams kernel_params(int width, int height, int tile,
+                                        const RegionGrowingParams& params, bool measure,
+                                        const Eigen::Vector3d* moments_origin) {
+  const auto w = static_cast<std::uint32_t>(width), h = static_cast<std::uint32_t>(height);
+  const auto t = static_cast<std::uint32_t>(tile);
+  const std::uint32_t tiles_x = (w + t - 1) / t, tile_count = tiles_x * ((h + t - 1) / t);
+  const Eigen::Vector3f origin =
+      moments_origin ? moments_origin->cast<float>().eval() : Eigen::Vector3f::Zero();
+  return {w, h, t, tiles_x, tile_count, (tile_count + 63) / 64 * 64, 8 * t * t + 1,
+          // The threshold in Lab codes (1/64 units).
+          static_cast<std::uint32_t>(
+              std::llround(static_cast<double>(params.lab_threshold) * kLabCodeScale)),
+          params.max_depth_jump, measure ? 1u : 0u, std::min(t, w) * std::min(t, h), origin.x(),
+          origin.y(), origin.z()};
 }
 
-// What the growing of one tile reads.
-struct GrowInput {
-  const LabCode* lab;
-  const Point4f* points;
-  int width;
-  std::int64_t threshold;  // codes
-  double depth_ratio;
-  const Eigen::Vector3d* moments_origin;  // null: no moments
-};
-
-// What the growing of a run of tiles measures: per segment (in label order).
-struct GrowOutput {
-  std::vector<Eigen::Vector4d> colour_sums;  // code sums, count
-  std::vector<geometry::SegmentMoments> moments;
-};
-
-// Marks pixels without a point or a colour in the label image, so that one read of a neighbour's
-// label tells both whether it is taken and whether it is valid; unmarked afterwards.
-constexpr std::uint32_t kInvalid = kNoLabel - 1;
-
-// Grows every segment of the tile [x0, x1) x [y0, y1) with the paper's stack, numbering them
-// from `first`; labels of the tile's pixels are kNoLabel or kInvalid. Returns the number of
-// segments. out (optional) receives each segment's measures. Wide: an integer type that holds
-// (T n)^2 for the tile's pixel count n (int64 up to 64 x 64 pixels).
-template <class Wide>
-std::uint32_t grow_tile(const GrowInput& in, int x0, int y0, int x1, int y1, std::uint32_t first,
-                        std::uint32_t* label, std::vector<std::uint32_t>& stack, GrowOutput* out) {
-  const int width = in.width;
-  const Wide threshold_sq = static_cast<Wide>(in.threshold) * in.threshold;
-  std::int32_t offsets[8];
-  for (int k = 0; k < 8; ++k) offsets[k] = kNeighbourDy[k] * width + kNeighbourDx[k];
-  std::uint32_t next = first;
-  for (int seed_y = y0; seed_y < y1; ++seed_y) {
-    for (int seed_x = x0; seed_x < x1; ++seed_x) {
-      const std::size_t seed = static_cast<std::size_t>(seed_y) * width + seed_x;
-      if (label[seed] != kNoLabel) continue;
-      const std::uint32_t id = next++;
-      std::int64_t sum_l = 0, sum_a = 0, sum_b = 0, count = 0;
-      // Moments: sum d, sum d d^T (upper triangle), d = p - origin, in double.
-      double m[9] = {};
-      stack.clear();
-      stack.push_back(static_cast<std::uint32_t>(seed));
-      while (!stack.empty()) {
-        const std::uint32_t pixel = stack.back();
-        stack.pop_back();
-        if (label[pixel] != kNoLabel) continue;
-        const LabCode& c = in.lab[pixel];
-        if (count > 0) {  // the seed joins its own segment: distance 0 to its colour
-          const Wide dl = count * c[0] - sum_l, da = count * c[1] - sum_a,
-                     db = count * c[2] - sum_b;
-          if (dl * dl + da * da + db * db >= threshold_sq * count * count) continue;
-        }
-        label[pixel] = id;
-        ++count;
-        sum_l += c[0], sum_a += c[1], sum_b += c[2];
-        if (in.moments_origin) {
-          const Point4f& point = in.points[pixel];
-          const double dx = point.x() - in.moments_origin->x();
-          const double dy = point.y() - in.moments_origin->y();
-          const double dz = point.z() - in.moments_origin->z();
-          m[0] += dx, m[1] += dy, m[2] += dz;
-          m[3] += dx * dx, m[4] += dx * dy, m[5] += dx * dz;
-          m[6] += dy * dy, m[7] += dy * dz, m[8] += dz * dz;
-        }
-        const int x = static_cast<int>(pixel % static_cast<std::uint32_t>(width));
-        const int y = static_cast<int>(pixel / static_cast<std::uint32_t>(width));
-        const double depth = in.points[pixel].z();
-        const auto push = [&](std::uint32_t neighbour) {
-          if (label[neighbour] != kNoLabel) return;
-          if (in.depth_ratio > 0.0 && std::fabs(static_cast<double>(in.points[neighbour].z()) -
-                                                depth) > in.depth_ratio * depth) {
-            return;
-          }
-          stack.push_back(neighbour);
-        };
-        if (x > x0 && y > y0 && x + 1 < x1 && y + 1 < y1) {  // all 8 neighbours in the tile
-          for (int k = 0; k < 8; ++k) push(pixel + offsets[k]);
-        } else {
-          for (int k = 0; k < 8; ++k) {
-            const int nx = x + kNeighbourDx[k], ny = y + kNeighbourDy[k];
-            if (nx >= x0 && ny >= y0 && nx < x1 && ny < y1) push(pixel + offsets[k]);
-          }
-        }
-      }
-      if (out) {
-        out->colour_sums.emplace_back(static_cast<double>(sum_l), static_cast<double>(sum_a),
-                                      static_cast<double>(sum_b), static_cast<double>(count));
-        if (in.moments_origin) {
-          geometry::SegmentMoments& moments = out->moments.emplace_back();
-          moments.count = static_cast<std::uint64_t>(count);
-          moments.sum = Eigen::Vector3d(m[0], m[1], m[2]);
-          moments.sum_outer << m[3], m[4], m[5], m[4], m[6], m[7], m[5], m[7], m[8];
-        }
-      }
-    }
-  }
-  return next - first;
-}
-
-void check_inputs(int lab_width, int lab_height, int width, int height,
-                  const RegionGrowingParams& params) {
-  require(lab_width == width && lab_height == height,
-          "region growing: Lab image is " + size_text(lab_width, lab_height) +
-              " but the point image is " + size_text(width, height));
-  params.validate();
-}
-
-void fill_colours(const std::vector<Eigen::Vector4d>& sums, std::vector<Eigen::Vector3f>& colours) {
-  colours.resize(sums.size());
-  for (std::size_t s = 0; s < sums.size(); ++s) {
-    colours[s] = sums[s].w() > 0
-                     ? (sums[s].head<3>() / (sums[s].w() * kLabCodeScale)).cast<float>().eval()
-                     : Eigen::Vector3f::Zero();
+// Each segment's colour and (with_moments) moments from the kernels' statistics.
+void fill_statistics(const double* values, std::uint32_t count, bool with_moments,
+                     SegmentStatistics& statistics) {
+  statistics.colours.resize(count);
+  if (with_moments) statistics.moments.resize(count);
+  for (std::uint32_t s = 0; s < count; ++s) {
+    const double* v = values + std::size_t{s} * kStatistics;
+    statistics.colours[s] =
+        v[0] > 0 ? (Eigen::Vector3d(v[1], v[2], v[3]) / (v[0] * kLabCodeScale)).cast<float>().eval()
+                 : Eigen::Vector3f::Zero();
+    if (!with_moments) continue;
+    geometry::SegmentMoments& moments = statistics.moments[s];
+    moments.count = static_cast<std::uint64_t>(v[0]);
+    moments.sum = Eigen::Vector3d(v[4], v[5], v[6]);
+    moments.sum_outer << v[7], v[8], v[9], v[8], v[10], v[11], v[9], v[11], v[12];
   }
 }
 
-// Each chunk of tiles numbered its segments from 0: shift them by the segments of the chunks before,
-// so that the labels are those of one sequential scan. Returns the segment count.
-std::uint32_t number_chunks_in_scan_order(const std::uint32_t* chunk_counts, std::uint32_t* labels,
-                                          int width, int height, int tile, std::size_t tile_count) {
-  const int tiles_x = (width + tile - 1) / tile;
-  std::uint32_t total = 0;
-  for (std::size_t chunk = 0; chunk < compute::detail::kCpuChunks; ++chunk) {
-    const std::uint32_t offset = total;
-    total += chunk_counts[chunk];
-    if (offset == 0 || chunk_counts[chunk] == 0) continue;
-    const std::size_t begin = tile_count * chunk / compute::detail::kCpuChunks;
-    const std::size_t end = tile_count * (chunk + 1) / compute::detail::kCpuChunks;
-    for (std::size_t t = begin; t < end; ++t) {
-      const int x0 = static_cast<int>(t % tiles_x) * tile;
-      const int y0 = static_cast<int>(t / tiles_x) * tile;
-      for (int y = y0; y < std::min(height, y0 + tile); ++y) {
-        std::uint32_t* row = labels + static_cast<std::size_t>(y) * width;
-        for (int x = x0; x < std::min(width, x0 + tile); ++x) {
-          if (row[x] != kNoLabel) row[x] += offset;
-        }
-      }
-    }
-  }
-  return total;
-}
-
+// The passes of kernels/region_grow on host arrays (any tile size).
 std::uint32_t grow_on_host(const LabCode* lab, const Point4f* points, int width, int height,
                            const RegionGrowingParams& params, std::uint32_t* labels,
                            SegmentStatistics* statistics, const Eigen::Vector3d* moments_origin) {
-  const std::size_t pixel_count = static_cast<std::size_t>(width) * height;
   if (statistics) {
     statistics->colours.clear();
     statistics->moments.clear();
   }
-  if (pixel_count == 0) return 0;
-  const GrowInput in{lab,
-                     points,
-                     width,
-                     threshold_code(params.lab_threshold),
-                     static_cast<double>(params.max_depth_jump),
-                     statistics ? moments_origin : nullptr};
+  if (width == 0 || height == 0) return 0;
   const int tile = params.tile_size > 0 ? params.tile_size : std::max(width, height);
-  const int tiles_x = (width + tile - 1) / tile, tiles_y = (height + tile - 1) / tile;
-  const std::size_t tile_count = static_cast<std::size_t>(tiles_x) * tiles_y;
-  // (T n)^2 < 2^63 for T <= 64000 codes and n <= 4096 pixels.
-  const bool narrow = static_cast<std::int64_t>(tile) * tile <= 4096;
-  // Contiguous runs of tiles per chunk, numbered from 0 within the chunk (then put in scan order).
-  std::uint32_t chunk_counts[compute::detail::kCpuChunks] = {};
-  GrowOutput chunk_outputs[compute::detail::kCpuChunks];
-  compute::detail::for_each_chunk(
-      tile_count, params.tile_size > 0 ? pixel_count : 0,
-      [&](std::size_t begin, std::size_t end, std::size_t chunk) {
-        std::vector<std::uint32_t> stack;
-        stack.reserve(narrow ? 8 * static_cast<std::size_t>(tile) * tile + 1 : 1 << 16);
-        std::uint32_t count = 0;
-        for (std::size_t t = begin; t < end; ++t) {
-          const int x0 = static_cast<int>(t % tiles_x) * tile;
-          const int y0 = static_cast<int>(t / tiles_x) * tile;
-          const int x1 = std::min(width, x0 + tile), y1 = std::min(height, y0 + tile);
-          for (int y = y0; y < y1; ++y) {
-            const std::size_t row = static_cast<std::size_t>(y) * width;
-            for (int x = x0; x < x1; ++x) {
-              labels[row + x] =
-                  lab[row + x][3] != 0 && is_valid(points[row + x]) ? kNoLabel : kInvalid;
-            }
-          }
-          GrowOutput* out = statistics ? &chunk_outputs[chunk] : nullptr;
-          count += narrow ? grow_tile<std::int64_t>(in, x0, y0, x1, y1, count, labels, stack, out)
-                          : grow_tile<__int128>(in, x0, y0, x1, y1, count, labels, stack, out);
-          for (int y = y0; y < y1; ++y) {
-            std::uint32_t* row = labels + static_cast<std::size_t>(y) * width;
-            for (int x = x0; x < x1; ++x) {
-              if (row[x] == kInvalid) row[x] = kNoLabel;
-            }
-          }
-        }
-        chunk_counts[chunk] = count;
-      });
-  const std::uint32_t total =
-      number_chunks_in_scan_order(chunk_counts, labels, width, height, tile, tile_count);
+  const kernels::RegionGrowParams kp =
+      kernel_params(width, height, tile, params, statistics != nullptr, moments_origin);
+  std::vector<std::uint32_t> tile_counts(kp.padded_tile_count, 0);
+  // Slots written only for the segments that exist: left uninitialised.
+  const std::unique_ptr<double[]> slots(
+      statistics ? new double[std::size_t{kp.tile_count} * kp.slots_per_tile * kStatistics]
+                 : nullptr);
+  kernels::region_grow_tiles_cpu(kp, {reinterpret_cast<const kernels::LabCode4*>(lab),
+                                      reinterpret_cast<const kernels::float4*>(points), labels,
+                                      tile_counts.data(), slots.get()});
+  const std::uint32_t total = kernels::region_grow_scan_cpu(kp, tile_counts.data());
+  kernels::region_grow_offsets_cpu(kp, labels, tile_counts.data());
   if (statistics) {
-    std::vector<Eigen::Vector4d> sums;
-    sums.reserve(total);
-    for (GrowOutput& part : chunk_outputs) {
-      sums.insert(sums.end(), part.colour_sums.begin(), part.colour_sums.end());
-      statistics->moments.insert(statistics->moments.end(), part.moments.begin(),
-                                 part.moments.end());
-    }
-    fill_colours(sums, statistics->colours);
+    std::vector<double> values(std::size_t{total} * kStatistics);
+    kernels::region_grow_statistics_cpu(kp, tile_counts.data(), total, slots.get(), values.data());
+    fill_statistics(values.data(), total, moments_origin != nullptr, *statistics);
   }
   return total;
 }
@@ -266,7 +109,10 @@ void RegionGrowingParams::validate() const {
 std::uint32_t grow_regions(const LabCodeImage& lab, const PointImage& points,
                            const RegionGrowingParams& params, SegmentLabelImage& labels,
                            SegmentStatistics* statistics, const Eigen::Vector3d* moments_origin) {
-  check_inputs(lab.width(), lab.height(), points.width(), points.height(), params);
+  require(lab.width() == points.width() && lab.height() == points.height(),
+          "region growing: Lab image is " + size_text(lab.width(), lab.height()) +
+              " but the point image is " + size_text(points.width(), points.height()));
+  params.validate();
   if (labels.width() != points.width() || labels.height() != points.height())
     labels = SegmentLabelImage(points.width(), points.height());
   return grow_on_host(lab.data(), points.data(), points.width(), points.height(), params,
@@ -287,11 +133,21 @@ std::uint32_t segment_count(const SegmentLabelImage& labels) {
   return count;
 }
 
-RegionGrower::RegionGrower(const compute::Context& context) : context_(&context) {}
+RegionGrower::RegionGrower(const compute::Context& context)
+    : context_(&context), status_(context, 2) {}
 
 std::uint32_t RegionGrower::grow(const LabCodeImage& lab, const compute::Buffer<Point4f>& points,
                                  const RegionGrowingParams& params,
                                  std::vector<Eigen::Vector3f>* colours) {
+  SegmentStatistics statistics;
+  const std::uint32_t count = grow(lab, points, params, colours ? &statistics : nullptr, nullptr);
+  if (colours) *colours = std::move(statistics.colours);
+  return count;
+}
+
+std::uint32_t RegionGrower::grow(const LabCodeImage& lab, const compute::Buffer<Point4f>& points,
+                                 const RegionGrowingParams& params, SegmentStatistics* statistics,
+                                 const Eigen::Vector3d* moments_origin) {
   require(points.size() == lab.size(), "region growing: Lab image is " +
                                            size_text(lab.width(), lab.height()) + " but " +
                                            std::to_string(points.size()) + " points are given");
@@ -299,81 +155,68 @@ std::uint32_t RegionGrower::grow(const LabCodeImage& lab, const compute::Buffer<
   width_ = lab.width();
   height_ = lab.height();
   if (labels_.size() != lab.size()) labels_ = compute::Buffer<std::uint32_t>(*context_, lab.size());
-  const bool on_device = !context_->is_cpu() && params.tile_size > 0 &&
-                         params.tile_size <= kMaxDeviceTileSize && !lab.empty();
-  if (context_->is_cpu()) {
-    SegmentStatistics statistics;
-    const std::uint32_t count =
-        grow_on_host(lab.data(), points.host_span().data(), width_, height_, params,
-                     labels_.host_span().data(), colours ? &statistics : nullptr, nullptr);
-    if (colours) *colours = std::move(statistics.colours);
-    return count;
+  if (statistics) {
+    statistics->colours.clear();
+    statistics->moments.clear();
   }
-  host_labels_ = SegmentLabelImage(width_, height_);
-  std::uint32_t count = 0;
-  if (on_device) {
-    count = grow_on_device(lab, points, params);
-    labels_.download(host_labels_.pixels());
-  } else {
-    // Untiled (or larger tiles): the sequential growing on the host, labels uploaded.
-    std::vector<Point4f> host_points(points.size());
-    points.download(host_points);
-    count = grow_on_host(lab.data(), host_points.data(), width_, height_, params,
-                         host_labels_.data(), nullptr, nullptr);
-    labels_.upload(host_labels_.pixels());
+  if (lab.empty()) return 0;
+  if (params.tile_size > 0 && params.tile_size <= kMaxDeviceTileSize) {
+    return grow_tiles(lab, points, params, statistics, moments_origin);
   }
-  if (colours) {
-    std::vector<Eigen::Vector4d> sums(count, Eigen::Vector4d::Zero());
-    for (std::size_t i = 0; i < host_labels_.size(); ++i) {
-      const std::uint32_t s = host_labels_.data()[i];
-      if (s == kNoLabel) continue;
-      const LabCode& c = lab.data()[i];
-      sums[s] += Eigen::Vector4d(c[0], c[1], c[2], 1.0);
-    }
-    fill_colours(sums, *colours);
-  }
+  // Untiled (or larger tiles than a device's integers allow): the passes on the host.
+  host_points_.resize(points.size());
+  points.download(host_points_);
+  host_labels_.resize(lab.size());
+  const std::uint32_t count = grow_on_host(lab.data(), host_points_.data(), width_, height_, params,
+                                           host_labels_.data(), statistics, moments_origin);
+  labels_.upload(host_labels_);
   return count;
 }
 
-std::uint32_t RegionGrower::grow_on_device(const LabCodeImage& lab,
-                                           const compute::Buffer<Point4f>& points,
-                                           const RegionGrowingParams& params) {
+std::uint32_t RegionGrower::grow_tiles(const LabCodeImage& lab,
+                                       const compute::Buffer<Point4f>& points,
+                                       const RegionGrowingParams& params,
+                                       SegmentStatistics* statistics,
+                                       const Eigen::Vector3d* moments_origin) {
   const compute::Context& context = *context_;
-  const auto tile = static_cast<std::uint32_t>(params.tile_size);
-  const std::uint32_t tiles_x = (static_cast<std::uint32_t>(width_) + tile - 1) / tile;
-  const std::uint32_t tiles_y = (static_cast<std::uint32_t>(height_) + tile - 1) / tile;
-  const std::uint32_t tile_count = tiles_x * tiles_y;
-  const RegionGrowKernelParams kernel_params{
-      static_cast<std::uint32_t>(width_),
-      static_cast<std::uint32_t>(height_),
-      tile,
-      tiles_x,
-      tile_count,
-      (tile_count + 63) / 64 * 64,
-      8 * tile * tile + 1,
-      static_cast<std::uint32_t>(threshold_code(params.lab_threshold)),
-      params.max_depth_jump};
-  if (lab_.size() != lab.size()) lab_ = compute::Buffer<LabCode>(context, lab.size());
-  lab_.upload(lab.pixels());
-  if (tile_counts_.size() != kernel_params.padded_tile_count) {
-    tile_counts_ = compute::Buffer<std::uint32_t>(context, kernel_params.padded_tile_count);
+  const kernels::RegionGrowParams kp = kernel_params(width_, height_, params.tile_size, params,
+                                                     statistics != nullptr, moments_origin);
+  lab_.refer_or_upload(context, lab.pixels());  // no copy on the CPU backend
+  if (tile_counts_.size() != kp.padded_tile_count) {
+    tile_counts_ = compute::Buffer<std::uint32_t>(context, kp.padded_tile_count);
   }
-  const std::size_t stack_entries = std::size_t{tile_count} * kernel_params.stack_stride;
-  if (stacks_.size() != stack_entries) {
+  const std::size_t stack_entries = std::size_t{kp.tile_count} * kp.stack_stride;
+  if (stacks_.size() != stack_entries)
     stacks_ = compute::Buffer<std::uint32_t>(context, stack_entries);
-  }
-  if (status_.empty()) status_ = compute::Buffer<std::uint32_t>(context, 2);
+  const std::size_t slot_values = std::size_t{kp.tile_count} * kp.slots_per_tile * kStatistics;
+  if (statistics && slots_.size() < slot_values)
+    slots_ = compute::Buffer<double>(context, slot_values);
   tile_counts_.fill_zero();
   status_.fill_zero();
-  compute::dispatch(context, kTilesKernel, {lab_, points, labels_, tile_counts_, stacks_, status_},
-                    kernel_params, {compute::groups_for(tile_count, kTilesKernel.local_x), 1});
-  compute::dispatch(context, kScanKernel, {tile_counts_, status_}, kernel_params, {1, 1});
-  compute::dispatch(context, kOffsetsKernel, {labels_, tile_counts_}, kernel_params,
+  compute::dispatch(context, kTilesKernel,
+                    {lab_, points, labels_, tile_counts_, stacks_, status_,
+                     statistics ? compute::BufferArg(slots_) : compute::BufferArg()},
+                    kp, {compute::groups_for(kp.tile_count, kTilesKernel.local_x), 1});
+  compute::dispatch(context, kScanKernel, {tile_counts_, status_}, kp, {1, 1});
+  compute::dispatch(context, kOffsetsKernel, {labels_, tile_counts_}, kp,
                     {compute::groups_for(lab.size(), kOffsetsKernel.local_x), 1});
   std::uint32_t status[2] = {};
   status_.download(status);
-  require(status[1] == 0, "region growing: a device stack overflowed (a bug)");
-  return status[0];
+  require(status[KG_REGION_GROW_OVERFLOWS] == 0,
+          "region growing: a device stack overflowed (a bug)");
+  const std::uint32_t count = status[KG_REGION_GROW_SEGMENT_COUNT];
+  if (statistics && count > 0) {
+    if (statistics_.size() < std::size_t{count} * kStatistics) {
+      statistics_ = compute::Buffer<double>(context, std::size_t{count} * kStatistics);
+    }
+    compute::dispatch(
+        context, kStatisticsKernel, {tile_counts_, status_, slots_, statistics_}, kp,
+        {compute::groups_for(slot_values / kStatistics, kStatisticsKernel.local_x), 1});
+    host_statistics_.resize(std::size_t{count} * kStatistics);
+    statistics_.download(std::span<double>(host_statistics_));
+    fill_statistics(host_statistics_.data(), count, moments_origin != nullptr, *statistics);
+  }
+  return count;
 }
 
 SegmentLabelImage RegionGrower::download_labels() const {

@@ -164,6 +164,149 @@ void compact_features(HaarCascade& cascade) {
   cascade.features = std::move(used);
 }
 
+// Negatives for the next stage: windows every earlier stage lets through, mined from the
+// backgrounds in a new random order, at most negatives_per_stage of them.
+std::vector<GrayImage> mine_negatives(const HaarCascade& cascade,
+                                      const std::vector<TrainingBackground>& backgrounds,
+                                      std::vector<std::size_t>& background_order,
+                                      const DetectionParams& scan,
+                                      const CascadeTrainingParams& params, std::mt19937_64& rng) {
+  std::vector<GrayImage> negatives;
+  std::shuffle(background_order.begin(), background_order.end(), rng);
+  for (std::size_t i : background_order) {
+    if (static_cast<int>(negatives.size()) >= params.negatives_per_stage) break;
+    mine_windows(cascade, backgrounds[i], scan, params.negative_max_iou,
+                 params.max_windows_per_background, rng, negatives);
+  }
+  if (static_cast<int>(negatives.size()) > params.negatives_per_stage) {
+    negatives.resize(static_cast<std::size_t>(params.negatives_per_stage));
+  }
+  return negatives;
+}
+
+// One stage's samples (np positives then nn negatives) as binned features, with their labels
+// (+1 / -1), boosting weights and the stage's scores so far.
+struct StageSamples {
+  std::size_t np, nn, n;
+  std::vector<double> labels, weights, scores;
+  BinnedFeatures binned;
+};
+
+// Labels +1 / -1, weights half and half, scores 0.
+StageSamples make_stage_samples(const HaarCascade& cascade, const std::vector<GrayImage>& positives,
+                                const std::vector<GrayImage>& negatives) {
+  const std::size_t np = positives.size(), nn = negatives.size(), n = np + nn;
+  StageSamples out{
+      np, nn, n, std::vector<double>(n), std::vector<double>(n), std::vector<double>(n, 0.0), {}};
+  std::vector<IntegralImage> samples;
+  std::vector<double> inverse_norms;
+  samples.reserve(n);
+  for (std::size_t s = 0; s < n; ++s) {
+    samples.emplace_back(s < np ? positives[s] : negatives[s - np]);
+    inverse_norms.push_back(1.0 / window_normaliser(cascade, samples.back(), 0, 0));
+    out.labels[s] = s < np ? 1.0 : -1.0;
+    out.weights[s] = s < np ? 0.5 / static_cast<double>(np) : 0.5 / static_cast<double>(nn);
+  }
+  out.binned = bin_features(cascade.features, samples, inverse_norms);
+  return out;
+}
+
+// The best stump over all `features`: their two halves on two threads.
+StumpChoice best_stump_in_parallel(const StageSamples& s, std::size_t features) {
+  const std::size_t half = features / 2;
+  StumpChoice second;
+  std::thread worker(
+      [&] { second = best_stump(s.binned, s.n, half, features, s.weights, s.labels); });
+  StumpChoice best = best_stump(s.binned, s.n, 0, half, s.weights, s.labels);
+  worker.join();
+  if (second.score > best.score) best = second;
+  return best;
+}
+
+// Adds the stump's response to every sample's score and reweights the samples (sum 1).
+void apply_stump(StageSamples& s, const StumpChoice& best) {
+  const std::uint8_t* row = s.binned.bins.data() + best.feature * s.n;
+  double total = 0;
+  for (std::size_t i = 0; i < s.n; ++i) {
+    const double h = row[i] <= best.last_left_bin ? best.left : best.right;
+    s.scores[i] += h;
+    s.weights[i] *= std::exp(-s.labels[i] * h);
+    total += s.weights[i];
+  }
+  for (double& w : s.weights) w /= total;
+}
+
+// A trained stage with its false alarm and hit rate on the stage's samples.
+struct StageResult {
+  CascadeStage stage;
+  double false_alarm = 1, hit_rate = 1;
+};
+
+// Sets the stage's threshold to keep min_hit_rate of the positives, and the false alarm it leaves.
+void set_threshold(const StageSamples& s, const CascadeTrainingParams& params,
+                   StageResult& result) {
+  std::vector<double> positive_scores(s.np);
+  std::copy_n(s.scores.begin(), s.np, positive_scores.begin());
+  std::sort(positive_scores.begin(), positive_scores.end(), std::greater<>());
+  const std::size_t keep = std::clamp<std::size_t>(
+      static_cast<std::size_t>(std::ceil(params.min_hit_rate * static_cast<double>(s.np))), 1,
+      s.np);
+  result.stage.threshold = static_cast<float>(positive_scores[keep - 1] - 1e-6);
+  std::size_t passing = 0;
+  for (std::size_t i = s.np; i < s.n; ++i) passing += s.scores[i] >= result.stage.threshold;
+  result.false_alarm = static_cast<double>(passing) / static_cast<double>(s.nn);
+  result.hit_rate = static_cast<double>(keep) / static_cast<double>(s.np);
+}
+
+// Gentle AdaBoost: stumps until the stage's false alarm is low enough (or max_stumps_per_stage).
+StageResult train_stage(const HaarCascade& cascade, StageSamples& samples,
+                        const CascadeTrainingParams& params) {
+  StageResult result;
+  while (static_cast<int>(result.stage.stumps.size()) < params.max_stumps_per_stage) {
+    const StumpChoice best = best_stump_in_parallel(samples, cascade.features.size());
+    if (best.score < 0) break;  // no feature separates anything
+    const std::size_t f = best.feature;
+    const BinnedFeatures& binned = samples.binned;
+    result.stage.stumps.push_back(
+        {static_cast<int>(f), binned.minimum[f] + binned.bin_width[f] * (best.last_left_bin + 1),
+         static_cast<float>(best.left), static_cast<float>(best.right)});
+    apply_stump(samples, best);
+    set_threshold(samples, params, result);
+    if (result.false_alarm <= params.max_false_alarm) break;
+  }
+  return result;
+}
+
+// The positives the stage passes (those it rejects the detector would never see again).
+std::vector<GrayImage> passing_positives(std::vector<GrayImage>& positives,
+                                         const std::vector<double>& scores, float threshold) {
+  std::vector<GrayImage> kept;
+  for (std::size_t s = 0; s < positives.size(); ++s) {
+    if (scores[s] >= threshold) kept.push_back(std::move(positives[s]));
+  }
+  return kept;
+}
+
+std::string stage_line(int stage_index, const StageResult& result, std::size_t negatives,
+                       std::size_t positives_left) {
+  std::ostringstream line;
+  line << "stage " << stage_index << ": " << result.stage.stumps.size() << " stumps, false alarm "
+       << result.false_alarm << " on " << negatives << " negatives, hit rate " << result.hit_rate
+       << " (" << positives_left << " positives left)";
+  return line.str();
+}
+
+// A cascade without stages, with every feature of its window.
+HaarCascade empty_cascade(const CascadeTrainingParams& params) {
+  HaarCascade cascade;
+  cascade.object_class = params.object_class;
+  cascade.window = params.window;
+  cascade.min_stddev = params.min_stddev;
+  cascade.features = enumerate_haar_features(params.window, params.feature_position_step,
+                                             params.feature_size_step);
+  return cascade;
+}
+
 }  // namespace
 
 HaarCascade train_cascade(const std::vector<GrayImage>& positives,
@@ -172,12 +315,7 @@ HaarCascade train_cascade(const std::vector<GrayImage>& positives,
                           const std::function<void(const std::string&)>& log) {
   check_inputs(positives, backgrounds, params);
   const auto start = std::chrono::steady_clock::now();
-  HaarCascade cascade;
-  cascade.object_class = params.object_class;
-  cascade.window = params.window;
-  cascade.min_stddev = params.min_stddev;
-  cascade.features = enumerate_haar_features(params.window, params.feature_position_step,
-                                             params.feature_size_step);
+  HaarCascade cascade = empty_cascade(params);
   CascadeTrainingReport local;
   CascadeTrainingReport& rep = report ? *report : local;
   rep = {};
@@ -190,17 +328,8 @@ HaarCascade train_cascade(const std::vector<GrayImage>& positives,
 
   std::vector<GrayImage> current_positives = positives;
   for (int stage_index = 0; stage_index < params.max_stages; ++stage_index) {
-    // Negatives: windows every earlier stage lets through.
-    std::vector<GrayImage> negatives;
-    std::shuffle(background_order.begin(), background_order.end(), rng);
-    for (std::size_t i : background_order) {
-      if (static_cast<int>(negatives.size()) >= params.negatives_per_stage) break;
-      mine_windows(cascade, backgrounds[i], scan, params.negative_max_iou,
-                   params.max_windows_per_background, rng, negatives);
-    }
-    if (static_cast<int>(negatives.size()) > params.negatives_per_stage) {
-      negatives.resize(static_cast<std::size_t>(params.negatives_per_stage));
-    }
+    const std::vector<GrayImage> negatives =
+        mine_negatives(cascade, backgrounds, background_order, scan, params, rng);
     if (negatives.size() < 20) {
       rep.ran_out_of_negatives = true;
       if (log)
@@ -208,74 +337,15 @@ HaarCascade train_cascade(const std::vector<GrayImage>& positives,
             " negative windows left; stopping");
       break;
     }
-    // Samples: positives then negatives, labels +1 / -1, weights half and half.
-    const std::size_t np = current_positives.size(), nn = negatives.size(), n = np + nn;
-    std::vector<IntegralImage> samples;
-    std::vector<double> inverse_norms, labels(n), weights(n), scores(n, 0.0);
-    samples.reserve(n);
-    for (std::size_t s = 0; s < n; ++s) {
-      samples.emplace_back(s < np ? current_positives[s] : negatives[s - np]);
-      inverse_norms.push_back(1.0 / window_normaliser(cascade, samples.back(), 0, 0));
-      labels[s] = s < np ? 1.0 : -1.0;
-      weights[s] = s < np ? 0.5 / static_cast<double>(np) : 0.5 / static_cast<double>(nn);
-    }
-    const BinnedFeatures binned = bin_features(cascade.features, samples, inverse_norms);
-
-    CascadeStage stage;
-    double false_alarm = 1, hit_rate = 1;
-    std::vector<double> positive_scores(np);
-    while (static_cast<int>(stage.stumps.size()) < params.max_stumps_per_stage) {
-      // Two halves of the features on two threads.
-      const std::size_t features = cascade.features.size(), half = features / 2;
-      StumpChoice second;
-      std::thread worker([&] { second = best_stump(binned, n, half, features, weights, labels); });
-      StumpChoice best = best_stump(binned, n, 0, half, weights, labels);
-      worker.join();
-      if (second.score > best.score) best = second;
-      if (best.score < 0) break;  // no feature separates anything
-      const std::size_t f = best.feature;
-      stage.stumps.push_back({static_cast<int>(f),
-                              binned.minimum[f] + binned.bin_width[f] * (best.last_left_bin + 1),
-                              static_cast<float>(best.left), static_cast<float>(best.right)});
-      const std::uint8_t* row = binned.bins.data() + f * n;
-      double total = 0;
-      for (std::size_t s = 0; s < n; ++s) {
-        const double h = row[s] <= best.last_left_bin ? best.left : best.right;
-        scores[s] += h;
-        weights[s] *= std::exp(-labels[s] * h);
-        total += weights[s];
-      }
-      for (double& w : weights) w /= total;
-      // Threshold keeping min_hit_rate of the positives; the false alarm it leaves.
-      std::copy_n(scores.begin(), np, positive_scores.begin());
-      std::sort(positive_scores.begin(), positive_scores.end(), std::greater<>());
-      const std::size_t keep = std::clamp<std::size_t>(
-          static_cast<std::size_t>(std::ceil(params.min_hit_rate * static_cast<double>(np))), 1,
-          np);
-      stage.threshold = static_cast<float>(positive_scores[keep - 1] - 1e-6);
-      std::size_t passing = 0;
-      for (std::size_t s = np; s < n; ++s) passing += scores[s] >= stage.threshold;
-      false_alarm = static_cast<double>(passing) / static_cast<double>(nn);
-      hit_rate = static_cast<double>(keep) / static_cast<double>(np);
-      if (false_alarm <= params.max_false_alarm) break;
-    }
-    cascade.stages.push_back(stage);
-    rep.stumps_per_stage.push_back(static_cast<int>(stage.stumps.size()));
-    rep.stage_false_alarm.push_back(false_alarm);
-    rep.stage_hit_rate.push_back(hit_rate);
-    // Positives the stage rejects are dropped, as the detector would never see them again.
-    std::vector<GrayImage> kept;
-    for (std::size_t s = 0; s < np; ++s) {
-      if (scores[s] >= stage.threshold) kept.push_back(std::move(current_positives[s]));
-    }
-    current_positives = std::move(kept);
-    if (log) {
-      std::ostringstream line;
-      line << "stage " << stage_index << ": " << stage.stumps.size() << " stumps, false alarm "
-           << false_alarm << " on " << nn << " negatives, hit rate " << hit_rate << " ("
-           << current_positives.size() << " positives left)";
-      log(line.str());
-    }
+    StageSamples samples = make_stage_samples(cascade, current_positives, negatives);
+    const StageResult result = train_stage(cascade, samples, params);
+    cascade.stages.push_back(result.stage);
+    rep.stumps_per_stage.push_back(static_cast<int>(result.stage.stumps.size()));
+    rep.stage_false_alarm.push_back(result.false_alarm);
+    rep.stage_hit_rate.push_back(result.hit_rate);
+    current_positives =
+        passing_positives(current_positives, samples.scores, result.stage.threshold);
+    if (log) log(stage_line(stage_index, result, samples.nn, current_positives.size()));
     if (current_positives.empty()) break;
   }
   compact_features(cascade);

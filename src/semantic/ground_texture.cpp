@@ -15,7 +15,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 #include "semantic/quantile.hpp"
 
 namespace kartograf::semantic {
@@ -326,7 +326,7 @@ std::filesystem::path default_ground_texture_model_path() {
 
 namespace {
 
-using synth::Rng;
+using kartograf::Rng;
 using Colour = Eigen::Vector3d;  // linear 0..255 RGB before noise and clamping
 using HeightField = std::function<double(double x, double y)>;
 using ColourField = std::function<Colour(double x, double y)>;
@@ -414,7 +414,7 @@ HeightField smooth_field(Rng& rng, int waves, double min_wavelength, double max_
 double position_noise(std::uint64_t key, double x, double y, std::uint64_t stream) {
   const auto ix = static_cast<std::uint64_t>(std::llround(x * 1e4) + (1LL << 40));
   const auto iy = static_cast<std::uint64_t>(std::llround(y * 1e4) + (1LL << 40));
-  return synth::hash_uniform(synth::hash_key(key, ix, iy), stream);
+  return hash_uniform(hash_key(key, ix, iy), stream);
 }
 
 PatchSampling sampling_for(Rng& rng, GroundPatchStyle style) {
@@ -469,7 +469,7 @@ PointCloud pavement_patch(Rng& rng, GroundPatchStyle style) {
     return Unit{row, column, u + shift - column * length, v - row * width};
   };
   auto unit_random = [key](const Unit& unit, std::uint64_t stream) {
-    return synth::hash_uniform(synth::hash_key(key, static_cast<std::uint64_t>(unit.row + 1000),
+    return hash_uniform(hash_key(key, static_cast<std::uint64_t>(unit.row + 1000),
                                                static_cast<std::uint64_t>(unit.column + 1000)),
                                stream);
   };
@@ -612,7 +612,7 @@ PointCloud inaccessible_patch(Rng& rng, GroundPatchStyle style) {
 
 PointCloud synthesize_ground_patch(GroundClass ground, GroundPatchStyle style, std::uint64_t seed) {
   Rng rng(
-      synth::hash_key(seed, static_cast<std::uint64_t>(ground), static_cast<std::uint64_t>(style)));
+      hash_key(seed, static_cast<std::uint64_t>(ground), static_cast<std::uint64_t>(style)));
   switch (ground) {
     case GroundClass::pavement:
       return pavement_patch(rng, style);
@@ -636,7 +636,7 @@ GroundSamples synthesize_ground_samples(int per_class, GroundPatchStyle style, s
       const GroundFeatures f = ground_features(
           synthesize_ground_patch(
               ground, style,
-              synth::hash_key(seed, 0x67726f756e64ULL, static_cast<std::uint64_t>(i))),
+              hash_key(seed, 0x67726f756e64ULL, static_cast<std::uint64_t>(i))),
           params);
       samples.features.insert(samples.features.end(), f.begin(), f.end());
       samples.labels.push_back(ground);

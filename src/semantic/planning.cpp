@@ -49,15 +49,15 @@ double distance_to_segment(const Eigen::Vector2d& p, const Eigen::Vector2d& a,
 
 }  // namespace
 
-void PlannerOptions::validate() const {
+void PlannerParams::validate() const {
   require(std::isfinite(robot_radius) && robot_radius >= 0,
-          "PlannerOptions: robot_radius must be >= 0, got " + std::to_string(robot_radius));
+          "PlannerParams: robot_radius must be >= 0, got " + std::to_string(robot_radius));
   require(unobserved_weight >= 0.0f && unobserved_weight <= 1.0f,
-          "PlannerOptions: unobserved_weight must be in [0, 1], got " +
+          "PlannerParams: unobserved_weight must be in [0, 1], got " +
               std::to_string(unobserved_weight));
 }
 
-Image<float> planning_weights(const SemanticGrid& grid, const PlannerOptions& options) {
+Image<float> planning_weights(const SemanticGrid& grid, const PlannerParams& options) {
   options.validate();
   const int w = grid.width(), h = grid.height();
   Image<float> out(w, h, 0.0f);
@@ -153,7 +153,7 @@ PlannedPath plan_on_weights(const Image<float>& weights, double resolution,
 std::optional<Eigen::Vector2d> nearest_passable_point(const SemanticGrid& grid,
                                                       const Eigen::Vector2d& point,
                                                       double max_distance,
-                                                      const PlannerOptions& options) {
+                                                      const PlannerParams& options) {
   require(std::isfinite(max_distance) && max_distance >= 0,
           "nearest_passable_point: max_distance must be >= 0");
   const Image<float> weights = planning_weights(grid, options);
@@ -173,7 +173,7 @@ std::optional<Eigen::Vector2d> nearest_passable_point(const SemanticGrid& grid,
 }
 
 PlannedPath plan_path(const SemanticGrid& grid, const Eigen::Vector2d& start,
-                      const Eigen::Vector2d& goal, const PlannerOptions& options) {
+                      const Eigen::Vector2d& goal, const PlannerParams& options) {
   const std::string what = "plan_path from " + format_xy(start) + " to " + format_xy(goal);
   const Eigen::Vector2i from = start_cell(grid, start, what);
   const Eigen::Vector2i to = grid.cell_of(goal);
@@ -220,7 +220,7 @@ static PlannedPath plan_to_targets(const SemanticGrid& grid, const Image<float>&
 }
 
 PlannedPath plan_to_nearest_door(const SemanticGrid& grid, const Eigen::Vector2d& start,
-                                 const DoorQueryOptions& query, const PlannerOptions& options) {
+                                 const DoorQueryParams& query, const PlannerParams& options) {
   const std::string what = "go to the nearest door from " + format_xy(start);
   require(query.arrival_radius > 0, what + ": arrival_radius must be positive");
   std::vector<std::pair<int, Eigen::Vector2d>> doors;
@@ -235,7 +235,7 @@ PlannedPath plan_to_nearest_door(const SemanticGrid& grid, const Eigen::Vector2d
 }
 
 PlannedPath plan_along_nearest_wall(const SemanticGrid& grid, const Eigen::Vector2d& start,
-                                    const WallQueryOptions& query, const PlannerOptions& options) {
+                                    const WallQueryParams& query, const PlannerParams& options) {
   const std::string what = "drive along the nearest wall from " + format_xy(start);
   require(query.offset > 0 && query.keep_weight > 0 && query.keep_weight <= 1 &&
               query.arrival_radius > 0,

@@ -386,11 +386,11 @@ std::vector<Label> split_offset_layers(const PointImage& smoothed_points,
   return parents;
 }
 
-std::vector<RegionMeasurements> measure_regions(const PointImage& points,
-                                                const NormalImage& normals,
-                                                const RegionSegmentation& regions,
-                                                const Eigen::Vector3d& up,
-                                                const MeasureParams& params) {
+namespace {
+
+void check_measurable(const PointImage& points, const NormalImage& normals,
+                      const RegionSegmentation& regions, const Eigen::Vector3d& up,
+                      const MeasureParams& params) {
   const int w = points.width(), h = points.height();
   require(normals.width() == w && normals.height() == h && regions.labels.width() == w &&
               regions.labels.height() == h,
@@ -400,116 +400,177 @@ std::vector<RegionMeasurements> measure_regions(const PointImage& points,
           "measure_regions: trim_fraction must be in [0, 0.5)");
   require(params.occluder_relative_range >= 0 && params.occluder_relative_range < 1,
           "measure_regions: occluder_relative_range must be in [0, 1)");
-  const auto n_regions = static_cast<std::size_t>(regions.region_count);
-  std::vector<RegionMeasurements> out(n_regions);
-  std::vector<std::vector<int>> members(n_regions);
-  std::vector<std::set<Label>> adjacent(n_regions);
-  const LabelImage& labels = regions.labels;
+}
+
+// What measuring one region reads: the images and the parameters.
+struct RegionInputs {
+  const PointImage& points;
+  const LabelImage& labels;
+  const Eigen::Vector3d& up;
+  const MeasureParams& params;
+  int w, h;
+};
+
+// Each region's pixels (indices y * w + x) and the regions within adjacency_radius of it.
+struct RegionPixels {
+  std::vector<std::vector<int>> members;
+  std::vector<std::set<Label>> adjacent;
+};
+
+// One raster pass: the pixels and neighbours of each region, and the sums of its points and
+// normals into out's centroid and mean_normal.
+RegionPixels gather_regions(const RegionInputs& in, const NormalImage& normals,
+                            std::vector<RegionMeasurements>& out) {
+  const int w = in.w, h = in.h;
+  const LabelImage& labels = in.labels;
+  RegionPixels pixels{std::vector<std::vector<int>>(out.size()),
+                      std::vector<std::set<Label>>(out.size())};
   for (int y = 0; y < h; ++y) {
     for (int x = 0; x < w; ++x) {
       const Label l = labels(x, y);
       if (l == kUnlabeled) continue;
       RegionMeasurements& m = out[l - 1u];
-      members[l - 1u].push_back(y * w + x);
-      m.centroid += vec3(points(x, y));
+      pixels.members[l - 1u].push_back(y * w + x);
+      m.centroid += vec3(in.points(x, y));
       if (is_valid(normals(x, y))) m.mean_normal += vec3(normals(x, y));  // filled pixels have none
-      for (int d = 1; d <= params.adjacency_radius; ++d) {
+      for (int d = 1; d <= in.params.adjacency_radius; ++d) {
         for (const auto& [qx, qy] : {std::pair{x + d, y}, std::pair{x, y + d}}) {
           if (qx >= w || qy >= h) continue;
           const Label o = labels(qx, qy);
           if (o != kUnlabeled && o != l) {
-            adjacent[l - 1u].insert(o);
-            adjacent[o - 1u].insert(l);
+            pixels.adjacent[l - 1u].insert(o);
+            pixels.adjacent[o - 1u].insert(l);
           }
         }
       }
     }
   }
+  return pixels;
+}
+
+// Area: the parallelogram towards each pixel's right and lower neighbours of the region,
+// projected on the mean normal (depth noise would inflate the raw parallelogram).
+void measure_area(const RegionInputs& in, const std::vector<int>& members, RegionMeasurements& m) {
+  const PointImage& points = in.points;
+  for (const int i : members) {
+    const int x = i % in.w, y = i / in.w;
+    if (x + 1 < in.w && y + 1 < in.h && in.labels(x + 1, y) == m.id &&
+        in.labels(x, y + 1) == m.id) {
+      m.area += std::fabs((vec3(points(x + 1, y)) - vec3(points(x, y)))
+                              .cross(vec3(points(x, y + 1)) - vec3(points(x, y)))
+                              .dot(m.mean_normal));
+    }
+  }
+}
+
+// The normal of the plane fitted to the region's points, turned like its mean normal.
+Eigen::Vector3d fitted_plane_normal(const PointImage& points, const std::vector<int>& members,
+                                    const RegionMeasurements& m) {
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const int i : members) {
+    const Eigen::Vector3d d = vec3(points.pixels()[static_cast<std::size_t>(i)]) - m.centroid;
+    scatter += d * d.transpose();
+  }
+  Eigen::Vector3d normal =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
+  if (normal.dot(m.mean_normal) < 0) normal = -normal;
+  return normal;
+}
+
+// Horizontal axis: in the plane and horizontal for a vertical region; for others the major
+// principal axis of the points projected onto the horizontal plane.
+Eigen::Vector3d horizontal_axis(const RegionInputs& in, const std::vector<int>& members,
+                                const RegionMeasurements& m) {
+  const Eigen::Vector3d& up = in.up;
+  if (m.orientation == RegionOrientation::vertical) return up.cross(m.mean_normal).normalized();
+  Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
+  for (const int i : members) {
+    Eigen::Vector3d d = vec3(in.points.pixels()[static_cast<std::size_t>(i)]) - m.centroid;
+    d -= d.dot(up) * up;
+    scatter += d * d.transpose();
+  }
+  return Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
+}
+
+// The trimmed height range and the trimmed width along the horizontal axis.
+void measure_extent(const RegionInputs& in, const std::vector<int>& members,
+                    RegionMeasurements& m) {
+  const Eigen::Vector3d axis = horizontal_axis(in, members, m);
+  std::vector<double> heights, along;
+  heights.reserve(members.size());
+  along.reserve(members.size());
+  for (const int i : members) {
+    const Eigen::Vector3d p = vec3(in.points.pixels()[static_cast<std::size_t>(i)]);
+    heights.push_back(p.dot(in.up));
+    along.push_back(p.dot(axis));
+  }
+  trimmed_extent(heights, in.params.trim_fraction, m.min_height, m.max_height);
+  double low = 0, high = 0;
+  m.width = trimmed_extent(along, in.params.trim_fraction, low, high);
+}
+
+// Where the region meets the image border or a pixel without a point, the surface may go on
+// out of view: classify that spot by its height within the region.
+void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMeasurements& m) {
+  const int w = in.w, h = in.h;
+  const PointImage& points = in.points;
+  const double band = std::max(0.1, 0.15 * m.height());
+  for (const int i : members) {
+    const int x = i % w, y = i / w;
+    bool open = x == 0 || y == 0 || x == w - 1 || y == h - 1, occluded = false;
+    const double range = vec3(points(x, y)).norm();
+    for (const auto& [qx, qy] :
+         {std::pair{x - 1, y}, std::pair{x + 1, y}, std::pair{x, y - 1}, std::pair{x, y + 1}}) {
+      if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
+      const Point4f& q = points(qx, qy);
+      open = open || !is_valid(q);
+      const bool nearer = q.head<3>().norm() < (1.0 - in.params.occluder_relative_range) * range;
+      occluded = occluded || (is_valid(q) && in.labels(qx, qy) != m.id && nearer);
+    }
+    if (!open && !occluded) continue;
+    const double height = vec3(points(x, y)).dot(in.up);
+    const bool top = height >= m.max_height - band, bottom = height <= m.min_height + band;
+    if (open) {
+      m.cut_above = m.cut_above || top;
+      m.cut_below = m.cut_below || bottom;
+      m.cut_sideways = m.cut_sideways || (!top && !bottom);
+    } else {
+      m.occluded_below = m.occluded_below || bottom;
+      m.occluded_sideways = m.occluded_sideways || (!top && !bottom);
+    }
+  }
+}
+
+}  // namespace
+
+std::vector<RegionMeasurements> measure_regions(const PointImage& points,
+                                                const NormalImage& normals,
+                                                const RegionSegmentation& regions,
+                                                const Eigen::Vector3d& up,
+                                                const MeasureParams& params) {
+  check_measurable(points, normals, regions, up, params);
+  const RegionInputs in{points, regions.labels, up, params, points.width(), points.height()};
+  const auto n_regions = static_cast<std::size_t>(regions.region_count);
+  std::vector<RegionMeasurements> out(n_regions);
+  const RegionPixels pixels = gather_regions(in, normals, out);
   const double horizontal_cos = cos_deg(params.horizontal_tolerance_deg);
   const double vertical_sin = std::sin(params.vertical_tolerance_deg * std::numbers::pi / 180.0);
   for (std::size_t r = 0; r < n_regions; ++r) {
     RegionMeasurements& m = out[r];
+    const std::vector<int>& members = pixels.members[r];
     m.id = static_cast<Label>(r + 1);
-    m.pixel_count = static_cast<int>(members[r].size());
+    m.pixel_count = static_cast<int>(members.size());
     m.centroid /= m.pixel_count;
     m.mean_normal.normalize();
-    // Area: the parallelogram towards each pixel's right and lower neighbours of the region,
-    // projected on the mean normal (depth noise would inflate the raw parallelogram).
-    for (const int i : members[r]) {
-      const int x = i % w, y = i / w;
-      if (x + 1 < w && y + 1 < h && labels(x + 1, y) == m.id && labels(x, y + 1) == m.id) {
-        m.area += std::fabs((vec3(points(x + 1, y)) - vec3(points(x, y)))
-                                .cross(vec3(points(x, y + 1)) - vec3(points(x, y)))
-                                .dot(m.mean_normal));
-      }
-    }
-    m.neighbours.assign(adjacent[r].begin(), adjacent[r].end());
+    measure_area(in, members, m);
+    m.neighbours.assign(pixels.adjacent[r].begin(), pixels.adjacent[r].end());
     const double along_up = m.mean_normal.dot(up);
     m.orientation = std::fabs(along_up) >= horizontal_cos ? RegionOrientation::horizontal
                     : std::fabs(along_up) <= vertical_sin ? RegionOrientation::vertical
                                                           : RegionOrientation::other;
-    {
-      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-      for (const int i : members[r]) {
-        const Eigen::Vector3d d = vec3(points.pixels()[static_cast<std::size_t>(i)]) - m.centroid;
-        scatter += d * d.transpose();
-      }
-      m.plane_normal =
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(0);
-      if (m.plane_normal.dot(m.mean_normal) < 0) m.plane_normal = -m.plane_normal;
-    }
-    // Horizontal axis: in the plane and horizontal for a vertical region; for others the major
-    // principal axis of the points projected onto the horizontal plane.
-    Eigen::Vector3d axis;
-    std::vector<double> heights, along;
-    heights.reserve(members[r].size());
-    along.reserve(members[r].size());
-    if (m.orientation == RegionOrientation::vertical) {
-      axis = up.cross(m.mean_normal).normalized();
-    } else {
-      Eigen::Matrix3d scatter = Eigen::Matrix3d::Zero();
-      for (const int i : members[r]) {
-        Eigen::Vector3d d = vec3(points.pixels()[static_cast<std::size_t>(i)]) - m.centroid;
-        d -= d.dot(up) * up;
-        scatter += d * d.transpose();
-      }
-      axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(scatter).eigenvectors().col(2);
-    }
-    for (const int i : members[r]) {
-      const Eigen::Vector3d p = vec3(points.pixels()[static_cast<std::size_t>(i)]);
-      heights.push_back(p.dot(up));
-      along.push_back(p.dot(axis));
-    }
-    trimmed_extent(heights, params.trim_fraction, m.min_height, m.max_height);
-    double low = 0, high = 0;
-    m.width = trimmed_extent(along, params.trim_fraction, low, high);
-    // Where the region meets the image border or a pixel without a point, the surface may go on
-    // out of view: classify that spot by its height within the region.
-    const double band = std::max(0.1, 0.15 * m.height());
-    for (const int i : members[r]) {
-      const int x = i % w, y = i / w;
-      bool open = x == 0 || y == 0 || x == w - 1 || y == h - 1, occluded = false;
-      const double range = vec3(points(x, y)).norm();
-      for (const auto& [qx, qy] :
-           {std::pair{x - 1, y}, std::pair{x + 1, y}, std::pair{x, y - 1}, std::pair{x, y + 1}}) {
-        if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-        const Point4f& q = points(qx, qy);
-        open = open || !is_valid(q);
-        const bool nearer = q.head<3>().norm() < (1.0 - params.occluder_relative_range) * range;
-        occluded = occluded || (is_valid(q) && labels(qx, qy) != m.id && nearer);
-      }
-      if (!open && !occluded) continue;
-      const double height = vec3(points(x, y)).dot(up);
-      const bool top = height >= m.max_height - band, bottom = height <= m.min_height + band;
-      if (open) {
-        m.cut_above = m.cut_above || top;
-        m.cut_below = m.cut_below || bottom;
-        m.cut_sideways = m.cut_sideways || (!top && !bottom);
-      } else {
-        m.occluded_below = m.occluded_below || bottom;
-        m.occluded_sideways = m.occluded_sideways || (!top && !bottom);
-      }
-    }
+    m.plane_normal = fitted_plane_normal(points, members, m);
+    measure_extent(in, members, m);
+    find_cuts(in, members, m);
   }
   return out;
 }

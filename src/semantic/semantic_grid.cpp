@@ -14,8 +14,8 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
-#include "kartograf/eval/connected_components.hpp"
-#include "semantic/quantile.hpp"
+#include "kartograf/core/connected_components.hpp"
+#include "semantic/grid_doorways.hpp"
 
 namespace kartograf::semantic {
 namespace {
@@ -52,43 +52,6 @@ std::optional<double> median_z(std::span<const Eigen::Vector3d> points,
   std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
   return z[z.size() / 2];
 }
-
-// The wall-labelled points in the robot's height band, by cell (compressed rows): doorway jambs
-// are measured on them, finer than the cells.
-class WallPointIndex {
- public:
-  WallPointIndex(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
-                 std::span<const SemanticClass> labels, const SemanticGridOptions& options)
-      : grid_(grid), start_(static_cast<std::size_t>(grid.width()) * grid.height() + 1, 0) {
-    const auto in_band = [&](std::size_t i) {
-      const double h = points[i].z() - grid.floor_z;
-      return labels[i] == SemanticClass::wall && points[i].allFinite() && h >= options.band_min &&
-             h <= options.band_max;
-    };
-    const auto slot = [&](std::size_t i) {
-      const Eigen::Vector2i c = grid.cell_of(points[i].head<2>());
-      return static_cast<std::size_t>(c.y()) * grid.width() + c.x();
-    };
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (in_band(i)) ++start_[slot(i) + 1];
-    }
-    for (std::size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
-    points_.resize(start_.back());
-    std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (in_band(i)) points_[next[slot(i)]++] = points[i].head<2>();
-    }
-  }
-  std::span<const Eigen::Vector2d> in_cell(const Eigen::Vector2i& c) const {
-    const std::size_t k = static_cast<std::size_t>(c.y()) * grid_.width() + c.x();
-    return {points_.data() + start_[k], start_[k + 1] - start_[k]};
-  }
-
- private:
-  const SemanticGrid& grid_;
-  std::vector<std::size_t> start_;
-  std::vector<Eigen::Vector2d> points_;
-};
 
 // Fills an object's metric description from its cells: centre, main axis and extent along it,
 // area, outline, height range.
@@ -151,7 +114,7 @@ void describe_cells(const SemanticGrid& grid, const Image<CellEvidence>& evidenc
 
 // The cells of each connected component of `mask` (8-connected), in raster order.
 std::vector<std::vector<Eigen::Vector2i>> components(const Image<std::uint8_t>& mask) {
-  const LabelImage labels = eval::label_connected_components(mask, {eval::Connectivity::eight, 1});
+  const LabelImage labels = label_connected_components(mask, {Connectivity::eight, 1});
   std::vector<std::vector<Eigen::Vector2i>> out;
   for (int row = 0; row < mask.height(); ++row) {
     for (int col = 0; col < mask.width(); ++col) {
@@ -219,237 +182,6 @@ bool point_in_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2
       inside = !inside;
   }
   return inside;
-}
-
-// How far beyond an opening's ends, and how far either side of its line, its jambs are looked
-// for [m] (walls are at most kMaxWallThickness thick).
-constexpr double kJambDepth = 0.15;
-constexpr double kMaxWallThickness = 0.3;
-
-// An opening found between two collinear wall pieces: its two ends on the wall line.
-struct WallGap {
-  Eigen::Vector2d a, b;
-  int merged = 1;
-};
-
-// A doorway's opening in the frame of its gap (centre; along the wall; across it) [m].
-struct Opening {
-  double along_min, along_max, across_min, across_max;
-  bool contains(double along, double across) const {
-    return along >= along_min && along <= along_max && across >= across_min && across <= across_max;
-  }
-};
-
-// Distance from the opening's centre line to one jamb's reveal, from the |along| of that jamb's
-// points: the reveal (a surface across the wall) piles its points up at one distance, the
-// faces spread theirs evenly beyond it. The densest centimetre within 10 cm of the nearest points
-// (a low quantile: flying pixels), refined by the mean around it.
-double reveal_distance(std::vector<double>& along) {
-  for (double& a : along) a = std::fabs(a);
-  const double nearest = detail::quantile(along, 0.02);
-  constexpr int kBins = 10;  // 1 cm each
-  std::array<int, kBins> counts{};
-  for (const double a : along) {
-    const int bin = static_cast<int>((a - nearest) / 0.01);
-    if (bin >= 0 && bin < kBins) ++counts[bin];
-  }
-  const auto peak = std::max_element(counts.begin(), counts.end()) - counts.begin();
-  const double centre = nearest + 0.01 * (static_cast<double>(peak) + 0.5);
-  double sum = 0;
-  int n = 0;
-  for (const double a : along) {
-    if (std::fabs(a - centre) <= 0.015) sum += a, ++n;
-  }
-  return sum / n;
-}
-
-// The opening between two jambs, measured on their wall points (finer than the cells, which
-// straddle the faces): the reveals bound it along the wall, the faces (and the reveals, which
-// span the wall) across it. Empty when either jamb has too few points or the result is no
-// plausible doorway.
-std::optional<Opening> measure_jambs(const SemanticGrid& grid, const WallPointIndex& walls,
-                                     const Eigen::Vector2d& centre, const Eigen::Vector2d& u,
-                                     double width, const SemanticGridOptions& options) {
-  constexpr double kInside = 0.1;  // jamb points may lie this far inside the cells' opening
-  constexpr std::size_t kMinPoints = 10;
-  constexpr double kRevealMargin = 0.03;  // face points lie this far beyond the reveals
-  const Eigen::Vector2d n(-u.y(), u.x());
-  std::vector<double> side_a, side_b, alongs, offsets;
-  const double res = grid.resolution;
-  const Eigen::Vector2i c0 = grid.cell_of(centre);
-  const int reach =
-      static_cast<int>(std::ceil((0.5 * width + kJambDepth + kMaxWallThickness) / res)) + 1;
-  for (int dy = -reach; dy <= reach; ++dy) {
-    for (int dx = -reach; dx <= reach; ++dx) {
-      const Eigen::Vector2i c = c0 + Eigen::Vector2i(dx, dy);
-      if (!grid.contains(c)) continue;
-      for (const Eigen::Vector2d& p : walls.in_cell(c)) {
-        const double along = u.dot(p - centre), off = n.dot(p - centre);
-        if (std::fabs(off) > kMaxWallThickness || std::fabs(along) < 0.5 * width - kInside ||
-            std::fabs(along) > 0.5 * width + kJambDepth)
-          continue;
-        (along < 0 ? side_a : side_b).push_back(along);
-        alongs.push_back(along);
-        offsets.push_back(off);
-      }
-    }
-  }
-  if (side_a.size() < kMinPoints || side_b.size() < kMinPoints) return std::nullopt;
-  Opening o{-reveal_distance(side_a), reveal_distance(side_b), 0, 0};
-  // The faces: two means of the offsets of the points beyond the reveals (on the faces), started
-  // at their extremes; the mean of a face's points is unbiased where the cells straddle it.
-  std::vector<double> faces;
-  for (std::size_t i = 0; i < offsets.size(); ++i) {
-    const double along = alongs[i];
-    if (along < o.along_min - kRevealMargin || along > o.along_max + kRevealMargin)
-      faces.push_back(offsets[i]);
-  }
-  if (faces.size() < 2 * kMinPoints) return std::nullopt;
-  double lo = detail::quantile(faces, 0.02), hi = detail::quantile(faces, 0.98);
-  for (int iteration = 0; iteration < 10; ++iteration) {
-    double sum_lo = 0, sum_hi = 0;
-    std::size_t n_lo = 0, n_hi = 0;
-    for (const double f : faces) {
-      if (f - lo < hi - f)
-        sum_lo += f, ++n_lo;
-      else
-        sum_hi += f, ++n_hi;
-    }
-    if (n_lo < kMinPoints || n_hi < kMinPoints) return std::nullopt;
-    lo = sum_lo / n_lo, hi = sum_hi / n_hi;
-  }
-  o.across_min = lo, o.across_max = hi;
-  const double measured_width = o.along_max - o.along_min;
-  const bool plausible = measured_width >= 0.75 * options.min_door_width &&
-                         measured_width <= 1.25 * options.max_door_width &&
-                         std::fabs(measured_width - width) <= 2 * kInside &&
-                         o.across_max - o.across_min >= 2 * res &&
-                         o.across_max - o.across_min <= kMaxWallThickness;
-  if (!plausible) return std::nullopt;
-  return o;
-}
-
-// Doorways as gaps of door width in a wall line, with observed floor along the gap and no obstacle
-// across its middle. The two faces of a wall give one gap each; gaps whose centres are closer
-// than half the smallest door width merge.
-template <class AddObject>
-void add_gap_doorways(SemanticGrid& grid, const SemanticGridOptions& options,
-                      const WallPointIndex& walls, const std::vector<int>& wall_ids,
-                      int& doorway_count, AddObject&& add_object) {
-  const double res = grid.resolution;
-  auto floor_fraction = [&](const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
-    const double length = (b - a).norm();
-    int passable = 0, total = 0;
-    for (double t = 2 * res; t <= length - 2 * res; t += 0.5 * res) {
-      const Eigen::Vector2i c = grid.cell_of(a + (b - a) * (t / length));
-      if (!grid.contains(c)) return 0.0;
-      ++total;
-      passable += grid.weight(c.x(), c.y()) > 0;
-    }
-    return total ? static_cast<double>(passable) / total : 0.0;
-  };
-  // From each end of each wall piece, walk on along its line: floor for a door's width, then wall
-  // again (any wall cell, within a cell of the line) is an opening.
-  auto is_wall = [&](const Eigen::Vector2d& p) {
-    const Eigen::Vector2i c = grid.cell_of(p);
-    return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::wall;
-  };
-  std::vector<WallGap> gaps;
-  for (const int id : wall_ids) {
-    const SemanticObject& wall = grid.objects[id - 1];
-    const Eigen::Vector2d u = (wall.axis_end - wall.axis_start).normalized();
-    const Eigen::Vector2d n(-u.y(), u.x());
-    const std::array<std::pair<Eigen::Vector2d, Eigen::Vector2d>, 2> ends = {
-        std::pair{wall.axis_end, u}, std::pair{wall.axis_start, Eigen::Vector2d(-u)}};
-    for (const auto& [from, dir] : ends) {
-      // Leave this piece's own end (noisy, up to 0.3 m), cross the opening, meet wall again.
-      double open_from = -1, hit = -1;
-      for (double t = 0.5 * res; t <= 0.3 + options.max_door_width + res; t += 0.5 * res) {
-        const Eigen::Vector2d p = from + t * dir;
-        const Eigen::Vector2i c = grid.cell_of(p);
-        if (!grid.contains(c)) break;
-        const bool wall_here = is_wall(p) || is_wall(p + res * n) || is_wall(p - res * n);
-        if (open_from < 0) {
-          if (!wall_here)
-            open_from = t;
-          else if (t > 0.3)
-            break;
-          continue;
-        }
-        if (wall_here) {
-          if (t - open_from >= options.min_door_width && t - open_from <= options.max_door_width)
-            hit = t;
-          break;
-        }
-        if (grid.weight(c.x(), c.y()) == 0.0f) break;  // furniture or another obstacle
-      }
-      if (hit < 0) continue;
-      const WallGap gap{from + open_from * dir, from + hit * dir};
-      if (floor_fraction(gap.a, gap.b) < options.min_gap_floor_fraction) continue;
-      // One must be able to pass through: no obstacle across the gap's middle on either side.
-      bool passable = true;
-      const Eigen::Vector2d middle = 0.5 * (gap.a + gap.b);
-      for (double t = -options.door_passage_depth; t <= options.door_passage_depth; t += res) {
-        const Eigen::Vector2i c = grid.cell_of(middle + t * n);
-        passable &= grid.contains(c) && grid.weight(c.x(), c.y()) != 0.0f;
-      }
-      if (passable) gaps.push_back(gap);
-    }
-  }
-  // Merge the gaps of the two faces of one wall (orienting each like the first); merged gaps
-  // hold sums until divided below.
-  std::vector<WallGap> merged;
-  for (WallGap gap : gaps) {
-    auto same = std::find_if(merged.begin(), merged.end(), [&](const WallGap& m) {
-      const Eigen::Vector2d centre = 0.5 * (m.a + m.b) / m.merged;
-      return (centre - 0.5 * (gap.a + gap.b)).norm() < 0.5 * options.min_door_width;
-    });
-    if (same == merged.end()) {
-      merged.push_back(gap);
-      continue;
-    }
-    if ((same->a / same->merged - gap.a).norm() > (same->a / same->merged - gap.b).norm())
-      std::swap(gap.a, gap.b);
-    same->a += gap.a, same->b += gap.b, ++same->merged;
-  }
-  for (WallGap& gap : merged) {
-    gap.a /= gap.merged, gap.b /= gap.merged;
-    const Eigen::Vector2d centre = 0.5 * (gap.a + gap.b);
-    // Its cells: passable cells inside the opening as its jambs measure it, else along the gap
-    // within the faces' misalignment of its line.
-    const double width = (gap.b - gap.a).norm();
-    const Eigen::Vector2d u = (gap.b - gap.a) / width, n(-u.y(), u.x());
-    const double across = 0.5 * options.max_wall_misalignment + res;
-    Opening opening{-0.5 * width, 0.5 * width, -across, across};
-    if (const auto measured = measure_jambs(grid, walls, centre, u, width, options))
-      opening = *measured;
-    const Eigen::Vector2d door_centre = centre + 0.5 * (opening.along_min + opening.along_max) * u +
-                                        0.5 * (opening.across_min + opening.across_max) * n;
-    std::vector<Eigen::Vector2i> cells;
-    const Eigen::Vector2i c0 = grid.cell_of(centre);
-    const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
-    for (int dy = -reach; dy <= reach; ++dy) {
-      for (int dx = -reach; dx <= reach; ++dx) {
-        const Eigen::Vector2i c = c0 + Eigen::Vector2i(dx, dy);
-        if (!grid.contains(c) || !(grid.weight(c.x(), c.y()) > 0)) continue;
-        if (opening.contains(u.dot(grid.cell_center(c) - centre),
-                             n.dot(grid.cell_center(c) - centre)))
-          cells.push_back(c);
-      }
-    }
-    if (cells.empty()) continue;
-    for (const auto& c : cells) {
-      grid.classes(c.x(), c.y()) = SemanticClass::door;
-      grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::door);
-    }
-    SemanticObject& door =
-        add_object(ObjectKind::doorway, SemanticClass::door,
-                   "doorway " + std::to_string(++doorway_count), std::move(cells));
-    door.centre = door_centre;
-    door.axis_start = centre + opening.along_min * u + (door_centre - centre).dot(n) * n;
-    door.axis_end = centre + opening.along_max * u + (door_centre - centre).dot(n) * n;
-    door.width = opening.along_max - opening.along_min;
-  }
 }
 
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
@@ -526,7 +258,7 @@ void fill_enclosed_by_unclassified(SemanticGrid& grid, double max_area, float we
 // lattice) puts noisy points on both sides of it. The cell that sees floor and whose band points
 // hug the side facing an obstacle cell with less floor is free: the surface belongs to the other.
 void remove_spill(SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                  const SemanticGridOptions& options, Image<std::uint8_t>& leaf,
+                  const SemanticGridParams& options, Image<std::uint8_t>& leaf,
                   Image<std::uint8_t>& furniture) {
   const std::array<Eigen::Vector2i, 4> sides = {Eigen::Vector2i(-1, 0), Eigen::Vector2i(1, 0),
                                                 Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)};
@@ -561,7 +293,7 @@ bool is_obstacle(float weight_value) {
 
 // Obstacle cells with no obstacle among their 8 neighbours become what their floor evidence says.
 void remove_isolated_obstacles(SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                               const SemanticGridOptions& options, Image<std::uint8_t>& leaf,
+                               const SemanticGridParams& options, Image<std::uint8_t>& leaf,
                                Image<std::uint8_t>& furniture) {
   std::vector<Eigen::Vector2i> specks;
   for (int row = 0; row < grid.height(); ++row) {
@@ -587,66 +319,8 @@ void remove_isolated_obstacles(SemanticGrid& grid, const Image<CellEvidence>& ev
   }
 }
 
-}  // namespace
-
-void TraversabilityWeights::validate() const {
-  for (std::size_t c = 0; c < by_class.size(); ++c) {
-    const float w = by_class[c];
-    require(std::isnan(w) || (w >= 0.0f && w <= 1.0f),
-            "TraversabilityWeights: weight of class " + std::string(kSemanticClassNames[c]) +
-                " must be in [0, 1] or NaN (unknown), got " + std::to_string(w));
-  }
-  require(unclassified_obstacle >= 0.0f && unclassified_obstacle <= 1.0f,
-          "TraversabilityWeights: unclassified_obstacle must be in [0, 1], got " +
-              std::to_string(unclassified_obstacle));
-}
-
-void SemanticGridOptions::validate() const {
-  auto positive = [](double v, const char* name) {
-    require(std::isfinite(v) && v > 0, std::string("SemanticGridOptions: ") + name +
-                                           " must be positive, got " + std::to_string(v));
-  };
-  positive(resolution, "resolution");
-  positive(floor_tolerance, "floor_tolerance");
-  positive(band_max, "band_max");
-  require(band_min >= 0 && band_min < band_max,
-          "SemanticGridOptions: need 0 <= band_min < band_max, got " + std::to_string(band_min) +
-              " and " + std::to_string(band_max));
-  require(min_obstacle_points >= 1 && min_floor_points >= 1,
-          "SemanticGridOptions: min_obstacle_points and min_floor_points must be >= 1");
-  require(margin >= 0, "SemanticGridOptions: margin must be >= 0");
-  require(min_door_width > 0 && min_door_width < max_door_width,
-          "SemanticGridOptions: need 0 < min_door_width < max_door_width");
-  weights.validate();
-}
-
-std::string_view to_string(ObjectKind kind) {
-  switch (kind) {
-    case ObjectKind::wall:
-      return "wall";
-    case ObjectKind::doorway:
-      return "doorway";
-    case ObjectKind::door_leaf:
-      return "door";
-    case ObjectKind::furniture:
-      return "furniture";
-    case ObjectKind::detection:
-      return "detection";
-  }
-  return "?";
-}
-
-const SemanticObject& SemanticGrid::object(int id) const {
-  require(id >= 1 && id <= static_cast<int>(objects.size()),
-          "SemanticGrid: no object " + std::to_string(id) + " (the map has " +
-              std::to_string(objects.size()) + ")");
-  return objects[static_cast<std::size_t>(id - 1)];
-}
-
-SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
-                                 std::span<const SemanticClass> labels,
-                                 const SemanticGridOptions& options,
-                                 std::span<const ObjectDetection> detections) {
+void check_inputs(std::span<const Eigen::Vector3d> points, std::span<const SemanticClass> labels,
+                  const SemanticGridParams& options) {
   options.validate();
   require(points.size() == labels.size(), "build_semantic_grid: " + std::to_string(points.size()) +
                                               " points but " + std::to_string(labels.size()) +
@@ -656,7 +330,12 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                                            std::to_string(static_cast<int>(c)) +
                                                            " is no SemanticClass");
   }
+}
 
+// A grid over the points' extent (plus the margin), every cell unobserved, with its floor and
+// ceiling heights (given or the median of their points).
+SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
+                        std::span<const SemanticClass> labels, const SemanticGridParams& options) {
   SemanticGrid grid;
   grid.resolution = options.resolution;
   grid.weights = options.weights;
@@ -691,9 +370,16 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   grid.classes = Image<SemanticClass>(size.x(), size.y(), SemanticClass::unknown);
   grid.weight = Image<float>(size.x(), size.y(), kUnobserved);
   grid.cell_objects = Image<std::vector<int>>(size.x(), size.y());
+  return grid;
+}
 
-  // Evidence per cell.
-  Image<CellEvidence> evidence(size.x(), size.y());
+// What the points say about each cell of `grid`.
+Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
+                                    std::span<const Eigen::Vector3d> points,
+                                    std::span<const SemanticClass> labels,
+                                    const SemanticGridParams& options) {
+  const double res = options.resolution;
+  Image<CellEvidence> evidence(grid.width(), grid.height());
   const double below_ceiling = grid.ceiling_z
                                    ? *grid.ceiling_z - grid.floor_z - options.ceiling_margin
                                    : std::numeric_limits<double>::infinity();
@@ -722,111 +408,147 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
       e.z_max = std::max(e.z_max, static_cast<float>(p.z()));
     }
   }
+  return evidence;
+}
 
-  // Cell classes.
-  Image<std::uint8_t> leaf(size.x(), size.y(), 0), furniture(size.x(), size.y(), 0);
-  for (int row = 0; row < size.y(); ++row) {
-    for (int col = 0; col < size.x(); ++col) {
+// The most frequent class of a cell's band points (floor and ceiling aside; the first on ties).
+SemanticClass dominant_band_class(const CellEvidence& e) {
+  std::size_t best = 0;
+  for (std::size_t k = 0; k < e.band.size(); ++k) {
+    if (k == index_of(SemanticClass::floor) || k == index_of(SemanticClass::ceiling)) continue;
+    if (e.band[k] > e.band[best]) best = k;
+  }
+  return static_cast<SemanticClass>(best);
+}
+
+// The cells of door leaves and of furniture, which become objects of their own.
+struct ObstacleMasks {
+  Image<std::uint8_t> leaf, furniture;
+};
+
+// Each cell's class and weight from its evidence: obstacle evidence first, then floor.
+ObstacleMasks classify_cells(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                             const SemanticGridParams& options) {
+  const int w = grid.width(), h = grid.height();
+  ObstacleMasks masks{Image<std::uint8_t>(w, h, 0), Image<std::uint8_t>(w, h, 0)};
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
       const CellEvidence& e = evidence(col, row);
       SemanticClass c = SemanticClass::unknown;
-      float w = kUnobserved;
+      float weight = kUnobserved;
       const int band = e.band_total();
       if (band >= options.min_obstacle_points &&
           band >= options.min_obstacle_floor_ratio * e.floor) {
-        std::size_t best = 0;
-        for (std::size_t k = 0; k < e.band.size(); ++k) {
-          if (k == index_of(SemanticClass::floor) || k == index_of(SemanticClass::ceiling))
-            continue;
-          if (e.band[k] > e.band[best]) best = k;
-        }
-        c = static_cast<SemanticClass>(best);
-        w = c == SemanticClass::unknown ? options.weights.unclassified_obstacle
-                                        : options.weights.of(c);
-        leaf(col, row) = c == SemanticClass::door;
-        furniture(col, row) = c == SemanticClass::furniture;
+        c = dominant_band_class(e);
+        weight = c == SemanticClass::unknown ? options.weights.unclassified_obstacle
+                                             : options.weights.of(c);
+        masks.leaf(col, row) = c == SemanticClass::door;
+        masks.furniture(col, row) = c == SemanticClass::furniture;
       } else if (e.floor >= options.min_floor_points) {
         c = SemanticClass::floor;
-        w = options.weights.of(c);
+        weight = options.weights.of(c);
       }
       grid.classes(col, row) = c;
-      grid.weight(col, row) = w;
+      grid.weight(col, row) = weight;
     }
   }
+  return masks;
+}
 
-  if (options.spill_margin > 0) remove_spill(grid, evidence, options, leaf, furniture);
-  if (options.remove_isolated_obstacles)
-    remove_isolated_obstacles(grid, evidence, options, leaf, furniture);
+// Appends an object of `cells` to the grid, described from its cells, and returns it.
+SemanticObject& append_object(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                              ObjectKind kind, SemanticClass label, const std::string& name,
+                              std::vector<Eigen::Vector2i> cells) {
+  SemanticObject object;
+  object.id = static_cast<int>(grid.objects.size()) + 1;
+  object.kind = kind;
+  object.label = label;
+  object.name = name;
+  object.cells = std::move(cells);
+  describe_cells(grid, evidence, object);
+  grid.objects.push_back(std::move(object));
+  return grid.objects.back();
+}
 
-  auto add_object = [&](ObjectKind kind, SemanticClass label, const std::string& name,
-                        std::vector<Eigen::Vector2i> cells) -> SemanticObject& {
-    SemanticObject object;
-    object.id = static_cast<int>(grid.objects.size()) + 1;
-    object.kind = kind;
-    object.label = label;
-    object.name = name;
-    object.cells = std::move(cells);
-    describe_cells(grid, evidence, object);
-    grid.objects.push_back(std::move(object));
-    return grid.objects.back();
-  };
-
-  if (options.max_furniture_fill_area > 0)
-    fill_furniture(grid, furniture, options.max_furniture_fill_area,
-                   options.weights.of(SemanticClass::furniture));
-  if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
-    fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
-  int doorway_count = 0;
+// Door leaves, then furniture: one object per connected piece of their masks.
+void add_obstacle_objects(ObstacleMasks& masks, const detail::AddObject& add_object) {
   int leaf_count = 0;
-  for (auto& cells : components(leaf))
+  for (auto& cells : components(masks.leaf))
     add_object(ObjectKind::door_leaf, SemanticClass::door, "door " + std::to_string(++leaf_count),
                std::move(cells));
   int furniture_count = 0;
-  for (auto& cells : components(furniture))
+  for (auto& cells : components(masks.furniture))
     add_object(ObjectKind::furniture, SemanticClass::furniture,
                "furniture " + std::to_string(++furniture_count), std::move(cells));
+}
 
-  // Walls: straight pieces (cells of one direction, connected); corner cells join the nearest.
-  const Image<int> bins = wall_direction_bins(grid.classes);
-  Image<int> wall_id(size.x(), size.y(), 0);
-  int wall_count = 0;
-  std::vector<int> wall_ids;
-  for (int row = 0; row < size.y(); ++row) {
-    for (int col = 0; col < size.x(); ++col) {
-      const int bin = bins(col, row);
-      if (bin < 0 || wall_id(col, row)) continue;
-      std::vector<Eigen::Vector2i> cells{{col, row}};
-      wall_id(col, row) = -1;
-      for (std::size_t k = 0; k < cells.size(); ++k) {
-        for (int dy = -1; dy <= 1; ++dy) {
-          for (int dx = -1; dx <= 1; ++dx) {
-            const Eigen::Vector2i n = cells[k] + Eigen::Vector2i(dx, dy);
-            if (!grid.contains(n) || wall_id(n.x(), n.y()) || bins(n.x(), n.y()) != bin) continue;
-            wall_id(n.x(), n.y()) = -1;
-            cells.push_back(n);
-          }
-        }
+// The cells connected (8-neighbours) to (col, row) with its direction bin, not yet taken (taken
+// ones are marked -1 in wall_id).
+std::vector<Eigen::Vector2i> grow_wall_piece(const SemanticGrid& grid, const Image<int>& bins,
+                                             Image<int>& wall_id, int col, int row) {
+  const int bin = bins(col, row);
+  std::vector<Eigen::Vector2i> cells{{col, row}};
+  wall_id(col, row) = -1;
+  for (std::size_t k = 0; k < cells.size(); ++k) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Eigen::Vector2i n = cells[k] + Eigen::Vector2i(dx, dy);
+        if (!grid.contains(n) || wall_id(n.x(), n.y()) || bins(n.x(), n.y()) != bin) continue;
+        wall_id(n.x(), n.y()) = -1;
+        cells.push_back(n);
       }
+    }
+  }
+  return cells;
+}
+
+// The straight wall pieces: each cell's wall object id (0: none, -2: a piece too short to be a
+// wall) and the ids of the walls.
+struct WallPieces {
+  Image<int> wall_id;
+  std::vector<int> ids;
+};
+
+// Walls: straight pieces (cells of one direction, connected) of at least min_wall_length.
+WallPieces add_straight_walls(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                              const SemanticGridParams& options,
+                              const detail::AddObject& add_object) {
+  const Image<int> bins = wall_direction_bins(grid.classes);
+  WallPieces walls{Image<int>(grid.width(), grid.height(), 0), {}};
+  int wall_count = 0;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const int bin = bins(col, row);
+      if (bin < 0 || walls.wall_id(col, row)) continue;
+      const std::vector<Eigen::Vector2i> cells =
+          grow_wall_piece(grid, bins, walls.wall_id, col, row);
       const double angle = bin * std::numbers::pi / 8;
       const Eigen::Vector2d direction(std::cos(angle), std::sin(angle));
       SemanticObject candidate;
       candidate.cells = cells;
       describe_cells(grid, evidence, candidate, false, direction);
       if (candidate.width < options.min_wall_length) {
-        for (const auto& c : cells) wall_id(c.x(), c.y()) = -2;  // a leftover
+        for (const auto& c : cells) walls.wall_id(c.x(), c.y()) = -2;  // a leftover
         continue;
       }
       SemanticObject& wall = add_object(ObjectKind::wall, SemanticClass::wall,
                                         "wall " + std::to_string(++wall_count), cells);
       wall.centre = candidate.centre, wall.axis_start = candidate.axis_start;
       wall.axis_end = candidate.axis_end, wall.width = candidate.width;
-      wall_ids.push_back(wall.id);
-      for (const auto& c : cells) wall_id(c.x(), c.y()) = wall.id;
+      walls.ids.push_back(wall.id);
+      for (const auto& c : cells) walls.wall_id(c.x(), c.y()) = wall.id;
     }
   }
-  // Leftover wall cells (corners, short pieces) join the wall with the most cells around them.
+  return walls;
+}
+
+// Leftover wall cells (corners, short pieces) join the wall with the most cells around them.
+void join_leftover_wall_cells(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                              const WallPieces& walls) {
+  const Image<int>& wall_id = walls.wall_id;
   std::vector<std::vector<Eigen::Vector2i>> extra(grid.objects.size() + 1);
-  for (int row = 0; row < size.y(); ++row) {
-    for (int col = 0; col < size.x(); ++col) {
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
       if (grid.classes(col, row) != SemanticClass::wall || wall_id(col, row) > 0) continue;
       std::vector<int> votes(grid.objects.size() + 1, 0);
       for (int dy = -4; dy <= 4; ++dy) {
@@ -839,17 +561,18 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
       if (*best > 0) extra[best - votes.begin()].push_back({col, row});
     }
   }
-  for (const int id : wall_ids) {
+  for (const int id : walls.ids) {
     SemanticObject& wall = grid.objects[id - 1];
     if (extra[id].empty()) continue;
     wall.cells.insert(wall.cells.end(), extra[id].begin(), extra[id].end());
     describe_cells(grid, evidence, wall, /*keep_axis=*/true);
   }
+}
 
-  add_gap_doorways(grid, options, WallPointIndex(grid, points, labels, options), wall_ids,
-                   doorway_count, add_object);
-
-  // Detections: their own objects on the cells whose centres their footprint covers.
+// Detections: their own objects on the cells whose centres their footprint covers.
+void add_detections(SemanticGrid& grid, const SemanticGridParams& options,
+                    std::span<const ObjectDetection> detections,
+                    const detail::AddObject& add_object) {
   for (std::size_t d = 0; d < detections.size(); ++d) {
     const ObjectDetection& det = detections[d];
     const std::string what = "build_semantic_grid: detection " + std::to_string(d) + " (" +
@@ -860,8 +583,8 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
     require(!det.weight || (*det.weight >= 0.0f && *det.weight <= 1.0f),
             what + ": weight must be in [0, 1]");
     std::vector<Eigen::Vector2i> cells;
-    for (int row = 0; row < size.y(); ++row) {
-      for (int col = 0; col < size.x(); ++col) {
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
         if (point_in_polygon(grid.cell_center({col, row}), det.footprint))
           cells.push_back({col, row});
       }
@@ -878,6 +601,91 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
     object.z_min = det.z_min, object.z_max = det.z_max;
     object.contour = det.footprint;
   }
+}
+
+}  // namespace
+
+void TraversabilityWeights::validate() const {
+  for (std::size_t c = 0; c < by_class.size(); ++c) {
+    const float w = by_class[c];
+    require(std::isnan(w) || (w >= 0.0f && w <= 1.0f),
+            "TraversabilityWeights: weight of class " + std::string(kSemanticClassNames[c]) +
+                " must be in [0, 1] or NaN (unknown), got " + std::to_string(w));
+  }
+  require(unclassified_obstacle >= 0.0f && unclassified_obstacle <= 1.0f,
+          "TraversabilityWeights: unclassified_obstacle must be in [0, 1], got " +
+              std::to_string(unclassified_obstacle));
+}
+
+void SemanticGridParams::validate() const {
+  auto positive = [](double v, const char* name) {
+    require(std::isfinite(v) && v > 0, std::string("SemanticGridParams: ") + name +
+                                           " must be positive, got " + std::to_string(v));
+  };
+  positive(resolution, "resolution");
+  positive(floor_tolerance, "floor_tolerance");
+  positive(band_max, "band_max");
+  require(band_min >= 0 && band_min < band_max,
+          "SemanticGridParams: need 0 <= band_min < band_max, got " + std::to_string(band_min) +
+              " and " + std::to_string(band_max));
+  require(min_obstacle_points >= 1 && min_floor_points >= 1,
+          "SemanticGridParams: min_obstacle_points and min_floor_points must be >= 1");
+  require(margin >= 0, "SemanticGridParams: margin must be >= 0");
+  require(min_door_width > 0 && min_door_width < max_door_width,
+          "SemanticGridParams: need 0 < min_door_width < max_door_width");
+  weights.validate();
+}
+
+std::string_view to_string(ObjectKind kind) {
+  switch (kind) {
+    case ObjectKind::wall:
+      return "wall";
+    case ObjectKind::doorway:
+      return "doorway";
+    case ObjectKind::door_leaf:
+      return "door";
+    case ObjectKind::furniture:
+      return "furniture";
+    case ObjectKind::detection:
+      return "detection";
+  }
+  return "?";
+}
+
+const SemanticObject& SemanticGrid::object(int id) const {
+  require(id >= 1 && id <= static_cast<int>(objects.size()),
+          "SemanticGrid: no object " + std::to_string(id) + " (the map has " +
+              std::to_string(objects.size()) + ")");
+  return objects[static_cast<std::size_t>(id - 1)];
+}
+
+SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
+                                 std::span<const SemanticClass> labels,
+                                 const SemanticGridParams& options,
+                                 std::span<const ObjectDetection> detections) {
+  check_inputs(points, labels, options);
+  SemanticGrid grid = empty_grid(points, labels, options);
+  const Image<CellEvidence> evidence = gather_evidence(grid, points, labels, options);
+  ObstacleMasks masks = classify_cells(grid, evidence, options);
+  if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);
+  if (options.remove_isolated_obstacles)
+    remove_isolated_obstacles(grid, evidence, options, masks.leaf, masks.furniture);
+
+  const detail::AddObject add_object = [&](ObjectKind kind, SemanticClass label,
+                                           const std::string& name,
+                                           std::vector<Eigen::Vector2i> cells) -> SemanticObject& {
+    return append_object(grid, evidence, kind, label, name, std::move(cells));
+  };
+  if (options.max_furniture_fill_area > 0)
+    fill_furniture(grid, masks.furniture, options.max_furniture_fill_area,
+                   options.weights.of(SemanticClass::furniture));
+  if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
+    fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
+  add_obstacle_objects(masks, add_object);
+  const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);
+  join_leftover_wall_cells(grid, evidence, walls);
+  detail::add_gap_doorways(grid, options, points, labels, walls.ids, add_object);
+  add_detections(grid, options, detections, add_object);
 
   for (const SemanticObject& object : grid.objects) {
     for (const auto& c : object.cells) grid.cell_objects(c.x(), c.y()).push_back(object.id);

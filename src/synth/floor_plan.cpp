@@ -28,7 +28,7 @@ CellRange overlapped_cells(const OccupancyGrid& grid, const Rect2& r) {
 
 }  // namespace
 
-FloorPlan make_floor_plan(const World& world, const FloorPlanOptions& options) {
+FloorPlan make_floor_plan(const World& world, const FloorPlanParams& options) {
   require(options.resolution > 0 && options.resolution <= 1,
           "make_floor_plan: resolution must be in (0, 1] m");
   require(options.margin >= 0, "make_floor_plan: margin must be >= 0");

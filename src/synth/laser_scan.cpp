@@ -5,7 +5,7 @@
 #include <numbers>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "parallel.hpp"
 
@@ -18,20 +18,20 @@ enum Stream : std::uint64_t { kRange = 1, kDark = 2 };
 
 }  // namespace
 
-void LaserScanOptions::validate() const {
-  require(columns >= 2 && lines >= 2, "LaserScanOptions: needs at least 2 columns and 2 lines");
+void LidarScanParams::validate() const {
+  require(columns >= 2 && lines >= 2, "LidarScanParams: needs at least 2 columns and 2 lines");
   require(horizontal_fov_deg > 0 && horizontal_fov_deg <= 360,
-          "LaserScanOptions: fov must be in (0, 360]");
+          "LidarScanParams: fov must be in (0, 360]");
   require(
       min_elevation_deg < max_elevation_deg && min_elevation_deg >= -90 && max_elevation_deg <= 90,
-      "LaserScanOptions: elevations must satisfy -90 <= min < max <= 90");
+      "LidarScanParams: elevations must satisfy -90 <= min < max <= 90");
   require(range_sigma >= 0 && min_range >= 0 && max_range > min_range,
-          "LaserScanOptions: range_sigma >= 0 and 0 <= min_range < max_range");
+          "LidarScanParams: range_sigma >= 0 and 0 <= min_range < max_range");
   require(dark_albedo > 0 && grazing_limit_deg > 0 && grazing_limit_deg <= 90,
-          "LaserScanOptions: dark_albedo > 0 and grazing_limit_deg in (0, 90]");
+          "LidarScanParams: dark_albedo > 0 and grazing_limit_deg in (0, 90]");
 }
 
-Eigen::Vector3d laser_beam_direction(const LaserScanOptions& o, int column, int row) {
+Eigen::Vector3d laser_beam_direction(const LidarScanParams& o, int column, int row) {
   const double azimuth =
       (-0.5 * o.horizontal_fov_deg + column * o.horizontal_fov_deg / (o.columns - 1)) * kDegree;
   const double elevation =
@@ -42,7 +42,7 @@ Eigen::Vector3d laser_beam_direction(const LaserScanOptions& o, int column, int 
 }
 
 LaserScan scan_laser(const RayCaster& caster, const Eigen::Isometry3d& sensor_to_world,
-                     const LaserScanOptions& options, std::uint64_t seed) {
+                     const LidarScanParams& options, std::uint64_t seed) {
   options.validate();
   const World& world = caster.world();
   LaserScan scan;

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <numbers>
 
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 
 namespace kartograf::synth {
 

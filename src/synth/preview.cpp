@@ -4,7 +4,7 @@
 #include <cmath>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 
 namespace kartograf::synth {
 

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 #include "kartograf/core/error.hpp"
 
@@ -53,6 +54,100 @@ inline bool crosses_box(const double (&b)[2][3], const SlabRay& r, double before
   const double near = std::max(r.enter(b, 0), std::max(r.enter(b, 1), r.enter(b, 2)));
   const double far = std::min(r.leave(b, 0), std::min(r.leave(b, 1), r.leave(b, 2)));
   return near <= far && far > kMinT && near < before;
+}
+
+// A ray's inverse direction for the grid walk: 0 where a component is 0 (flagged in zero).
+struct GridRay {
+  bool zero[3];
+  Eigen::Vector3d inv;
+
+  explicit GridRay(const Eigen::Vector3d& d) {
+    for (int a = 0; a < 3; ++a) {
+      zero[a] = d[a] == 0.0;
+      inv[a] = zero[a] ? 0.0 : 1.0 / d[a];
+    }
+  }
+};
+
+// The nearest surface found so far along a ray.
+struct NearestHit {
+  double t = kInf;
+  int solid = -3;  // -1 floor, -2 ceiling, -3 nothing
+  int axis = 2;    // of the face hit
+};
+
+// Floor and ceiling bound every ray that is not horizontal.
+NearestHit floor_or_ceiling(const Eigen::Vector3d& o, const Eigen::Vector3d& d, const GridRay& r,
+                            double height) {
+  NearestHit hit;
+  if (d.z() < 0 && o.z() > 0) {
+    hit.t = -o.z() * r.inv.z();
+    hit.solid = -1;
+  } else if (d.z() > 0 && o.z() < height) {
+    hit.t = (height - o.z()) * r.inv.z();
+    hit.solid = -2;
+  }
+  return hit;
+}
+
+// The uniform grid over the floor plan: nx by ny cells of size cell from min.
+struct GridFrame {
+  Eigen::Vector2d min;
+  double cell;
+  int nx, ny;
+};
+
+// The part of the ray over the grid: [t_lo, t_hi], empty when t_lo > t_hi.
+std::pair<double, double> span_over_grid(const GridFrame& g, const Eigen::Vector3d& o,
+                                         const GridRay& r) {
+  double t_lo = 0, t_hi = kInf;
+  const Eigen::Vector2d grid_max = g.min + g.cell * Eigen::Vector2d(g.nx, g.ny);
+  for (int a = 0; a < 2; ++a) {
+    if (r.zero[a]) {
+      if (o[a] < g.min[a] || o[a] > grid_max[a]) t_hi = -1;
+      continue;
+    }
+    double t0 = (g.min[a] - o[a]) * r.inv[a], t1 = (grid_max[a] - o[a]) * r.inv[a];
+    if (t0 > t1) std::swap(t0, t1);
+    t_lo = std::max(t_lo, t0);
+    t_hi = std::min(t_hi, t1);
+  }
+  return {t_lo, t_hi};
+}
+
+// Walks the grid cells along the ray from t_lo (a DDA walk): test_cell(c) tests the boxes of cell
+// c and returns the ray parameter of the nearest hit so far. The walk stops at the first cell
+// whose hit lies before the ray leaves it, or where the ray leaves the grid.
+template <class TestCell>
+void walk_cells(const GridFrame& g, const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                const GridRay& r, double t_lo, double t_hi, TestCell&& test_cell) {
+  const Eigen::Vector2d start = o.head<2>() + t_lo * d.head<2>();
+  int cx = std::clamp(static_cast<int>(std::floor((start.x() - g.min.x()) / g.cell)), 0, g.nx - 1);
+  int cy = std::clamp(static_cast<int>(std::floor((start.y() - g.min.y()) / g.cell)), 0, g.ny - 1);
+  const int step_x = d.x() > 0 ? 1 : -1, step_y = d.y() > 0 ? 1 : -1;
+  // Ray parameters of the next cell borders, and between borders.
+  auto next_border = [&](int a, int c, int step) {
+    if (r.zero[a]) return kInf;
+    const double border = g.min[a] + g.cell * (c + (step > 0 ? 1 : 0));
+    return (border - o[a]) * r.inv[a];
+  };
+  double t_next_x = next_border(0, cx, step_x), t_next_y = next_border(1, cy, step_y);
+  const double dt_x = r.zero[0] ? kInf : g.cell * std::fabs(r.inv.x());
+  const double dt_y = r.zero[1] ? kInf : g.cell * std::fabs(r.inv.y());
+  for (;;) {
+    const double best = test_cell(static_cast<std::size_t>(cy) * g.nx + cx);
+    const double t_exit = std::min({t_next_x, t_next_y, t_hi});
+    if (best <= t_exit || t_exit >= t_hi) break;
+    if (t_next_x < t_next_y) {
+      cx += step_x;
+      t_next_x += dt_x;
+      if (cx < 0 || cx >= g.nx) break;
+    } else {
+      cy += step_y;
+      t_next_y += dt_y;
+      if (cy < 0 || cy >= g.ny) break;
+    }
+  }
 }
 
 }  // namespace
@@ -154,99 +249,39 @@ void RayCaster::resolve(SurfaceHit& hit, int solid) const {
 std::optional<SurfaceHit> RayCaster::cast(const Eigen::Vector3d& o,
                                           const Eigen::Vector3d& d) const {
   const SlabRay ray(o, d);
-  bool zero[3];
-  Eigen::Vector3d inv;
-  for (int a = 0; a < 3; ++a) {
-    zero[a] = d[a] == 0.0;
-    inv[a] = zero[a] ? 0.0 : 1.0 / d[a];
-  }
-
-  // Floor and ceiling bound every ray that is not horizontal.
-  double best = kInf;
-  int best_solid = -3;  // -1 floor, -2 ceiling, -3 nothing
-  int best_axis = 2;
-  if (d.z() < 0 && o.z() > 0) {
-    best = -o.z() * inv.z();
-    best_solid = -1;
-  } else if (d.z() > 0 && o.z() < world_.height) {
-    best = (world_.height - o.z()) * inv.z();
-    best_solid = -2;
-  }
-
-  // The part of the ray over the grid.
-  double t_lo = 0, t_hi = kInf;
-  const Eigen::Vector2d grid_max = grid_min_ + cell_ * Eigen::Vector2d(nx_, ny_);
-  for (int a = 0; a < 2; ++a) {
-    if (zero[a]) {
-      if (o[a] < grid_min_[a] || o[a] > grid_max[a]) t_hi = -1;
-      continue;
-    }
-    double t0 = (grid_min_[a] - o[a]) * inv[a], t1 = (grid_max[a] - o[a]) * inv[a];
-    if (t0 > t1) std::swap(t0, t1);
-    t_lo = std::max(t_lo, t0);
-    t_hi = std::min(t_hi, t1);
-  }
-
-  if (t_lo <= t_hi && t_lo < best) {
-    const Eigen::Vector2d start = o.head<2>() + t_lo * d.head<2>();
-    int cx =
-        std::clamp(static_cast<int>(std::floor((start.x() - grid_min_.x()) / cell_)), 0, nx_ - 1);
-    int cy =
-        std::clamp(static_cast<int>(std::floor((start.y() - grid_min_.y()) / cell_)), 0, ny_ - 1);
-    const int step_x = d.x() > 0 ? 1 : -1, step_y = d.y() > 0 ? 1 : -1;
-    // Ray parameters of the next cell borders, and between borders.
-    auto next_border = [&](int a, int c, int step) {
-      if (zero[a]) return kInf;
-      const double border = grid_min_[a] + cell_ * (c + (step > 0 ? 1 : 0));
-      return (border - o[a]) * inv[a];
-    };
-    double t_next_x = next_border(0, cx, step_x), t_next_y = next_border(1, cy, step_y);
-    const double dt_x = zero[0] ? kInf : cell_ * std::fabs(inv.x());
-    const double dt_y = zero[1] ? kInf : cell_ * std::fabs(inv.y());
-    for (;;) {
-      const std::size_t c = static_cast<std::size_t>(cy) * nx_ + cx;
-      for (std::uint32_t i = cell_start_[c]; i < cell_start_[c + 1]; ++i) {
-        const Group& g = groups_[i];
-        if (g.count > 1 && !crosses_box(g.bounds, ray, best)) continue;
-        for (std::uint32_t k = g.first; k < g.first + g.count; ++k) {
-          const Part& part = parts_[k];
-          double t;
-          int axis;
-          if (enter_box(part.bounds, ray, t, axis) && t < best) {
-            best = t;
-            best_solid = part.solid;
-            best_axis = axis;
-          }
-        }
-      }
-      const double t_exit = std::min({t_next_x, t_next_y, t_hi});
-      if (best <= t_exit || t_exit >= t_hi) break;
-      if (t_next_x < t_next_y) {
-        cx += step_x;
-        t_next_x += dt_x;
-        if (cx < 0 || cx >= nx_) break;
-      } else {
-        cy += step_y;
-        t_next_y += dt_y;
-        if (cy < 0 || cy >= ny_) break;
+  const GridRay grid_ray(d);
+  NearestHit best = floor_or_ceiling(o, d, grid_ray, world_.height);
+  const GridFrame grid{grid_min_, cell_, nx_, ny_};
+  const auto [t_lo, t_hi] = span_over_grid(grid, o, grid_ray);
+  const auto test_cell = [&](std::size_t c) {
+    for (std::uint32_t i = cell_start_[c]; i < cell_start_[c + 1]; ++i) {
+      const Group& g = groups_[i];
+      if (g.count > 1 && !crosses_box(g.bounds, ray, best.t)) continue;
+      for (std::uint32_t k = g.first; k < g.first + g.count; ++k) {
+        const Part& part = parts_[k];
+        double t;
+        int axis;
+        if (enter_box(part.bounds, ray, t, axis) && t < best.t) best = {t, part.solid, axis};
       }
     }
-  }
+    return best.t;
+  };
+  if (t_lo <= t_hi && t_lo < best.t) walk_cells(grid, o, d, grid_ray, t_lo, t_hi, test_cell);
 
-  if (best_solid == -3) return std::nullopt;
+  if (best.solid == -3) return std::nullopt;
   SurfaceHit hit;
-  hit.t = best;
-  hit.point = o + best * d;
-  if (best_solid >= 0) {
-    hit.face = make_face(best_axis, d[best_axis] < 0);
+  hit.t = best.t;
+  hit.point = o + best.t * d;
+  if (best.solid >= 0) {
+    hit.face = make_face(best.axis, d[best.axis] < 0);
     // Snap the hit onto the face exactly (the product above rounds).
-    const Box3& box = world_.solids[static_cast<std::size_t>(best_solid)].box;
-    hit.point[best_axis] = d[best_axis] < 0 ? box.max[best_axis] : box.min[best_axis];
+    const Box3& box = world_.solids[static_cast<std::size_t>(best.solid)].box;
+    hit.point[best.axis] = d[best.axis] < 0 ? box.max[best.axis] : box.min[best.axis];
   } else {
-    hit.face = best_solid == -1 ? Face::pos_z : Face::neg_z;
-    hit.point.z() = best_solid == -1 ? 0.0 : world_.height;
+    hit.face = best.solid == -1 ? Face::pos_z : Face::neg_z;
+    hit.point.z() = best.solid == -1 ? 0.0 : world_.height;
   }
-  resolve(hit, best_solid);
+  resolve(hit, best.solid);
   return hit;
 }
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 #include "kartograf/synth/ray_caster.hpp"
 #include "parallel.hpp"
 #include "plane_rasterizer.hpp"
@@ -353,7 +353,7 @@ void NoiseModel::validate() const {
 
 SyntheticFrame render(const World& world, const PinholeIntrinsics& intrinsics,
                       const Eigen::Isometry3d& camera_to_world, const NoiseModel& noise,
-                      std::uint64_t frame_seed, const RenderOptions& options) {
+                      std::uint64_t frame_seed, const RenderParams& options) {
   intrinsics.validate("render");
   noise.validate();
   return FrameRenderer(world, intrinsics, camera_to_world, noise, frame_seed).run(options.threads);

@@ -7,7 +7,7 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 
 namespace kartograf::synth {
 
@@ -166,7 +166,7 @@ class TourPlan {
 // or ends, and changes speed by at most kMaxSpeedChange per frame (a bounded acceleration:
 // continuous velocity, C1 positions). The classic two-pass construction: the pointwise speed
 // limit, then forward and backward passes bounding d(v^2)/du by 2 a, around the closed tour.
-std::vector<double> frames_per_metre(const TourPlan& plan, const TourOptions& options,
+std::vector<double> frames_per_metre(const TourPlan& plan, const TourParams& options,
                                      int& samples) {
   const double length = plan.length();
   samples = std::max(8, static_cast<int>(std::ceil(length / kSampleStep)));
@@ -205,14 +205,14 @@ std::vector<double> frames_per_metre(const TourPlan& plan, const TourOptions& op
 
 }  // namespace
 
-void TourOptions::validate() const {
+void TourParams::validate() const {
   require(camera_height > 0.1 && std::isfinite(camera_height),
-          "TourOptions: camera_height must be > 0.1 m");
-  require(std::fabs(pitch_deg) < 80, "TourOptions: pitch_deg must be within +-80 degrees");
+          "TourParams: camera_height must be > 0.1 m");
+  require(std::fabs(pitch_deg) < 80, "TourParams: pitch_deg must be within +-80 degrees");
   require(look_around_deg >= 0 && look_around_deg <= 90,
-          "TourOptions: look_around_deg must be in [0, 90]");
-  require(max_step > 0 && max_yaw_step_deg > 0, "TourOptions: per-frame limits must be positive");
-  require(frame_rate > 0 && std::isfinite(frame_rate), "TourOptions: frame_rate must be positive");
+          "TourParams: look_around_deg must be in [0, 90]");
+  require(max_step > 0 && max_yaw_step_deg > 0, "TourParams: per-frame limits must be positive");
+  require(frame_rate > 0 && std::isfinite(frame_rate), "TourParams: frame_rate must be positive");
 }
 
 Eigen::Isometry3d camera_pose(const Eigen::Vector3d& position, double yaw, double pitch_down,
@@ -230,7 +230,7 @@ Eigen::Isometry3d camera_pose(const Eigen::Vector3d& position, double yaw, doubl
 }
 
 // Frames the tour needs at the per-frame limits.
-double frames_at_limits(const TourPlan& plan, const TourOptions& options) {
+double frames_at_limits(const TourPlan& plan, const TourParams& options) {
   int samples = 0;
   const std::vector<double> rate = frames_per_metre(plan, options, samples);
   double total = 0;
@@ -238,14 +238,14 @@ double frames_at_limits(const TourPlan& plan, const TourOptions& options) {
   return total;
 }
 
-int tour_frames_needed(const World& world, const TourOptions& options) {
+int tour_frames_needed(const World& world, const TourParams& options) {
   options.validate();
   return static_cast<int>(
              std::ceil(frames_at_limits(TourPlan(world, 0.0, options.survey), options))) +
          1;
 }
 
-Trajectory robot_tour(const World& world, int frame_count, const TourOptions& options) {
+Trajectory robot_tour(const World& world, int frame_count, const TourParams& options) {
   require(frame_count >= 2,
           "robot_tour: needs at least 2 frames, got " + std::to_string(frame_count));
   options.validate();
@@ -314,7 +314,7 @@ std::pair<Eigen::Vector2d, double> most_open_point(const World& world, Label roo
 }
 
 Trajectory handheld(const World& world, Label room, int frame_count, std::uint64_t seed,
-                    const HandheldOptions& options) {
+                    const HandheldParams& options) {
   require(frame_count >= 1, "handheld: needs at least 1 frame");
   require(options.frame_rate > 0, "handheld: frame_rate must be positive");
   const auto [center, clearance] = most_open_point(world, room);

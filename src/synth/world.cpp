@@ -32,7 +32,7 @@ namespace kartograf::synth {
 
 namespace {
 
-using Units = std::int64_t;  // layout coordinates in multiples of BuildingOptions::grid_step
+using Units = std::int64_t;  // layout coordinates in multiples of BuildingParams::grid_step
 
 constexpr double kDoorMargin = 0.35;    // from a doorway's edge to the room's corner
 constexpr double kApproach = 0.5;       // the route is straight this far beyond each wall face
@@ -50,7 +50,7 @@ struct Row {
 
 class LayoutBuilder {
  public:
-  LayoutBuilder(std::uint64_t seed, const BuildingOptions& options) : o_(options), rng_(seed) {
+  LayoutBuilder(std::uint64_t seed, const BuildingParams& options) : o_(options), rng_(seed) {
     w_.seed = seed;
     w_.options = options;
   }
@@ -63,7 +63,7 @@ class LayoutBuilder {
       place_doorways();
       build_route();
       if (o_.tour_frames <= 0 || attempt == kLayoutAttempts - 1 ||
-          tour_frames_needed(w_, TourOptions{}) <= o_.tour_frames) {
+          tour_frames_needed(w_, TourParams{}) <= o_.tour_frames) {
         break;
       }
       w_.rooms.clear();
@@ -486,7 +486,7 @@ class LayoutBuilder {
     w_.route = std::move(simplified);
   }
 
-  const BuildingOptions& o_;
+  const BuildingParams& o_;
   Rng rng_;
   World w_;
   Units t_ = 0, corridor_ = 0, length_ = 0;
@@ -503,34 +503,34 @@ double polygon_area(const std::vector<Eigen::Vector3d>& polygon) {
 
 }  // namespace
 
-void BuildingOptions::validate() const {
+void BuildingParams::validate() const {
   auto range = [](double lo, double hi, const char* name) {
     require(std::isfinite(lo) && std::isfinite(hi) && lo > 0 && lo <= hi,
-            std::string("BuildingOptions: ") + name + " range [" + std::to_string(lo) + ", " +
+            std::string("BuildingParams: ") + name + " range [" + std::to_string(lo) + ", " +
                 std::to_string(hi) + "] is empty or not positive");
   };
   require(room_count >= 1 && room_count <= 10,
-          "BuildingOptions: room_count must be in 1..10, got " + std::to_string(room_count));
+          "BuildingParams: room_count must be in 1..10, got " + std::to_string(room_count));
   range(min_room_side, max_room_side, "room side");
   range(min_ceiling, max_ceiling, "ceiling height");
   range(min_corridor_width, max_corridor_width, "corridor width");
   range(min_door_width, max_door_width, "door width");
   range(min_door_height, max_door_height, "door height");
   range(min_wall_thickness, max_wall_thickness, "wall thickness");
-  require(grid_step > 0 && grid_step <= 0.1, "BuildingOptions: grid_step must be in (0, 0.1] m");
-  require(min_room_side >= 2.5, "BuildingOptions: rooms need sides of at least 2.5 m");
-  require(min_corridor_width >= 1.2, "BuildingOptions: the corridor must be at least 1.2 m wide");
+  require(grid_step > 0 && grid_step <= 0.1, "BuildingParams: grid_step must be in (0, 0.1] m");
+  require(min_room_side >= 2.5, "BuildingParams: rooms need sides of at least 2.5 m");
+  require(min_corridor_width >= 1.2, "BuildingParams: the corridor must be at least 1.2 m wide");
   require(0.4 * min_room_side >= kDoorMargin + 0.5 * max_door_width,
-          "BuildingOptions: doorways of max_door_width do not fit rooms of min_room_side");
+          "BuildingParams: doorways of max_door_width do not fit rooms of min_room_side");
   require(min_door_width >= 0.8,
-          "BuildingOptions: doorways narrower than 0.8 m do not let the robot pass");
+          "BuildingParams: doorways narrower than 0.8 m do not let the robot pass");
   require(max_door_height + 0.2 <= min_ceiling,
-          "BuildingOptions: doorways must be at least 0.2 m lower than the ceiling");
+          "BuildingParams: doorways must be at least 0.2 m lower than the ceiling");
   require(min_furniture >= 0 && min_furniture <= max_furniture && max_furniture <= 12,
-          "BuildingOptions: furniture count range must satisfy 0 <= min <= max <= 12");
+          "BuildingParams: furniture count range must satisfy 0 <= min <= max <= 12");
   require(door_leaf_probability >= 0 && door_leaf_probability <= 1,
-          "BuildingOptions: door_leaf_probability must be in [0, 1]");
-  require(tour_frames >= 0, "BuildingOptions: tour_frames must be >= 0");
+          "BuildingParams: door_leaf_probability must be in [0, 1]");
+  require(tour_frames >= 0, "BuildingParams: tour_frames must be >= 0");
 }
 
 std::string to_string(FurnitureKind kind) {
@@ -652,7 +652,7 @@ std::vector<Rect2> World::obstacle_footprints() const {
   return footprints;
 }
 
-World make_building(std::uint64_t seed, const BuildingOptions& options) {
+World make_building(std::uint64_t seed, const BuildingParams& options) {
   options.validate();
   return LayoutBuilder(seed, options).build();
 }

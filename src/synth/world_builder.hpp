@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "kartograf/synth/random.hpp"
+#include "kartograf/core/random.hpp"
 #include "kartograf/synth/world.hpp"
 
 namespace kartograf::synth::detail {

@@ -32,7 +32,7 @@ struct DeviceLimits {
   bool fp64 = false;
   bool int64 = false;  // 64-bit integers in kernels
   bool int64_atomics = false;
-  bool device_timestamps = false;  // kernels can be timed on the device (ContextOptions::profile)
+  bool device_timestamps = false;  // kernels can be timed on the device (ContextParams::profile)
 };
 
 // One line: "work-group 1024, shared 48 KiB, subgroup 32, fp64 yes, ..." (unknown values left out).

@@ -11,7 +11,7 @@
 
 namespace kartograf::compute {
 
-// One device command as the device timed it (ContextOptions::profile).
+// One device command as the device timed it (ContextParams::profile).
 struct DeviceTiming {
   std::string command;  // the kernel's name, or "upload", "download", "copy", "fill"
   double milliseconds = 0;
@@ -21,7 +21,7 @@ namespace detail {
 class Device;
 }
 
-struct ContextOptions {
+struct ContextParams {
   BackendChoice backend = BackendChoice::automatic;
   // Index into the backend's usable devices (the CPU backend has one: 0); empty: the best one
   // (discrete > integrated > other). With `automatic`, an index into the backend it takes.
@@ -37,7 +37,7 @@ struct ContextOptions {
 
   // KARTOGRAF_BACKEND=auto|cpu|vulkan|opencl, KARTOGRAF_DEVICE=<index>,
   // KARTOGRAF_VULKAN_VALIDATION=1.
-  static ContextOptions from_environment();
+  static ContextParams from_environment();
   // Only KARTOGRAF_DEVICE and KARTOGRAF_VULKAN_VALIDATION, for callers that choose the backend
   // themselves (the CLI's --backend). Throws Error naming the variable and its value when
   // KARTOGRAF_DEVICE is not a device index.
@@ -47,7 +47,7 @@ struct ContextOptions {
 class Context {
  public:
   // Throws Error naming the backend and why it cannot be used (no loader, no driver, no device...).
-  explicit Context(const ContextOptions& options);
+  explicit Context(const ContextParams& options);
   // The backend named by KARTOGRAF_BACKEND (automatic when unset).
   static Context from_environment();
   static Context cpu();
@@ -58,6 +58,7 @@ class Context {
 
   BackendKind backend() const;
   const DeviceInfo& device_info() const;
+  // For the compute layer and tests only: operations dispatch the same way on every backend.
   bool is_cpu() const { return backend() == BackendKind::cpu; }
 
   // Waits until every dispatched operation has finished.
@@ -67,19 +68,18 @@ class Context {
   // Vulkan with validation on: messages of severity error so far. Zero elsewhere.
   std::uint64_t validation_errors() const;
   bool validation_active() const;
-  // With ContextOptions::profile: every command completed since the last call, in issue order
+  // With ContextParams::profile: every command completed since the last call, in issue order
   // (waits for what is pending). Empty on the CPU backend or without profiling.
   std::vector<DeviceTiming> take_device_timings() const;
 
-  // For operations' device paths (see compute/kernel.hpp). Null on the CPU backend.
-  detail::Device* device() const { return device_.get(); }
+  // The backend's device, for compute/kernel.hpp's dispatch (every backend has one).
+  detail::Device* device() const { return &checked_device(); }
 
  private:
   friend class RawBuffer;
   std::shared_ptr<detail::Device> shared_device() const { return device_; }
-  Context();
+  detail::Device& checked_device() const;
   std::shared_ptr<detail::Device> device_;
-  DeviceInfo cpu_info_;
 };
 
 }  // namespace kartograf::compute

@@ -30,7 +30,7 @@
 
 namespace kartograf::eval {
 
-struct SegCompOptions {
+struct SegCompParams {
   double threshold = 0.8;  // T; the paper reports 0.51 ... 0.95, and 0.8 in most tables
 };
 
@@ -51,11 +51,11 @@ struct SegCompResult {
 
 SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
                                           const LabelImage& predicted,
-                                          const SegCompOptions& options = {});
+                                          const SegCompParams& options = {});
 
 SegCompResult compare_plane_segmentations(const LabelImage& ground_truth,
                                           const LabelImage& predicted,
-                                          const SegCompOptions& options,
+                                          const SegCompParams& options,
                                           const PlaneNormals& ground_truth_normals,
                                           const PlaneNormals& predicted_normals);
 

@@ -34,7 +34,7 @@
 
 namespace kartograf::eval {
 
-struct RoomEvaluationOptions {
+struct RoomEvaluationParams {
   int min_region_pixels = 101;  // smaller regions are ignored by recall/precision (ipa: > 100)
 };
 
@@ -55,6 +55,6 @@ struct RoomSegmentationScores {
 // Throws Error if the images differ in size or the ground truth has no room of min_region_pixels.
 RoomSegmentationScores evaluate_room_segmentation(const LabelImage& ground_truth,
                                                   const LabelImage& segmentation,
-                                                  const RoomEvaluationOptions& options = {});
+                                                  const RoomEvaluationParams& options = {});
 
 }  // namespace kartograf::eval

@@ -17,7 +17,7 @@
 
 namespace kartograf::eval {
 
-struct SemanticEvaluationOptions {
+struct SemanticEvaluationParams {
   bool include_unknown_ground_truth = false;
 };
 
@@ -34,6 +34,6 @@ struct SemanticScores {
 // Throws Error on different sizes, a pixel value that is no SemanticClass, or no pixel to evaluate.
 SemanticScores evaluate_semantic_segmentation(const SemanticImage& ground_truth,
                                               const SemanticImage& predicted,
-                                              const SemanticEvaluationOptions& options = {});
+                                              const SemanticEvaluationParams& options = {});
 
 }  // namespace kartograf::eval

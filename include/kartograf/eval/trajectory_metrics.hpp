@@ -82,7 +82,7 @@ AteResult compute_ate(const MatchedPoses& poses, Alignment alignment);
 
 enum class DeltaUnit { frames, seconds };
 
-struct RpeOptions {
+struct RpeParams {
   double delta = 1;  // frames (a positive whole number) or seconds (> 0)
   DeltaUnit unit = DeltaUnit::frames;
 };
@@ -92,7 +92,7 @@ struct RpeResult {
   ErrorStatistics rotation_deg;
 };
 // Throws Error when no pair is delta apart (or, for seconds, the timestamps are not increasing).
-RpeResult compute_rpe(const MatchedPoses& poses, const RpeOptions& options);
+RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options);
 
 // ATE with the given alignment, and RPE on the estimate that alignment moved.
 struct TrajectoryEvaluation {
@@ -100,6 +100,6 @@ struct TrajectoryEvaluation {
   RpeResult rpe;
 };
 TrajectoryEvaluation evaluate_trajectory(const MatchedPoses& poses, Alignment alignment,
-                                         const RpeOptions& rpe_options);
+                                         const RpeParams& rpe_options);
 
 }  // namespace kartograf::eval

@@ -46,8 +46,8 @@ struct SegmentMomentSet {
   Eigen::Matrix3d covariance(std::uint32_t label) const;
 };
 
-// The reducer's fixed-point arithmetic for host code that visits a segment's points itself (the
-// region growing sums moments as it grows): the same integers as every backend's reduction.
+// The reducer's fixed-point scales (its terms are those of kernels/segment_moments), and the
+// moments its integer sums stand for.
 class FixedPointMoments {
  public:
   using Sums = std::array<std::int64_t, 10>;  // count, sum d (3), sum d d^T (xx xy xz yy yz zz)
@@ -55,43 +55,12 @@ class FixedPointMoments {
   // point_count: the length of the cloud the labels cover (it sets the fixed-point scales).
   FixedPointMoments(std::size_t point_count, const SegmentMomentParams& params);
 
-  // Adds a valid point; false (nothing added) when it lies beyond max_offset.
-  bool add(const Point4f& p, Sums& sums) const {
-    const double dx = static_cast<double>(p.x()) - origin_.x();
-    const double dy = static_cast<double>(p.y()) - origin_.y();
-    const double dz = static_cast<double>(p.z()) - origin_.z();
-    if (std::fabs(dx) > bound_ || std::fabs(dy) > bound_ || std::fabs(dz) > bound_) return false;
-    sums[0] += 1;
-    sums[1] += to_fixed(dx, first_scale_);
-    sums[2] += to_fixed(dy, first_scale_);
-    sums[3] += to_fixed(dz, first_scale_);
-    sums[4] += to_fixed(dx * dx, second_scale_);
-    sums[5] += to_fixed(dx * dy, second_scale_);
-    sums[6] += to_fixed(dx * dz, second_scale_);
-    sums[7] += to_fixed(dy * dy, second_scale_);
-    sums[8] += to_fixed(dy * dz, second_scale_);
-    sums[9] += to_fixed(dz * dz, second_scale_);
-    return true;
-  }
   SegmentMoments moments(const Sums& sums) const;
 
   float first_scale() const { return static_cast<float>(first_scale_); }
   float second_scale() const { return static_cast<float>(second_scale_); }
 
  private:
-  // Round half to even, as the kernels round, inline: adding and subtracting 1.5 * 2^52 rounds
-  // any |v| < 2^51 to an integer in double arithmetic; larger values (tiny clouds) take nearbyint.
-  static std::int64_t to_fixed(double value, double scale) {
-    constexpr double kRoundingShift = 6755399441055744.0;  // 1.5 * 2^52
-    const double v = value * scale;
-    if (std::fabs(v) < 2251799813685248.0) {  // 2^51
-      return static_cast<std::int64_t>((v + kRoundingShift) - kRoundingShift);
-    }
-    return static_cast<std::int64_t>(std::nearbyint(v));
-  }
-
-  Eigen::Vector3d origin_;
-  double bound_;
   double first_scale_;
   double second_scale_;
 };

@@ -18,8 +18,9 @@
 // by a float ulp: centroids agree with the CPU backend within 1e-6 m (|coordinates| < 8 m), normals
 // within 1e-6, colours exactly; against an all-double reference within the same bounds.
 //
-// Device path: six passes (hash insert, per-thread counts, scan, numbering in first-point order,
-// fixed-point accumulation, finalisation) and one wait, for the voxel count.
+// Every backend, the CPU included, runs the six passes of kernels/voxel_downsample (hash insert,
+// per-thread counts, scan, numbering in first-point order, fixed-point accumulation,
+// finalisation) and waits once, for the voxel count.
 #include <cstdint>
 
 #include "kartograf/compute/buffer.hpp"

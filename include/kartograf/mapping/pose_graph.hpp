@@ -32,7 +32,7 @@ struct PoseGraph {
   }
 };
 
-struct PoseGraphOptions {
+struct PoseGraphParams {
   int max_iterations = 100;
   double initial_lambda = 1e-6;            // relative to the diagonal of J^T J
   double relative_cost_tolerance = 1e-10;  // stop when a step improves the cost by less
@@ -55,7 +55,7 @@ struct PoseGraphSummary {
 
 // Optimises graph.poses in place; pruned edges are removed from graph.edges. Throws Error on an
 // edge naming a missing node, a non-finite measurement or information matrix, or an empty graph.
-PoseGraphSummary optimize_pose_graph(PoseGraph& graph, const PoseGraphOptions& options = {});
+PoseGraphSummary optimize_pose_graph(PoseGraph& graph, const PoseGraphParams& options = {});
 
 // chi^2 = e^T Omega e of one edge at the current poses, e = log(Z^-1 T_i^-1 T_j).
 double edge_chi2(const PoseGraph& graph, const PoseGraphEdge& edge);

@@ -44,13 +44,13 @@ struct LoopConsistency {
 // ICP's information describes random errors, and odometry also drifts systematically, so a
 // correct loop closing 8 cm of drift would otherwise look like an outlier. Inconsistent ones are
 // removed by LoopConsistency instead.
-PoseGraphOptions slam_graph_options();
+PoseGraphParams slam_graph_options();
 
 struct SlamParams {
   registration::OdometryParams odometry;
   bool loop_closure = true;
   LoopClosureParams loops;
-  PoseGraphOptions graph = slam_graph_options();
+  PoseGraphParams graph = slam_graph_options();
   LoopConsistency consistency;
   bool build_map = true;
   MapFusionParams map;

@@ -49,9 +49,9 @@ struct MapPipelineParams {
   semantic::LabellingParams labelling;  // gravity.prior_up defaults to the camera's -y
   segmentation::PlaneExtractionParams planes = view_plane_params();
   mapping::PlaneMapParams plane_map;
-  semantic::SemanticGridOptions grid;
+  semantic::SemanticGridParams grid;
   rooms::RoomMethod room_method = rooms::RoomMethod::distance;
-  rooms::RoomMethodOptions rooms;
+  rooms::RoomMethodParams rooms;
   bool rooms_end_at_doorways = true;  // doorway cells count as occupied for the segmentation
   // Rooms take the unlabelled cells their walls and doorways enclose: furniture, floor the views
   // missed (rooms::extend_rooms_over_enclosed). Off: rooms cover observed free floor only.

@@ -18,8 +18,9 @@
 // backend makes the same decision for every pair. Against unquantised H and S the decisions differ
 // only for pairs within the table's quantisation (0.7 deg, 0.002) of the threshold.
 //
-// Device path: a pass writes per-pair differences and per-work-group partial sums, reduce_rows adds
-// the partials (two passes, no atomics: as icp_sums.hpp), a third pass applies the gate. The table
+// Passes, on every backend (rule and kernels: kernels/color_gate/): a pass writes per-pair
+// differences and per-work-group partial sums, reduce_rows adds the partials (two passes, no
+// atomics: as icp_sums.hpp), a third pass applies the gate. The table
 // (32 MiB) is uploaded once per ColorGate. Nothing is read back unless statistics() is called.
 #include <cstdint>
 #include <memory>
@@ -63,12 +64,11 @@ class ColorGate {
  private:
   const compute::Context* context_;
   ColorGateParams params_;
-  compute::Buffer<HsiCode> table_;              // device only: hsi_table(), uploaded on first use
+  compute::Buffer<HsiCode> table_;              // hsi_table(), uploaded on first use
   compute::Buffer<std::uint32_t> differences_;  // per source point: flags | dH << 8 | dS << 16
   compute::Buffer<double> partials_;
   compute::Buffer<double> sums_;  // pairs, sum dS, hue pairs, sum dH
   compute::Buffer<std::uint32_t> rejected_;
-  ColorGateStatistics host_statistics_;  // CPU backend
 };
 
 // A finder that gates another finder's pairs by colour. Both clouds need colours.

@@ -56,11 +56,8 @@ struct AssociationParams {
 
 // Uniform 1-in-k selection: point i of a cloud whose rows are `width` points long (0: unorganized)
 // is selected when (i + row) % k == 0, so an organized frame gets a diagonal lattice rather than
-// every k-th column. Shared by every finder (and mirrored in the projective association kernel).
-inline bool is_selected(std::uint32_t i, std::uint32_t width, std::uint32_t k) {
-  const std::uint32_t row = width == 0 ? 0 : i / width;
-  return (i + row) % k == 0;
-}
+// every k-th column. Shared by every finder: the rule is kernels/correspondence/selection.h.
+bool is_selected(std::uint32_t i, std::uint32_t width, std::uint32_t k);
 
 struct CorrespondenceBuffers {
   compute::Buffer<std::int32_t> target_index;

@@ -43,8 +43,6 @@ class DepthWeightedFinder : public CorrespondenceFinder {
   std::unique_ptr<CorrespondenceFinder> inner_;
   DepthWeightParams params_;
   bool stale_ = true;  // prepare() was called: the next find() writes the weights
-  std::vector<Point4f> host_points_;
-  std::vector<float> host_weights_;
 };
 
 }  // namespace kartograf::registration

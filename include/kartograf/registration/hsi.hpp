@@ -52,15 +52,6 @@ std::span<const HsiCode> hsi_table();
 inline HsiCode hsi_lookup(std::span<const HsiCode> table, std::uint32_t packed_rgb) {
   return table[packed_rgb & 0xffffffu];
 }
-
-// Circular distance of two hue codes (0..127, in bins of 360/255 deg) and distance of two
-// saturation codes (0..255): the per-pair differences of the colour gate.
-inline std::uint32_t hue_code_distance(std::uint32_t a, std::uint32_t b) {
-  const std::uint32_t d = a > b ? a - b : b - a;
-  return d < kHueCodes - d ? d : kHueCodes - d;
-}
-inline std::uint32_t saturation_code_distance(std::uint32_t a, std::uint32_t b) {
-  return a > b ? a - b : b - a;
-}
+// The colour gate's distances of two codes are its kernel rule's (kernels/color_gate/color_gate.h).
 
 }  // namespace kartograf::registration

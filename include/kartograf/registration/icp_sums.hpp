@@ -81,7 +81,7 @@ class IcpReduction {
 
  private:
   const compute::Context* context_;
-  compute::Buffer<double> frame_;     // R, t, pivots, max distance^2
+  compute::Buffer<double> frame_;     // R, t, pivots, max distance^2, robust scale
   compute::Buffer<double> partials_;  // one row per work-group
   compute::Buffer<double> result_;    // the final row
 };

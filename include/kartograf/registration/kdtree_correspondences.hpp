@@ -88,9 +88,6 @@ class KdTreeCorrespondences : public CorrespondenceFinder {
   KdTreeParams params_;
   std::optional<KdTree> tree_;
   const compute::Buffer<Point4f>* built_for_ = nullptr;
-  std::vector<Point4f> target_normals_;  // host copy (device contexts)
-  std::vector<Point4f> source_points_, source_normals_;
-  std::vector<std::int32_t> result_;
 };
 
 }  // namespace kartograf::registration

@@ -46,15 +46,11 @@ class VoxelHashCorrespondences : public CorrespondenceFinder {
   double cell_size_ = 0;
   std::size_t cell_count_ = 0;
   unsigned capacity_log2_ = 0;
-  // The grid; host vectors on the CPU backend, device buffers elsewhere.
-  std::vector<std::uint64_t> host_keys_;     // per slot: cell key, 0 = empty
-  std::vector<std::uint32_t> host_ranges_;   // per slot: first, count (into the sorted points)
-  std::vector<Point4f> host_points_;         // target points sorted by cell
-  std::vector<std::uint32_t> host_indices_;  // their indices in the target
-  compute::Buffer<std::uint64_t> keys_;
-  compute::Buffer<std::uint32_t> ranges_;
-  compute::Buffer<Point4f> points_;
-  compute::Buffer<std::uint32_t> indices_;
+  // The grid.
+  compute::Buffer<std::uint64_t> keys_;     // per slot: cell key, 0 = empty
+  compute::Buffer<std::uint32_t> ranges_;   // per slot: first, count (into the sorted points)
+  compute::Buffer<Point4f> points_;         // target points sorted by cell
+  compute::Buffer<std::uint32_t> indices_;  // their indices in the target
   compute::Buffer<double> frame_;
 };
 

@@ -88,9 +88,10 @@ struct ClassifierTrainingParams {
   LaserFeatureParams features;
 };
 
-// Trains on the labelled free cells of the maps. Throws Error when a class has no sample or the
-// maps are bad (naming the map).
-RoomClassifier train_room_classifier(const std::vector<RoomTrainingMap>& maps,
+// Trains on the labelled free cells of the maps, their scans run on `context`. Throws Error when a
+// class has no sample or the maps are bad (naming the map).
+RoomClassifier train_room_classifier(const compute::Context& context,
+                                     const std::vector<RoomTrainingMap>& maps,
                                      const ClassifierTrainingParams& params = {});
 
 struct FeatureSegmentationParams {
@@ -107,11 +108,10 @@ struct FeatureSegmentationParams {
 };
 
 // The class of every free cell (none elsewhere), as the segmentation sees it. The laser scans run
-// on `context` when it is a device backend (laser_scan_device.hpp; identical scans), else (null
-// included) on the CPU's threads.
-Image<PlaceClass> classify_places(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                  const FeatureSegmentationParams& params = {},
-                                  const compute::Context* context = nullptr);
+// on `context` (laser_scan_device.hpp; identical scans on every backend).
+Image<PlaceClass> classify_places(const compute::Context& context, const OccupancyGrid& map,
+                                  const RoomClassifier& classifier,
+                                  const FeatureSegmentationParams& params = {});
 
 // The classifier shipped with Kartograf (models/rooms/room_hallway_boost.yml.gz, trained by
 // tools/train_room_classifier on ipa_room_segmentation's training maps): $KARTOGRAF_ROOM_MODEL
@@ -120,8 +120,8 @@ std::filesystem::path default_room_classifier_path();
 
 // Throws Error for a map without free cells, a resolution <= 0, bad limits, a stride < 1 or an
 // empty classifier.
-RoomSegmentation segment_feature_based(const OccupancyGrid& map, const RoomClassifier& classifier,
-                                       const FeatureSegmentationParams& params = {},
-                                       const compute::Context* context = nullptr);
+RoomSegmentation segment_feature_based(const compute::Context& context, const OccupancyGrid& map,
+                                       const RoomClassifier& classifier,
+                                       const FeatureSegmentationParams& params = {});
 
 }  // namespace kartograf::rooms

@@ -7,8 +7,8 @@
 // Work split: one work-item per (cell, beam) on a GPU; on the CPU-hosted drivers (lavapipe, PoCL)
 // one work-item per cell with a loop over its beams, which measured as fast or faster there
 // (bench/laser_scan_bench.cpp; office_e, 80k cells: lavapipe 1.56 s vs 1.64 s, PoCL 1.3-2.2 s vs
-// 2.3 s). The CPU backend runs LaserScanner's loop on KARTOGRAF_CPU_THREADS threads
-// (src/compute/cpu_parallel.hpp).
+// 2.3 s), and on the CPU backend (its kernel, kernels/laser_scan/, runs chunks of cells on
+// KARTOGRAF_CPU_THREADS threads, src/compute/cpu_parallel.hpp).
 #include <cstdint>
 #include <span>
 #include <vector>

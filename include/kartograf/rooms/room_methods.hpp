@@ -23,7 +23,7 @@ std::string to_string(RoomMethod method);
 RoomMethod parse_room_method(const std::string& name);
 const std::vector<RoomMethod>& all_room_methods();
 
-struct RoomMethodOptions {
+struct RoomMethodParams {
   std::optional<AreaLimits> room_area;  // else the method's own default
   // Segment the map without its furniture (furniture.hpp), then give the furniture's cells no
   // room: the rooms stay whole where tables and chairs stand. Empty: segment the map as it is
@@ -32,11 +32,11 @@ struct RoomMethodOptions {
   // feature, vrf: the trained model (default_room_classifier_path() or default_vrf_model_path()
   // when empty).
   std::filesystem::path model;
-  // feature: the backend its laser scans run on (null: the CPU's threads). Not owned.
-  const compute::Context* context = nullptr;
 };
 
-RoomSegmentation segment_rooms(const OccupancyGrid& map, RoomMethod method,
-                               const RoomMethodOptions& options = {});
+// `context`: the backend the feature method's laser scans run on (the other methods run on the
+// host).
+RoomSegmentation segment_rooms(const compute::Context& context, const OccupancyGrid& map,
+                               RoomMethod method, const RoomMethodParams& options = {});
 
 }  // namespace kartograf::rooms

@@ -1,6 +1,6 @@
 #pragma once
 // Plane extraction from one organized RGB-D frame, docs/methods.md M1 steps 2-4: Lab region growing
-// (over-segmentation), per-segment moments on the context's backend and plane fits, merging of
+// (over-segmentation) with per-segment moments on the context's backend and plane fits, merging of
 // neighbouring segments, and the output planes with a per-pixel plane id image.
 #include <cstdint>
 #include <vector>
@@ -56,8 +56,8 @@ struct Plane {
 
 struct PlaneExtractionTimings {  // milliseconds, host wall clock
   double lab = 0;
-  double growing = 0;  // CPU backend: with the moments, summed as the segments grow
-  double moments = 0;  // device backends: the moment reduction
+  double growing = 0;  // with the moments, summed as the segments grow
+  double moments = 0;  // (0: the moments are summed by the growing)
   double merging = 0;
   double refinement = 0;  // border pixels, growth into left-over pixels, left-over planes
   double output = 0;      // plane records and the label image
@@ -96,15 +96,20 @@ class PlaneExtractor {
   const compute::Context* context_;
   PinholeIntrinsics intrinsics_;
   PlaneExtractionParams params_;
+  // Grows the frame's segments (segments_, statistics_' colours) with their moments about
+  // moments.origin; returns the segment count.
+  std::uint32_t grow_segments(const PointImage& points, geometry::SegmentMomentSet& moments);
+  // pixel_plane_: each pixel's merged plane, refined (params_.refine_pixels).
+  void assign_pixels(const PointImage& points, MergedPlanes& merged);
+
   RegionGrower grower_;
-  SegmentPlaneFitter fitter_;
-  compute::Buffer<Point4f> points_;          // device backends: the frame's points
+  compute::Buffer<Point4f> points_;          // the frame's points on the context
   LabCodeImage lab_;                         // the frame's colours (host)
   SegmentLabelImage segments_;               // the frame's segments (host)
   std::vector<std::uint32_t> pixel_plane_;   // scratch: merged plane per pixel
   std::vector<std::uint32_t> flood_queue_;   // scratch: pixels to grow planes from
   std::vector<std::uint8_t> flood_sources_;  // scratch: which pixels start the growth
-  SegmentStatistics statistics_;             // scratch: colours (and CPU: moments) per segment
+  SegmentStatistics statistics_;             // scratch: colours and moments per segment
 };
 
 }  // namespace kartograf::segmentation

@@ -14,7 +14,8 @@
 // what makes the growing parallel: each tile is the paper's sequential growing on its own, so
 // tiles run on separate CPU threads, or one GPU work-item each (Vulkan, OpenCL; tiles of at most
 // kMaxDeviceTileSize pixels), with the same labels as the sequential scan of the tiles. Without
-// tiles (the paper) the device backends grow on the host.
+// tiles (the paper), or with larger ones, RegionGrower grows on the host. The passes (one rule,
+// one wrapper per backend) are in kernels/region_grow/.
 #include <cstdint>
 #include <vector>
 
@@ -47,12 +48,12 @@ struct RegionGrowingParams {
   void validate() const;  // throws Error naming the first bad field
 };
 
-// What the CPU growing also measures of each segment as it grows (one pass for all).
+// What the growing also measures of each segment as it grows (one pass for all).
 struct SegmentStatistics {
   std::vector<Eigen::Vector3f> colours;  // mean Lab colour
-  // With a moments origin: each segment's moments about it, summed in double in the order the
-  // segment grew (so the same for any thread count; within rounding of the fixed-point sums of
-  // geometry::SegmentMomentReducer, which the device backends use).
+  // With a moments origin (rounded to float): each segment's moments about it, summed in double
+  // in the order the segment grew (so the same for any thread count; within rounding of the
+  // fixed-point sums of geometry::SegmentMomentReducer).
   std::vector<geometry::SegmentMoments> moments;
 };
 
@@ -79,21 +80,25 @@ class RegionGrower {
   explicit RegionGrower(const compute::Context& context);
 
   // lab (host) and points (on this context, row-major) are width x height. Returns the segment
-  // count; one host wait on device backends. colours as in grow_regions (on device backends, a
-  // pass over the downloaded labels). Throws Error on a size mismatch or bad parameters.
+  // count; one host wait. colours as in grow_regions. Throws Error on a size mismatch or bad
+  // parameters.
   std::uint32_t grow(const LabCodeImage& lab, const compute::Buffer<Point4f>& points,
                      const RegionGrowingParams& params,
                      std::vector<Eigen::Vector3f>* colours = nullptr);
+  // The same with statistics (and moments about moments_origin) as grow_regions measures them:
+  // the same values on every backend, up to the devices' double rounding of the moments.
+  std::uint32_t grow(const LabCodeImage& lab, const compute::Buffer<Point4f>& points,
+                     const RegionGrowingParams& params, SegmentStatistics* statistics,
+                     const Eigen::Vector3d* moments_origin);
 
   // The labels of the last grow(), on the device, and as an image.
   const compute::Buffer<std::uint32_t>& labels() const { return labels_; }
   SegmentLabelImage download_labels() const;
-  // Device backends: the labels of the last grow(), downloaded by it.
-  const SegmentLabelImage& host_labels() const { return host_labels_; }
 
  private:
-  std::uint32_t grow_on_device(const LabCodeImage& lab, const compute::Buffer<Point4f>& points,
-                               const RegionGrowingParams& params);
+  std::uint32_t grow_tiles(const LabCodeImage& lab, const compute::Buffer<Point4f>& points,
+                           const RegionGrowingParams& params, SegmentStatistics* statistics,
+                           const Eigen::Vector3d* moments_origin);
 
   const compute::Context* context_;
   int width_ = 0;
@@ -103,7 +108,11 @@ class RegionGrower {
   compute::Buffer<std::uint32_t> tile_counts_;  // segments per tile, then their prefix sums
   compute::Buffer<std::uint32_t> stacks_;       // one growing stack per tile
   compute::Buffer<std::uint32_t> status_;       // [0]: segment count, [1]: stack overflows
-  SegmentLabelImage host_labels_;               // device backends: the downloaded labels
+  compute::Buffer<double> slots_;               // measuring: statistics per (tile, segment)
+  compute::Buffer<double> statistics_;          // measuring: statistics in label order
+  std::vector<double> host_statistics_;         // scratch: the statistics downloaded
+  std::vector<Point4f> host_points_;            // untiled: the points grown on the host
+  std::vector<std::uint32_t> host_labels_;      // untiled: the labels grown on the host
 };
 
 }  // namespace kartograf::segmentation

@@ -2,7 +2,7 @@
 // A trained Haar cascade (haar_cascade.hpp) run on organized views as it was trained, and its
 // detections turned into objects of the hybrid map (semantic_grid.hpp: ObjectDetection).
 //
-// A view's grey normals image is made as for training (synthetic_stairs.hpp: absolute encoding,
+// A view's grey normals image is made as for training (training/synthetic_stairs.hpp: absolute encoding,
 // 5x5 smoothing); views wider than max_width are halved first (every other pixel), so that a
 // 640x480 camera frame looks like the 320x240 training views. Detections are kept when their
 // metric size (measure_detection) fits the class; each carries the points of its box's central
@@ -32,6 +32,10 @@ struct ViewDetection {
   Detection box;                        // in the view's pixels
   std::vector<Eigen::Vector3d> points;  // its central half's valid points, view frame
 };
+
+// Metric sizes a flight of stairs can have as measured by measure_detection on the square box of
+// a detection (which also covers some wall or floor around it).
+SizeLimits stairs_size_limits();
 
 class ObjectDetector {
  public:

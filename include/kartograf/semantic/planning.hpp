@@ -19,7 +19,7 @@
 
 namespace kartograf::semantic {
 
-struct PlannerOptions {
+struct PlannerParams {
   double robot_radius = 0.20;      // cells whose centre is within this of an obstacle's are blocked
   float unobserved_weight = 0.0f;  // weight of unobserved cells (0: never drive into the unknown)
 
@@ -36,7 +36,7 @@ struct PlannedPath {
 
 // The weights the planner uses: unobserved cells get unobserved_weight, then every cell within
 // robot_radius of a weight-0 cell becomes 0.
-Image<float> planning_weights(const SemanticGrid& grid, const PlannerOptions& options = {});
+Image<float> planning_weights(const SemanticGrid& grid, const PlannerParams& options = {});
 
 // A* on a weight image (values in [0, 1], 0 impassable) with cells `resolution` metres apart.
 // is_goal says which cells end the search; heuristic must not overestimate the remaining cost
@@ -50,9 +50,9 @@ PlannedPath plan_on_weights(const Image<float>& weights, double resolution,
 
 // Point to point, on planning_weights(grid, options).
 PlannedPath plan_path(const SemanticGrid& grid, const Eigen::Vector2d& start,
-                      const Eigen::Vector2d& goal, const PlannerOptions& options = {});
+                      const Eigen::Vector2d& goal, const PlannerParams& options = {});
 
-struct DoorQueryOptions {
+struct DoorQueryParams {
   double arrival_radius = 0.35;  // the path ends within this of the door's centre [m]
   bool doorways_only = true;     // openings, not door leaves standing against a wall
 };
@@ -60,10 +60,10 @@ struct DoorQueryOptions {
 // target_object. Throws Error when the map has no door, "goal unreachable: ..." when none can be
 // reached.
 PlannedPath plan_to_nearest_door(const SemanticGrid& grid, const Eigen::Vector2d& start,
-                                 const DoorQueryOptions& query = {},
-                                 const PlannerOptions& options = {});
+                                 const DoorQueryParams& query = {},
+                                 const PlannerParams& options = {});
 
-struct WallQueryOptions {
+struct WallQueryParams {
   double offset = 0.5;        // metres from the wall line, on the robot's side
   double keep_weight = 0.25;  // cells off the offset line are this much slower at 1 m off it
   double arrival_radius = 0.3;
@@ -73,8 +73,8 @@ struct WallQueryOptions {
 // min_wall_length), kept at `offset`
 // from the wall's line (leaving it only around obstacles). The wall's id in target_object.
 PlannedPath plan_along_nearest_wall(const SemanticGrid& grid, const Eigen::Vector2d& start,
-                                    const WallQueryOptions& query = {},
-                                    const PlannerOptions& options = {});
+                                    const WallQueryParams& query = {},
+                                    const PlannerParams& options = {});
 
 // The centre of the passable cell (after inflating by the robot radius) nearest to `point`
 // within `max_distance` [m]: where a robot standing on unobserved ground (a scanner cannot see the
@@ -82,7 +82,7 @@ PlannedPath plan_along_nearest_wall(const SemanticGrid& grid, const Eigen::Vecto
 std::optional<Eigen::Vector2d> nearest_passable_point(const SemanticGrid& grid,
                                                       const Eigen::Vector2d& point,
                                                       double max_distance,
-                                                      const PlannerOptions& options = {});
+                                                      const PlannerParams& options = {});
 
 // Draws the path (cell centres joined by lines, a dot at each end) onto a picture made by
 // render_map.

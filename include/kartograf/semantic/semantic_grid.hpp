@@ -63,7 +63,7 @@ struct TraversabilityWeights {
   void validate() const;
 };
 
-struct SemanticGridOptions {
+struct SemanticGridParams {
   double resolution = 0.05;         // metres per cell
   std::optional<double> floor_z;    // default: median z of the floor points (else 0)
   std::optional<double> ceiling_z;  // default: median z of the ceiling points (else none)
@@ -157,7 +157,7 @@ struct SemanticGrid {
 // mismatched sizes, bad options, no finite point, or a bad detection.
 SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                  std::span<const SemanticClass> labels,
-                                 const SemanticGridOptions& options = {},
+                                 const SemanticGridParams& options = {},
                                  std::span<const ObjectDetection> detections = {});
 
 // ---- Exports (data only; io/ writes the files) -----------------------------------------------

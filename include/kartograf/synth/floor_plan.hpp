@@ -36,12 +36,12 @@ struct FloorPlan {
   std::vector<RoomRecord> room_records;
 };
 
-struct FloorPlanOptions {
+struct FloorPlanParams {
   double resolution = 0.05;  // metres per cell
   double margin = 0.5;       // metres of outside around the building
   bool furniture = true;     // false: the plain map (no furniture, no door leaves)
 };
 
-FloorPlan make_floor_plan(const World& world, const FloorPlanOptions& options = {});
+FloorPlan make_floor_plan(const World& world, const FloorPlanParams& options = {});
 
 }  // namespace kartograf::synth

@@ -18,7 +18,7 @@
 
 namespace kartograf::synth {
 
-struct LaserScanOptions {
+struct LidarScanParams {
   int columns = 361;
   double horizontal_fov_deg = 180.0;
   int lines = 201;
@@ -43,10 +43,10 @@ struct LaserScan {
 };
 
 LaserScan scan_laser(const RayCaster& caster, const Eigen::Isometry3d& sensor_to_world,
-                     const LaserScanOptions& options, std::uint64_t seed);
+                     const LidarScanParams& options, std::uint64_t seed);
 
 // The unit direction of beam (column, row) in the sensor frame.
-Eigen::Vector3d laser_beam_direction(const LaserScanOptions& options, int column, int row);
+Eigen::Vector3d laser_beam_direction(const LidarScanParams& options, int column, int row);
 
 // A scanner 0.8 m above the floor at the most open point of the largest room, facing the room's
 // longer extent.

@@ -85,7 +85,7 @@ struct SyntheticFrame {
   Image<float> depth_metres;  // ground truth: exact z [m], NaN where the ray hits nothing
 };
 
-struct RenderOptions {
+struct RenderParams {
   int threads = 0;  // 0: std::thread::hardware_concurrency()
 };
 
@@ -95,6 +95,6 @@ struct RenderOptions {
 // (the tests compare with RayCaster), with a visibility pass ten times cheaper.
 SyntheticFrame render(const World& world, const PinholeIntrinsics& intrinsics,
                       const Eigen::Isometry3d& camera_to_world, const NoiseModel& noise,
-                      std::uint64_t frame_seed, const RenderOptions& options = {});
+                      std::uint64_t frame_seed, const RenderParams& options = {});
 
 }  // namespace kartograf::synth

@@ -19,7 +19,7 @@
 
 namespace kartograf::synth {
 
-struct TourOptions {
+struct TourParams {
   double camera_height = 1.0;     // metres above the floor
   double pitch_deg = 12.0;        // downwards
   double look_around_deg = 30.0;  // yaw sweep inside each room: up to this far left, then right
@@ -37,13 +37,13 @@ struct TourOptions {
 };
 
 // frame_count >= 2 frames; the last pose equals the first (the route is a loop).
-Trajectory robot_tour(const World& world, int frame_count, const TourOptions& options = {});
+Trajectory robot_tour(const World& world, int frame_count, const TourParams& options = {});
 
 // The least number of frames for which the tour, without looking around, stays within max_step
 // and max_yaw_step_deg.
-int tour_frames_needed(const World& world, const TourOptions& options = {});
+int tour_frames_needed(const World& world, const TourParams& options = {});
 
-struct HandheldOptions {
+struct HandheldParams {
   double height = 1.45;  // metres: mean camera height
   double frame_rate = 30.0;
   double start_time = 0.0;
@@ -52,7 +52,7 @@ struct HandheldOptions {
 // A hand-held sequence in `room` (a World::rooms id), centred on the room's point farthest from
 // walls and furniture. Deterministic in seed.
 Trajectory handheld(const World& world, Label room, int frame_count, std::uint64_t seed,
-                    const HandheldOptions& options = {});
+                    const HandheldParams& options = {});
 
 // Camera-to-world pose (TUM optical frame) of a camera at `position` whose viewing direction has
 // heading yaw (from +x towards +y) and is pitched down by pitch; roll turns it about the view.

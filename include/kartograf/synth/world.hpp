@@ -5,7 +5,7 @@
 // equation and its polygon; every room has an id and a rectangle.
 //
 // Frame: metres, z up, floor at z = 0, ceiling at z = height. The layout (rooms, walls, doorways)
-// lies on a grid of BuildingOptions::grid_step (5 cm), so that a 5 cm floor plan is exact.
+// lies on a grid of BuildingParams::grid_step (5 cm), so that a 5 cm floor plan is exact.
 #include <array>
 #include <cstdint>
 #include <string>
@@ -21,7 +21,7 @@
 
 namespace kartograf::synth {
 
-struct BuildingOptions {
+struct BuildingParams {
   int room_count = 4;  // rooms besides the corridor, 1..10: half north of the corridor, half south
   double min_room_side = 3.0, max_room_side = 6.0;
   double min_ceiling = 2.5, max_ceiling = 3.0;  // one height for the whole building
@@ -33,7 +33,7 @@ struct BuildingOptions {
   double door_leaf_probability = 0.6;        // an open door leaf beside a doorway
   double grid_step = 0.05;                   // layout coordinates are multiples of this
   // The layout is redrawn (up to 100 times) until a robot tour of this many frames fits the
-  // default TourOptions' per-frame limits (12 cm, 4 degrees); 0: no such constraint.
+  // default TourParams' per-frame limits (12 cm, 4 degrees); 0: no such constraint.
   int tour_frames = 300;
 
   // Throws Error naming the first inconsistent field.
@@ -121,7 +121,7 @@ struct Plane {
 
 struct World {
   std::uint64_t seed = 0;
-  BuildingOptions options;
+  BuildingParams options;
   double height = 0;  // ceiling height
   double wall_thickness = 0;
   Rect2 bounds;             // footprint of the building, outer walls included
@@ -160,7 +160,7 @@ struct World {
 std::vector<Label> continuous_surface_ids(const World& world);
 
 // The building for `seed`. Throws Error when the options are inconsistent.
-World make_building(std::uint64_t seed, const BuildingOptions& options = {});
+World make_building(std::uint64_t seed, const BuildingParams& options = {});
 
 // The route as a rounded path (radius up to 1.5 m), as the tour drives it.
 RoutePath route_path(const World& world);

@@ -456,7 +456,7 @@ BackendStatus probe_opencl() {
   return status;
 }
 
-std::shared_ptr<Device> create_opencl_device(const ContextOptions& options) {
+std::shared_ptr<Device> create_opencl_device(const ContextParams& options) {
   Enumeration found = enumerate_devices();
   if (found.devices.empty()) throw Error("OpenCL backend unavailable: " + found.problem);
   std::vector<FoundDevice*> usable;

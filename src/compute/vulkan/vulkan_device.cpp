@@ -665,7 +665,7 @@ class VulkanDevice final : public Device {
   std::vector<BufferHandles> retired_;                   // likewise
   std::map<std::string, Pipeline, std::less<>> pipelines_;
   std::unique_ptr<DeviceBuffer> placeholder_;
-  std::unique_ptr<VulkanTimestamps> timestamps_;  // with ContextOptions::profile
+  std::unique_ptr<VulkanTimestamps> timestamps_;  // with ContextParams::profile
   static constexpr std::size_t kPoolLimitBytes = std::size_t{256} << 20;
   static constexpr std::size_t kInlineUpdateBytes = 65536;  // vkCmdUpdateBuffer's limit
   std::multimap<std::pair<std::size_t, int>, BufferHandles> pool_;  // freed, kept for reuse
@@ -699,7 +699,7 @@ BackendStatus probe_vulkan() {
   return status;
 }
 
-std::shared_ptr<Device> create_vulkan_device(const ContextOptions& options) {
+std::shared_ptr<Device> create_vulkan_device(const ContextParams& options) {
   std::shared_ptr<VulkanInstance> instance;
   try {
     instance = VulkanInstance::create(options.vulkan_validation);

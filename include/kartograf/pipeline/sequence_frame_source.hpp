@@ -1,0 +1,47 @@
+#pragma once
+// Where the formats meet the pipeline: a sequence read from a folder (formats/sequence.hpp) as the
+// pipeline's FrameSource, and the check before a run that its depth is usable at all.
+#include <cstddef>
+#include <optional>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "kartograf/formats/sequence.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/mapping/frame_source.hpp"
+
+namespace kartograf::pipeline {
+
+// Unusable depth found before a run: throws Error naming the depth file, the depth scale, the
+// values found and --depth-scale when none of the first frames (up to 5) has a pixel within
+// range (all zero, or all beyond range as when metres are stored as millimetres).
+void check_depth_usable(const io::Sequence& sequence, const geometry::DepthRange& range);
+
+// A Sequence as the pipeline's FrameSource: frames [0, count) (count: all when empty or larger).
+// Ground-truth poses are collected as frames are read, so that the caller can score a run
+// without reading the frames again.
+class SequenceFrameSource final : public mapping::FrameSource {
+ public:
+  explicit SequenceFrameSource(const io::Sequence& sequence,
+                               std::optional<std::size_t> count = std::nullopt);
+
+  std::size_t size() const override { return count_; }
+  PinholeIntrinsics camera() const override { return sequence_->intrinsics(); }
+  double depth_units_per_metre() const override { return sequence_->depth_units_per_metre(); }
+  registration::RgbdImages frame(std::size_t i) const override;
+
+  // Per frame read so far (index = frame): its ground-truth pose, if the data set has one.
+  const std::vector<std::optional<Eigen::Isometry3d>>& ground_truth() const {
+    return ground_truth_;
+  }
+
+ private:
+  const io::Sequence* sequence_;
+  std::size_t count_;
+  // Written by frame(), which the pipeline calls from its prefetch thread one call at a time;
+  // read after the run.
+  mutable std::vector<std::optional<Eigen::Isometry3d>> ground_truth_;
+};
+
+}  // namespace kartograf::pipeline

@@ -1,0 +1,34 @@
+// CPU wrapper of kernels/backproject/backproject.h.
+#include "compute/cpu/cpu_kernel.hpp"
+#include "kernels/backproject/backproject.h"
+
+namespace kartograf::kernels {
+
+namespace {
+
+void backproject(const compute::detail::CpuDispatch& call) {
+  const auto params = call.params_as<BackprojectParams>();
+  const auto* depth = call.buffer<const std::uint16_t>(0);
+  const auto* factors = call.buffer<const float>(1);
+  auto* points = call.buffer<float4>(2);
+  // Rows in chunks; each row a plain loop over x so that it vectorizes.
+  compute::detail::for_each_chunk(
+      params.height, std::size_t(params.width) * params.height,
+      [&](std::size_t first, std::size_t last, std::size_t) {
+        for (std::size_t y = first; y < last; ++y) {
+          const std::size_t row = y * params.width;
+          const float row_factor = factors[params.width + y];
+          for (uint x = 0; x < params.width; ++x) {
+            points[row + x] = backproject_depth(depth[row + x], factors[x], row_factor, params);
+          }
+        }
+      });
+}
+
+}  // namespace
+
+void register_backproject_cpu(compute::detail::CpuKernelRegistry& registry) {
+  registry.add("backproject", backproject);
+}
+
+}  // namespace kartograf::kernels

@@ -1,0 +1,76 @@
+// OpenCL wrapper of kernels/icp_sums/icp_sums.h: the point-to-point and point-to-plane sums, one
+// row per work-group (kg_store_group_sums, kernels/common.cl).
+#include "kernels/icp_sums/icp_sums.h"
+
+// Source point i's pair, when it has one that counts; `considered` counts i when it is valid and
+// selected (as load_pair in icp_sums.glsl and icp_sums_cpu.cpp).
+inline bool icp_load_pair(uint i, __global const float4* source, __global const float4* target,
+                          __global const int* correspondences, __global const float* weights,
+                          IcpSumsParams params, IcpFrame frame, double* considered,
+                          IcpPair* pair) {
+  const int entry = params.has_correspondences != 0u ? correspondences[i] : (int)i;
+  if (!icp_is_selected(entry)) return false;
+  const float4 p = source[i];
+  if (kg_isnan(p.x)) return false;
+  *considered += 1.0;
+  const int j = icp_target_of(entry, params);
+  if (j < 0) return false;
+  const double weight = params.has_weights != 0u ? (double)weights[i] : 1.0;
+  if (!(weight > 0.0)) return false;
+  const float4 q = target[j];
+  if (kg_isnan(q.x)) return false;
+  *pair = icp_pair(p, q, (uint)j, weight, frame);
+  return icp_pair_in_range(*pair, frame);
+}
+
+// Both kernels' body; target_normals is null for point-to-point.
+inline void icp_sum_pairs(__global const float4* source, __global const float4* target,
+                          __global const float4* target_normals,
+                          __global const int* correspondences, __global const float* weights,
+                          __global const double* frame_values, __global double* partials,
+                          IcpSumsParams params, __local double* shared_sums) {
+  double sums[KG_MAX_SUMS];
+  for (uint k = 0; k < KG_MAX_SUMS; ++k) sums[k] = 0.0;
+  const IcpFrame frame = KG_ICP_READ_FRAME(frame_values);
+  double considered = 0.0;
+  const uint stride = get_num_groups(0) * KG_ICP_SUMS_LOCAL_X;
+  for (uint i = get_global_id(0); i < params.pair_count; i += stride) {
+    IcpPair pair;
+    if (!icp_load_pair(i, source, target, correspondences, weights, params, frame, &considered,
+                       &pair)) {
+      continue;
+    }
+    if (!target_normals) {
+      icp_add_point_to_point(sums, pair, frame, params.robust_kernel);
+      continue;
+    }
+    const float4 normal = target_normals[pair.target_index];
+    if (!kg_isnan(normal.x)) icp_add_point_to_plane(sums, pair, normal, frame, params.robust_kernel);
+  }
+  if (!target_normals) {
+    sums[KG_ICP_POINT_CONSIDERED] = considered;
+    kg_store_group_sums(sums, KG_ICP_POINT_SUMS, shared_sums, partials);
+  } else {
+    sums[KG_ICP_PLANE_CONSIDERED] = considered;
+    kg_store_group_sums(sums, KG_ICP_PLANE_SUMS, shared_sums, partials);
+  }
+}
+
+__kernel void icp_point_to_point(__global const float4* source, __global const float4* target,
+                                 __global const int* correspondences, __global const float* weights,
+                                 __global const double* frame_values, __global double* partials,
+                                 const IcpSumsParams params) {
+  __local double shared_sums[KG_MAX_SUMS * KG_REDUCTION_GROUP];
+  icp_sum_pairs(source, target, 0, correspondences, weights, frame_values, partials, params,
+                shared_sums);
+}
+
+__kernel void icp_point_to_plane(__global const float4* source, __global const float4* target,
+                                 __global const float4* target_normals,
+                                 __global const int* correspondences, __global const float* weights,
+                                 __global const double* frame_values, __global double* partials,
+                                 const IcpSumsParams params) {
+  __local double shared_sums[KG_MAX_SUMS * KG_REDUCTION_GROUP];
+  icp_sum_pairs(source, target, target_normals, correspondences, weights, frame_values, partials,
+                params, shared_sums);
+}

@@ -1,0 +1,65 @@
+// Vulkan GLSL's side of shaders/prelude.h.
+#ifndef KARTOGRAF_SHADERS_PRELUDE_GLSL_H
+#define KARTOGRAF_SHADERS_PRELUDE_GLSL_H
+
+#extension GL_EXT_shader_explicit_arithmetic_types_int64 : require
+
+#define KG_RULES_BEGIN
+#define KG_RULES_END
+#define KG_INLINE
+#define KG_FORCE_INLINE
+
+#define float3 vec3
+#define float4 vec4
+#define uint2 uvec2
+#define int2 ivec2
+#define double3 dvec3
+
+#define KG_FLOAT3(x, y, z) vec3(x, y, z)
+#define KG_FLOAT4(x, y, z, w) vec4(x, y, z, w)
+#define KG_FLOAT4_XYZ_W(v, w) vec4(v, w)
+#define KG_FLOAT(x) float(x)
+#define KG_UINT(x) uint(x)
+#define KG_INT(x) int(x)
+#define KG_DOUBLE(x) double(x)
+#define KG_DOUBLE3(x, y, z) dvec3(x, y, z)
+#define KG_INT64(x) int64_t(x)
+#define KG_UINT64(x) uint64_t(x)
+#define kg_round_even_int64(x) int64_t(roundEven(x))
+
+// A function on 64-bit integers that the CPU may also instantiate with a wider type.
+#define KG_WIDE_INT_TEMPLATE
+#define kg_wide_int int64_t
+
+#define KG_INOUT_ARRAY(type, name, size) inout type name[size]
+#define KG_STRUCT_BEGIN(name) struct name {
+#define KG_STRUCT_END(name) };
+
+#define kg_fabs(x) abs(x)
+#define kg_rsqrt(x) inversesqrt(x)
+#define kg_isnan(x) isnan(x)
+#define kg_xyz(v) (v).xyz
+
+#define KG_NAN uintBitsToFloat(0x7fc00000u)
+
+// Atomics on a buffer's element (the 64-bit ones need GL_EXT_shader_atomic_int64 in the shader).
+#define kg_atomic_add_u32(buffer, index, value) atomicAdd(buffer[index], value)
+#define kg_atomic_add_i64(buffer, index, value) atomicAdd(buffer[index], value)
+#define kg_atomic_max_u32(buffer, index, value) atomicMax(buffer[index], value)
+#define kg_atomic_cas_u64(buffer, index, compare, value) atomicCompSwap(buffer[index], compare, value)
+
+// No fused multiply-add in the value a declaration marks (GLSL's `precise`).
+#define KG_PRECISE precise
+
+// A rule that reads a buffer: GLSL cannot pass one, so the shader declares the buffer under the
+// parameter's name before it includes the rule, and both macros expand to nothing.
+#define KG_BUFFER_PARAM(type, name)
+#define KG_BUFFER_ARG(name)
+
+// A parameter block is a struct; the shader's push-constant block holds one, named `params`.
+#define KG_PARAMS_BEGIN(name) struct name {
+#define KG_PARAM(type, field) type field;
+#define KG_PARAMS_END(name) };
+#define KG_PUSH_PARAMS(name) layout(push_constant) uniform name##Block { name params; }
+
+#endif

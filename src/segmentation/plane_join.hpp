@@ -1,0 +1,31 @@
+#pragma once
+// What the two passes of merge_segments (plane_merge.hpp) share, and the second pass: joining
+// adjacent merged planes (plane_join.cpp).
+#include <Eigen/Core>
+
+#include "kartograf/core/point_image.hpp"
+#include "kartograf/segmentation/plane_merge.hpp"
+
+namespace kartograf::segmentation::detail {
+
+// The distance allowance at `at` for a plane with `plane`'s normal.
+inline double allowance(const PlaneMergeParams& params, const Eigen::Vector3d& at,
+                        const SegmentPlane& plane) {
+  return distance_allowance(params, at, plane.normal);
+}
+
+// Moments are additive: those of the union of two pieces.
+inline void add_moments(geometry::SegmentMoments& into, const geometry::SegmentMoments& m) {
+  into.count += m.count;
+  into.sum += m.sum;
+  into.sum_outer += m.sum_outer;
+}
+
+// Second pass: joins adjacent merged planes, lowest cost first (cost: RMS of the joint fit over the
+// allowance at its depth; joins only below 1 and within the angle), then drops the absorbed planes
+// and renumbers the rest in order. `points` (may be null) enables the see-through test.
+void join_adjacent_planes(const SegmentLabelImage& labels, const PointImage* points,
+                          const PlaneMergeParams& params, const Eigen::Vector3d& origin,
+                          MergedPlanes& merged);
+
+}  // namespace kartograf::segmentation::detail
