@@ -18,13 +18,13 @@ KG_PARAM(uint, max_units)
 KG_PARAM(float, metres_per_unit)
 KG_PARAMS_END(BackprojectParams)
 
-// Branch-free, so that the CPU loop vectorizes.
+// A select per component, branch-free, so that the CPU loop vectorizes.
 KG_INLINE float4 backproject_depth(uint d, float column_factor, float row_factor,
                                    BackprojectParams p) {
   const bool valid = d != 0u && d >= p.min_units && d <= p.max_units;
   const float z = KG_FLOAT(d);
-  return valid ? KG_FLOAT4(z * column_factor, z * row_factor, z * p.metres_per_unit, 1.0f)
-               : KG_INVALID_POINT;
+  return KG_FLOAT4(valid ? z * column_factor : KG_NAN, valid ? z * row_factor : KG_NAN,
+                   valid ? z * p.metres_per_unit : KG_NAN, valid ? 1.0f : KG_NAN);
 }
 
 KG_RULES_END

@@ -35,6 +35,7 @@ using Cell = ScanCell;
 // Cells per device dispatch: the scans of a batch (360 beams: 23 MB of ranges) stay well within
 // what every driver binds.
 constexpr std::size_t kDeviceBatchCells = 16384;
+constexpr std::size_t kHostBatchCells = 512;
 
 // The features of a scan at every cell, rows in the order of `cells`. The scans run on `context`
 // (DeviceLaserScanner: the same scans, bit for bit, on every backend) in batches; the features on
@@ -44,8 +45,12 @@ std::vector<float> features_at(const compute::Context& context, const LaserScann
   const auto beams = static_cast<std::size_t>(scanner.beams());
   std::vector<float> features(cells.size() * kLaserFeatureCount);
   DeviceLaserScanner device(context, scanner);
-  for (std::size_t begin = 0; begin < cells.size(); begin += kDeviceBatchCells) {
-    const std::size_t count = std::min(kDeviceBatchCells, cells.size() - begin);
+  // Where device memory is host memory (the CPU, CPU-hosted drivers), batches small enough that
+  // the ranges stay in cache between the scan and the features.
+  const std::size_t batch =
+      context.device_info().unified_memory ? kHostBatchCells : kDeviceBatchCells;
+  for (std::size_t begin = 0; begin < cells.size(); begin += batch) {
+    const std::size_t count = std::min(batch, cells.size() - begin);
     const std::vector<double> ranges =
         device.scan_ranges(std::span(cells).subspan(begin, count), count);
     compute::detail::for_each_chunk(
