@@ -1,17 +1,9 @@
-// Prepended to every Kartograf OpenCL kernel file (all are built as one program).
+// Prepended to every Kartograf OpenCL kernel file (all are built as one program): the extensions
+// every kernel needs and the work-group reduction the ICP sums and the colour gate share.
 #pragma OPENCL EXTENSION cl_khr_fp64 : enable
 #pragma OPENCL EXTENSION cl_khr_int64_base_atomics : enable
 
-#define KG_INVALID_POINT ((float4)(NAN, NAN, NAN, NAN))
 #include "kernels/reduce_rows/reduce_rows.h"  // KG_REDUCTION_GROUP, KG_MAX_SUMS
-
-inline bool kg_is_valid_point(float4 p) { return !isnan(p.x); }
-
-// Adds value as a 64-bit fixed-point integer (value * scale, rounded to nearest even) with an
-// atomic: integer addition is exact and associative, so the sum does not depend on the order.
-inline void kg_add_fixed(__global long* sums, uint slot, double value, double scale) {
-  atom_add(&sums[slot], convert_long_rte(value * scale));
-}
 
 // The first pass of a two-pass reduction: each work-item has summed its share into `sums`; the
 // work-group adds those in local memory (a fixed-order tree: results do not vary from run to run)

@@ -40,8 +40,6 @@
 #error "kernel rules compile as C++, OpenCL C or Vulkan GLSL"
 #endif
 
-#ifndef KG_INVALID_POINT
 #define KG_INVALID_POINT KG_FLOAT4(KG_NAN, KG_NAN, KG_NAN, KG_NAN)
-#endif
 
 #endif
