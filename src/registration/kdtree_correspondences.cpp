@@ -10,6 +10,12 @@
 
 namespace kartograf::registration {
 
+bool NormalGate::accepts(std::size_t j) const {
+  const Point4f& n = normals[j];
+  return kernels::nearest_normal_accepts({normal.x(), normal.y(), normal.z()},
+                                         {n.x(), n.y(), n.z(), n.w()}, min_cosine);
+}
+
 namespace {
 
 // nanoflann's view of the tree's points, in double (so distances are the shared rule's doubles).

@@ -34,11 +34,9 @@ struct NormalGate {
   Eigen::Vector3d normal = Eigen::Vector3d::Zero();
   double min_cosine = -1;
 
-  bool accepts(std::size_t j) const {
-    const Point4f& n = normals[j];
-    return is_valid(n) &&
-           normal.x() * n.x() + normal.y() * n.y() + normal.z() * n.z() >= min_cosine;
-  }
+  // Target normal j valid and normal . n_j >= min_cosine: the voxel-hash search's gate
+  // (kernels/voxel_hash_nearest/voxel_hash_nearest.h), one rule for both.
+  bool accepts(std::size_t j) const;
 };
 
 struct KdTreeParams {
