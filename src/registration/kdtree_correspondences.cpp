@@ -118,6 +118,8 @@ void KdTreeCorrespondences::build(const CloudView& target) {
   require(target.points != nullptr, "k-d tree correspondences: target points are required");
   tree_.emplace(compute::read_on_host(*target.points), params_);
   built_for_ = target.points;
+  target_normals_.reset();
+  if (target.normals) target_normals_.emplace(*target.normals);
 }
 
 void KdTreeCorrespondences::prepare(const CloudView& target, int) {
@@ -141,7 +143,9 @@ void KdTreeCorrespondences::find(const CloudView& source, const CloudView& targe
   const compute::Buffer<Point4f> absent;
   const auto source_points = compute::read_on_host(*source.points);
   const auto source_normals = compute::read_on_host(query.use_normals ? *source.normals : absent);
-  const auto target_normals = compute::read_on_host(query.use_normals ? *target.normals : absent);
+  if (query.use_normals && !target_normals_) target_normals_.emplace(*target.normals);
+  const std::span<const Point4f> target_normals =
+      query.use_normals ? target_normals_->span() : std::span<const Point4f>();
   auto result = compute::write_on_host(out.target_index, compute::HostWriteStart::overwrite_all);
   const auto width = source.camera ? static_cast<std::uint32_t>(source.camera->width) : 0u;
   const double max_distance_sq = query.max_distance_sq();

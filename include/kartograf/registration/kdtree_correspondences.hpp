@@ -86,6 +86,9 @@ class KdTreeCorrespondences : public CorrespondenceFinder {
   KdTreeParams params_;
   std::optional<KdTree> tree_;
   const compute::Buffer<Point4f>* built_for_ = nullptr;
+  // The target's normals on the host for the normal gate: the buffer itself on the CPU backend,
+  // else downloaded once per build, not once per ICP iteration.
+  std::optional<compute::HostView<Point4f>> target_normals_;
 };
 
 }  // namespace kartograf::registration
