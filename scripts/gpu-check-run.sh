@@ -4,7 +4,8 @@
 #   device: a machine where nothing is installed: the carried loaders and layer are unpacked under a
 #           temporary folder (never into /), NVIDIA's Vulkan and OpenCL drivers are looked for.
 #   local:  this machine's loaders and drivers (lavapipe, PoCL); every backend must be there.
-# Writes OUT_DIR/gpu-check.log, devices.txt, conformance.xml, gpu-check.json, gpu-check-table.txt;
+# Writes OUT_DIR/gpu-check.log, devices.txt, conformance.xml, gpu-check.json, gpu-check-table.txt
+# (device: clocks.csv, the GPU's clocks through the benchmark);
 # prints the table last. Exit status 0 only if the conformance tests and the benchmark passed.
 set -uo pipefail
 bundle="$(cd "$1" && pwd)" out="$2" mode="$3"
@@ -67,9 +68,18 @@ KARTOGRAF_DATA_DIR="$work/data" KARTOGRAF_TEST_BACKENDS="$available" timeout 300
 conformance=$?
 echo "== benchmark ($((SECONDS - started)) s so far)"
 quick=(); [ "$mode" = local ] && quick=(--quick)
+# The GPU's clocks and power state through the benchmark: device times that change between runs
+# of the same code (an idle GPU clocks down) show here.
+clocks_pid=
+if [ "$mode" = device ] && command -v nvidia-smi >/dev/null; then
+  nvidia-smi --query-gpu=timestamp,pstate,clocks.sm,clocks.mem,power.draw,temperature.gpu \
+    --format=csv -lms 250 >"$out/clocks.csv" 2>&1 &
+  clocks_pid=$!
+fi
 timeout 360 "$bundle/bin/kartograf_gpu_check" --data "$work/data" --out "$out" --backends "$available" \
   "${quick[@]}"
 benchmark=$?
+[ -n "$clocks_pid" ] && kill "$clocks_pid" 2>/dev/null
 echo "== done in $((SECONDS - started)) s: conformance tests $([ $conformance = 0 ] && echo passed || echo "FAILED ($conformance)") on $available; benchmark $([ $benchmark = 0 ] && echo passed || echo "FAILED ($benchmark)")"
 cat "$out/gpu-check-table.txt" 2>/dev/null
 [ $conformance = 0 ] && [ $benchmark = 0 ]

@@ -19,7 +19,10 @@
 //   constants KG_NAN, KG_INVALID_POINT (all-NaN float4)
 //   functions KG_INLINE before each function (KG_FORCE_INLINE: a large per-item one); arguments
 //             by value (GLSL has no pointers), except
-//             KG_INOUT_ARRAY(type, name, size): an array the function adds to (e.g. a row of sums)
+//             KG_ACCUMULATOR(type, name, size): a leading parameter, the array the function adds to
+//             (a row of sums), declared once before with KG_ACCUMULATOR_STORAGE(type, name, size)
+//             (GLSL: a module-scope array per invocation, never copied per call; C, C++: nothing,
+//             the caller's array); KG_ACCUMULATOR_ARG(name) passes it; no comma after either
 //   buffers   KG_BUFFER_PARAM(type, name) opens a function's parameters with a buffer it reads or
 //             writes (GLSL: the shader's buffer of that name, declared before the rule's #include),
 //             KG_BUFFER_ARG(name) passes one on; no comma after either

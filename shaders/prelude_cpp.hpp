@@ -118,8 +118,10 @@ inline uint64_t kg_atomic_cas_u64(uint64_t* buffer, uint index, uint64_t compare
 // A function on 64-bit integers that the CPU may also instantiate with a wider type (__int128).
 #define KG_WIDE_INT_TEMPLATE template <class kg_wide_int>
 
-// An array a function adds to (GLSL: inout, copied in and out; C and C++: a pointer).
-#define KG_INOUT_ARRAY(type, name, size) type* name
+// An array a function adds to, its leading parameter (see prelude.h).
+#define KG_ACCUMULATOR_STORAGE(type, name, size)
+#define KG_ACCUMULATOR(type, name, size) type *name,
+#define KG_ACCUMULATOR_ARG(name) name,
 #define KG_STRUCT_BEGIN(name) struct name {
 #define KG_STRUCT_END(name) \
   }                         \

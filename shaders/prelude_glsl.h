@@ -31,7 +31,11 @@
 #define KG_WIDE_INT_TEMPLATE
 #define kg_wide_int int64_t
 
-#define KG_INOUT_ARRAY(type, name, size) inout type name[size]
+// An array the function adds to: the module-scope array (per invocation) that the rule declares
+// with KG_ACCUMULATOR_STORAGE, so that no array is copied in and out on every call.
+#define KG_ACCUMULATOR_STORAGE(type, name, size) type name[size];
+#define KG_ACCUMULATOR(type, name, size)
+#define KG_ACCUMULATOR_ARG(name)
 #define KG_STRUCT_BEGIN(name) struct name {
 #define KG_STRUCT_END(name) };
 

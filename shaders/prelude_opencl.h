@@ -27,7 +27,9 @@ typedef ulong uint64_t;
 #define KG_WIDE_INT_TEMPLATE
 #define kg_wide_int long
 
-#define KG_INOUT_ARRAY(type, name, size) type* name
+#define KG_ACCUMULATOR_STORAGE(type, name, size)
+#define KG_ACCUMULATOR(type, name, size) type *name,
+#define KG_ACCUMULATOR_ARG(name) name,
 #define KG_STRUCT_BEGIN(name) typedef struct {
 #define KG_STRUCT_END(name) } name;
 

@@ -1,5 +1,7 @@
 // The compute runtime itself: contexts, buffers, kernel builds, backend selection and errors.
 #include <cstdlib>
+#include <filesystem>
+#include <fstream>
 #include <numeric>
 #include <string>
 
@@ -135,6 +137,20 @@ TEST_P(ComputeRuntimeTest, ReferOrUploadHoldsTheValuesAndCopiesNothingOnTheHost)
   const std::vector<std::uint32_t> again = {1, 2, 3};
   buffer.refer_or_upload(context(), again);
   EXPECT_EQ(buffer.to_vector(), again);
+}
+
+TEST_P(ComputeRuntimeTest, OpenclSourceDirReplacesAnEmbeddedKernelFile) {
+  if (GetParam() != compute::BackendKind::opencl) GTEST_SKIP() << "an OpenCL build option";
+  const std::filesystem::path dir = std::filesystem::temp_directory_path() / "kartograf-cl-variant";
+  std::filesystem::create_directories(dir);
+  std::ofstream(dir / "reduce_rows.cl") << "this is not OpenCL C\n";
+  compute::ContextParams params;
+  params.backend = compute::BackendChoice::opencl;
+  setenv("KARTOGRAF_OPENCL_SOURCE_DIR", dir.c_str(), 1);
+  EXPECT_ERROR_MENTIONS(compute::Context(params).build_all_kernels(), "OpenCL", "failed");
+  unsetenv("KARTOGRAF_OPENCL_SOURCE_DIR");
+  std::filesystem::remove_all(dir);
+  EXPECT_NO_THROW(compute::Context(params).build_all_kernels());
 }
 
 KARTOGRAF_INSTANTIATE_BACKEND_TESTS(ComputeRuntimeTest);

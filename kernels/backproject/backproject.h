@@ -18,14 +18,13 @@ KG_PARAM(uint, max_units)
 KG_PARAM(float, metres_per_unit)
 KG_PARAMS_END(BackprojectParams)
 
-// A select per component, branch-free, so that the CPU loop vectorizes.
+// The point of depth value d; all NaN when d is not valid.
 KG_INLINE float4 backproject_depth(uint d, float column_factor, float row_factor,
                                    BackprojectParams p) {
-  // Bitwise, not &&: a short-circuit test compiles to branches in the CPU loop.
-  const bool valid = (KG_UINT(d != 0u) & KG_UINT(d >= p.min_units) & KG_UINT(d <= p.max_units)) != 0u;
-  const float z = KG_FLOAT(d);
-  return KG_FLOAT4(valid ? z * column_factor : KG_NAN, valid ? z * row_factor : KG_NAN,
-                   valid ? z * p.metres_per_unit : KG_NAN, valid ? 1.0f : KG_NAN);
+  const bool valid = d != 0u && d >= p.min_units && d <= p.max_units;
+  // One select: NaN times a factor is NaN, so the invalid point comes out of the products.
+  const float z = valid ? KG_FLOAT(d) : KG_NAN;
+  return KG_FLOAT4(z * column_factor, z * row_factor, z * p.metres_per_unit, valid ? 1.0f : KG_NAN);
 }
 
 KG_RULES_END

@@ -2,7 +2,7 @@
 // icp_point_to_plane.comp defines KG_ICP_WITH_NORMALS (the target normals are then binding 2);
 // icp_point_to_point.comp does not.
 #extension GL_GOOGLE_include_directive : require
-#include "kernels/icp_sums/icp_sums.h"
+#include "kernels/icp_sums/icp_sums.h"  // GLSL: declares the invocation's row, sums[]
 
 #ifdef KG_ICP_WITH_NORMALS
 #define KG_ICP_NORMAL_BINDINGS 1
@@ -52,7 +52,6 @@ bool load_pair(uint i, IcpFrame frame, inout double considered, out IcpPair pair
 }
 
 void main() {
-  double sums[KG_MAX_SUMS];
   for (uint k = 0; k < KG_MAX_SUMS; ++k) sums[k] = 0.0;
   const IcpFrame frame = KG_ICP_READ_FRAME(frame_values);
   double considered = 0.0;
@@ -62,9 +61,9 @@ void main() {
     if (!load_pair(i, frame, considered, pair)) continue;
 #ifdef KG_ICP_WITH_NORMALS
     const vec4 normal = target_normals[pair.target_index];
-    if (!kg_isnan(normal.x)) icp_add_point_to_plane(sums, pair, normal, frame, params.robust_kernel);
+    if (!kg_isnan(normal.x)) icp_add_point_to_plane(KG_ACCUMULATOR_ARG(sums) pair, normal, frame, params.robust_kernel);
 #else
-    icp_add_point_to_point(sums, pair, frame, params.robust_kernel);
+    icp_add_point_to_point(KG_ACCUMULATOR_ARG(sums) pair, frame, params.robust_kernel);
 #endif
   }
   sums[KG_ICP_ROW_CONSIDERED] = considered;

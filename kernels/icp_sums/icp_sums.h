@@ -132,7 +132,7 @@ KG_INLINE int icp_target_of(int entry, IcpSumsParams p) {
 }
 
 // Valid source point p, valid target point q = target[target_index], the caller's weight (> 0).
-KG_INLINE IcpPair icp_pair(float4 p, float4 q, uint target_index, double weight, IcpFrame f) {
+KG_FORCE_INLINE IcpPair icp_pair(float4 p, float4 q, uint target_index, double weight, IcpFrame f) {
   const double px = KG_DOUBLE(p.x), py = KG_DOUBLE(p.y), pz = KG_DOUBLE(p.z);
   IcpPair pair;
   pair.moved =
@@ -152,9 +152,12 @@ KG_INLINE bool icp_pair_in_range(IcpPair pair, IcpFrame f) {
   return pair.distance_sq <= f.max_distance_sq;
 }
 
+// A work-item's row of sums (GLSL: module scope; C, C++: the caller's array).
+KG_ACCUMULATOR_STORAGE(double, sums, KG_MAX_SUMS)
+
 // Adds a counted pair to a point-to-point row.
-KG_INLINE void icp_add_point_to_point(KG_INOUT_ARRAY(double, sums, KG_MAX_SUMS), IcpPair pair,
-                                      IcpFrame f, uint robust_kernel) {
+KG_FORCE_INLINE void icp_add_point_to_point(KG_ACCUMULATOR(double, sums, KG_MAX_SUMS) IcpPair pair,
+                                            IcpFrame f, uint robust_kernel) {
   const double3 da = pair.moved - f.source_pivot;
   const double3 db = pair.target - f.target_pivot;
   const double a[3] = {da.x, da.y, da.z};
@@ -177,8 +180,8 @@ KG_INLINE void icp_add_point_to_point(KG_INOUT_ARRAY(double, sums, KG_MAX_SUMS),
 }
 
 // Adds a counted pair whose target normal is valid to a point-to-plane row.
-KG_INLINE void icp_add_point_to_plane(KG_INOUT_ARRAY(double, sums, KG_MAX_SUMS), IcpPair pair,
-                                      float4 normal, IcpFrame f, uint robust_kernel) {
+KG_FORCE_INLINE void icp_add_point_to_plane(KG_ACCUMULATOR(double, sums, KG_MAX_SUMS) IcpPair pair,
+                                            float4 normal, IcpFrame f, uint robust_kernel) {
   const double3 n = KG_DOUBLE3(KG_DOUBLE(normal.x), KG_DOUBLE(normal.y), KG_DOUBLE(normal.z));
   const double3 arm = cross(pair.moved - f.source_pivot, n);
   const double j[6] = {arm.x, arm.y, arm.z, n.x, n.y, n.z};

@@ -1,6 +1,7 @@
 // CPU wrapper of kernels/icp_sums/icp_sums.h: each chunk of source points (in the chunks of
 // compute::detail::for_each_chunk) sums its pairs into one row, and the chunk rows become the
 // dispatch's partial rows in chunk order (store_chunk_rows), which reduce_rows adds in order.
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <span>
@@ -63,13 +64,14 @@ void sum_pairs(const compute::detail::CpuDispatch& call, const IcpInputs& in,
   const std::size_t count = in.params.pair_count;
   const auto sum_chunk = [&](std::size_t begin, std::size_t end, std::size_t chunk) {
     const IcpInputs chunk_in = in;  // a copy the row's stores cannot alias
-    double* sums = rows[chunk].sums;
-    std::uint64_t considered = 0;  // an integer: no floating-point dependency chain
+    double sums[KG_MAX_SUMS] = {};  // local, so that the sums can stay in registers
+    std::uint64_t considered = 0;   // an integer: no floating-point dependency chain
     for (std::size_t i = begin; i < end; ++i) {
       IcpPair pair;
       if (load_pair(chunk_in, uint(i), considered, pair)) add_pair(sums, pair, chunk_in);
     }
     sums[considered_slot] = static_cast<double>(considered);
+    std::copy(sums, sums + KG_MAX_SUMS, rows[chunk].sums);
   };
   compute::detail::for_each_chunk(count, count, sum_chunk);
   store_chunk_rows(std::span<const ChunkRow>(rows), sum_count, call.groups.x, partials);
@@ -79,7 +81,8 @@ void icp_point_to_point(const compute::detail::CpuDispatch& call) {
   const IcpInputs in = inputs_of(call, 2);
   sum_pairs(call, in, KG_ICP_POINT_CONSIDERED, KG_ICP_POINT_SUMS, call.buffer<double>(5),
             [](double* sums, const IcpPair& pair, const IcpInputs& chunk_in) {
-              icp_add_point_to_point(sums, pair, chunk_in.frame, chunk_in.params.robust_kernel);
+              icp_add_point_to_point(KG_ACCUMULATOR_ARG(sums) pair, chunk_in.frame,
+                                     chunk_in.params.robust_kernel);
             });
 }
 
@@ -90,7 +93,7 @@ void icp_point_to_plane(const compute::detail::CpuDispatch& call) {
             [normals](double* sums, const IcpPair& pair, const IcpInputs& chunk_in) {
               const float4 normal = normals[pair.target_index];
               if (kg_isnan(normal.x)) return;
-              icp_add_point_to_plane(sums, pair, normal, chunk_in.frame,
+              icp_add_point_to_plane(KG_ACCUMULATOR_ARG(sums) pair, normal, chunk_in.frame,
                                      chunk_in.params.robust_kernel);
             });
 }

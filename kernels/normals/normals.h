@@ -36,8 +36,9 @@ KG_INLINE float4 normal_from_neighbours(float4 centre, float4 left, float4 right
                                         float4 down, NormalsParams p) {
   if (kg_isnan(centre.x)) return KG_INVALID_POINT;
   const float4 along_x = normal_tangent(left, centre, right, p.max_depth_jump);
+  if (along_x.w == 0.0f) return KG_INVALID_POINT;
   const float4 along_y = normal_tangent(up, centre, down, p.max_depth_jump);
-  if (along_x.w == 0.0f || along_y.w == 0.0f) return KG_INVALID_POINT;
+  if (along_y.w == 0.0f) return KG_INVALID_POINT;
   const float3 n = cross(kg_xyz(along_x), kg_xyz(along_y));
   const float length_sq = dot(n, n);
   // Relative to the tangents' lengths: parallel tangents give no normal at any scale.

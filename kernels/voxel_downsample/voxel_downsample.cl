@@ -63,7 +63,7 @@ __kernel void voxel_downsample_accumulate(__global const float4* points, __globa
   const int slot = point_slots[i];
   if (slot < 0) return;
   long terms[KG_VOXEL_MAX_SUMS];
-  voxel_point_terms_at(points, normals, colors, i, params, terms);
+  voxel_point_terms_at(points, normals, colors, terms, i, params);
   const uint base = voxel_of_slot[slot] * params.stride;
   for (uint k = 0u; k < KG_VOXEL_MAX_SUMS; ++k) {  // unrolled: terms stays in registers
     if (k < params.stride && terms[k] != 0L) atom_add(&sums[base + k], terms[k]);

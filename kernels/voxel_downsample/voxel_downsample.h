@@ -97,10 +97,13 @@ KG_INLINE bool voxel_normal_usable(float4 n) {
   return !kg_isnan(n.x) && voxel_normal_bounded(n);
 }
 
+// A point's terms (GLSL: module scope; C, C++: the caller's array).
+KG_ACCUMULATOR_STORAGE(int64_t, terms, KG_VOXEL_MAX_SUMS)
+
 // The terms point p (with its normal n and colour c where the cloud has them) adds to the sums of
 // its voxel, terms[0..stride) (0: nothing to add). The wrappers add them: atomics on devices.
-KG_FORCE_INLINE void voxel_point_terms(float4 p, float4 n, uint c, VoxelSumParams params,
-                                       KG_INOUT_ARRAY(int64_t, terms, KG_VOXEL_MAX_SUMS)) {
+KG_FORCE_INLINE void voxel_point_terms(KG_ACCUMULATOR(int64_t, terms, KG_VOXEL_MAX_SUMS) float4 p,
+                                       float4 n, uint c, VoxelSumParams params) {
   const double3 scaled = voxel_scaled(p, params.inverse_size);
   const double3 fraction = scaled - voxel_floor(scaled);  // exact
   terms[KG_VOXEL_SUM_COUNT] = KG_INT64(1);
@@ -263,12 +266,13 @@ KG_FORCE_INLINE void voxel_assign_chunk(
 // Point i's terms, reading its normal and colour where the cloud has them.
 KG_FORCE_INLINE void voxel_point_terms_at(KG_BUFFER_PARAM(const float4, points)
                                               KG_BUFFER_PARAM(const float4, normals)
-                                                  KG_BUFFER_PARAM(const uint, colors) uint i,
-                                          VoxelSumParams params,
-                                          KG_INOUT_ARRAY(int64_t, terms, KG_VOXEL_MAX_SUMS)) {
+                                                  KG_BUFFER_PARAM(const uint, colors)
+                                                      KG_ACCUMULATOR(int64_t, terms,
+                                                                     KG_VOXEL_MAX_SUMS) uint i,
+                                          VoxelSumParams params) {
   const float4 n = params.has_normals != 0u ? normals[i] : KG_INVALID_POINT;
   const uint c = params.has_colors != 0u ? colors[i] : 0u;
-  voxel_point_terms(points[i], n, c, params, terms);
+  voxel_point_terms(KG_ACCUMULATOR_ARG(terms) points[i], n, c, params);
 }
 
 #endif

@@ -11,7 +11,7 @@ layout(std430, binding = 3) readonly buffer PointSlots { int point_slots[]; };
 layout(std430, binding = 4) readonly buffer VoxelOfSlot { uint voxel_of_slot[]; };
 layout(std430, binding = 5) buffer Sums { int64_t sums[]; };
 
-// After the buffers: the rule reads them.
+// After the buffers: the rule reads them (and declares the invocation's terms[]).
 #define KG_VOXEL_ACCUMULATE_PASS
 #include "kernels/voxel_downsample/voxel_downsample.h"
 
@@ -23,8 +23,7 @@ void main() {
   if (i >= params.count) return;
   const int slot = point_slots[i];
   if (slot < 0) return;
-  int64_t terms[KG_VOXEL_MAX_SUMS];
-  voxel_point_terms_at(i, params, terms);
+  voxel_point_terms_at(i, params);
   const uint base = voxel_of_slot[slot] * params.stride;
   for (uint k = 0u; k < KG_VOXEL_MAX_SUMS; ++k) {  // unrolled: terms stays in registers
     if (k < params.stride && terms[k] != 0l) atomicAdd(sums[base + k], terms[k]);

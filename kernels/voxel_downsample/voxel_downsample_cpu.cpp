@@ -87,7 +87,7 @@ void accumulate(const CpuDispatch& call) {
     const int slot = point_slots[i];
     if (slot < 0) continue;
     int64_t terms[KG_VOXEL_MAX_SUMS];
-    voxel_point_terms_at(points, normals, colors, i, params, terms);
+    voxel_point_terms_at(points, normals, colors, terms, i, params);
     int64_t* voxel_sums = sums + std::size_t{voxel_of_slot[slot]} * params.stride;
     for (uint k = 0; k < params.stride; ++k) voxel_sums[k] += terms[k];
   }

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <vector>
 
@@ -15,13 +16,18 @@ namespace {
 // Host memory: its own, or a view of memory the caller keeps alive (RawBuffer::refer_or_upload).
 class CpuBuffer final : public DeviceBuffer {
  public:
-  explicit CpuBuffer(std::size_t bytes) : owned_(bytes), data_(owned_.data()), size_(bytes) {}
+  // Uninitialised, as device memory is (fill_zero clears): pages a kernel never touches are never
+  // faulted in, e.g. region growing's per-tile stacks, tens of MB of which a frame uses a little.
+  explicit CpuBuffer(std::size_t bytes)
+      : owned_(std::make_unique_for_overwrite<std::byte[]>(bytes)),
+        data_(owned_.get()),
+        size_(bytes) {}
   CpuBuffer(std::byte* view, std::size_t bytes) : data_(view), size_(bytes) {}
   std::byte* data() { return data_; }
   std::size_t size() const { return size_; }
 
  private:
-  std::vector<std::byte> owned_;
+  std::unique_ptr<std::byte[]> owned_;
   std::byte* data_;
   std::size_t size_;
 };

@@ -7,6 +7,8 @@
 
 #include <cstdlib>
 #include <deque>
+#include <fstream>
+#include <iterator>
 #include <map>
 #include <mutex>
 #include <string>
@@ -391,23 +393,59 @@ class OpenclDevice final : public Device {
     std::lock_guard lock(build_mutex_);
     if (program_) return;
     const OpenclApi& cl = opencl_api();
+    const std::vector<std::string> sources = program_sources();
     std::vector<const char*> texts;
-    for (const EmbeddedText& source : embedded_opencl_sources()) texts.push_back(source.text);
+    for (const std::string& source : sources) texts.push_back(source.c_str());
     cl_int status = CL_SUCCESS;
     cl_program program = cl.clCreateProgramWithSource(
         context_, static_cast<cl_uint>(texts.size()), texts.data(), nullptr, &status);
     check(status, "clCreateProgramWithSource");
-    status = cl.clBuildProgram(program, 1, &id_, "-cl-std=CL1.2", nullptr, nullptr);
+    // KARTOGRAF_OPENCL_BUILD_OPTIONS: extra compiler options, e.g. NVIDIA's -cl-nv-verbose
+    // (registers and spills per kernel in the log); KARTOGRAF_OPENCL_BUILD_LOG: a file that
+    // receives the log.
+    const char* extra = std::getenv("KARTOGRAF_OPENCL_BUILD_OPTIONS");
+    const std::string options = std::string("-cl-std=CL1.2 ") + (extra ? extra : "");
+    status = cl.clBuildProgram(program, 1, &id_, options.c_str(), nullptr, nullptr);
     if (status != CL_SUCCESS) {
-      size_t size = 0;
-      cl.clGetProgramBuildInfo(program, id_, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
-      std::string log(size, '\0');
-      cl.clGetProgramBuildInfo(program, id_, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+      const std::string log = build_log(program);
       cl.clReleaseProgram(program);
       throw Error("OpenCL: building the kernels for " + info_.name + " failed (" +
                   cl_error_name(status) + "):\n" + log);
     }
+    if (const char* log_path = std::getenv("KARTOGRAF_OPENCL_BUILD_LOG")) {
+      std::ofstream(log_path, std::ios::app) << "options: " << options << "\n"
+                                             << build_log(program);
+    }
     program_ = program;
+  }
+
+  // The embedded sources; with KARTOGRAF_OPENCL_SOURCE_DIR set, a file of the same name there
+  // (includes expanded) replaces one: kernel variants tried on a machine without a build.
+  static std::vector<std::string> program_sources() {
+    const char* override_dir = std::getenv("KARTOGRAF_OPENCL_SOURCE_DIR");
+    std::vector<std::string> sources;
+    for (const EmbeddedText& source : embedded_opencl_sources()) {
+      std::ifstream replacement;
+      if (override_dir && *override_dir) {
+        replacement.open(std::string(override_dir) + "/" + std::string(source.name));
+      }
+      if (!replacement.is_open()) {
+        sources.emplace_back(source.text);
+        continue;
+      }
+      sources.emplace_back(std::istreambuf_iterator<char>(replacement),
+                           std::istreambuf_iterator<char>());
+    }
+    return sources;
+  }
+
+  std::string build_log(cl_program program) const {
+    const OpenclApi& cl = opencl_api();
+    size_t size = 0;
+    cl.clGetProgramBuildInfo(program, id_, CL_PROGRAM_BUILD_LOG, 0, nullptr, &size);
+    std::string log(size, '\0');
+    cl.clGetProgramBuildInfo(program, id_, CL_PROGRAM_BUILD_LOG, size, log.data(), nullptr);
+    return log;
   }
 
   cl_kernel kernel_named(std::string_view name) {
