@@ -26,6 +26,10 @@
 //   buffers   KG_BUFFER_PARAM(type, name) opens a function's parameters with a buffer it reads or
 //             writes (GLSL: the shader's buffer of that name, declared before the rule's #include),
 //             KG_BUFFER_ARG(name) passes one on; no comma after either
+//   groups    device code only (kernels/work_group/): KG_LANE, KG_GROUP, KG_GROUP_BARRIER(),
+//             KG_SHARED_STORAGE(type, name, size) (GLSL: the shared array; OpenCL: the kernel
+//             declares it), KG_SHARED(type, name) / KG_SHARED_ARG(name) (a leading parameter, like
+//             a buffer), KG_IN_ARRAY(type, name, size) (an array read, passed by value in GLSL)
 //   params    KG_PARAMS_BEGIN(Name) KG_PARAM(uint|int|float, field)... KG_PARAMS_END(Name)
 //   structs   KG_STRUCT_BEGIN(Name) type field; ... KG_STRUCT_END(Name) (values passed and returned)
 //   scopes    KG_RULES_BEGIN / KG_RULES_END around a rule header's declarations

@@ -52,6 +52,17 @@
 #define kg_atomic_max_u32(buffer, index, value) atomicMax(buffer[index], value)
 #define kg_atomic_cas_u64(buffer, index, compare, value) atomicCompSwap(buffer[index], compare, value)
 
+// Work-group procedures (device code, kernels/work_group/): the lane and the group, a barrier on
+// shared memory, shared arrays at module scope (the procedure's own KG_SHARED_STORAGE; KG_SHARED
+// and KG_SHARED_ARG expand to nothing) and an array passed in by value.
+#define KG_LANE gl_LocalInvocationID.x
+#define KG_GROUP gl_WorkGroupID.x
+#define KG_GROUP_BARRIER() barrier()
+#define KG_SHARED_STORAGE(type, name, size) shared type name[size];
+#define KG_SHARED(type, name)
+#define KG_SHARED_ARG(name)
+#define KG_IN_ARRAY(type, name, size) type name[size]
+
 // No fused multiply-add in the value a declaration marks (GLSL's `precise`).
 #define KG_PRECISE precise
 

@@ -47,6 +47,16 @@ typedef ulong uint64_t;
 #define kg_atomic_cas_u64(buffer, index, compare, value) \
   atom_cmpxchg(&(buffer)[index], compare, value)
 
+// Work-group procedures (device code, kernels/work_group/): the kernel declares each shared array
+// (`__local type name[size]`) and passes it on with KG_SHARED_ARG.
+#define KG_LANE get_local_id(0)
+#define KG_GROUP get_group_id(0)
+#define KG_GROUP_BARRIER() barrier(CLK_LOCAL_MEM_FENCE)
+#define KG_SHARED_STORAGE(type, name, size)
+#define KG_SHARED(type, name) __local type* name,
+#define KG_SHARED_ARG(name) name,
+#define KG_IN_ARRAY(type, name, size) const type* name
+
 // GLSL's `precise`: OpenCL C forbids the contraction instead with `#pragma OPENCL FP_CONTRACT OFF`
 // at the top of the function's body (inside `#if defined(__OPENCL_C_VERSION__)`: at file scope it
 // would reach every kernel joined after it).

@@ -18,7 +18,7 @@ layout(std430, binding = 5) writeonly buffer Partials { double partials[]; };
 layout(local_size_x = KG_COLOR_GATE_DIFFERENCES_LOCAL_X) in;
 KG_PUSH_PARAMS(ColorGateDifferencesParams);
 
-#include "shaders/reduction.glsl"
+#include "kernels/work_group/group_sums.h"
 
 void main() {
   double sums[KG_MAX_SUMS];
@@ -29,5 +29,5 @@ void main() {
     differences[i] = d;
     for (uint k = 0; k < KG_COLOR_GATE_SUMS; ++k) sums[k] += double(color_gate_sum_term(d, k));
   }
-  store_group_sums(sums, KG_COLOR_GATE_SUMS);
+  kg_store_group_sums(KG_BUFFER_ARG(partials) KG_SHARED_ARG(shared_sums) sums, KG_COLOR_GATE_SUMS);
 }

@@ -1,6 +1,7 @@
 // OpenCL wrapper of kernels/icp_sums/icp_sums.h: the point-to-point and point-to-plane sums, one
-// row per work-group (kg_store_group_sums, kernels/common.cl).
+// row per work-group (kg_store_group_sums, kernels/work_group/group_sums.h).
 #include "kernels/icp_sums/icp_sums.h"
+#include "kernels/work_group/group_sums.h"
 
 // Source point i's pair, when it has one that counts; `considered` counts i when it is valid and
 // selected (as load_pair in icp_sums.glsl and icp_sums_cpu.cpp). The frame is read here, for each
@@ -57,10 +58,10 @@ KG_FORCE_INLINE void icp_sum_pairs(__global const float4* source, __global const
   }
   if (!with_normals) {
     sums[KG_ICP_POINT_CONSIDERED] = considered;
-    kg_store_group_sums(sums, KG_ICP_POINT_SUMS, shared_sums, partials);
+    kg_store_group_sums(partials, shared_sums, sums, KG_ICP_POINT_SUMS);
   } else {
     sums[KG_ICP_PLANE_CONSIDERED] = considered;
-    kg_store_group_sums(sums, KG_ICP_PLANE_SUMS, shared_sums, partials);
+    kg_store_group_sums(partials, shared_sums, sums, KG_ICP_PLANE_SUMS);
   }
 }
 
@@ -68,7 +69,7 @@ __kernel void icp_point_to_point(__global const float4* source, __global const f
                                  __global const int* correspondences, __global const float* weights,
                                  __global const double* frame_values, __global double* partials,
                                  const IcpSumsParams params) {
-  __local double shared_sums[KG_MAX_SUMS * KG_REDUCTION_GROUP];
+  __local double shared_sums[KG_GROUP_SUMS_SHARED];
   icp_sum_pairs(source, target, 0, correspondences, weights, frame_values, partials, params,
                 shared_sums, false);
 }
@@ -78,7 +79,7 @@ __kernel void icp_point_to_plane(__global const float4* source, __global const f
                                  __global const int* correspondences, __global const float* weights,
                                  __global const double* frame_values, __global double* partials,
                                  const IcpSumsParams params) {
-  __local double shared_sums[KG_MAX_SUMS * KG_REDUCTION_GROUP];
+  __local double shared_sums[KG_GROUP_SUMS_SHARED];
   icp_sum_pairs(source, target, target_normals, correspondences, weights, frame_values, partials,
                 params, shared_sums, true);
 }

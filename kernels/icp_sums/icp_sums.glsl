@@ -29,7 +29,7 @@ layout(std430, binding = 4 + KG_ICP_NORMAL_BINDINGS) readonly buffer Frame { dou
 layout(std430, binding = 5 + KG_ICP_NORMAL_BINDINGS) writeonly buffer Partials { double partials[]; };
 KG_PUSH_PARAMS(IcpSumsParams);
 
-#include "shaders/reduction.glsl"
+#include "kernels/work_group/group_sums.h"
 
 // Source point i's pair, when it has one that counts; `considered` counts i when it is valid and
 // selected (as load_pair in icp_sums.cl and icp_sums_cpu.cpp).
@@ -67,5 +67,5 @@ void main() {
 #endif
   }
   sums[KG_ICP_ROW_CONSIDERED] = considered;
-  store_group_sums(sums, KG_ICP_ROW_SUMS);
+  kg_store_group_sums(KG_BUFFER_ARG(partials) KG_SHARED_ARG(shared_sums) sums, KG_ICP_ROW_SUMS);
 }

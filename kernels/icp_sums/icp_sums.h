@@ -162,8 +162,12 @@ KG_FORCE_INLINE void icp_add_point_to_point(KG_ACCUMULATOR(double, sums, KG_MAX_
   const double3 db = pair.target - f.target_pivot;
   const double a[3] = {da.x, da.y, da.z};
   const double b[3] = {db.x, db.y, db.z};
-  const double w =
-      pair.weight * robust_kernel_weight(robust_kernel, f.robust_scale, sqrt(pair.distance_sq));
+  // The square root only for a robust kernel: it was a third of the CPU loop's time without one.
+  const double robust =
+      robust_kernel == KG_ROBUST_NONE
+          ? 1.0
+          : robust_kernel_weight(robust_kernel, f.robust_scale, sqrt(pair.distance_sq));
+  const double w = pair.weight * robust;
   sums[KG_ICP_POINT_PAIRS] += 1.0;
   sums[KG_ICP_POINT_WEIGHT_SUM] += w;
   for (int r = 0; r < 3; ++r) {

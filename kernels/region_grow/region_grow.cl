@@ -1,6 +1,7 @@
 // OpenCL wrapper of kernels/region_grow/region_grow.h: the four passes, with the names, buffers
 // and parameters of the region_grow_*.comp shaders.
 #include "kernels/region_grow/region_grow.h"
+#include "kernels/work_group/group_scan.h"
 
 inline bool region_grow_valid_pixel(__global const short4* lab, __global const float4* points,
                                     uint i) {
@@ -71,34 +72,13 @@ __kernel void region_grow_tiles(__global const short4* lab, __global const float
   tile_counts[t] = next;
 }
 
-// Pass 2: one work-group, exclusive prefix sums of the tile counts, the total to the status (see
-// region_grow_scan.comp).
+// Pass 2: one work-group, exclusive prefix sums of the tile counts, the total to the status
+// (kernels/work_group/group_scan.h).
 __kernel void region_grow_scan(__global uint* tile_counts, __global uint* status,
                                const RegionGrowParams params) {
-  __local uint part_offsets[KG_REGION_GROW_SCAN_LOCAL_X];
-  const uint lane = get_local_id(0);
-  const uint part = params.padded_tile_count / KG_REGION_GROW_SCAN_LOCAL_X;
-  const uint base = lane * part;
-  uint sum = 0;
-  for (uint j = 0; j < part; ++j) sum += tile_counts[base + j];
-  part_offsets[lane] = sum;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (lane == 0) {
-    uint running = 0;
-    for (uint l = 0; l < KG_REGION_GROW_SCAN_LOCAL_X; ++l) {
-      const uint value = part_offsets[l];
-      part_offsets[l] = running;
-      running += value;
-    }
-    status[KG_REGION_GROW_SEGMENT_COUNT] = running;
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  uint offset = part_offsets[lane];
-  for (uint j = 0; j < part; ++j) {
-    const uint value = tile_counts[base + j];
-    tile_counts[base + j] = offset;
-    offset += value;
-  }
+  __local uint part_offsets[KG_GROUP_SCAN_LANES];
+  const uint total = kg_group_exclusive_scan(tile_counts, part_offsets, params.padded_tile_count);
+  if (get_local_id(0) == 0u) status[KG_REGION_GROW_SEGMENT_COUNT] = total;
 }
 
 // Pass 3: tile-local segment numbers plus the tile's offset (see region_grow_offsets.comp).

@@ -1,5 +1,6 @@
 // OpenCL wrapper of kernels/voxel_downsample/voxel_downsample.h (the six passes).
 #include "kernels/voxel_downsample/voxel_downsample.h"
+#include "kernels/work_group/group_scan.h"
 
 __kernel void voxel_downsample_insert(__global const float4* points, __global const float4* normals,
                                       __global ulong* keys, __global uint* first,
@@ -18,32 +19,10 @@ __kernel void voxel_downsample_count(__global const int* point_slots, __global c
 }
 
 // One work-group: exclusive prefix sums of counts[0..thread_count) in place, the total after them.
-// Each lane scans a contiguous part, lane 0 scans the lanes' part sums.
 __kernel void voxel_downsample_scan(__global uint* counts, const VoxelScanParams params) {
-  __local uint part_offsets[KG_VOXEL_DOWNSAMPLE_LOCAL_X];
-  const uint lane = get_local_id(0);
-  const uint part = params.thread_count / KG_VOXEL_DOWNSAMPLE_LOCAL_X;
-  const uint base = lane * part;
-  uint sum = 0u;
-  for (uint j = 0u; j < part; ++j) sum += counts[base + j];
-  part_offsets[lane] = sum;
-  barrier(CLK_LOCAL_MEM_FENCE);
-  if (lane == 0u) {
-    uint running = 0u;
-    for (uint l = 0u; l < KG_VOXEL_DOWNSAMPLE_LOCAL_X; ++l) {
-      const uint value = part_offsets[l];
-      part_offsets[l] = running;
-      running += value;
-    }
-    counts[params.thread_count] = running;
-  }
-  barrier(CLK_LOCAL_MEM_FENCE);
-  uint offset = part_offsets[lane];
-  for (uint j = 0u; j < part; ++j) {
-    const uint value = counts[base + j];
-    counts[base + j] = offset;
-    offset += value;
-  }
+  __local uint part_offsets[KG_GROUP_SCAN_LANES];
+  const uint total = kg_group_exclusive_scan(counts, part_offsets, params.thread_count);
+  if (get_local_id(0) == 0u) counts[params.thread_count] = total;
 }
 
 __kernel void voxel_downsample_assign(__global const int* point_slots, __global const uint* first,
