@@ -2,7 +2,15 @@
 # Checks that every source and header includes only its own layer and the layers below it, as
 # docs/architecture.md draws them: a lower layer cannot include an upper one. Exits 1 and names each
 # offending include. Usage: scripts/check-layers.sh [SOURCE_ROOT]
+# With --tests LIST (lines "LAYER tests/FILE", written by tests/CMakeLists.txt), checks instead that
+# each test file, with the test headers it includes, includes only LAYER and the layers below it:
+# the per-layer test binaries (kartograf_<layer>_tests) link only their layer.
 set -euo pipefail
+test_list=""
+if [ "${1:-}" = "--tests" ]; then
+  test_list=$2
+  shift 2
+fi
 root=${1:-$(cd "$(dirname "$0")/.." && pwd)}
 cd "$root"
 
@@ -24,22 +32,57 @@ declare -A allowed=(
   [training]="core compute geometry segmentation semantic synth"
 )
 
+# check_include FILE LINE INCLUDE LAYER: counts and names an include of a layer LAYER may not use.
 failures=0
+check_include() {
+  local used
+  # Public headers (kartograf/<layer>/...) and src/'s private ones (<layer>/...).
+  used=$(printf '%s' "$3" | sed -E 's|.*"(kartograf/)?([a-z_]+)/.*|\2|')
+  [ -n "${allowed[$used]+known}" ] || return 0  # not a layer (kernels/, shaders/, ...)
+  [ "$used" = "$4" ] && return 0
+  case " ${allowed[$4]} " in
+    *" $used "*) ;;
+    *)
+      echo "$1:$2: layer '$4' includes '$used' ($3); allowed: ${allowed[$4]:-nothing}"
+      failures=$((failures + 1))
+      ;;
+  esac
+}
+
+# The test files: each file and the test headers (tests/*.hpp) it includes, transitively.
+check_test_file() {
+  local layer=$1 file=$2 line include header
+  while IFS=: read -r line include; do
+    header=$(printf '%s' "$include" | sed -E 's|#include "([^"]+)"|\1|')
+    if [ -f "tests/$header" ] && [ -z "${seen[$header]+yes}" ]; then
+      seen[$header]=1
+      check_test_file "$layer" "tests/$header"
+    fi
+    check_include "$file" "$line" "$include" "$layer"
+  done < <(grep -noE '#include "[^"]+"' "$file" || true)
+}
+if [ -n "$test_list" ]; then
+  while read -r layer file; do
+    [ -n "$layer" ] || continue
+    [ "$layer" = rooms_scan ] && layer=rooms  # kartograf_rooms_scan: the rooms layer without OpenCV
+    [ -n "${allowed[$layer]+known}" ] || { echo "$test_list: unknown layer '$layer'"; exit 1; }
+    declare -A seen=()
+    check_test_file "$layer" "$file"
+    unset seen
+  done < "$test_list"
+  if [ "$failures" -gt 0 ]; then
+    echo "$failures include(s) of test files cross the layers upward"
+    exit 1
+  fi
+  echo "layers: every test binary's files include only its layer and those below"
+  exit 0
+fi
+
 for layer in "${!allowed[@]}"; do
   for dir in "include/kartograf/$layer" "src/$layer"; do
     [ -d "$dir" ] || continue
     while IFS=: read -r file line include; do
-      # Public headers (kartograf/<layer>/...) and src/'s private ones (<layer>/...).
-      used=$(printf '%s' "$include" | sed -E 's|.*"(kartograf/)?([a-z_]+)/.*|\2|')
-      [ -n "${allowed[$used]+known}" ] || continue  # not a layer (kernels/, shaders/, ...)
-      [ "$used" = "$layer" ] && continue
-      case " ${allowed[$layer]} " in
-        *" $used "*) ;;
-        *)
-          echo "$file:$line: layer '$layer' includes '$used' ($include); allowed: ${allowed[$layer]:-nothing}"
-          failures=$((failures + 1))
-          ;;
-      esac
+      check_include "$file" "$line" "$include" "$layer"
     done < <(grep -rnoE '#include "(kartograf/)?[a-z_]+/[^"]+"' "$dir" || true)
   done
 done

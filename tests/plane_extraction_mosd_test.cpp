@@ -1,5 +1,6 @@
-// Plane extraction on the PCL mOSD table-top frames (organized PCD files read through kartograf_io,
-// so in kartograf_tests only, not in the device tests): the table is found as one plane.
+// Plane extraction on the PCL mOSD table-top frames (organized PCD files read through
+// kartograf_formats, so in kartograf_pipeline_tests only, not in the device tests): the table is
+// found as one plane.
 #include <gtest/gtest.h>
 
 #include <algorithm>

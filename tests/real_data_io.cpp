@@ -1,5 +1,5 @@
-// The real data of the device tests as kartograf_tests reads it: the original files, through
-// kartograf_io.
+// The real data of the device tests as the binaries above the file layers read it: the original
+// files, through kartograf_formats.
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "real_data.hpp"

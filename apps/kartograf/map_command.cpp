@@ -11,6 +11,7 @@
 #include "commands.hpp"
 #include "interrupts.hpp"
 #include "kartograf/outputs/map_outputs.hpp"
+#include "kartograf/outputs/map_run_info.hpp"
 #include "kartograf/outputs/synthetic_dataset.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
@@ -21,19 +22,6 @@
 namespace kartograf::cli {
 
 namespace {
-
-Json parameters_json(const MapOptions& o, const pipeline::MapPipelineParams& p) {
-  return {{"method", o.run.method},
-          {"reestimate_interval", o.run.reestimate_interval},
-          {"label_step", p.label_step},
-          {"label_width", p.label_width},
-          {"grid_resolution_m", p.grid.resolution},
-          {"map_voxel_m", p.slam.map.voxel_size},
-          {"room_method", rooms::to_string(p.room_method)},
-          {"rooms_end_at_doorways", p.rooms_end_at_doorways},
-          {"rooms_take_enclosed", p.rooms_take_enclosed},
-          {"room_fragment_area_m2", p.room_fragment_area_m2}};
-}
 
 void print_summary(std::ostream& out, const pipeline::MapPipelineResult& r,
                    const std::optional<pipeline::MapEvaluation>& e) {
@@ -140,14 +128,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   std::optional<pipeline::MapEvaluation> evaluation;
   if (!truth.poses.empty()) evaluation = pipeline::evaluate_map(result, truth);
 
-  io::MapRunInfo info;
-  info.sequence = o.run.sequence.string();
-  info.layout = std::string(io::to_string(run.opened.detected.layout));
-  info.backend = std::string(compute::to_string(context.backend()));
-  info.device = context.device_info().name;
-  info.has_timestamps = run.opened.detected.has_timestamps;
-  info.parameters_json = parameters_json(o, params).dump();
-  info.input_json = input_json(run.opened).dump();
+  const io::MapRunInfo info = io::map_run_info(run_record(o.run, context), run.opened, params);
   {
     const InterruptsDeferred writing;  // a signal waits for the files, then drops them
     io::write_map_outputs(folder.dir(), result, evaluation, info);

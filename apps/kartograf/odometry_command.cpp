@@ -11,6 +11,7 @@
 #include "kartograf/formats/text_file.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/mapping/slam.hpp"
+#include "kartograf/outputs/odometry_stats.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
@@ -47,23 +48,23 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
                            stamped_trajectory(result.poses, result.timestamps, has_timestamps));
   const auto ate = absolute_trajectory_error(*run.source, result.poses);
   const double frames = static_cast<double>(result.poses.size());
-  const double with_io = result.timing.wall_seconds > 0 ? frames / result.timing.wall_seconds : 0;
-  const double without_io = result.compute_seconds > 0 ? frames / result.compute_seconds : 0;
-  const Json summary = frame_summary_json(result.frames);
+  const io::OdometryThroughput throughput = io::odometry_throughput(result);
+  const io::SequenceRunRecord record = run_record(o.run, context);
 
   out << "odometry: " << o.run.sequence.string() << " ("
       << io::to_string(run.opened.detected.layout) << ", " << result.poses.size()
-      << " frames), method " << o.run.method << ", backend "
-      << compute::to_string(context.backend()) << " (" << context.device_info().name << ")\n"
+      << " frames), method " << o.run.method << ", backend " << record.backend << " ("
+      << record.device << ")\n"
       << "  " << io::describe_input(run.opened) << "\n"
       << "  trajectory " << o.out.string() << "\n";
   char line[256];
   std::snprintf(line, sizeof(line),
                 "  frames_per_s %.1f with file I/O, %.1f without (loading %.1f ms/frame on the "
                 "prefetch thread)\n",
-                with_io, without_io, 1000.0 * result.timing.load_seconds / std::max(frames, 1.0));
+                throughput.with_io, throughput.without_io,
+                1000.0 * result.timing.load_seconds / std::max(frames, 1.0));
   out << line;
-  out << "  " << frame_summary_line(summary) << "\n";
+  out << "  " << io::frame_counts_line(io::count_odometry_frames(result.frames)) << "\n";
   if (ate) {
     std::snprintf(line, sizeof(line), "  ate_rmse_m %.6f (max %.6f, %zu poses with ground truth)\n",
                   ate->translation_m.rmse, ate->translation_m.max, ate->translation_m.count);
@@ -71,24 +72,8 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
   }
 
   if (!o.stats.empty()) {
-    Json json;
-    json["sequence"] = o.run.sequence.string();
-    json["layout"] = io::to_string(run.opened.detected.layout);
-    json["input"] = input_json(run.opened);
-    json["method"] = o.run.method;
-    json["backend"] = compute::to_string(context.backend());
-    json["device"] = context.device_info().name;
-    json["reestimate_interval"] = params.reestimate_interval;
-    json["frames_per_s_with_io"] = with_io;
-    json["frames_per_s_without_io"] = without_io;
-    json["wall_seconds"] = result.timing.wall_seconds;
-    json["load_seconds"] = result.timing.load_seconds;
-    json["ate_rmse_m"] = ate ? Json(ate->translation_m.rmse) : Json();
-    json["summary"] = summary;
-    Json per_frame = Json::array();
-    for (const auto& f : result.frames) per_frame.push_back(frame_json(f));
-    json["per_frame"] = std::move(per_frame);
-    io::write_text_file(stats_file, json.dump(1) + "\n");
+    io::write_text_file(stats_file,
+                        io::odometry_stats_json(record, run.opened, params, result, ate));
   }
   files.commit();
   return 0;

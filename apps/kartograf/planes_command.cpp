@@ -10,24 +10,25 @@
 #include <memory>
 #include <ostream>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "backend_option.hpp"
 #include "commands.hpp"
 #include "interrupts.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/geometry/backproject.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/formats/pcd.hpp"
-#include "kartograf/outputs/plane_io.hpp"
 #include "kartograf/formats/ply.hpp"
 #include "kartograf/formats/sequence.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/formats/text_file.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/outputs/plane_io.hpp"
+#include "kartograf/outputs/plane_run.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
@@ -59,14 +60,14 @@ segmentation::PlaneExtractionParams extraction_params(const PlanesOptions& o) {
   return params;
 }
 
-Json run_json(const PlanesOptions& o, const compute::Context& context) {
-  return {{"lab_threshold", o.lab_threshold},
-          {"normal_angle_deg", o.normal_angle_deg},
-          {"min_plane_pixels", o.min_plane_pixels},
-          {"neighbours", o.neighbours},
-          {"fit", o.fit},
-          {"backend", compute::to_string(context.backend())},
-          {"device", context.device_info().name}};
+io::PlaneRunRecord run_record(const PlanesOptions& o, const compute::Context& context) {
+  return {.lab_threshold = o.lab_threshold,
+          .normal_angle_deg = o.normal_angle_deg,
+          .min_plane_pixels = o.min_plane_pixels,
+          .neighbours = o.neighbours,
+          .fit = o.fit,
+          .backend = std::string(compute::to_string(context.backend())),
+          .device = context.device_info().name};
 }
 
 // An organized PCD with colour: its pixels are the camera's; intrinsics are not needed for the
@@ -124,9 +125,9 @@ PlaneInput rgbd_input(const PlanesOptions& o, const compute::Context& context) {
 
 // Extracts and writes one frame's files into dir (staging; shown_dir: where they will be); returns
 // its summary.
-Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& input,
-                   const fs::path& dir, const fs::path& shown_dir, const Json& run,
-                   std::ostream& out) {
+io::PlaneFrameRecord extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& input,
+                                   const fs::path& dir, const fs::path& shown_dir,
+                                   const std::string& run_json, std::ostream& out) {
   const segmentation::PlaneSet set = extractor.extract(input.points, input.color);
   std::size_t valid = 0, labelled = 0;
   for (std::size_t i = 0; i < input.points.size(); ++i) {
@@ -141,7 +142,7 @@ Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& in
     io::write_label_png(dir / "labels.png", set.labels);
     io::write_png(dir / "segmentation.png", io::plane_overlay(input.color, set.labels));
     io::write_ply(dir / "planes.ply", io::plane_points(input.points, set.labels));
-    io::write_planes_json(dir / "planes.json", set, {input.name, input.intrinsics, run.dump()});
+    io::write_planes_json(dir / "planes.json", set, {input.name, input.intrinsics, run_json});
   }
   const double coverage = 100.0 * static_cast<double>(labelled) / static_cast<double>(valid);
   char line[256];
@@ -151,13 +152,13 @@ Json extract_frame(segmentation::PlaneExtractor& extractor, const PlaneInput& in
                 input.name.c_str(), set.planes.size(), set.segment_count, set.merged_count,
                 coverage, set.timings.total(), shown_dir.string().c_str());
   out << line;
-  return {{"source", input.name},
-          {"dir", shown_dir.string()},
-          {"planes", set.planes.size()},
-          {"segments", set.segment_count},
-          {"valid_pixels", valid},
-          {"plane_pixels", labelled},
-          {"milliseconds", set.timings.total()}};
+  return {.source = input.name,
+          .dir = shown_dir.string(),
+          .planes = set.planes.size(),
+          .segments = set.segment_count,
+          .valid_pixels = valid,
+          .plane_pixels = labelled,
+          .milliseconds = set.timings.total()};
 }
 
 }  // namespace
@@ -222,7 +223,8 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
   const compute::Context context = backend_context(o.backend, o.backend_source);
   const segmentation::PlaneExtractionParams params = extraction_params(o);
   params.validate();
-  const Json run = run_json(o, context);
+  const io::PlaneRunRecord run = run_record(o, context);
+  const std::string run_json = io::plane_run_json(run);
   OutputFolder folder(
       "planes", o.out_dir, o.force,
       {"planes.json", "labels.png", "segmentation.png", "planes.ply", "summary.json"});
@@ -233,7 +235,7 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
     const PlaneInput input = extension == ".pcd" ? pcd_input(o.input) : rgbd_input(o, context);
     segmentation::PlaneExtractor extractor(context, input.intrinsics, params);
-    extract_frame(extractor, input, folder.dir(), o.out_dir, run, out);
+    extract_frame(extractor, input, folder.dir(), o.out_dir, run_json, out);
     folder.commit();
     return 0;
   }
@@ -249,7 +251,7 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
   geometry::DepthRange range;
   range.units_per_metre = sequence.depth_units_per_metre();
   ProgressBar bar(err, o.progress);
-  Json frames = Json::array();
+  std::vector<io::PlaneFrameRecord> frames;
   const std::size_t total = sequence.size();
   for (std::size_t i = 0; i < total; ++i) {
     io::RgbdFrame frame = sequence.frame(i);
@@ -259,17 +261,12 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
                      geometry::backproject(context, frame.depth, sequence.intrinsics(), range),
                      std::move(frame.color), sequence.intrinsics()};
     frames.push_back(
-        extract_frame(extractor, input, folder.dir() / number, o.out_dir / number, run, out));
+        extract_frame(extractor, input, folder.dir() / number, o.out_dir / number, run_json, out));
     bar.update("planes", frames.size(), total);
   }
   bar.finish();
-  Json summary;
-  summary["sequence"] = o.input.string();
-  summary["layout"] = io::to_string(opened.detected.layout);
-  summary["input"] = input_json(opened);
-  summary["run"] = run;
-  summary["frames"] = std::move(frames);
-  io::write_text_file(folder.dir() / "summary.json", summary.dump(1) + "\n");
+  io::write_text_file(folder.dir() / "summary.json",
+                      io::plane_sequence_summary_json(o.input.string(), opened, run, frames));
   folder.commit();
   return 0;
 }

@@ -17,7 +17,6 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "backend_option.hpp"
 #include "commands.hpp"
@@ -29,6 +28,7 @@
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/formats/text_file.hpp"
 #include "kartograf/outputs/room_io.hpp"
+#include "kartograf/outputs/room_run.hpp"
 #include "kartograf/rooms/room_methods.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
@@ -164,11 +164,10 @@ int run_rooms_command(const RoomsOptions& o, bool resolution_given, std::ostream
   const InterruptsDeferred writing;  // a signal waits for the files, then drops them
   const fs::path& dir = folder.dir();
   // Everything is computed before the first file is written; each write is atomic.
-  const nlohmann::ordered_json run = {
-      {"method", o.method}, {"resolution", map.resolution}, {"free_threshold", o.free_threshold}};
+  const std::string run_json = io::room_run_json({o.method, map.resolution, o.free_threshold});
   io::write_label_png(dir / "rooms.png", result.rooms);
   io::write_png(dir / "rooms_color.png", io::room_overlay(map, result.rooms));
-  io::write_rooms_json(dir / "rooms.json", result, map, o.map.string(), run.dump());
+  io::write_rooms_json(dir / "rooms.json", result, map, o.map.string(), run_json);
   folder.commit();
   double area = 0;
   for (const rooms::RoomRecord& r : result.records) area += r.area_m2;

@@ -21,15 +21,16 @@
 #include "interrupts.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/geometry/backproject.hpp"
-#include "kartograf/geometry/range_image.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/formats/pcd.hpp"
 #include "kartograf/formats/ply.hpp"
-#include "kartograf/outputs/semantic_map_io.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/formats/tum.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/geometry/range_image.hpp"
+#include "kartograf/outputs/semantic_map_io.hpp"
+#include "kartograf/pipeline/labelled_view_pool.hpp"
 #include "kartograf/semantic/classify.hpp"
 #include "kartograf/semantic/labelled_views.hpp"
 #include "kartograf/semantic/normals_image.hpp"
@@ -76,11 +77,10 @@ struct Views {
   std::optional<semantic::ObjectDetector> detector;
 };
 
-// A labelled view of points seen from `pose`: its points join the map in the world frame, its up
-// direction the area-weighted vote; the first view is the one pictured and the sensor's place.
-void add_view(const PointImage& points, semantic::SemanticLabelling labelling,
-              const Eigen::Isometry3d& pose, const Views& views, LabelledPoints& out) {
-  out.pooled.add(points, labelling.semantic, labelling.gravity, pose);
+// What a pooled view of points seen from `pose` adds beyond its points and its up vote: its
+// detections (--detect); the first view is the one pictured and the sensor's place.
+void note_view(const PointImage& points, semantic::SemanticLabelling labelling,
+               const Eigen::Isometry3d& pose, const Views& views, LabelledPoints& out) {
   if (views.detector) {
     for (semantic::ViewDetection& d : views.detector->detect(views.context, points)) {
       for (Eigen::Vector3d& p : d.points) p = pose * p;
@@ -131,14 +131,9 @@ LabelledPoints map_points(const SemanticOptions& o, const Views& views, const Po
   for (const Eigen::Isometry3d& viewpoint : viewpoints) {
     const geometry::RangeImage image =
         geometry::make_range_image(cloud.points, viewpoint, range_params);
-    semantic::SemanticLabelling labelling;
-    try {
-      labelling = semantic::label_organized_points(views.context, image.points);
-    } catch (const Error& e) {
-      out.pooled.skip(e.what());
-      continue;
-    }
-    add_view(image.points, std::move(labelling), viewpoint, views, out);
+    std::optional<semantic::SemanticLabelling> labelling =
+        pipeline::label_and_pool_view(views.context, image.points, viewpoint, {}, out.pooled);
+    if (labelling) note_view(image.points, std::move(*labelling), viewpoint, views, out);
   }
   require(out.pooled.views() > 0, "semantic: no view of '" + o.input.string() +
                                       "' could be labelled: " + out.pooled.first_skip_reason());
@@ -158,8 +153,9 @@ LabelledPoints scan_points(const SemanticOptions& o, const Views& views, std::os
   if (!cloud.organized()) return map_points(o, views, cloud.to_point_cloud(), cloud.viewpoint, err);
   const PointImage points = cloud.to_point_image();
   LabelledPoints out;
-  add_view(points, semantic::label_organized_points(views.context, points),
-           Eigen::Isometry3d::Identity(), views, out);
+  semantic::SemanticLabelling labelling = semantic::label_organized_points(views.context, points);
+  out.pooled.add(points, labelling.semantic, labelling.gravity, Eigen::Isometry3d::Identity());
+  note_view(points, std::move(labelling), Eigen::Isometry3d::Identity(), views, out);
   make_up_z(out);
   return out;
 }
@@ -193,15 +189,9 @@ LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std
     if (!pose) continue;
     const PointImage points =
         geometry::backproject(views.context, frame.depth, sequence.intrinsics(), range);
-    semantic::SemanticLabelling labelling;
-    try {
-      labelling = semantic::label_organized_points(views.context, points, params);
-    } catch (const Error& e) {
-      // e.g. a wall seen from close by: no floor or ceiling to find gravity
-      out.pooled.skip(e.what());
-      continue;
-    }
-    add_view(points, std::move(labelling), *pose, views, out);
+    std::optional<semantic::SemanticLabelling> labelling =
+        pipeline::label_and_pool_view(views.context, points, *pose, params, out.pooled);
+    if (labelling) note_view(points, std::move(*labelling), *pose, views, out);
   }
   const std::string& failure = out.pooled.first_skip_reason();
   require(out.pooled.views() > 0, "semantic: no frame of '" + o.input.string() +

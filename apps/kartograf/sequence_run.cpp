@@ -7,8 +7,8 @@
 #include <iostream>
 
 #include "backend_option.hpp"
-#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "option_checks.hpp"
 
 namespace kartograf::cli {
@@ -81,26 +81,6 @@ io::OpenedSequence open_input(const std::filesystem::path& folder, const Sequenc
   return opened;
 }
 
-Json input_json(const io::OpenedSequence& opened) {
-  const PinholeIntrinsics& k = opened.camera.intrinsics;
-  Json skipped = Json::array();
-  for (const io::SkippedFrame& frame : opened.skipped)
-    skipped.push_back({{"frame", frame.position}, {"reason", frame.reason}});
-  return {{"camera",
-           {{"fx", k.fx},
-            {"fy", k.fy},
-            {"cx", k.cx},
-            {"cy", k.cy},
-            {"width", k.width},
-            {"height", k.height},
-            {"source", opened.camera.source},
-            {"description", opened.camera.description}}},
-          {"depth_units_per_metre", opened.sequence->depth_units_per_metre()},
-          {"depth_scale_source", opened.depth_scale_source},
-          {"frames_skipped", opened.skipped.size()},
-          {"skipped_frames", std::move(skipped)}};
-}
-
 registration::OdometryParams odometry_params(const SequenceRunOptions& options) {
   registration::OdometryParams params;
   params.method = options.method == "p2p"      ? registration::OdometryMethod::point_to_point
@@ -114,6 +94,12 @@ registration::OdometryParams odometry_params(const SequenceRunOptions& options) 
 
 compute::Context make_run_context(const SequenceRunOptions& options) {
   return backend_context(options.backend, options.backend_source);
+}
+
+io::SequenceRunRecord run_record(const SequenceRunOptions& options,
+                                 const compute::Context& context) {
+  return {options.sequence.string(), options.method,
+          std::string(compute::to_string(context.backend())), context.device_info().name};
 }
 
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
@@ -191,7 +177,9 @@ void warn_about(std::ostream& err, ProgressBar& bar, const registration::Odometr
 
 mapping::SlamObserver slam_progress_observer(std::ostream& err, ProgressBar& bar) {
   mapping::SlamObserver observer;
-  observer.on_frame = [&err, &bar](const registration::OdometryFrame& f) { warn_about(err, bar, f); };
+  observer.on_frame = [&err, &bar](const registration::OdometryFrame& f) {
+    warn_about(err, bar, f);
+  };
   observer.on_progress = [&bar](std::string_view stage, std::size_t done, std::size_t total) {
     bar.update(stage, done, total);
   };
@@ -224,70 +212,6 @@ std::optional<eval::AteResult> absolute_trajectory_error(
   const eval::MatchedPoses matched = eval::match_frames(source.ground_truth(), poses);
   if (matched.size() < 3) return std::nullopt;
   return eval::compute_ate(matched, eval::Alignment::se3);
-}
-
-Json report_json(const registration::RegistrationReport& r) {
-  Json json;
-  json["verdict"] = registration::to_string(r.verdict);
-  json["fitness"] = r.fitness;
-  json["inlier_rmse_m"] = r.inlier_rmse;
-  json["inliers"] = r.inliers;
-  json["iterations"] = r.iterations;
-  json["converged"] = r.converged;
-  json["degenerate"] = r.degenerate;
-  json["eigenvalue_ratio"] = r.eigenvalue_ratio;
-  json["correction_m"] = r.correction_m;
-  json["correction_deg"] = r.correction_deg;
-  return json;
-}
-
-Json frame_json(const registration::OdometryFrame& frame) {
-  Json json;
-  json["frame"] = frame.index;
-  json["keyframe"] = frame.keyframe;
-  json["fallback"] = frame.fallback;
-  json["retried"] = frame.retried;
-  json["degenerate"] = frame.degenerate;
-  json["photometric"] = frame.photometric;
-  json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
-  json["previous"] = frame.previous ? report_json(*frame.previous) : Json();
-  json["reestimate"] = frame.reestimate ? report_json(*frame.reestimate) : Json();
-  json["seconds"] = frame.seconds;
-  return json;
-}
-
-Json frame_summary_json(const std::vector<registration::OdometryFrame>& frames) {
-  std::size_t fallbacks = 0, retried = 0, degenerate = 0, photometric = 0, keyframes = 0,
-              reestimates = 0, reestimates_rejected = 0;
-  for (const auto& f : frames) {
-    fallbacks += f.fallback;
-    retried += f.retried;
-    keyframes += f.keyframe;
-    degenerate += f.degenerate;
-    photometric += f.photometric;
-    reestimates += f.reestimate.has_value();
-    reestimates_rejected += f.reestimate && !f.reestimate->accepted();
-  }
-  Json json;
-  json["frames"] = frames.size();
-  json["keyframes"] = keyframes;
-  json["fallbacks"] = fallbacks;
-  json["retried_from_identity"] = retried;
-  json["degenerate_frames"] = degenerate;
-  json["photometric_frames"] = photometric;
-  json["reestimates"] = reestimates;
-  json["reestimates_rejected"] = reestimates_rejected;
-  return json;
-}
-
-std::string frame_summary_line(const Json& summary) {
-  const auto count = [&](const char* key) {
-    return std::to_string(summary[key].get<std::size_t>());
-  };
-  return "keyframes " + count("keyframes") + ", fallbacks " + count("fallbacks") +
-         ", re-estimates " + count("reestimates") + " (rejected " + count("reestimates_rejected") +
-         "), degenerate frames " + count("degenerate_frames") + " (" + count("photometric_frames") +
-         " measured by image intensity)";
 }
 
 }  // namespace kartograf::cli

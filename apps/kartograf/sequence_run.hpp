@@ -1,7 +1,8 @@
 #pragma once
 // What `kartograf odometry` and `kartograf slam` share: options, opening the sequence, the compute
-// context, a progress bar, warnings about rejected registrations, trajectories in TUM format,
-// scoring against ground truth and per-frame statistics as JSON. Wiring only.
+// context, a progress bar, warnings about rejected registrations, trajectories in TUM format and
+// scoring against ground truth (the stats documents: kartograf/outputs/odometry_stats.hpp). Wiring
+// only.
 #include <chrono>
 #include <cstddef>
 #include <cstdint>
@@ -14,20 +15,18 @@
 #include <vector>
 
 #include <CLI/CLI.hpp>
-#include <nlohmann/json.hpp>
 
 #include "commands.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/trajectory.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
-#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/mapping/slam.hpp"
+#include "kartograf/outputs/odometry_stats.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/registration/odometry.hpp"
 
 namespace kartograf::cli {
-
-using Json = nlohmann::ordered_json;
 
 // The most frames a frame option takes (--first, --frames): far beyond any recording.
 inline constexpr std::uint64_t kMaxFrames = 100000000;
@@ -44,11 +43,11 @@ io::SequenceParams sequence_options(const SequenceInputOptions& options);
 // out, and one line with the frame count, the camera and the depth scale.
 io::OpenedSequence open_input(const std::filesystem::path& folder,
                               const SequenceInputOptions& options, std::ostream& err);
-// The camera, depth scale and frames left out, for stats.json and summaries.
-Json input_json(const io::OpenedSequence& opened);
-
 registration::OdometryParams odometry_params(const SequenceRunOptions& options);
 compute::Context make_run_context(const SequenceRunOptions& options);
+// The options and the context as the stats documents record them.
+io::SequenceRunRecord run_record(const SequenceRunOptions& options,
+                                 const compute::Context& context);
 
 // The opened sequence and the pipeline's view of it.
 struct OpenedRun {
@@ -90,12 +89,5 @@ Trajectory ground_truth_trajectory(const pipeline::SequenceFrameSource& source,
 // ATE (SE(3) alignment) of the estimate's frames that have ground truth; empty without any.
 std::optional<eval::AteResult> absolute_trajectory_error(
     const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
-
-Json report_json(const registration::RegistrationReport& report);
-Json frame_json(const registration::OdometryFrame& frame);
-// Counts over frames: fallbacks, retried, rejected re-estimates, degenerate, keyframes.
-Json frame_summary_json(const std::vector<registration::OdometryFrame>& frames);
-// One line of those counts, for the summaries on stdout.
-std::string frame_summary_line(const Json& summary);
 
 }  // namespace kartograf::cli

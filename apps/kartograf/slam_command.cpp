@@ -16,6 +16,7 @@
 #include "kartograf/formats/top_view.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/mapping/slam.hpp"
+#include "kartograf/outputs/slam_stats.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
@@ -24,96 +25,23 @@ namespace kartograf::cli {
 
 namespace {
 
-Json loop_closure_json(const mapping::LoopClosureRecord& record) {
-  const mapping::LoopCandidate& c = record.closure.candidate;
-  Json json;
-  json["query_frame"] = c.query_frame;
-  json["match_frame"] = c.match_frame;
-  json["distance_m"] = c.distance_m;
-  json["view_angle_deg"] = c.view_angle_deg;
-  json["overlap"] = c.overlap;
-  json["registration"] = report_json(record.closure.report);
-  const Eigen::Isometry3d& motion = record.closure.constraint.motion;
-  const Eigen::Quaterniond rotation(motion.linear());
-  json["motion"] = {motion.translation().x(),
-                    motion.translation().y(),
-                    motion.translation().z(),
-                    rotation.x(),
-                    rotation.y(),
-                    rotation.z(),
-                    rotation.w()};
-  json["chi2"] = record.chi2;
-  json["residual_m"] = record.residual_m;
-  json["residual_deg"] = record.residual_deg;
-  json["pruned"] = record.pruned;
-  return json;
-}
-
 // What the summary and stats.json say beyond the result itself.
 struct SlamFigures {
   std::optional<eval::AteResult> slam_ate, odometry_ate;
-  std::size_t accepted = 0, pruned = 0;
-  Json loops = Json::array();
+  io::LoopClosureCounts loops;
 };
 
 SlamFigures slam_figures(const OpenedRun& run, const mapping::SlamResult& result) {
   SlamFigures f;
   f.slam_ate = absolute_trajectory_error(*run.source, result.poses);
   f.odometry_ate = absolute_trajectory_error(*run.source, result.odometry.poses);
-  for (const auto& record : result.loop_closures) {
-    f.accepted += record.closure.report.accepted();
-    f.pruned += record.pruned;
-    f.loops.push_back(loop_closure_json(record));
-  }
+  f.loops = io::count_loop_closures(result);
   return f;
-}
-
-Json slam_stats_json(const SlamOptions& o, const OpenedRun& run, const compute::Context& context,
-                     const mapping::SlamParams& params, const mapping::SlamResult& result,
-                     const SlamFigures& f) {
-  const mapping::SlamTimings& t = result.timing;
-  Json json;
-  json["sequence"] = o.run.sequence.string();
-  json["layout"] = io::to_string(run.opened.detected.layout);
-  json["input"] = input_json(run.opened);
-  json["frames"] = result.poses.size();
-  json["method"] = o.run.method;
-  json["backend"] = compute::to_string(context.backend());
-  json["device"] = context.device_info().name;
-  json["reestimate_interval"] = params.odometry.reestimate_interval;
-  json["odometry_ate_rmse_m"] = f.odometry_ate ? Json(f.odometry_ate->translation_m.rmse) : Json();
-  json["slam_ate_rmse_m"] = f.slam_ate ? Json(f.slam_ate->translation_m.rmse) : Json();
-  json["timing_s"] = {{"total", t.total_seconds},
-                      {"odometry", t.odometry_seconds},
-                      {"loop_closure", t.loop_closure_seconds},
-                      {"optimisation", t.optimisation_seconds},
-                      {"map", t.map_seconds},
-                      {"loading", t.load_seconds}};
-  json["loop_closure"] = {{"enabled", params.loop_closure},
-                          {"candidates", result.loop_candidates},
-                          {"accepted", f.accepted},
-                          {"pruned", f.pruned},
-                          {"closures", f.loops}};
-  json["pose_graph"] = {{"nodes", result.poses.size()},
-                        {"edges", result.graph_edges},
-                        {"optimisations", result.graph_optimisations},
-                        {"iterations", result.final_graph.iterations},
-                        {"initial_cost", result.final_graph.initial_cost},
-                        {"final_cost", result.final_graph.final_cost},
-                        {"converged", result.final_graph.converged}};
-  json["map"] = {{"points", result.map.size()},
-                 {"voxels", result.map_voxels},
-                 {"voxel_size_m", params.map.voxel_size}};
-  json["odometry"] = frame_summary_json(result.odometry.frames);
-  Json per_frame = Json::array();
-  for (const auto& frame : result.odometry.frames) per_frame.push_back(frame_json(frame));
-  json["per_frame"] = std::move(per_frame);
-  return json;
 }
 
 // Writes the files into the staging folder; returns whether groundtruth.txt was among them.
 bool write_slam_files(const std::filesystem::path& dir, const OpenedRun& run,
-                      const mapping::SlamResult& result, bool build_map, const Json& stats) {
+                      const mapping::SlamResult& result, bool build_map, const std::string& stats) {
   const bool has_timestamps = run.opened.detected.has_timestamps;
   const std::vector<double>& timestamps = result.odometry.timestamps;
   io::write_tum_trajectory(dir / "trajectory.txt",
@@ -124,24 +52,24 @@ bool write_slam_files(const std::filesystem::path& dir, const OpenedRun& run,
   if (!truth.empty()) io::write_tum_trajectory(dir / "groundtruth.txt", truth);
   if (build_map) io::write_ply(dir / "map.ply", result.map);
   io::write_top_view_png(dir / "top_view.png", result.map, result.poses);
-  io::write_text_file(dir / "stats.json", stats.dump(1) + "\n");
+  io::write_text_file(dir / "stats.json", stats);
   return !truth.empty();
 }
 
 void print_slam_summary(std::ostream& out, const SlamOptions& o, const OpenedRun& run,
-                        const Json& stats, const mapping::SlamResult& result, const SlamFigures& f,
-                        bool wrote_truth) {
+                        const io::SequenceRunRecord& record, const mapping::SlamResult& result,
+                        const SlamFigures& f, bool wrote_truth) {
   const mapping::SlamTimings& t = result.timing;
   const double frames = static_cast<double>(result.poses.size());
   char line[256];
   out << "slam: " << o.run.sequence.string() << " (" << io::to_string(run.opened.detected.layout)
       << ", " << result.poses.size() << " frames), method " << o.run.method << ", backend "
-      << stats["backend"].get<std::string>() << " (" << stats["device"].get<std::string>() << ")\n";
+      << record.backend << " (" << record.device << ")\n";
   out << "  " << io::describe_input(run.opened) << "\n";
-  out << "  " << frame_summary_line(stats["odometry"]) << "\n";
+  out << "  " << io::frame_counts_line(io::count_odometry_frames(result.odometry.frames)) << "\n";
   std::snprintf(line, sizeof(line),
                 "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",
-                f.accepted, result.loop_candidates, f.pruned);
+                f.loops.accepted, result.loop_candidates, f.loops.pruned);
   out << line;
   std::snprintf(line, sizeof(line), "  map_points %zu (voxel %.3f m)\n", result.map.size(),
                 o.voxel_size);
@@ -197,14 +125,16 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   bar.finish();
 
   const SlamFigures figures = slam_figures(run, result);
-  const Json stats = slam_stats_json(o, run, context, params, result, figures);
+  const io::SequenceRunRecord record = run_record(o.run, context);
+  const std::string stats = io::slam_stats_json(record, run.opened, params, result,
+                                                figures.slam_ate, figures.odometry_ate);
   bool wrote_truth = false;
   {
     const InterruptsDeferred writing;  // a signal waits for the files, then drops them
     wrote_truth = write_slam_files(folder.dir(), run, result, params.build_map, stats);
     folder.commit();
   }
-  print_slam_summary(out, o, run, stats, result, figures, wrote_truth);
+  print_slam_summary(out, o, run, record, result, figures, wrote_truth);
   return 0;
 }
 

@@ -8,6 +8,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
+#include "kartograf/pipeline/labelled_view_pool.hpp"
 #include "kartograf/semantic/labelled_views.hpp"
 
 namespace kartograf::pipeline {
@@ -205,14 +206,15 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
     const PointImage points =
         geometry::backproject(context, decimate(frame.depth, factor), view_camera, range);
     const Eigen::Isometry3d& pose = result.slam.poses[i];
+    const std::string frame_name = "frame " + std::to_string(i) + ": ";
+    const std::optional<semantic::SemanticLabelling> labelling =
+        label_and_pool_view(context, points, pose, labelling_params, views, frame_name);
     try {
-      const semantic::SemanticLabelling labelling =
-          semantic::label_organized_points(context, points, labelling_params);
-      views.add(points, labelling.semantic, labelling.gravity, pose);
-      plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)), points,
-                         labelling.semantic, pose);
+      if (labelling)
+        plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)),
+                           points, labelling->semantic, pose);
     } catch (const Error& e) {
-      views.skip("frame " + std::to_string(i) + ": " + e.what());  // e.g. a wall seen close by
+      views.skip(frame_name + e.what());  // a pooled view whose planes failed: skipped as well
     }
     if (observer.slam.on_progress) observer.slam.on_progress("views", i + 1, frames);
   }

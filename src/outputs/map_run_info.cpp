@@ -1,0 +1,40 @@
+#include "kartograf/outputs/map_run_info.hpp"
+
+#include <string>
+
+#include "run_json.hpp"
+
+namespace kartograf::io {
+
+namespace {
+
+// The parameters a run can change (options of `kartograf map`), a JSON object.
+detail::RunJson parameters_json(const std::string& method, const pipeline::MapPipelineParams& p) {
+  return {{"method", method},
+          {"reestimate_interval", p.slam.odometry.reestimate_interval},
+          {"label_step", p.label_step},
+          {"label_width", p.label_width},
+          {"grid_resolution_m", p.grid.resolution},
+          {"map_voxel_m", p.slam.map.voxel_size},
+          {"room_method", rooms::to_string(p.room_method)},
+          {"rooms_end_at_doorways", p.rooms_end_at_doorways},
+          {"rooms_take_enclosed", p.rooms_take_enclosed},
+          {"room_fragment_area_m2", p.room_fragment_area_m2}};
+}
+
+}  // namespace
+
+MapRunInfo map_run_info(const SequenceRunRecord& record, const OpenedSequence& opened,
+                        const pipeline::MapPipelineParams& params) {
+  MapRunInfo info;
+  info.sequence = record.sequence;
+  info.layout = std::string(to_string(opened.detected.layout));
+  info.backend = record.backend;
+  info.device = record.device;
+  info.has_timestamps = opened.detected.has_timestamps;
+  info.parameters_json = parameters_json(record.method, params).dump();
+  info.input_json = detail::input_json(opened).dump();
+  return info;
+}
+
+}  // namespace kartograf::io

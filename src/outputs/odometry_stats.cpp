@@ -1,0 +1,146 @@
+#include "kartograf/outputs/odometry_stats.hpp"
+
+#include <utility>
+
+#include "run_json.hpp"
+
+namespace kartograf::io {
+
+namespace detail {
+
+RunJson input_json(const OpenedSequence& opened) {
+  const PinholeIntrinsics& k = opened.camera.intrinsics;
+  RunJson skipped = RunJson::array();
+  for (const SkippedFrame& frame : opened.skipped)
+    skipped.push_back({{"frame", frame.position}, {"reason", frame.reason}});
+  return {{"camera",
+           {{"fx", k.fx},
+            {"fy", k.fy},
+            {"cx", k.cx},
+            {"cy", k.cy},
+            {"width", k.width},
+            {"height", k.height},
+            {"source", opened.camera.source},
+            {"description", opened.camera.description}}},
+          {"depth_units_per_metre", opened.sequence->depth_units_per_metre()},
+          {"depth_scale_source", opened.depth_scale_source},
+          {"frames_skipped", opened.skipped.size()},
+          {"skipped_frames", std::move(skipped)}};
+}
+
+RunJson registration_report_json(const registration::RegistrationReport& r) {
+  RunJson json;
+  json["verdict"] = registration::to_string(r.verdict);
+  json["fitness"] = r.fitness;
+  json["inlier_rmse_m"] = r.inlier_rmse;
+  json["inliers"] = r.inliers;
+  json["iterations"] = r.iterations;
+  json["converged"] = r.converged;
+  json["degenerate"] = r.degenerate;
+  json["eigenvalue_ratio"] = r.eigenvalue_ratio;
+  json["correction_m"] = r.correction_m;
+  json["correction_deg"] = r.correction_deg;
+  return json;
+}
+
+namespace {
+
+RunJson frame_json(const registration::OdometryFrame& frame) {
+  RunJson json;
+  json["frame"] = frame.index;
+  json["keyframe"] = frame.keyframe;
+  json["fallback"] = frame.fallback;
+  json["retried"] = frame.retried;
+  json["degenerate"] = frame.degenerate;
+  json["photometric"] = frame.photometric;
+  json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
+  json["previous"] = frame.previous ? registration_report_json(*frame.previous) : RunJson();
+  json["reestimate"] = frame.reestimate ? registration_report_json(*frame.reestimate) : RunJson();
+  json["seconds"] = frame.seconds;
+  return json;
+}
+
+}  // namespace
+
+RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames) {
+  const OdometryFrameCounts counts = count_odometry_frames(frames);
+  RunJson json;
+  json["frames"] = counts.frames;
+  json["keyframes"] = counts.keyframes;
+  json["fallbacks"] = counts.fallbacks;
+  json["retried_from_identity"] = counts.retried_from_identity;
+  json["degenerate_frames"] = counts.degenerate_frames;
+  json["photometric_frames"] = counts.photometric_frames;
+  json["reestimates"] = counts.reestimates;
+  json["reestimates_rejected"] = counts.reestimates_rejected;
+  return json;
+}
+
+RunJson per_frame_json(const std::vector<registration::OdometryFrame>& frames) {
+  RunJson json = RunJson::array();
+  for (const registration::OdometryFrame& frame : frames) json.push_back(frame_json(frame));
+  return json;
+}
+
+}  // namespace detail
+
+std::string sequence_input_json(const OpenedSequence& opened) {
+  return detail::input_json(opened).dump();
+}
+
+OdometryFrameCounts count_odometry_frames(const std::vector<registration::OdometryFrame>& frames) {
+  OdometryFrameCounts counts;
+  counts.frames = frames.size();
+  for (const registration::OdometryFrame& f : frames) {
+    counts.fallbacks += f.fallback;
+    counts.retried_from_identity += f.retried;
+    counts.keyframes += f.keyframe;
+    counts.degenerate_frames += f.degenerate;
+    counts.photometric_frames += f.photometric;
+    counts.reestimates += f.reestimate.has_value();
+    counts.reestimates_rejected += f.reestimate && !f.reestimate->accepted();
+  }
+  return counts;
+}
+
+std::string frame_counts_line(const OdometryFrameCounts& c) {
+  const auto count = [](std::size_t n) { return std::to_string(n); };
+  return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) +
+         ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
+         "), degenerate frames " + count(c.degenerate_frames) + " (" + count(c.photometric_frames) +
+         " measured by image intensity)";
+}
+
+OdometryThroughput odometry_throughput(const mapping::OdometryRun& run) {
+  const double frames = static_cast<double>(run.poses.size());
+  OdometryThroughput throughput;
+  throughput.with_io = run.timing.wall_seconds > 0 ? frames / run.timing.wall_seconds : 0;
+  throughput.without_io = run.compute_seconds > 0 ? frames / run.compute_seconds : 0;
+  return throughput;
+}
+
+std::string odometry_stats_json(const SequenceRunRecord& record, const OpenedSequence& opened,
+                                const registration::OdometryParams& params,
+                                const mapping::OdometryRun& run,
+                                const std::optional<eval::AteResult>& ate) {
+  using detail::RunJson;
+  const OdometryThroughput throughput = odometry_throughput(run);
+  RunJson json;
+  json["sequence"] = record.sequence;
+  json["layout"] = to_string(opened.detected.layout);
+  json["input"] = detail::input_json(opened);
+  json["method"] = record.method;
+  json["backend"] = record.backend;
+  json["device"] = record.device;
+  json["reestimate_interval"] = params.reestimate_interval;
+  json["frames_per_s_with_io"] = throughput.with_io;
+  json["frames_per_s_without_io"] = throughput.without_io;
+  json["wall_seconds"] = run.timing.wall_seconds;
+  json["load_seconds"] = run.timing.load_seconds;
+  json["ate_rmse_m"] = ate ? RunJson(ate->translation_m.rmse) : RunJson();
+  json["summary"] = detail::frame_counts_json(run.frames);
+  json["per_frame"] = detail::per_frame_json(run.frames);
+  return json.dump(1) + "\n";
+}
+
+}  // namespace kartograf::io

@@ -1,0 +1,105 @@
+#include "kartograf/outputs/slam_stats.hpp"
+
+#include <utility>
+
+#include <Eigen/Geometry>
+
+#include "run_json.hpp"
+
+namespace kartograf::io {
+
+namespace {
+
+using detail::RunJson;
+
+RunJson loop_closure_json(const mapping::LoopClosureRecord& record) {
+  const mapping::LoopCandidate& c = record.closure.candidate;
+  RunJson json;
+  json["query_frame"] = c.query_frame;
+  json["match_frame"] = c.match_frame;
+  json["distance_m"] = c.distance_m;
+  json["view_angle_deg"] = c.view_angle_deg;
+  json["overlap"] = c.overlap;
+  json["registration"] = detail::registration_report_json(record.closure.report);
+  const Eigen::Isometry3d& motion = record.closure.constraint.motion;
+  const Eigen::Quaterniond rotation(motion.linear());
+  json["motion"] = {motion.translation().x(),
+                    motion.translation().y(),
+                    motion.translation().z(),
+                    rotation.x(),
+                    rotation.y(),
+                    rotation.z(),
+                    rotation.w()};
+  json["chi2"] = record.chi2;
+  json["residual_m"] = record.residual_m;
+  json["residual_deg"] = record.residual_deg;
+  json["pruned"] = record.pruned;
+  return json;
+}
+
+RunJson loop_closures_json(const mapping::SlamParams& params, const mapping::SlamResult& result) {
+  const LoopClosureCounts counts = count_loop_closures(result);
+  RunJson closures = RunJson::array();
+  for (const mapping::LoopClosureRecord& record : result.loop_closures)
+    closures.push_back(loop_closure_json(record));
+  return {{"enabled", params.loop_closure},
+          {"candidates", result.loop_candidates},
+          {"accepted", counts.accepted},
+          {"pruned", counts.pruned},
+          {"closures", std::move(closures)}};
+}
+
+RunJson ate_rmse_json(const std::optional<eval::AteResult>& ate) {
+  return ate ? RunJson(ate->translation_m.rmse) : RunJson();
+}
+
+}  // namespace
+
+LoopClosureCounts count_loop_closures(const mapping::SlamResult& result) {
+  LoopClosureCounts counts;
+  for (const mapping::LoopClosureRecord& record : result.loop_closures) {
+    counts.accepted += record.closure.report.accepted();
+    counts.pruned += record.pruned;
+  }
+  return counts;
+}
+
+std::string slam_stats_json(const SequenceRunRecord& record, const OpenedSequence& opened,
+                            const mapping::SlamParams& params, const mapping::SlamResult& result,
+                            const std::optional<eval::AteResult>& slam_ate,
+                            const std::optional<eval::AteResult>& odometry_ate) {
+  const mapping::SlamTimings& t = result.timing;
+  RunJson json;
+  json["sequence"] = record.sequence;
+  json["layout"] = to_string(opened.detected.layout);
+  json["input"] = detail::input_json(opened);
+  json["frames"] = result.poses.size();
+  json["method"] = record.method;
+  json["backend"] = record.backend;
+  json["device"] = record.device;
+  json["reestimate_interval"] = params.odometry.reestimate_interval;
+  json["odometry_ate_rmse_m"] = ate_rmse_json(odometry_ate);
+  json["slam_ate_rmse_m"] = ate_rmse_json(slam_ate);
+  json["timing_s"] = {{"total", t.total_seconds},
+                      {"odometry", t.odometry_seconds},
+                      {"loop_closure", t.loop_closure_seconds},
+                      {"optimisation", t.optimisation_seconds},
+                      {"map", t.map_seconds},
+                      {"loading", t.load_seconds}};
+  json["loop_closure"] = loop_closures_json(params, result);
+  json["pose_graph"] = {{"nodes", result.poses.size()},
+                        {"edges", result.graph_edges},
+                        {"optimisations", result.graph_optimisations},
+                        {"iterations", result.final_graph.iterations},
+                        {"initial_cost", result.final_graph.initial_cost},
+                        {"final_cost", result.final_graph.final_cost},
+                        {"converged", result.final_graph.converged}};
+  json["map"] = {{"points", result.map.size()},
+                 {"voxels", result.map_voxels},
+                 {"voxel_size_m", params.map.voxel_size}};
+  json["odometry"] = detail::frame_counts_json(result.odometry.frames);
+  json["per_frame"] = detail::per_frame_json(result.odometry.frames);
+  return json.dump(1) + "\n";
+}
+
+}  // namespace kartograf::io
