@@ -18,6 +18,9 @@ for ((round = 1; round <= rounds; ++round)); do
     dir=$old
     [ "$side" = new ] && dir=$new
     run "$dir" kartograf_bench '^(backproject|normals|icp_point_to_plane_sums|icp_point_to_point_sums)/cpu/640x480/steady' "$side"
+    # The ICP sums on the CPU-hosted drivers too (lavapipe, PoCL): their kernels changed with the CPU's.
+    run "$dir" kartograf_bench '^(icp_point_to_plane_sums|icp_point_to_point_sums)/(vulkan|opencl)/640x480/steady' "$side"
+    run "$dir" kartograf_cloud_bench '^nn_kdtree/cpu/300000/query' "$side"
     run "$dir" kartograf_segmentation_bench '^plane_extraction/cpu/' "$side"
     run "$dir" kartograf_odometry_bench '^odometry/cpu/640x480/iterations' "$side"
     run "$dir" kartograf_rooms_bench '^rooms/(morphological|voronoi|feature|vrf)/Freiburg52_scan_plain' "$side"

@@ -8,7 +8,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/plane_metrics.hpp"
 #include "label_image_builders.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

@@ -1,14 +1,12 @@
-// Room metrics (eval/room_metrics.hpp) and connected-component labelling on hand-made label
-// images with hand-computed answers, and on the real ipa_room_segmentation ground truth.
+// Room metrics (eval/room_metrics.hpp) on hand-made label images with hand-computed answers (on the
+// real ipa_room_segmentation ground truth: eval_real_data_test.cpp).
 #include <cmath>
 #include <string>
 
 #include "kartograf/core/error.hpp"
-#include "kartograf/core/connected_components.hpp"
 #include "kartograf/eval/room_metrics.hpp"
-#include "kartograf/formats/occupancy_map_io.hpp"
 #include "label_image_builders.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {
@@ -97,59 +95,6 @@ TEST(EvalRooms, RejectsBadInput) {
   EXPECT_DOUBLE_EQ(scores.recall_mean, 0);
   EXPECT_DOUBLE_EQ(scores.precision_mean, 0);
   EXPECT_DOUBLE_EQ(scores.mcc, 0);
-}
-
-TEST(EvalConnectedComponents, NumbersRegionsInRasterOrderAndDropsSpecks) {
-  // Region a (top left, 4 px) touches region b (5 px) only diagonally; c is a 1-px speck; d
-  // (2 px) starts on row 0 to the right of a, so it is numbered before b.
-  const char* rows[] = {
-      "aa..d",  //
-      "aa..d",  //
-      "..b..",  //
-      "..bb.",  //
-      "c.bb.",  //
-  };
-  Image<std::uint8_t> mask(5, 5, 0);
-  for (int y = 0; y < 5; ++y) {
-    for (int x = 0; x < 5; ++x) mask(x, y) = rows[y][x] != '.';
-  }
-  const LabelImage four = label_connected_components(mask, {Connectivity::four, 2});
-  EXPECT_EQ(four(0, 0), 1);  // a
-  EXPECT_EQ(four(4, 0), 2);  // d
-  EXPECT_EQ(four(2, 2), 3);  // b
-  EXPECT_EQ(four(3, 4), 3);
-  EXPECT_EQ(four(0, 4), 0);  // c: a speck of 1 < 2 pixels
-  EXPECT_EQ(four(2, 0), 0);  // background
-  const LabelImage eight = label_connected_components(mask, {Connectivity::eight, 1});
-  EXPECT_EQ(eight(0, 0), 1);  // a and b joined through the diagonal, d stays apart
-  EXPECT_EQ(eight(2, 2), 1);
-  EXPECT_EQ(eight(4, 0), 2);
-  EXPECT_EQ(eight(0, 4), 3);  // c kept with min_pixels 1
-  EXPECT_THROW(label_connected_components(mask, {Connectivity::four, 0}), Error);
-}
-
-TEST(EvalRooms, RealGroundTruthAgainstItselfScoresOne) {
-  // lab_ipa: 11 rooms as 4-connected white regions (what the data's SOURCE.txt states); ipa's own
-  // evaluation flood-fills 8-connected and sees 10, two rooms meeting at a diagonal. Scored
-  // against the 4-connected truth, that 8-connected reading loses precision only.
-  const auto maps = testing::data_dir() / "ipa_room_maps" / "test_maps";
-  const LabelImage rooms = io::read_room_ground_truth_png(maps / "lab_ipa_gt_segmentation.png");
-  const auto self = eval::evaluate_room_segmentation(rooms, rooms);
-  EXPECT_EQ(self.ground_truth_rooms, 11);
-  EXPECT_DOUBLE_EQ(self.recall_mean, 1);
-  EXPECT_DOUBLE_EQ(self.precision_mean, 1);
-  EXPECT_DOUBLE_EQ(self.precision_total, 1);
-  EXPECT_DOUBLE_EQ(self.mcc, 1);
-
-  io::RoomGroundTruthParams ipa_flood_fill;
-  ipa_flood_fill.connectivity = Connectivity::eight;
-  const LabelImage eight =
-      io::read_room_ground_truth_png(maps / "lab_ipa_gt_segmentation.png", ipa_flood_fill);
-  const auto merged = eval::evaluate_room_segmentation(rooms, eight);
-  EXPECT_EQ(merged.segments, 10);
-  EXPECT_DOUBLE_EQ(merged.recall_mean, 1);
-  EXPECT_LT(merged.precision_mean, 1);
-  EXPECT_LT(merged.mcc, 1);
 }
 
 }  // namespace

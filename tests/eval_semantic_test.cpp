@@ -5,7 +5,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/semantic_metrics.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

@@ -1,7 +1,6 @@
 // Trajectory metrics (eval/trajectory_metrics.hpp) on cases whose answers are known by hand: a
 // trajectory against itself, against a rigidly moved or scaled copy, a perturbation of a straight
-// line, a hand-computed RPE, and the real TUM fr1/xyz ground truth matched through
-// io::associate_timestamps as the CLI does.
+// line, a hand-computed RPE (the real TUM fr1/xyz ground truth: eval_real_data_test.cpp).
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -9,14 +8,15 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
-#include "kartograf/formats/tum.hpp"
-#include "test_support.hpp"
+#include "rigid_motion.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {
 
 using eval::Alignment;
 using eval::DeltaUnit;
+using testing::some_rigid_motion;
 
 Eigen::Isometry3d pose(const Eigen::Vector3d& position, double yaw, double roll = 0) {
   Eigen::Isometry3d p = Eigen::Isometry3d::Identity();
@@ -47,13 +47,6 @@ Trajectory line(int n) {
 
 eval::MatchedPoses same_instants(const Trajectory& gt, const Trajectory& estimate) {
   return {gt, estimate};
-}
-
-Eigen::Isometry3d some_rigid_motion() {
-  Eigen::Isometry3d t = Eigen::Isometry3d::Identity();
-  t.linear() = Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix();
-  t.translation() = Eigen::Vector3d(1.0, -2.0, 0.5);
-  return t;
 }
 
 TEST(EvalTrajectory, ATrajectoryAgainstItselfHasNoError) {
@@ -180,35 +173,6 @@ TEST(EvalTrajectory, Sim3RecoversAKnownScale) {
   const auto se3 = eval::compute_ate(same_instants(gt, scaled), Alignment::se3);
   EXPECT_GT(se3.translation_m.rmse, 0.1);
   EXPECT_DOUBLE_EQ(se3.alignment.scale, 1.0);
-}
-
-TEST(EvalTrajectory, MatchesThroughTimestampAssociationOnRealGroundTruth) {
-  // TUM fr1/xyz ground truth against a copy moved rigidly, every third pose dropped and the
-  // clock shifted by 3 ms: association pairs each kept pose with its original.
-  const Trajectory gt =
-      io::read_tum_trajectory(testing::data_dir() / "tum_fr1_xyz_lists_only" / "groundtruth.txt");
-  ASSERT_GT(gt.size(), 1000u);
-  Trajectory estimate;
-  const Eigen::Isometry3d motion = some_rigid_motion();
-  for (std::size_t k = 0; k < gt.size(); ++k) {
-    if (k % 3 == 2) continue;
-    estimate.push_back({gt[k].timestamp + 0.003, motion * gt[k].pose});
-  }
-  std::vector<double> gt_times, estimate_times;
-  for (const auto& p : gt) gt_times.push_back(p.timestamp);
-  for (const auto& p : estimate) estimate_times.push_back(p.timestamp);
-  const auto pairs = io::associate_timestamps(gt_times, estimate_times, 0.02);
-  ASSERT_EQ(pairs.size(), estimate.size());
-  const eval::MatchedPoses matched = eval::match_poses(gt, estimate, pairs);
-  for (std::size_t k = 0; k < matched.size(); ++k) {
-    // Timestamps near 1.3e9 s carry ~2e-7 s of double rounding.
-    ASSERT_NEAR(matched.estimate[k].timestamp - matched.ground_truth[k].timestamp, 0.003, 1e-6);
-  }
-  const auto result = eval::evaluate_trajectory(matched, Alignment::se3, {1, DeltaUnit::seconds});
-  EXPECT_LT(result.ate.translation_m.rmse, 1e-9);
-  EXPECT_LT(result.rpe.translation_m.rmse, 1e-9);
-  EXPECT_GT(result.rpe.translation_m.count, 1000u);
-  EXPECT_GT(eval::compute_ate(matched, Alignment::none).translation_m.rmse, 1.0);
 }
 
 TEST(EvalTrajectory, RejectsWhatCannotBeEvaluated) {

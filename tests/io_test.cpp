@@ -27,7 +27,7 @@
 #include "kartograf/core/point_cloud.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/ply.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

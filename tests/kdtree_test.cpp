@@ -6,7 +6,7 @@
 #include <random>
 
 #include "kartograf/registration/kdtree_correspondences.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

@@ -23,7 +23,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/formats/pcd.hpp"
 #include "kartograf/formats/ply.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

@@ -9,7 +9,7 @@
 
 #include "kartograf/outputs/plane_io.hpp"
 #include "kartograf/segmentation/plane_extraction.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

@@ -11,7 +11,7 @@
 #include <tuple>
 
 #include "kartograf/core/error.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

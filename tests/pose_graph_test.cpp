@@ -1,4 +1,4 @@
-// SE(3) exp/log and the pose-graph optimiser on graphs with known answers.
+// The pose-graph optimiser on graphs with known answers (SE(3) exp/log: se3_test.cpp).
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -7,57 +7,17 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/se3.hpp"
 #include "kartograf/mapping/pose_graph.hpp"
-#include "test_support.hpp"
+#include "se3_random.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {
 
 using se3::Vector6d;
-
-Vector6d random_twist(std::mt19937_64& rng, double rotation, double translation) {
-  std::uniform_real_distribution<double> u(-1, 1);
-  Vector6d xi;
-  for (int k = 0; k < 3; ++k) xi(k) = rotation * u(rng);
-  for (int k = 3; k < 6; ++k) xi(k) = translation * u(rng);
-  return xi;
-}
+using testing::random_twist;
 
 double pose_distance(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
   return se3::log(a.inverse() * b).norm();
-}
-
-TEST(Se3, ExpLogRoundTrip) {
-  std::mt19937_64 rng(7);
-  for (int trial = 0; trial < 200; ++trial) {
-    const double scale = trial < 100 ? 1.5 : 1e-9;  // large angles and the Taylor branch
-    const Vector6d xi = random_twist(rng, scale, 2.0 * scale);
-    const Vector6d back = se3::log(se3::exp(xi));
-    EXPECT_LT((back - xi).norm(), 1e-9 * std::max(1.0, xi.norm())) << xi.transpose();
-  }
-}
-
-TEST(Se3, ExpMatchesAngleAxisRotation) {
-  Vector6d xi;
-  xi << 0, 0, M_PI / 2, 1, 0, 0;
-  const Eigen::Isometry3d pose = se3::exp(xi);
-  EXPECT_NEAR(
-      (pose.linear() - Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitZ()).toRotationMatrix())
-          .norm(),
-      0, 1e-12);
-  // Moving 1 m along x while turning 90 degrees about z traces a quarter circle of radius 2/pi.
-  EXPECT_NEAR(pose.translation().x(), 2 / M_PI, 1e-12);
-  EXPECT_NEAR(pose.translation().y(), 2 / M_PI, 1e-12);
-}
-
-TEST(Se3, AdjointConjugates) {
-  std::mt19937_64 rng(11);
-  for (int trial = 0; trial < 50; ++trial) {
-    const Eigen::Isometry3d t = se3::exp(random_twist(rng, 1.0, 3.0));
-    const Vector6d xi = random_twist(rng, 0.5, 0.5);
-    const Eigen::Isometry3d lhs = t * se3::exp(xi) * t.inverse();
-    const Eigen::Isometry3d rhs = se3::exp(se3::adjoint(t) * xi);
-    EXPECT_LT((lhs.matrix() - rhs.matrix()).norm(), 1e-10);
-  }
 }
 
 // A square loop of `n` poses around a 4 m x 4 m room, turning at the corners.

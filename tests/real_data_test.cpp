@@ -9,7 +9,7 @@
 #include "device_data_files.hpp"
 #include "raw_image_file.hpp"
 #include "real_data.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf::testing {
 namespace {

@@ -4,7 +4,7 @@
 
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/outputs/room_io.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf::testing {
 

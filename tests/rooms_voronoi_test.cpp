@@ -9,7 +9,7 @@
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/voronoi_segmentation.hpp"
 #include "room_test_maps.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

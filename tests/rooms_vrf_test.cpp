@@ -14,7 +14,7 @@
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/rooms/voronoi_random_field.hpp"
 #include "room_test_maps.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

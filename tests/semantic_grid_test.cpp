@@ -19,7 +19,7 @@
 #include "kartograf/synth/floor_plan.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf::semantic {
 namespace {

@@ -14,7 +14,7 @@
 #include <vector>
 
 #include "kartograf/semantic/ground_texture.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf::semantic {
 namespace {

@@ -11,7 +11,7 @@
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/outputs/synthetic_dataset.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

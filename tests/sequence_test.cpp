@@ -5,7 +5,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/sequence.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

@@ -28,7 +28,7 @@
 #include "kartograf/formats/pcd.hpp"
 #include "kartograf/formats/ply.hpp"
 #include "kartograf/formats/sequence.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {

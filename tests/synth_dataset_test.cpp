@@ -16,7 +16,7 @@
 #include "kartograf/formats/pcd.hpp"
 #include "kartograf/formats/sequence.hpp"
 #include "kartograf/outputs/synthetic_dataset.hpp"
-#include "test_support.hpp"
+#include "test_support_core.hpp"
 
 namespace kartograf {
 namespace {
