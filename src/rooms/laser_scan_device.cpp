@@ -76,25 +76,44 @@ void DeviceLaserScanner::scan_steps(std::span<const ScanCell> cells,
                     {groups_x, groups_y});
 }
 
-std::vector<std::int32_t> DeviceLaserScanner::scan_steps(std::span<const ScanCell> cells,
-                                                         std::size_t batch_cells) {
+namespace {
+
+// Scans `cells` in batches of `batch_cells` into `steps`; use(first cell, steps) reads each batch's
+// steps in place where device memory is host memory (no copy on the CPU).
+template <class Use>
+void scan_in_batches(DeviceLaserScanner& scanner, std::span<const ScanCell> cells,
+                     std::size_t batch_cells, compute::Buffer<std::int32_t>& steps,
+                     const Use& use) {
   require(batch_cells > 0, "device laser scanner: batch_cells must be > 0");
-  const std::size_t beams = static_cast<std::size_t>(beams_);
-  std::vector<std::int32_t> steps(cells.size() * beams);
   for (std::size_t first = 0; first < cells.size(); first += batch_cells) {
     const std::size_t count = std::min(batch_cells, cells.size() - first);
-    scan_steps(cells.subspan(first, count), batch_steps_);
-    batch_steps_.download(std::span(steps).subspan(first * beams, count * beams));
+    scanner.scan_steps(cells.subspan(first, count), steps);
+    use(first, compute::read_on_host(steps));
   }
+}
+
+}  // namespace
+
+std::vector<std::int32_t> DeviceLaserScanner::scan_steps(std::span<const ScanCell> cells,
+                                                         std::size_t batch_cells) {
+  const std::size_t beams = static_cast<std::size_t>(beams_);
+  std::vector<std::int32_t> steps(cells.size() * beams);
+  scan_in_batches(*this, cells, batch_cells, batch_steps_,
+                  [&](std::size_t first, const auto& batch) {
+                    std::copy(batch.begin(), batch.end(), steps.begin() + first * beams);
+                  });
   return steps;
 }
 
 std::vector<double> DeviceLaserScanner::scan_ranges(std::span<const ScanCell> cells,
                                                     std::size_t batch_cells) {
-  const std::vector<std::int32_t> steps = scan_steps(cells, batch_cells);
-  std::vector<double> ranges(steps.size());
-  std::transform(steps.begin(), steps.end(), ranges.begin(),
-                 [&](std::int32_t s) { return s * resolution_; });
+  const std::size_t beams = static_cast<std::size_t>(beams_);
+  std::vector<double> ranges(cells.size() * beams);
+  scan_in_batches(*this, cells, batch_cells, batch_steps_,
+                  [&](std::size_t first, const auto& batch) {
+                    std::transform(batch.begin(), batch.end(), ranges.begin() + first * beams,
+                                   [&](std::int32_t s) { return s * resolution_; });
+                  });
   return ranges;
 }
 
