@@ -54,11 +54,13 @@ struct Segment {
 
 // Grows the segment seeded at `seed` with the paper's stack, labelling it `id`. Wide: an integer
 // type that holds (T n)^2 for the tile's pixel count n. (Parameters and tile by value: stores to
-// the labels cannot alias them.)
+// the labels cannot alias them. Inlined into the seed loop: a call per segment with these
+// arguments by value made the CPU's growing ~10 % slower.)
 template <class Wide>
-Segment grow_segment(const RegionGrowParams params, const RegionGrowArrays a, const Tile tile,
-                     const std::array<std::int32_t, 8> offsets, uint seed, uint id,
-                     std::vector<uint>& stack) {
+[[gnu::always_inline]] inline Segment grow_segment(const RegionGrowParams params,
+                                                   const RegionGrowArrays a, const Tile tile,
+                                                   const std::array<std::int32_t, 8> offsets,
+                                                   uint seed, uint id, std::vector<uint>& stack) {
   const Wide threshold_sq = static_cast<Wide>(params.threshold_code) * params.threshold_code;
   Segment s;
   stack.clear();
