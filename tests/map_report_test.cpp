@@ -93,6 +93,21 @@ TEST(MapEvaluation, FrameErrorsAreTheAtesPerFrameErrors) {
   EXPECT_NEAR(std::sqrt(squares / 20), e.trajectory->ate.translation_m.rmse, 1e-12);
 }
 
+TEST(MapEvaluation, ScoresTheOdometryBeforeLoopClosureOnItsOwn) {
+  pipeline::MapPipelineResult run = small_run(20);
+  const pipeline::MapGroundTruth truth = moved_truth(run, 99, 99, 0);
+  EXPECT_FALSE(pipeline::evaluate_map(run, truth).odometry_trajectory);  // no odometry poses
+  // The odometry drifted: 1 cm more along x per frame than the (perfect) SLAM poses.
+  run.slam.odometry.poses = run.poses;
+  for (std::size_t k = 0; k < run.poses.size(); ++k)
+    run.slam.odometry.poses[k].translation().x() += 0.01 * static_cast<double>(k);
+  const pipeline::MapEvaluation e = pipeline::evaluate_map(run, truth);
+  ASSERT_TRUE(e.trajectory && e.odometry_trajectory);
+  EXPECT_NEAR(e.trajectory->ate.translation_m.rmse, 0, 1e-9);
+  EXPECT_GT(e.odometry_trajectory->ate.translation_m.rmse, 0.001);
+  EXPECT_EQ(e.odometry_trajectory->ate.translation_m.count, 20u);
+}
+
 int yellow_pixels(const RgbImage& image) {
   int count = 0;
   for (int y = 0; y < image.height(); ++y)

@@ -56,6 +56,11 @@ MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth
   }
   out.trajectory = eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeParams{});
   out.frame_errors = frame_errors(matched, out.trajectory->ate);
+  const eval::MatchedPoses odometry = eval::match_frames(truth.poses, result.slam.odometry.poses);
+  if (odometry.size() >= kMinMatchedPoses) {
+    out.odometry_trajectory =
+        eval::evaluate_trajectory(odometry, eval::Alignment::se3, eval::RpeParams{});
+  }
   if (!truth.plan) {
     out.skipped.push_back("rooms, classes: no floor plan");
     return out;

@@ -37,6 +37,9 @@ struct FrameTrajectoryError {
 
 struct MapEvaluation {
   std::optional<eval::TrajectoryEvaluation> trajectory;
+  // The odometry's own trajectory (before loop closure), scored the same way: what the back end
+  // adds is the difference.
+  std::optional<eval::TrajectoryEvaluation> odometry_trajectory;
   std::vector<FrameTrajectoryError> frame_errors;  // in frame order; empty without a trajectory
   std::optional<eval::RoomSegmentationScores> rooms;
   std::optional<eval::SemanticScores> semantic;

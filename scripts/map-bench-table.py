@@ -1,0 +1,65 @@
+#!/usr/bin/env python3
+"""The table of scripts/map-bench.sh: one row per map run, read from RUNS/NAME/report.json.
+
+Usage: map-bench-table.py RUNS NAME...
+"""
+import json
+import sys
+from pathlib import Path
+
+# The sequences the defaults were tuned on (issue 23: figures tuned on a seed or sequence are marked).
+TUNED = {"survey-1": "yes", "7scenes": "frames 0-299"}
+CLASSES = ("floor", "wall", "door", "furniture")
+
+
+def cm(value):
+    return "-" if value is None else f"{100 * value:.2f}"
+
+
+def number(value, form="{:.2f}"):
+    return "-" if value is None else form.format(value)
+
+
+def get(report, *path):
+    node = report
+    for key in path:
+        if not isinstance(node, dict) or key not in node:
+            return None
+        node = node[key]
+    return node
+
+
+def row(runs, name):
+    path = Path(runs) / name / "report.json"
+    if not path.exists():
+        return f"| {name} | failed: no report.json (see {name}.log) |" + " |" * 10
+    r = json.loads(path.read_text())
+    odometry = get(r, "evaluation", "odometry_trajectory", "ate_rmse_m")
+    slam = get(r, "evaluation", "trajectory", "ate_rmse_m")
+    ratio = "-" if not odometry or slam is None else f"{slam / odometry:.2f}"
+    labelled, unlabelled = get(r, "views", "labelled") or 0, get(r, "views", "unlabelled") or 0
+    views = "-" if labelled + unlabelled == 0 else f"{100 * labelled / (labelled + unlabelled):.0f} %"
+    ious = " / ".join(number(get(r, "evaluation", "classes", "iou", c)) for c in CLASSES)
+    rooms = get(r, "evaluation", "rooms")
+    rooms_text = "-" if not rooms else f"{rooms['recall_mean']:.2f} / {rooms['precision_mean']:.2f}"
+    cells = [name, str(r.get("frames", "-")), cm(odometry), cm(slam), ratio,
+             str(get(r, "slam", "loop_closures_accepted")), views, ious, rooms_text,
+             number(get(r, "timing_s", "odometry_ms_per_frame"), "{:.1f}"),
+             number(get(r, "timing_s", "total"), "{:.0f}"), TUNED.get(name, "no")]
+    return "| " + " | ".join(cells) + " |"
+
+
+def main():
+    if len(sys.argv) < 3:
+        sys.exit(__doc__)
+    runs = sys.argv[1]
+    print("| sequence | frames | odometry ATE cm | SLAM ATE cm | SLAM / odometry | loops accepted "
+          "| views labelled | IoU floor / wall / door / furniture | rooms recall / precision "
+          "| odometry ms/frame | total s | tuned on |")
+    print("|---|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---|")
+    for name in sys.argv[2:]:
+        print(row(runs, name))
+
+
+if __name__ == "__main__":
+    main()
