@@ -190,6 +190,9 @@ Json report_of(bool with_evaluation) {
     r["evaluation"] = Json::parse(R"({
       "trajectory": {"ate_rmse_m": 0.0123, "ate_max_m": 0.03, "rpe_translation_rmse_m": 0.002,
                      "rpe_rotation_rmse_deg": 0.1, "poses": 19},
+      "odometry_trajectory": {"ate_rmse_m": 0.0246, "ate_max_m": 0.05,
+                              "rpe_translation_rmse_m": 0.003, "rpe_rotation_rmse_deg": 0.2,
+                              "poses": 19},
       "rooms": {"ground_truth_rooms": 2, "segments": 2, "recall_mean": 0.95, "recall_total": 0.96,
                 "precision_mean": 0.85, "precision_total": 0.9, "mcc": 1.0},
       "classes": {"iou": {"unknown": null, "floor": 0.9, "wall": 0.3, "ceiling": null, "door": 0.81,
@@ -241,6 +244,8 @@ TEST(MapReportHtml, SummaryAndMetricsFirstThenPicturesPlotsConfusionAnd3dView) {
   EXPECT_NE(page.at("2 unreadable frames skipped"), std::string::npos);
   EXPECT_NE(page.at("1.23 cm"), std::string::npos);                         // the ATE
   EXPECT_NE(page.at("class=\"value missed\">1.23 cm"), std::string::npos);  // target 1 cm
+  EXPECT_NE(page.at("odometry alone: ATE RMSE"), std::string::npos);        // before loop closure
+  EXPECT_NE(page.at("the back end changes the ATE by -50 %"), std::string::npos);
   EXPECT_NE(page.at("class=\"value met\">0.810"), std::string::npos);       // door IoU, target 0.8
   EXPECT_NE(page.at("Not scored: nothing"), std::string::npos);
   EXPECT_NE(page.at("<svg class=\"plot\""), std::string::npos);  // the error over time

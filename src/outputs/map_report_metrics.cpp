@@ -64,6 +64,18 @@ void trajectory_rows(std::ostringstream& html, const Json& t, const MapReportInp
                     "RMSE", std::nullopt, std::nullopt});
 }
 
+// The odometry's own ATE (before loop closure) beside the SLAM's: what the back end adds.
+void odometry_row(std::ostringstream& html, const Json& odometry, const Json& slam) {
+  const double before = odometry["ate_rmse_m"].get<double>();
+  const double after = slam["ate_rmse_m"].get<double>();
+  std::string change = "before loop closure and pose-graph optimisation";
+  if (before > 0)
+    change += "; the back end changes the ATE by " +
+              format_number(100 * (after - before) / before, "%+.0f") + " %";
+  metric_row(html, {"odometry alone: ATE RMSE", format_length(before), change, std::nullopt,
+                    std::nullopt});
+}
+
 void rooms_rows(std::ostringstream& html, const Json& r) {
   metric_row(html,
              {"rooms found / true", r["segments"].dump() + " / " + r["ground_truth_rooms"].dump(),
@@ -122,7 +134,10 @@ std::string report_metrics_section(const MapReportInput& input) {
            "<p>The sequence has no ground truth: nothing to compare with.</p>\n</section>\n";
   html << "<table class=\"metrics\"><tr><th>metric</th><th>value</th><th>how it compares</th>"
        << "<th>target</th></tr>\n";
-  if (const Json* t = report_member(*e, {"trajectory"})) trajectory_rows(html, *t, input);
+  if (const Json* t = report_member(*e, {"trajectory"})) {
+    trajectory_rows(html, *t, input);
+    if (const Json* o = report_member(*e, {"odometry_trajectory"})) odometry_row(html, *o, *t);
+  }
   if (const Json* r = report_member(*e, {"rooms"})) rooms_rows(html, *r);
   if (const Json* c = report_member(*e, {"classes"})) classes_rows(html, *c);
   html
