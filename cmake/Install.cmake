@@ -5,7 +5,7 @@ include(CMakePackageConfigHelpers)
 
 set(KARTOGRAF_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/kartograf)
 set(KARTOGRAF_LAYERS core compute geometry segmentation registration mapping eval synth rooms_scan
-    algorithms rooms semantic formats pipeline outputs)
+    algorithms rooms semantic features formats pipeline outputs)
 foreach(library ${KARTOGRAF_LAYERS})
   set_target_properties(kartograf_${library} PROPERTIES EXPORT_NAME ${library})
   add_library(kartograf::${library} ALIAS kartograf_${library})

@@ -26,9 +26,10 @@ declare -A allowed=(
   [synth]="core"
   [rooms]="core compute geometry"
   [semantic]="core compute geometry segmentation"
+  [features]="core compute geometry segmentation registration"
   [formats]="core"
-  [pipeline]="core compute geometry eval segmentation registration mapping rooms semantic formats"
-  [outputs]="core compute geometry eval segmentation registration mapping rooms semantic formats pipeline synth"
+  [pipeline]="core compute geometry eval segmentation registration mapping rooms semantic features formats"
+  [outputs]="core compute geometry eval segmentation registration mapping rooms semantic features formats pipeline synth"
   [training]="core compute geometry segmentation semantic synth"
 )
 

@@ -29,6 +29,16 @@ def get(report, *path):
     return node
 
 
+def loops_text(r):
+    """Accepted loop closures, those found by appearance, and frames from features by features."""
+    accepted = get(r, "slam", "loop_closures_accepted")
+    appearance = get(r, "slam", "loop_closures_by_appearance")
+    recovered = get(r, "slam", "frames_from_features")
+    if appearance is None:
+        return str(accepted)
+    return f"{accepted} ({appearance} app.) / {recovered}"
+
+
 def row(runs, name):
     path = Path(runs) / name / "report.json"
     if not path.exists():
@@ -43,7 +53,7 @@ def row(runs, name):
     rooms = get(r, "evaluation", "rooms")
     rooms_text = "-" if not rooms else f"{rooms['recall_mean']:.2f} / {rooms['precision_mean']:.2f}"
     cells = [name, str(r.get("frames", "-")), cm(odometry), cm(slam), ratio,
-             str(get(r, "slam", "loop_closures_accepted")), views, ious, rooms_text,
+             loops_text(r), views, ious, rooms_text,
              number(get(r, "timing_s", "odometry_ms_per_frame"), "{:.1f}"),
              number(get(r, "timing_s", "total"), "{:.0f}"), TUNED.get(name, "no")]
     return "| " + " | ".join(cells) + " |"
@@ -53,7 +63,7 @@ def main():
     if len(sys.argv) < 3:
         sys.exit(__doc__)
     runs = sys.argv[1]
-    print("| sequence | frames | odometry ATE cm | SLAM ATE cm | SLAM / odometry | loops accepted "
+    print("| sequence | frames | odometry ATE cm | SLAM ATE cm | SLAM / odometry | loops accepted (by appearance) / frames from features "
           "| views labelled | IoU floor / wall / door / furniture | rooms recall / precision "
           "| odometry ms/frame | total s | tuned on |")
     print("|---|---:|---:|---:|---:|---:|---:|---|---|---:|---:|---|")

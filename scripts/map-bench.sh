@@ -10,12 +10,17 @@
 # odometry's compute time per frame and the run's wall time. "tuned" marks the sequences the
 # defaults were tuned on (survey seed 1, 7-Scenes frames 0-299 within the 600).
 #   bash scripts/map-bench.sh [--out DIR] [--seeds "1 2 ... 10"] [--sets "survey tour-10 7scenes sun3d"]
-#                             [--kartograf BIN] [--data DIR (../shared/data)]
+#                             [--kartograf BIN] [--data DIR (../shared/data)] [--jobs N (1)]
+#                             [--peers PYTHON]
+# --peers: a python with open3d, opencv-contrib-python-headless and scipy (a venv); then the
+# odometry of Kartograf and of the peers (../shared/tools/peers/odometry_peers.py) runs on the
+# real sequences one after the other, alone on the machine, and a second table gives median
+# ms/frame and ATE of each.
 # Synthetic data are written once under DIR/data and reused; each map run goes to DIR/runs/NAME.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=build/map-bench seeds="1 2 3 4 5 6 7 8 9 10" sets="survey tour-10 7scenes sun3d"
-kartograf=build/apps/kartograf/kartograf data=../shared/data
+kartograf=build/apps/kartograf/kartograf data=../shared/data jobs=1 peers_python=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out="$2"; shift ;;
@@ -23,6 +28,8 @@ while [ $# -gt 0 ]; do
     --sets) sets="$2"; shift ;;
     --kartograf) kartograf="$2"; shift ;;
     --data) data="$2"; shift ;;
+    --jobs) jobs="$2"; shift ;;
+    --peers) peers_python="$2"; shift ;;
     *) echo "map-bench.sh: unknown argument '$1' (see the comment at the top)" >&2; exit 2 ;;
   esac
   shift
@@ -50,11 +57,18 @@ seven_scenes_600() {
   done
 }
 
-run_map() {  # name, sequence, map arguments...
+map_one() {  # name, sequence, map arguments...
   local name="$1" sequence="$2"; shift 2
   echo "map-bench: mapping $name" >&2
   "$kartograf" map "$sequence" --out "$out/runs/$name" --force --no-progress --backend cpu "$@" \
     >"$out/runs/$name.log" 2>&1 || echo "map-bench: $name failed (see $out/runs/$name.log)" >&2
+}
+
+# With --jobs N, up to N maps run at once (each on one thread; timings then share the cores).
+run_map() {
+  if [ "$jobs" -le 1 ]; then map_one "$@"; return; fi
+  while [ "$(jobs -rp | wc -l)" -ge "$jobs" ]; do wait -n; done
+  map_one "$@" &
 }
 
 names=()
@@ -80,4 +94,34 @@ for set in $sets; do
     *) echo "map-bench.sh: unknown set '$set'" >&2; exit 2 ;;
   esac
 done
+wait
 python3 scripts/map-bench-table.py "$out/runs" "${names[@]}" | tee "$out/table.md"
+
+# Odometry beside the peers, one sequence at a time (timings need the machine to themselves).
+peer_odometry() {  # name, sequence
+  local name="$1" sequence="$2" dir="$out/peers/$1"
+  mkdir -p "$dir"
+  "$kartograf" odometry "$sequence" --backend cpu --no-progress --force \
+    --out "$dir/kartograf.txt" --stats "$dir/kartograf.json" >/dev/null 2>&1
+  python3 - "$dir/kartograf.json" "$name" <<'PY'
+import json, statistics, sys
+j = json.load(open(sys.argv[1]))
+ms = statistics.median(f["seconds"] for f in j["per_frame"][1:]) * 1000
+print("| %s | kartograf | %.1f | %.2f |" % (sys.argv[2], ms, 100 * j["ate_rmse_m"]))
+PY
+  "$peers_python" "$data/../tools/peers/odometry_peers.py" "$sequence" "$dir" 2>/dev/null |
+    awk -v n="$name" '/ms\/frame/ {printf "| %s | %s | %.1f | %.2f |\n", n, $1, $5, 100 * $8}'
+}
+if [ -n "$peers_python" ]; then
+  {
+    echo
+    echo "| sequence | odometry | median ms/frame | ATE cm |"
+    echo "|---|---|---:|---:|"
+    for set in $sets; do
+      case "$set" in
+        7scenes) peer_odometry 7scenes "$out/data/7scenes_0_599" ;;
+        sun3d) peer_odometry sun3d "$data/sun3d_studyroom_fragment1" ;;
+      esac
+    done
+  } | tee -a "$out/table.md"
+fi

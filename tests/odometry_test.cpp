@@ -4,6 +4,7 @@
 // geometric information, agreement across backends, and bad input.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -230,6 +231,16 @@ TEST(PhotometricRefinement, RecoversTheSlideAlongATexturedWall) {
   EXPECT_NEAR(refined.motion.translation().z(), 0.0, 1e-12);
   RecordProperty("error_m",
                  testing::scientific((truth.inverse() * refined.motion).translation().norm()));
+  EXPECT_LT(refined.sigma_m, 1e-4);
+
+  // A refinement less certain than max_sigma_m is no measurement: the motion stays as given.
+  registration::PhotometricParams strict;
+  strict.max_sigma_m = refined.sigma_m / 2;
+  const registration::PhotometricResult uncertain = registration::refine_photometrically(
+      depth, source, target, camera, 1000.0, start, along_x, strict);
+  EXPECT_GT(uncertain.sigma_m, strict.max_sigma_m);
+  EXPECT_FALSE(uncertain.refined);
+  EXPECT_TRUE(uncertain.motion.isApprox(start));
 
   // An untextured wall gives nothing to refine: the motion is returned unchanged.
   const RgbImage grey(camera.width, camera.height, Rgb8{128, 128, 128});

@@ -18,12 +18,18 @@ PinholeIntrinsics qvga_kinect() {
 
 RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,
                                  const PinholeIntrinsics& camera, bool noise) {
+  return render_sequence(test_world(), poses, camera, noise);
+}
+
+RenderedSequence render_sequence(const synth::World& world,
+                                 const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera, bool noise) {
   RenderedSequence sequence;
   sequence.camera = camera;
   sequence.truth = poses;
   const synth::NoiseModel model = noise ? synth::NoiseModel::kinect() : synth::NoiseModel::none();
   for (std::size_t i = 0; i < poses.size(); ++i) {
-    synth::SyntheticFrame frame = synth::render(test_world(), camera, poses[i], model, 100 + i);
+    synth::SyntheticFrame frame = synth::render(world, camera, poses[i], model, 100 + i);
     sequence.frames.push_back(
         {std::move(frame.depth), std::move(frame.color), static_cast<double>(i) / 30.0});
   }

@@ -30,6 +30,10 @@ struct RenderedSequence {
 // One frame per pose, timestamps i / 30 s; noise: the Kinect model (seeded per frame) or none.
 RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,
                                  const PinholeIntrinsics& camera, bool noise = true);
+// The same in another world.
+RenderedSequence render_sequence(const synth::World& world,
+                                 const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera, bool noise = true);
 
 // The pipeline's view of a rendered sequence.
 class MemoryFrameSource final : public mapping::FrameSource {

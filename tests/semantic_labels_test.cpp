@@ -381,6 +381,45 @@ TEST_P(SemanticLabels, SyntheticFramesAndBackendsAgree) {
             2.0);
 }
 
+// A view of a wall from 0.6 m, level: no floor or ceiling in sight, so up cannot be estimated
+// from it; with up and the floor known from elsewhere (a map's gravity through the view's pose)
+// it is labelled, the wall as wall.
+TEST(SemanticLabels, KnownUpLabelsAViewWithoutFloor) {
+  const synth::World world = synth::make_building(5);
+  const Trajectory tour = synth::robot_tour(world, 300);
+  const PinholeIntrinsics k{160, 120, 131.25, 131.25, 79.5, 59.5};
+  const compute::Context context = compute::Context::cpu();
+  // Walk the tour's camera, levelled, towards what it sees until that is 0.6 m away.
+  const Eigen::Isometry3d start = tour[69].pose;
+  const Eigen::Vector3d ahead = start.linear().col(2);
+  const double yaw = std::atan2(ahead.y(), ahead.x());
+  Eigen::Isometry3d pose = synth::camera_pose(start.translation(), yaw, 0.0);
+  const synth::SyntheticFrame probe = synth::render(world, k, pose, synth::NoiseModel::none(), 1);
+  const double distance = probe.depth(80, 60) / 5000.0;
+  ASSERT_GT(distance, 0.7);
+  pose = synth::camera_pose(start.translation() + (distance - 0.6) * pose.linear().col(2), yaw, 0.0);
+  const synth::SyntheticFrame frame = synth::render(world, k, pose, synth::NoiseModel::none(), 1);
+  for (const SemanticClass c : frame.semantic.pixels()) {
+    ASSERT_NE(c, SemanticClass::floor);  // the view is what the test needs
+    ASSERT_NE(c, SemanticClass::ceiling);
+  }
+  const PointImage points = geometry::backproject(context, frame.depth, k, {5000.0, 0.1, 10.0});
+  LabellingParams params;
+  params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);
+  params.normals.smoothing_radius = 2;
+  params.regions.min_region_pixels = 20;
+  EXPECT_ERROR_MENTIONS(label_organized_points(context, points, params), "vote for the up axis");
+  const Eigen::Vector3d up = pose.linear().transpose() * Eigen::Vector3d::UnitZ();
+  params.gravity.known_up = up;
+  params.gravity.known_floor_height = -pose.translation().z();  // the floor is at z = 0
+  const SemanticLabelling labelled = label_organized_points(context, points, params);
+  EXPECT_LT(angle_deg(labelled.gravity.up, up), 1e-9);
+  const auto s = score(points, frame.semantic, labelled.semantic);
+  EXPECT_GE(iou(s, SemanticClass::wall), 0.9);
+  params.gravity.known_up = Eigen::Vector3d::Zero();
+  EXPECT_ERROR_MENTIONS(label_organized_points(context, points, params), "known up");
+}
+
 INSTANTIATE_TEST_SUITE_P(Backends, SemanticLabels,
                          ::testing::ValuesIn(::kartograf::testing::backends_under_test()),
                          ::kartograf::testing::backend_test_name);

@@ -185,6 +185,7 @@ struct MapOptions {
   int label_width = 320;
   double resolution = 0.05;
   std::string room_method = "distance";
+  bool no_features = false;
   bool force = false;
 };
 CLI::App* add_map_command(CLI::App& app, MapOptions& options);

@@ -85,6 +85,9 @@ CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
   command->add_option("--rooms", o.room_method, "Room segmentation method")
       ->check(CLI::IsMember({"morphological", "distance", "voronoi", "feature", "vrf"}))
       ->capture_default_str();
+  command->add_flag("--no-features", o.no_features,
+                    "No local image features: loop closure by pose only, no odometry recovery "
+                    "from features");
   command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
   return command;
 }
@@ -98,6 +101,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   pipeline::MapPipelineParams params;
   params.slam.odometry = odometry_params(o.run);
   params.label_step = o.label_step;
+  params.features = !o.no_features;
   params.label_width = o.label_width;
   params.grid.resolution = o.resolution;
   params.room_method = rooms::parse_room_method(o.room_method);

@@ -59,10 +59,10 @@ registration::IcpParams loop_closure_icp_params() {
   return params;
 }
 
-LoopClosureDetector::LoopClosureDetector(const compute::Context& context,
-                                         const PinholeIntrinsics& camera,
-                                         const geometry::DepthRange& range,
-                                         LoopClosureParams params)
+LoopClosureDetector::LoopClosureDetector(
+    const compute::Context& context, const PinholeIntrinsics& camera,
+    const geometry::DepthRange& range, LoopClosureParams params,
+    std::shared_ptr<const registration::FeatureFrontEnd> features)
     : camera_(camera),
       range_(range),
       params_(std::move(params)),
@@ -71,6 +71,8 @@ LoopClosureDetector::LoopClosureDetector(const compute::Context& context,
           registration::pyramid_level_at_most(camera.width, std::max(params_.icp_width, 1)))),
       information_level_(registration::pyramid_level_at_most(
           camera.width, std::max(params_.information_width, 1))),
+      features_(std::move(features)),
+      places_(features_ ? features_->make_place_index() : nullptr),
       builder_(context, camera, range),
       engine_(context, params_.icp,
               std::make_unique<registration::DepthWeightedFinder>(
@@ -82,14 +84,18 @@ LoopClosureDetector::LoopClosureDetector(const compute::Context& context,
 }
 
 void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& depth,
-                                       double path_length) {
+                                       double path_length, const RgbImage* color) {
   require(keyframes_.empty() || frame > keyframes_.back().frame,
           "loop closure: keyframe " + std::to_string(frame) + " added after frame " +
               std::to_string(keyframes_.empty() ? 0 : keyframes_.back().frame));
   require(
       depth.width() == camera_.width && depth.height() == camera_.height,
       "loop closure: keyframe " + std::to_string(frame) + " depth size differs from the camera");
-  Keyframe keyframe{frame, path_length, depth, {}};
+  Keyframe keyframe{frame, path_length, depth, {}, nullptr};
+  if (features_ && color && !color->empty()) {
+    keyframe.features = features_->describe(depth, *color, camera_, range_.units_per_metre);
+    places_->add(frame, keyframe.features);
+  }
   const int step = params_.sample_step;
   const double metres_per_unit = 1.0 / range_.units_per_metre;
   for (int v = step / 2; v < depth.height(); v += step) {
@@ -130,24 +136,35 @@ double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
   return static_cast<double>(seen) / static_cast<double>(source.samples.size());
 }
 
+LoopCandidate LoopClosureDetector::candidate_between(
+    std::size_t query, std::size_t match, std::span<const Eigen::Isometry3d> poses) const {
+  const Keyframe& j = keyframes_.at(query);
+  const Keyframe& i = keyframes_.at(match);
+  require_pose(poses, j.frame);
+  require_pose(poses, i.frame);
+  const Eigen::Isometry3d& pose_i = poses[i.frame];
+  const Eigen::Isometry3d& pose_j = poses[j.frame];
+  LoopCandidate c;
+  c.query = query;
+  c.match = match;
+  c.query_frame = j.frame;
+  c.match_frame = i.frame;
+  c.drift_allowance_m = params_.drift_fraction * std::max(0.0, j.path_length - i.path_length);
+  c.distance_m = (pose_j.translation() - pose_i.translation()).norm();
+  c.view_angle_deg = view_angle_deg(pose_i, pose_j);
+  return c;
+}
+
 std::vector<LoopCandidate> LoopClosureDetector::find_candidates(
     std::size_t query, std::span<const Eigen::Isometry3d> poses) const {
   const Keyframe& j = keyframes_.at(query);
-  require_pose(poses, j.frame);
-  const Eigen::Isometry3d& pose_j = poses[j.frame];
   std::vector<LoopCandidate> candidates;
   for (std::size_t match = 0; match < query; ++match) {
-    const Keyframe& i = keyframes_[match];
-    if (j.frame - i.frame < params_.min_frame_gap) continue;
-    require_pose(poses, i.frame);
-    const Eigen::Isometry3d& pose_i = poses[i.frame];
-    LoopCandidate c{query, match, j.frame, i.frame, 0, 0, 0, 0};
-    c.drift_allowance_m = params_.drift_fraction * std::max(0.0, j.path_length - i.path_length);
-    c.distance_m = (pose_j.translation() - pose_i.translation()).norm();
+    if (j.frame - keyframes_[match].frame < params_.min_frame_gap) continue;
+    LoopCandidate c = candidate_between(query, match, poses);
     if (c.distance_m > params_.max_distance + c.drift_allowance_m) continue;
-    c.view_angle_deg = view_angle_deg(pose_i, pose_j);
     if (c.view_angle_deg > params_.max_view_angle_deg) continue;
-    c.overlap = view_overlap(query, match, pose_i.inverse() * pose_j,
+    c.overlap = view_overlap(query, match, poses[c.match_frame].inverse() * poses[c.query_frame],
                              params_.depth_tolerance + c.drift_allowance_m);
     if (c.overlap < params_.min_overlap) continue;
     candidates.push_back(c);
@@ -159,6 +176,41 @@ std::vector<LoopCandidate> LoopClosureDetector::find_candidates(
   return candidates;
 }
 
+std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
+    std::size_t query, std::span<const Eigen::Isometry3d> poses, bool relocalise) const {
+  std::vector<LoopCandidate> candidates;
+  const Keyframe& j = keyframes_.at(query);
+  const std::size_t gap = relocalise ? 1 : params_.min_frame_gap;
+  if (!places_ || !j.features || j.frame < gap) return candidates;
+  const std::vector<registration::PlaceMatch> similar =
+      places_->query(*j.features, j.frame - gap + 1, params_.max_appearance_candidates);
+  for (const registration::PlaceMatch& place : similar) {
+    // Places are keyframes' frame indices, in increasing order.
+    const auto found = std::lower_bound(
+        keyframes_.begin(), keyframes_.begin() + static_cast<std::ptrdiff_t>(query), place.place,
+        [](const Keyframe& k, std::size_t frame) { return k.frame < frame; });
+    if (found == keyframes_.end() || found->frame != place.place || !found->features) continue;
+    const std::optional<registration::FeatureAlignment> aligned =
+        features_->align(*j.features, *found->features);
+    if (!aligned) continue;
+    LoopCandidate c =
+        candidate_between(query, static_cast<std::size_t>(found - keyframes_.begin()), poses);
+    // Buildings repeat their materials and furniture: a look-alike elsewhere is only believed
+    // where the estimate, with its drift allowance, could still be that wrong.
+    const Eigen::Isometry3d estimated = poses[c.match_frame].inverse() * poses[c.query_frame];
+    const double disagreement =
+        (estimated.translation() - aligned->source_to_target.translation()).norm();
+    if (disagreement > params_.max_distance + c.drift_allowance_m) continue;
+    c.by_appearance = true;
+    c.feature_motion = aligned->source_to_target;
+    c.feature_inliers = aligned->inliers;
+    c.appearance_score = place.score;
+    c.overlap = view_overlap(query, c.match, c.feature_motion, params_.depth_tolerance);
+    candidates.push_back(c);
+  }
+  return candidates;
+}
+
 LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
                                         std::span<const Eigen::Isometry3d> poses) {
   const Keyframe& query = keyframes_.at(candidate.query);
@@ -167,7 +219,9 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   require_pose(poses, match.frame);
   builder_.build(query.depth, nullptr, source_);
   builder_.build(match.depth, nullptr, target_);
-  const Eigen::Isometry3d expected = poses[match.frame].inverse() * poses[query.frame];
+  const Eigen::Isometry3d expected = candidate.by_appearance
+                                         ? candidate.feature_motion
+                                         : poses[match.frame].inverse() * poses[query.frame];
   const auto first = static_cast<std::size_t>(finest_level_);
   const std::vector<registration::CloudView> source_views = source_.views();
   const std::vector<registration::CloudView> target_views = target_.views();
@@ -179,7 +233,9 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
       params_.icp.min_eigenvalue_ratio);
 
   registration::RegistrationLimits limits = params_.verification;
-  limits.max_correction_m = params_.min_correction_m + candidate.drift_allowance_m;
+  // The features' motion does not drift: only the pose estimate's allowance grows with the path.
+  limits.max_correction_m =
+      params_.min_correction_m + (candidate.by_appearance ? 0.0 : candidate.drift_allowance_m);
   LoopClosure closure;
   closure.candidate = candidate;
   closure.report = registration::judge_registration(result, expected, limits, geometry.degeneracy);

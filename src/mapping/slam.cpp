@@ -239,6 +239,36 @@ PointCloud fuse_map(const compute::Context& context, const FrameSource& source,
   return fusion.cloud();
 }
 
+// The loop-closure candidates of the newest keyframe, by pose and by appearance (a match found
+// both ways is verified once, from the pose estimate), each verified; the accepted ones join the
+// graph. A keyframe the odometry lost (a fallback) is relocalised: any earlier keyframe may match
+// it by appearance. Returns whether any was accepted.
+bool close_loops(LoopClosureDetector& detector, GraphState& state, bool lost,
+                 const SlamObserver& observer, SlamResult& result) {
+  const std::size_t query = detector.keyframe_count() - 1;
+  std::vector<LoopCandidate> candidates = detector.find_candidates(query, state.estimate());
+  for (const LoopCandidate& c :
+       detector.find_appearance_candidates(query, state.estimate(), lost)) {
+    ++result.appearance_candidates;
+    const bool known =
+        std::any_of(candidates.begin(), candidates.end(),
+                    [&](const LoopCandidate& other) { return other.match == c.match; });
+    if (!known) candidates.push_back(c);
+  }
+  bool closed = false;
+  for (const LoopCandidate& candidate : candidates) {
+    ++result.loop_candidates;
+    LoopClosure closure = detector.verify(candidate, state.estimate());
+    if (observer.on_loop_closure) observer.on_loop_closure(closure);
+    if (closure.report.accepted()) {
+      state.add_loop(closure, result.loop_closures.size());
+      closed = true;
+    }
+    result.loop_closures.push_back({std::move(closure), false});
+  }
+  return closed;
+}
+
 }  // namespace
 
 PoseGraphParams slam_graph_options() {
@@ -269,7 +299,8 @@ SlamResult run_slam(const compute::Context& context, const FrameSource& source,
   std::optional<LoopClosureDetector> detector;
   const registration::OdometryParams& odometry_params = tracker.odometry().params();
   if (params.loop_closure) {
-    detector.emplace(context, source.camera(), odometry_params.depth_range, params.loops);
+    detector.emplace(context, source.camera(), odometry_params.depth_range, params.loops,
+                     params.features);
   }
   GraphState state(params.graph, params.consistency);
   const auto reestimate_interval = static_cast<std::size_t>(odometry_params.reestimate_interval);
@@ -290,19 +321,8 @@ SlamResult run_slam(const compute::Context& context, const FrameSource& source,
         if (observer.on_frame) observer.on_frame(frame);
         if (detector && frame.keyframe) {
           const auto loop_start = Clock::now();
-          detector->add_keyframe(i, images.depth, tracker.path_length(i));
-          bool closed = false;
-          for (const LoopCandidate& candidate :
-               detector->find_candidates(detector->keyframe_count() - 1, state.estimate())) {
-            ++result.loop_candidates;
-            LoopClosure closure = detector->verify(candidate, state.estimate());
-            if (observer.on_loop_closure) observer.on_loop_closure(closure);
-            if (closure.report.accepted()) {
-              state.add_loop(closure, result.loop_closures.size());
-              closed = true;
-            }
-            result.loop_closures.push_back({std::move(closure), false});
-          }
+          detector->add_keyframe(i, images.depth, tracker.path_length(i), color_of(images));
+          const bool closed = close_loops(*detector, state, frame.fallback, observer, result);
           result.timing.loop_closure_seconds += seconds_since(loop_start);
           if (closed) optimise();
         }

@@ -9,15 +9,15 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/atomic_file.hpp"
-#include "outputs/json_array.hpp"
-#include "outputs/map_report_html.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/formats/ply.hpp"
-#include "kartograf/outputs/room_io.hpp"
-#include "kartograf/outputs/semantic_map_io.hpp"
 #include "kartograf/formats/top_view.hpp"
 #include "kartograf/formats/tum.hpp"
+#include "kartograf/outputs/room_io.hpp"
+#include "kartograf/outputs/semantic_map_io.hpp"
+#include "outputs/json_array.hpp"
+#include "outputs/map_report_html.hpp"
 
 namespace kartograf::io {
 
@@ -136,13 +136,20 @@ Json report_json(const pipeline::MapPipelineResult& r,
   json["timing_s"] = {{"total", r.total_seconds()},
                       {"stages", std::move(stages)},
                       {"odometry_ms_per_frame", odometry_ms}};
-  std::size_t accepted = 0, pruned = 0;
+  std::size_t accepted = 0, pruned = 0, by_appearance = 0;
   for (const mapping::LoopClosureRecord& l : r.slam.loop_closures) {
     accepted += l.closure.report.accepted();
     pruned += l.pruned;
+    by_appearance += l.closure.report.accepted() && l.closure.candidate.by_appearance;
   }
+  std::size_t from_features = 0;
+  for (const registration::OdometryFrame& f : r.slam.odometry.frames)
+    from_features += f.from_features;
   json["slam"] = {{"loop_candidates", r.slam.loop_candidates},
+                  {"appearance_candidates", r.slam.appearance_candidates},
                   {"loop_closures_accepted", accepted},
+                  {"loop_closures_by_appearance", by_appearance},
+                  {"frames_from_features", from_features},
                   {"loop_closures_pruned", pruned},
                   {"pose_graph_converged", r.slam.final_graph.converged},
                   {"map_points", r.map.size()}};

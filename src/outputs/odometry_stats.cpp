@@ -51,6 +51,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["keyframe"] = frame.keyframe;
   json["fallback"] = frame.fallback;
   json["retried"] = frame.retried;
+  json["from_features"] = frame.from_features;
   json["degenerate"] = frame.degenerate;
   json["photometric"] = frame.photometric;
   json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
@@ -69,6 +70,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["keyframes"] = counts.keyframes;
   json["fallbacks"] = counts.fallbacks;
   json["retried_from_identity"] = counts.retried_from_identity;
+  json["from_features"] = counts.from_features;
   json["degenerate_frames"] = counts.degenerate_frames;
   json["photometric_frames"] = counts.photometric_frames;
   json["reestimates"] = counts.reestimates;
@@ -94,6 +96,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
   for (const registration::OdometryFrame& f : frames) {
     counts.fallbacks += f.fallback;
     counts.retried_from_identity += f.retried;
+    counts.from_features += f.from_features;
     counts.keyframes += f.keyframe;
     counts.degenerate_frames += f.degenerate;
     counts.photometric_frames += f.photometric;
@@ -105,7 +108,9 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
 
 std::string frame_counts_line(const OdometryFrameCounts& c) {
   const auto count = [](std::size_t n) { return std::to_string(n); };
-  return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) +
+  const std::string seeded =
+      c.from_features ? ", started from features " + count(c.from_features) : "";
+  return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) + seeded +
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
          "), degenerate frames " + count(c.degenerate_frames) + " (" + count(c.photometric_frames) +
          " measured by image intensity)";

@@ -20,6 +20,11 @@ RunJson loop_closure_json(const mapping::LoopClosureRecord& record) {
   json["distance_m"] = c.distance_m;
   json["view_angle_deg"] = c.view_angle_deg;
   json["overlap"] = c.overlap;
+  json["by_appearance"] = c.by_appearance;
+  if (c.by_appearance) {
+    json["feature_inliers"] = c.feature_inliers;
+    json["appearance_score"] = c.appearance_score;
+  }
   json["registration"] = detail::registration_report_json(record.closure.report);
   const Eigen::Isometry3d& motion = record.closure.constraint.motion;
   const Eigen::Quaterniond rotation(motion.linear());
@@ -44,6 +49,7 @@ RunJson loop_closures_json(const mapping::SlamParams& params, const mapping::Sla
     closures.push_back(loop_closure_json(record));
   return {{"enabled", params.loop_closure},
           {"candidates", result.loop_candidates},
+          {"appearance_candidates", result.appearance_candidates},
           {"accepted", counts.accepted},
           {"pruned", counts.pruned},
           {"closures", std::move(closures)}};

@@ -151,7 +151,93 @@ void segment_rooms(const compute::Context& context, const MapPipelineParams& par
   connect_rooms_through_doorways(grid, result.rooms);
 }
 
+// The views stage's inputs for one view.
+struct ViewLabeller {
+  const compute::Context& context;
+  const mapping::FrameSource& source;
+  int factor;
+  PinholeIntrinsics camera;  // of the decimated view
+  geometry::DepthRange range;
+  segmentation::PlaneExtractor extractor;
+
+  // Labels frame i at `pose`, pools it and its planes; on failure the reason goes to `failure`
+  // (when given; else the view is counted as skipped).
+  bool label(std::size_t i, const Eigen::Isometry3d& pose, const semantic::LabellingParams& params,
+             semantic::LabelledViews& views, mapping::PlaneMap& plane_map, std::string* failure) {
+    const registration::RgbdImages frame = source.frame(i);
+    const PointImage points =
+        geometry::backproject(context, decimate(frame.depth, factor), camera, range);
+    const std::string frame_name = "frame " + std::to_string(i) + ": ";
+    const std::optional<semantic::SemanticLabelling> labelling =
+        label_and_pool_view(context, points, pose, params, views, frame_name, failure);
+    if (!labelling) return false;
+    try {
+      plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)), points,
+                         labelling->semantic, pose);
+    } catch (const Error& e) {
+      views.skip(frame_name + e.what());  // a pooled view whose planes failed: skipped as well
+    }
+    return true;
+  }
+};
+
+// The floor's height along `up` (metres, world frame) from the pooled floor points.
+std::optional<double> floor_height_along(const semantic::LabelledViews& views,
+                                         const Eigen::Vector3d& up) {
+  std::vector<double> heights;
+  for (std::size_t i = 0; i < views.points().size(); ++i)
+    if (views.labels()[i] == SemanticClass::floor) heights.push_back(views.points()[i].dot(up));
+  if (heights.empty()) return std::nullopt;
+  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
+  std::nth_element(heights.begin(), middle, heights.end());
+  return *middle;
+}
+
+// Every label_step-th frame labelled with its own gravity estimate and pooled. Frames that cannot
+// find up alone (no floor or ceiling in sight: close to a wall, a kitchen counter) are labelled
+// again with the map's up and floor from the other views, through their SLAM pose.
+void label_views(const compute::Context& context, const mapping::FrameSource& source,
+                 const MapPipelineParams& params, const std::vector<Eigen::Isometry3d>& poses,
+                 semantic::LabelledViews& views, mapping::PlaneMap& plane_map,
+                 const MapPipelineObserver& observer) {
+  const PinholeIntrinsics camera = source.camera();
+  const int factor = std::max(1, (camera.width + params.label_width - 1) / params.label_width);
+  geometry::DepthRange range;
+  range.units_per_metre = source.depth_units_per_metre();
+  const PinholeIntrinsics view_camera = decimate(camera, factor);
+  ViewLabeller labeller{context, source,
+                        factor,  view_camera,
+                        range,   segmentation::PlaneExtractor(context, view_camera, params.planes)};
+  semantic::LabellingParams own = params.labelling;
+  if (!own.gravity.prior_up) own.gravity.prior_up = Eigen::Vector3d(0, -1, 0);  // image up
+  std::vector<std::pair<std::size_t, std::string>> retry;
+  for (std::size_t i = 0; i < poses.size(); i += params.label_step) {
+    std::string failure;
+    if (!labeller.label(i, poses[i], own, views, plane_map, &failure))
+      retry.push_back({i, failure});
+    if (observer.slam.on_progress) observer.slam.on_progress("views", i + 1, poses.size());
+  }
+  const Eigen::Vector3d up = views.up();
+  const std::optional<double> floor = floor_height_along(views, up);
+  for (const auto& [i, failure] : retry) {
+    if (views.views() == 0 || !floor) {
+      views.skip(failure);
+      continue;
+    }
+    semantic::LabellingParams known = params.labelling;
+    known.gravity.known_up = poses[i].linear().transpose() * up;
+    known.gravity.known_floor_height = *floor - up.dot(poses[i].translation());
+    labeller.label(i, poses[i], known, views, plane_map, nullptr);
+  }
+}
+
 }  // namespace
+
+features::OrbParams map_orb_params() {
+  features::OrbParams params;
+  params.fast_threshold = 5;
+  return params;
+}
 
 segmentation::PlaneExtractionParams view_plane_params() {
   segmentation::PlaneExtractionParams params;
@@ -186,38 +272,17 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   clock.start("slam");
   mapping::SlamParams slam_params = params.slam;
   slam_params.build_map = true;
+  if (params.features) {
+    const auto features = std::make_shared<const features::OrbFrontEnd>(params.orb);
+    slam_params.features = features;
+    slam_params.odometry.features = features;
+  }
   result.slam = mapping::run_slam(context, source, slam_params, observer.slam);
 
   clock.start("views");
-  const PinholeIntrinsics camera = source.camera();
-  const int factor = std::max(1, (camera.width + params.label_width - 1) / params.label_width);
-  const PinholeIntrinsics view_camera = decimate(camera, factor);
-  geometry::DepthRange range;
-  range.units_per_metre = source.depth_units_per_metre();
-  semantic::LabellingParams labelling_params = params.labelling;
-  if (!labelling_params.gravity.prior_up)
-    labelling_params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);  // image up
-  segmentation::PlaneExtractor extractor(context, view_camera, params.planes);
   semantic::LabelledViews views;
   mapping::PlaneMap plane_map(params.plane_map);
-  const std::size_t frames = result.slam.poses.size();
-  for (std::size_t i = 0; i < frames; i += params.label_step) {
-    const registration::RgbdImages frame = source.frame(i);
-    const PointImage points =
-        geometry::backproject(context, decimate(frame.depth, factor), view_camera, range);
-    const Eigen::Isometry3d& pose = result.slam.poses[i];
-    const std::string frame_name = "frame " + std::to_string(i) + ": ";
-    const std::optional<semantic::SemanticLabelling> labelling =
-        label_and_pool_view(context, points, pose, labelling_params, views, frame_name);
-    try {
-      if (labelling)
-        plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)),
-                           points, labelling->semantic, pose);
-    } catch (const Error& e) {
-      views.skip(frame_name + e.what());  // a pooled view whose planes failed: skipped as well
-    }
-    if (observer.slam.on_progress) observer.slam.on_progress("views", i + 1, frames);
-  }
+  label_views(context, source, params, result.slam.poses, views, plane_map, observer);
   result.labelled_views = views.views();
   result.unlabelled_views = views.skipped();
   result.first_unlabelled_reason = views.first_skip_reason();

@@ -98,24 +98,53 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
   return result;
 }
 
+namespace {
+
+// A matrix in balanced, normalised coordinates about the centre (BalancedEigen's) back in those
+// of GeometricInformation::information: xi = Ad(T(c)) xi_c, so H = A^T H_c A, A = Ad(T(c))^-1.
+se3::Matrix6d from_balanced(const BalancedEigen& eigen, const GeometricInformation& geometry,
+                            const se3::Matrix6d& balanced) {
+  const se3::Vector6d inverse_scale = eigen.scale.cwiseInverse();
+  const se3::Matrix6d about_centre =
+      eigen.normaliser * (inverse_scale.asDiagonal() * balanced * inverse_scale.asDiagonal());
+  const se3::Matrix6d to_centre = se3::adjoint(centre_pose(geometry).inverse());
+  return to_centre.transpose() * about_centre * to_centre;
+}
+
+// The balanced eigen-decomposition's part on its strong (weak: false) or weak (true)
+// eigenvectors, each weighted by weight(eigenvalue).
+template <typename Weight>
+se3::Matrix6d balanced_part(const BalancedEigen& eigen, double min_eigenvalue_ratio, bool weak,
+                            Weight weight) {
+  se3::Matrix6d part = se3::Matrix6d::Zero();
+  const double largest = eigen.solver.eigenvalues()(5);
+  for (int k = 0; k < 6; ++k) {
+    const double lambda = eigen.solver.eigenvalues()(k);
+    if ((lambda < min_eigenvalue_ratio * largest) != weak) continue;
+    const se3::Vector6d u = eigen.solver.eigenvectors().col(k);
+    part += weight(lambda) * u * u.transpose();
+  }
+  return part;
+}
+
+}  // namespace
+
 se3::Matrix6d constrained_information(const GeometricInformation& geometry,
                                       double min_eigenvalue_ratio) {
   const BalancedEigen eigen = balanced_eigen(geometry);
   if (!eigen.valid) return se3::Matrix6d::Zero();
-  se3::Matrix6d strong = se3::Matrix6d::Zero();
-  for (int k = 0; k < 6; ++k) {
-    const double lambda = eigen.solver.eigenvalues()(k);
-    if (lambda < min_eigenvalue_ratio * eigen.solver.eigenvalues()(5)) continue;
-    const se3::Vector6d u = eigen.solver.eigenvectors().col(k);
-    strong += lambda * u * u.transpose();
-  }
-  // Back from balanced, normalised coordinates to the sum about the centre, then to the origin:
-  // xi = Ad(T(c)) xi_c, so H = A^T H_c A with A = Ad(T(c))^-1.
+  const se3::Matrix6d strong =
+      balanced_part(eigen, min_eigenvalue_ratio, false, [](double lambda) { return lambda; });
+  return from_balanced(eigen, geometry, strong);
+}
+
+se3::Matrix6d motion_prior_information(const GeometricInformation& geometry, double strength) {
+  const BalancedEigen eigen = balanced_eigen(geometry);
+  if (!eigen.valid) return se3::Matrix6d::Zero();
+  // strength x the identity in balanced coordinates (trace 6: the mean direction's information),
+  // about the camera: H = S^-1 (strength normaliser I) S^-1.
   const se3::Vector6d inverse_scale = eigen.scale.cwiseInverse();
-  const se3::Matrix6d about_centre =
-      eigen.normaliser * (inverse_scale.asDiagonal() * strong * inverse_scale.asDiagonal());
-  const se3::Matrix6d to_centre = se3::adjoint(centre_pose(geometry).inverse());
-  return to_centre.transpose() * about_centre * to_centre;
+  return strength * eigen.normaliser * inverse_scale.cwiseProduct(inverse_scale).asDiagonal();
 }
 
 std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,

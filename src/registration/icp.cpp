@@ -63,6 +63,18 @@ Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& pose) {
   return result;
 }
 
+// Adds the prior's cost to a point-to-plane system linearised at `pose`. The solver's update is
+// D = T(pivot) exp(x) T(pivot)^-1 applied on the left, so e(D T) ~ e(T) + A x with
+// A = Ad(T^-1 T(pivot)).
+void add_prior(const IcpPrior& prior, const Eigen::Isometry3d& pose, PointToPlaneSystem& system) {
+  const se3::Matrix6d information = system.weight_sum * prior.information;
+  const Eigen::Isometry3d to_pivot(Eigen::Translation3d(system.pivot));
+  const se3::Matrix6d a = se3::adjoint(pose.inverse() * to_pivot);
+  const se3::Vector6d error = se3::log(prior.mean.inverse() * pose);
+  system.jtj.noalias() += a.transpose() * information * a;
+  system.jtr.noalias() += a.transpose() * (information * error);
+}
+
 }  // namespace
 
 IcpEngine::IcpEngine(const compute::Context& context, IcpParams params,
@@ -97,7 +109,7 @@ Correspondences IcpEngine::pairs_of(int level, const CloudView& source, const Cl
 IcpEngine::LevelOutcome IcpEngine::run_level(int level, const CloudView& source,
                                              const CloudView& target,
                                              const Eigen::Vector3d& centroid,
-                                             Eigen::Isometry3d& pose) {
+                                             Eigen::Isometry3d& pose, const IcpPrior* prior) {
   LevelOutcome outcome;
   const AssociationParams gates = gates_of(level);
   const int max_iterations = params_.levels[static_cast<std::size_t>(level)].max_iterations;
@@ -109,7 +121,14 @@ IcpEngine::LevelOutcome IcpEngine::run_level(int level, const CloudView& source,
     std::optional<Eigen::Isometry3d> delta;
     if (params_.metric == ErrorMetric::point_to_plane) {
       outcome.last->plane = reduction_.point_to_plane(pairs, pivot);
-      delta = solve_point_to_plane(*outcome.last->plane);
+      if (prior) {
+        // The prior joins the step only: fitness, RMSE and information stay the pairs' own.
+        PointToPlaneSystem with_prior = *outcome.last->plane;
+        add_prior(*prior, pose, with_prior);
+        delta = solve_point_to_plane(with_prior);
+      } else {
+        delta = solve_point_to_plane(*outcome.last->plane);
+      }
     } else {
       outcome.last->point = reduction_.point_to_point(pairs, pivot, pivot);
       delta = solve_point_to_point(*outcome.last->point);
@@ -179,6 +198,20 @@ IcpResult IcpEngine::align(const FramePyramid& source, const FramePyramid& targe
 IcpResult IcpEngine::align(std::span<const CloudView> source_levels,
                            std::span<const CloudView> target_levels,
                            const Eigen::Isometry3d& initial) {
+  return align_levels(source_levels, target_levels, initial, nullptr);
+}
+
+IcpResult IcpEngine::align(std::span<const CloudView> source_levels,
+                           std::span<const CloudView> target_levels,
+                           const Eigen::Isometry3d& initial, const IcpPrior& prior) {
+  require(prior.mean.matrix().allFinite() && prior.information.allFinite(),
+          "ICP: the prior has NaN/Inf entries");
+  return align_levels(source_levels, target_levels, initial, &prior);
+}
+
+IcpResult IcpEngine::align_levels(std::span<const CloudView> source_levels,
+                                  std::span<const CloudView> target_levels,
+                                  const Eigen::Isometry3d& initial, const IcpPrior* prior) {
   const std::size_t level_count = params_.levels.size();
   require(source_levels.size() >= level_count && target_levels.size() >= level_count,
           "ICP: " + std::to_string(level_count) + " levels configured but the source has " +
@@ -208,7 +241,7 @@ IcpResult IcpEngine::align(std::span<const CloudView> source_levels,
     const auto index = static_cast<std::size_t>(level);
     finder_->prepare(target_levels[index], level);
     const LevelOutcome outcome =
-        run_level(level, source_levels[index], target_levels[index], centroid, pose);
+        run_level(level, source_levels[index], target_levels[index], centroid, pose, prior);
     result.level_iterations[index] = outcome.iterations;
     result.iterations += outcome.iterations;
     if (level == 0) finest = outcome;

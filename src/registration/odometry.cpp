@@ -45,6 +45,9 @@ void validate(const OdometryParams& params) {
   require(params.reestimate_interval >= 0, "odometry: reestimate_interval must be >= 0");
   require(params.icp_width > 0 && params.information_width > 0 && params.min_icp_level >= 0,
           "odometry: icp_width and information_width must be > 0, min_icp_level >= 0");
+  require(params.motion_prior >= 0, "odometry: motion_prior must be >= 0");
+  require(params.feature_seed_m >= 0 && params.feature_seed_deg >= 0,
+          "odometry: feature_seed_m and feature_seed_deg must be >= 0");
   require(params.keyframes.max_interval >= 1, "odometry: keyframes.max_interval must be >= 1");
   require(params.fallback_sigma_m > 0 && params.fallback_sigma_deg > 0,
           "odometry: fallback standard deviations must be > 0");
@@ -181,22 +184,34 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
                                                     const Eigen::Isometry3d& initial,
                                                     const RegistrationLimits& limits) {
   const std::size_t current = frames_.size();  // frames_ grows when track() ends
-  IcpResult result;
+  // Degenerate views: ICP keeps the initial guess in the weak directions while it solves.
+  IcpPrior prior{initial, se3::Matrix6d::Zero()};
+  if (geometry_.degeneracy.degenerate && params_.motion_prior > 0) {
+    prior.information = motion_prior_information(geometry_, params_.motion_prior);
+  }
+  std::span<const CloudView> source_views;
+  std::span<const CloudView> target_views;
+  std::vector<CloudView> source_levels;
+  std::vector<CloudView> target_levels;
+  IcpEngine* engine = &engine_;
   if (planar_) {
     const auto view = [](const geometry::DeviceCloud& cloud) {
       return CloudView{&cloud.points, &cloud.normals, nullptr, std::nullopt};
     };
-    const CloudView source = view(planar_->samples[slot_of(current)]);
-    const CloudView target_view = view(planar_->samples[slot_of(target)]);
-    result = planar_->engine.align(std::span(&source, 1), std::span(&target_view, 1), initial);
+    source_levels = {view(planar_->samples[slot_of(current)])};
+    target_levels = {view(planar_->samples[slot_of(target)])};
+    source_views = source_levels;
+    target_views = target_levels;
+    engine = &planar_->engine;
   } else {
     const auto first = static_cast<std::size_t>(finest_level_);
     const std::size_t count = params_.icp.levels.size();
-    const std::vector<CloudView> source_views = pyramid_of(current).views();
-    const std::vector<CloudView> target_views = pyramid_of(target).views();
-    result = engine_.align(std::span(source_views).subspan(first, count),
-                           std::span(target_views).subspan(first, count), initial);
+    source_levels = pyramid_of(current).views();
+    target_levels = pyramid_of(target).views();
+    source_views = std::span<const CloudView>(source_levels).subspan(first, count);
+    target_views = std::span<const CloudView>(target_levels).subspan(first, count);
   }
+  const IcpResult result = engine->align(source_views, target_views, initial, prior);
   Attempt attempt;
   attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
   attempt.inlier_rmse = result.inlier_rmse;
@@ -205,7 +220,10 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
 
   // What the geometry cannot tell comes from the initial guess (the motion model)...
   const double ratio = params_.icp.min_eigenvalue_ratio;
-  attempt.motion = keep_constrained_directions(result.source_to_target, initial, geometry_, ratio);
+  if (params_.motion_prior == 0) {
+    attempt.motion =
+        keep_constrained_directions(result.source_to_target, initial, geometry_, ratio);
+  }
   // ...or from the images, when there are colours.
   const RgbImage& target_color = colors_[slot_of(target)];
   if (params_.photometric_refinement && color_ && !color_->empty() && !target_color.empty()) {
@@ -278,6 +296,7 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   }
   frame.keyframe = is_keyframe(frame);
   if (frame.keyframe) keyframes_.push_back(frame.index);
+  keep_images_for_features(depth, color);
   context_->finish();
   frame.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   depth_ = nullptr;
@@ -304,18 +323,44 @@ Eigen::Isometry3d RgbdOdometry::predict() const {
   return orthonormalized(predicted);
 }
 
-void RgbdOdometry::track_previous(OdometryFrame& frame) {
-  const std::size_t n = frame.index;
-  const Eigen::Isometry3d predicted = predict();
-  Attempt attempt = register_frames(n - 1, predicted, params_.frame_limits);
+bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
+  return motion.translation().norm() > params_.feature_seed_m ||
+         se3::rotation_angle(motion) > params_.feature_seed_deg * kDegree;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& predicted,
+                                                     OdometryFrame& frame) {
+  const std::size_t previous = frame.index - 1;
+  // A large predicted motion may be beyond ICP's basin: start from the features' motion.
+  if (is_large(predicted)) {
+    if (std::optional<Attempt> seeded = register_from_features()) {
+      frame.from_features = true;
+      return std::move(*seeded);
+    }
+  }
+  Attempt attempt = register_frames(previous, predicted, params_.frame_limits);
   if (!attempt.report.accepted() && !is_identity(predicted)) {
     // The motion model may have been wrong (a stop, a turn): start again from rest.
-    Attempt retry = register_frames(n - 1, Eigen::Isometry3d::Identity(), params_.frame_limits);
+    Attempt retry = register_frames(previous, Eigen::Isometry3d::Identity(), params_.frame_limits);
     if (retry.report.accepted()) {
       attempt = std::move(retry);
       frame.retried = true;
     }
   }
+  if (!attempt.report.accepted()) {
+    if (std::optional<Attempt> seeded = register_from_features()) {
+      frame.from_features = true;
+      frame.retried = false;
+      return std::move(*seeded);
+    }
+  }
+  return attempt;
+}
+
+void RgbdOdometry::track_previous(OdometryFrame& frame) {
+  const std::size_t n = frame.index;
+  const Eigen::Isometry3d predicted = predict();
+  const Attempt attempt = attempt_previous(predicted, frame);
   frame.previous = attempt.report;
   frame.photometric = attempt.photometric;
 
@@ -366,6 +411,38 @@ void RgbdOdometry::reestimate(OdometryFrame& frame) {
     poses_[j] = orthonormalized(anchor_pose * se3::exp(share * correction) *
                                 (anchor_pose.inverse() * poses_[j]));
   }
+}
+
+std::optional<RgbdOdometry::Attempt> RgbdOdometry::register_from_features() {
+  if (!params_.features || !color_ || color_->empty() || previous_color_.empty()) return {};
+  const FeatureFrontEnd& features = *params_.features;
+  const double units = params_.depth_range.units_per_metre;
+  if (!current_features_) {
+    current_features_ = features.describe(*depth_, *color_, builder_.camera(), units);
+  }
+  if (!previous_features_) {
+    previous_features_ =
+        features.describe(previous_depth_, previous_color_, builder_.camera(), units);
+  }
+  const std::optional<FeatureAlignment> aligned =
+      features.align(*current_features_, *previous_features_);
+  if (!aligned) return {};
+  Attempt attempt =
+      register_frames(frames_.size() - 1, aligned->source_to_target, params_.frame_limits);
+  if (!attempt.report.accepted()) return {};
+  return attempt;
+}
+
+void RgbdOdometry::keep_images_for_features(const DepthImage& depth, const RgbImage* color) {
+  // This frame's description, if one was made, serves as the next frame's previous one.
+  previous_features_ = std::move(current_features_);
+  current_features_.reset();
+  if (!params_.features || !color || color->empty()) {
+    previous_color_ = RgbImage();
+    return;
+  }
+  previous_depth_ = depth;
+  previous_color_ = *color;
 }
 
 bool RgbdOdometry::is_keyframe(const OdometryFrame& frame) const {

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -159,6 +160,22 @@ std::vector<Sample> samples_of(const DepthImage& depth, const Textured& source,
   return samples;
 }
 
+// PhotometricResult::sigma_m of the last sums.
+double motion_sigma(const Sums& sums, std::span<const se3::Vector6d> directions) {
+  if (sums.count <= directions.size()) return std::numeric_limits<double>::infinity();
+  const double variance = sums.squared / static_cast<double>(sums.count - directions.size());
+  const Eigen::MatrixXd covariance =
+      variance * sums.jtj.ldlt().solve(Eigen::MatrixXd::Identity(sums.jtj.rows(), sums.jtj.cols()));
+  double sigma = 0;
+  for (std::size_t d = 0; d < directions.size(); ++d) {
+    const auto k = static_cast<Eigen::Index>(d);
+    // A point 2 m ahead moves by |v| + 2 |omega| at most per unit of this direction.
+    const double size = directions[d].tail<3>().norm() + 2.0 * directions[d].head<3>().norm();
+    sigma = std::max(sigma, std::sqrt(std::max(0.0, covariance(k, k))) * size);
+  }
+  return std::isfinite(sigma) ? sigma : std::numeric_limits<double>::infinity();
+}
+
 }  // namespace
 
 PhotometricResult refine_photometrically(const DepthImage& source_depth,
@@ -212,12 +229,14 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
       sums = std::move(next);
     }
     if (passes == 1) {
+      result.sigma_m = motion_sigma(sums, directions);
       end_cost = sums.count ? sums.cost / sums.count : 0.0;
       result.pixels = sums.count;
       result.rmse_after = sums.count ? std::sqrt(sums.squared / sums.count) : 0.0;
     }
   }
-  result.refined = end_cost < start_cost && result.pixels >= params.min_pixels;
+  result.refined = end_cost < start_cost && result.pixels >= params.min_pixels &&
+                   result.sigma_m <= params.max_sigma_m;
   if (!result.refined) result.motion = source_to_target;
   return result;
 }

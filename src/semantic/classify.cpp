@@ -287,10 +287,17 @@ SemanticLabelling label_organized_points(const compute::Context& context, const 
   if (!gravity_params.prior_up && is_camera_frame(points)) {
     gravity_params.prior_up = Eigen::Vector3d(0, -1, 0);  // optical frame: y points down
   }
-  out.gravity = estimate_gravity(provisional, gravity_params);
+  if (gravity_params.known_up) {
+    require(gravity_params.known_up->allFinite() && gravity_params.known_up->norm() > 0,
+            "semantic labelling: the known up direction must be a finite, non-zero vector");
+    out.gravity.up = gravity_params.known_up->normalized();
+  } else {
+    out.gravity = estimate_gravity(provisional, gravity_params);
+  }
   out.measurements =
       measure_regions(points, out.normals, out.regions, out.gravity.up, params.measure);
   find_floor_and_ceiling(out.measurements, gravity_params, out.gravity);
+  if (!out.gravity.floor_height) out.gravity.floor_height = gravity_params.known_floor_height;
   out.region_classes = classify_regions(out.measurements, out.gravity, params.classes);
   // A layer that the rules do not recognise (no door leaf) is part of the surface it was split
   // from: offsets that large also come from smoothing at creases and from long grazing views.

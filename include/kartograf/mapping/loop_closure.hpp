@@ -15,7 +15,16 @@
 //     empty) does not count.
 // The best max_candidates by overlap are kept.
 //
-// Verification: point-to-plane ICP of j's frame against i's from the estimated relative pose, on
+// By appearance (when a registration::FeatureFrontEnd is given): every keyframe's local features
+// go into a place-recognition index; the max_appearance_candidates earlier keyframes (at least
+// min_frame_gap frames back) it finds most similar are candidates whatever the pose estimate
+// says, each with the relative pose of its matched features (RANSAC in 3-D), kept when that pose
+// puts j's camera within max_distance + drift_fraction x path of where the estimate puts it
+// (buildings repeat materials and furniture: a look-alike room elsewhere matches too). Those are
+// the loops whose view angle, overlap or ICP basin the drift spoiled for the tests above.
+//
+// Verification: point-to-plane ICP of j's frame against i's from the estimated relative pose (for
+// an appearance candidate: its features' relative pose, allowed min_correction_m), on
 // four pyramid levels from the first one at most icp_width wide (as odometry) whose coarsest gate
 // is wide (the estimate may be off by the drift), judged by `verification` (fitness, RMSE, and the
 // degeneracy of j's geometry, geometric_information.hpp) and accepted only when it corrects the
@@ -23,6 +32,7 @@
 // edge's information is that geometric information through `information`, with an error
 // proportional to the baseline added (baseline_error_fraction).
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -32,6 +42,7 @@
 #include "kartograf/core/intrinsics.hpp"
 #include "kartograf/core/point_image.hpp"
 #include "kartograf/geometry/backproject.hpp"
+#include "kartograf/registration/feature_front_end.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/odometry.hpp"
 #include "kartograf/registration/registration_check.hpp"
@@ -50,7 +61,8 @@ struct LoopClosureParams {
   int sample_step = 16;          // pixels between overlap samples
   double depth_tolerance = 0.1;  // metres
   double min_overlap = 0.4;
-  std::size_t max_candidates = 2;  // per keyframe
+  std::size_t max_candidates = 2;             // per keyframe
+  std::size_t max_appearance_candidates = 2;  // per keyframe, with a feature front end
   registration::IcpParams icp = loop_closure_icp_params();
   int icp_width = 320;  // as registration::OdometryParams
   int min_icp_level = 1;
@@ -73,6 +85,12 @@ struct LoopCandidate {
   double view_angle_deg = 0;
   double overlap = 0;
   double drift_allowance_m = 0;  // drift_fraction x path between them
+  // Found by appearance: the matched features' motion (match <- query), their RANSAC inliers and
+  // the place index's score.
+  bool by_appearance = false;
+  Eigen::Isometry3d feature_motion = Eigen::Isometry3d::Identity();
+  std::size_t feature_inliers = 0;
+  double appearance_score = 0;
 };
 
 struct LoopClosure {
@@ -86,12 +104,16 @@ struct LoopClosure {
 class LoopClosureDetector {
  public:
   // Throws Error on invalid intrinsics, range or parameters.
+  // features (optional): finds candidates by appearance too.
   LoopClosureDetector(const compute::Context& context, const PinholeIntrinsics& camera,
-                      const geometry::DepthRange& range, LoopClosureParams params = {});
+                      const geometry::DepthRange& range, LoopClosureParams params = {},
+                      std::shared_ptr<const registration::FeatureFrontEnd> features = nullptr);
 
-  // Keeps the keyframe's depth (for verification) and its overlap samples. path_length: metres
-  // travelled from the first frame to this one. Frames must come in increasing order.
-  void add_keyframe(std::size_t frame, const DepthImage& depth, double path_length);
+  // Keeps the keyframe's depth (for verification) and its overlap samples, and with a feature
+  // front end and a colour image its features. path_length: metres travelled from the first
+  // frame to this one. Frames must come in increasing order.
+  void add_keyframe(std::size_t frame, const DepthImage& depth, double path_length,
+                    const RgbImage* color = nullptr);
   std::size_t keyframe_count() const { return keyframes_.size(); }
   std::size_t frame_of(std::size_t keyframe) const { return keyframes_.at(keyframe).frame; }
 
@@ -99,6 +121,13 @@ class LoopClosureDetector {
   // camera-to-world estimates indexed by frame.
   std::vector<LoopCandidate> find_candidates(std::size_t query,
                                              std::span<const Eigen::Isometry3d> poses) const;
+  // Candidates for keyframe `query` by appearance (none without a feature front end), most
+  // similar first; poses as find_candidates (for the distance and overlap they report).
+  // relocalise: the query's pose is a guess (the odometry lost it): every earlier keyframe may
+  // match, not only those min_frame_gap back.
+  std::vector<LoopCandidate> find_appearance_candidates(std::size_t query,
+                                                        std::span<const Eigen::Isometry3d> poses,
+                                                        bool relocalise = false) const;
   // The fraction of keyframe `from`'s samples that keyframe `to` sees (see above), when the
   // camera of `from` is at from_to_to in the frame of `to`, with depth tolerance `tolerance`.
   double view_overlap(std::size_t from, std::size_t to, const Eigen::Isometry3d& from_to_to,
@@ -112,8 +141,11 @@ class LoopClosureDetector {
     std::size_t frame = 0;
     double path_length = 0;
     DepthImage depth;
-    std::vector<Eigen::Vector3f> samples;  // camera frame
+    std::vector<Eigen::Vector3f> samples;                              // camera frame
+    std::shared_ptr<const registration::FeatureDescription> features;  // or null
   };
+  LoopCandidate candidate_between(std::size_t query, std::size_t match,
+                                  std::span<const Eigen::Isometry3d> poses) const;
   static void require_pose(std::span<const Eigen::Isometry3d> poses, std::size_t frame);
 
   PinholeIntrinsics camera_;
@@ -122,6 +154,8 @@ class LoopClosureDetector {
   int finest_level_;
   int information_level_;
   std::vector<Keyframe> keyframes_;
+  std::shared_ptr<const registration::FeatureFrontEnd> features_;
+  std::unique_ptr<registration::PlaceIndex> places_;
   registration::RgbdPyramidBuilder builder_;
   registration::IcpEngine engine_;
   registration::FramePyramid source_, target_;

@@ -18,6 +18,7 @@
 //   4. A second pass over the frames fuses them at their optimised poses (MapFusion).
 #include <cstddef>
 #include <functional>
+#include <memory>
 #include <string_view>
 #include <vector>
 
@@ -50,6 +51,9 @@ struct SlamParams {
   registration::OdometryParams odometry;
   bool loop_closure = true;
   LoopClosureParams loops;
+  // Local features (optional; the features layer's OrbFrontEnd): loop-closure candidates by
+  // appearance, and the odometry's recovery from a lost frame.
+  std::shared_ptr<const registration::FeatureFrontEnd> features;
   PoseGraphParams graph = slam_graph_options();
   LoopConsistency consistency;
   bool build_map = true;
@@ -101,7 +105,8 @@ struct SlamResult {
   OdometryRun odometry;                          // the odometry's own estimate and reports
   std::vector<Eigen::Isometry3d> poses;          // optimised, camera-to-world, frame 0 = identity
   std::vector<LoopClosureRecord> loop_closures;  // every verified candidate
-  std::size_t loop_candidates = 0;
+  std::size_t loop_candidates = 0;               // verified, by pose or by appearance
+  std::size_t appearance_candidates = 0;         // found by appearance (some also by pose)
   std::size_t graph_optimisations = 0;
   PoseGraphSummary final_graph;  // the last optimisation
   std::size_t graph_edges = 0;   // after pruning

@@ -28,7 +28,7 @@ std::string sequence_input_json(const OpenedSequence& opened);
 // Counts over an odometry run's frames.
 struct OdometryFrameCounts {
   std::size_t frames = 0, keyframes = 0, fallbacks = 0, retried_from_identity = 0,
-              degenerate_frames = 0, photometric_frames = 0, reestimates = 0,
+              from_features = 0, degenerate_frames = 0, photometric_frames = 0, reestimates = 0,
               reestimates_rejected = 0;
 };
 OdometryFrameCounts count_odometry_frames(const std::vector<registration::OdometryFrame>& frames);

@@ -17,10 +17,12 @@ namespace kartograf::pipeline {
 // Labels `points` (organized, in the sensor frame) and adds them to `views` at `sensor_to_world`;
 // returns the labelling. A view that cannot be labelled (e.g. a wall seen from close by: no floor
 // or ceiling to find up from) is skipped in `views`, the reason prefixed by `skip_prefix`, and
-// nothing is returned.
+// nothing is returned. With `failure`, the reason goes there instead and `views` counts nothing
+// (the caller may try again, e.g. with a known up).
 std::optional<semantic::SemanticLabelling> label_and_pool_view(
     const compute::Context& context, const PointImage& points,
     const Eigen::Isometry3d& sensor_to_world, const semantic::LabellingParams& params,
-    semantic::LabelledViews& views, const std::string& skip_prefix = {});
+    semantic::LabelledViews& views, const std::string& skip_prefix = {},
+    std::string* failure = nullptr);
 
 }  // namespace kartograf::pipeline

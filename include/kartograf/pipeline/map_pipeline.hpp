@@ -29,6 +29,7 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/occupancy_grid.hpp"
 #include "kartograf/core/point_cloud.hpp"
+#include "kartograf/features/orb_front_end.hpp"
 #include "kartograf/mapping/frame_source.hpp"
 #include "kartograf/mapping/plane_map.hpp"
 #include "kartograf/mapping/slam.hpp"
@@ -42,8 +43,16 @@ namespace kartograf::pipeline {
 // Plane extraction on decimated views: planes of a quarter of the default's pixels count.
 segmentation::PlaneExtractionParams view_plane_params();
 
+// ORB for whole sequences: a low FAST threshold, since the synthetic world's smooth textures give
+// too few corners at OpenCV's default (20: 43-49 per 640x480 frame, 5: 270-350).
+features::OrbParams map_orb_params();
+
 struct MapPipelineParams {
-  mapping::SlamParams slam;             // its build_map is always on
+  mapping::SlamParams slam;  // its build_map is always on
+  // Local features (ORB) for the SLAM: loop-closure candidates by appearance and the odometry's
+  // recovery from a lost frame (they fill slam.features and slam.odometry.features).
+  bool features = true;
+  features::OrbParams orb = map_orb_params();
   std::size_t label_step = 5;           // views: every k-th frame
   int label_width = 320;                // views: decimated to at most this many pixels per row
   semantic::LabellingParams labelling;  // gravity.prior_up defaults to the camera's -y

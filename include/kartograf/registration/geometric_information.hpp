@@ -47,6 +47,15 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
 se3::Matrix6d constrained_information(const GeometricInformation& geometry,
                                       double min_eigenvalue_ratio);
 
+// The information (per unit weight, GeometricInformation::information's coordinates) of a motion
+// prior that is isotropic about the camera: rotations and camera translations equally certain in
+// the geometry's balanced units, each `strength` x the mean direction's information. Added to
+// ICP (icp.hpp's IcpPrior) with the motion model as its mean, it decides the directions the
+// geometry leaves free and barely moves the others. About the camera, not the centroid: the
+// motion model predicts the camera's own motion, so a turn it missed (a rotation the geometry
+// measures) must not shift the camera sideways, as holding the translation at the centroid does.
+se3::Matrix6d motion_prior_information(const GeometricInformation& geometry, double strength);
+
 // The weak directions (balanced eigenvalue below min_eigenvalue_ratio x the largest) as tangent
 // vectors of the right perturbation of a motion applied to the cloud, weakest first.
 std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,

@@ -62,6 +62,18 @@ struct IcpParams {
   double min_eigenvalue_ratio = 0.01;
 };
 
+// A Gaussian prior on the result (point-to-plane only): cost
+//   1/2 e^T (W information) e,  e = log(mean^-1 T),
+// T the source-to-target estimate, e its right perturbation (source frame, (omega, v)), W the
+// pairs' weight sum on the level being solved: `information` is per unit pair weight, so a prior
+// of the geometric information's scale (geometric_information.hpp) speaks like the pairs do. The
+// odometry pins the weak directions of degenerate views to the motion model with it, so ICP
+// never slides along them (sliding there also moves its pairs and corrupts the other directions).
+struct IcpPrior {
+  Eigen::Isometry3d mean = Eigen::Isometry3d::Identity();
+  se3::Matrix6d information = se3::Matrix6d::Zero();
+};
+
 class IcpEngine {
  public:
   // Throws Error on invalid parameters. finder: null selects ProjectiveAssociation.
@@ -77,6 +89,10 @@ class IcpEngine {
   IcpResult align(std::span<const CloudView> source_levels,
                   std::span<const CloudView> target_levels,
                   const Eigen::Isometry3d& initial = Eigen::Isometry3d::Identity());
+  // The same with a prior added to every point-to-plane step (ignored by point-to-point).
+  IcpResult align(std::span<const CloudView> source_levels,
+                  std::span<const CloudView> target_levels, const Eigen::Isometry3d& initial,
+                  const IcpPrior& prior);
 
   const IcpParams& params() const { return params_; }
 
@@ -84,7 +100,11 @@ class IcpEngine {
   struct LastSums;
   struct LevelOutcome;
   LevelOutcome run_level(int level, const CloudView& source, const CloudView& target,
-                         const Eigen::Vector3d& centroid, Eigen::Isometry3d& pose);
+                         const Eigen::Vector3d& centroid, Eigen::Isometry3d& pose,
+                         const IcpPrior* prior);
+  IcpResult align_levels(std::span<const CloudView> source_levels,
+                         std::span<const CloudView> target_levels, const Eigen::Isometry3d& initial,
+                         const IcpPrior* prior);
   void evaluate(const CloudView& source, const CloudView& target, const Eigen::Vector3d& centroid,
                 const LevelOutcome& finest, IcpResult& result);
   Correspondences pairs_of(int level, const CloudView& source, const CloudView& target,

@@ -43,6 +43,11 @@ struct GravityParams {
   // Axes that put the floor farther than max_sensor_height below the sensor or the ceiling
   // farther than this above it lose to any axis that does not (a wall is no floor or ceiling).
   double max_ceiling_height = 6.0;  // m
+  // Up known from elsewhere (a map's gravity through the view's pose; the points' frame): the
+  // view is labelled with it instead of estimating it, so a view without floor or ceiling in
+  // sight still is. known_floor_height (p . up of the floor) stands in when it sees no floor.
+  std::optional<Eigen::Vector3d> known_up;
+  std::optional<double> known_floor_height;
 };
 
 struct GravityEstimate {

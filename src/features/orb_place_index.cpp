@@ -1,0 +1,144 @@
+// ORB place recognition by descriptor votes (features/orb_place_index.hpp).
+#include "kartograf/features/orb_place_index.hpp"
+
+#include <algorithm>
+#include <string>
+
+#include <opencv2/features2d.hpp>
+
+#include "features/orb_description.hpp"
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::features {
+
+// Places in the order added (ids increasing), so the places below an id hold a prefix of the rows.
+struct OrbPlaceIndex::Store {
+  std::vector<std::size_t> ids;
+  std::vector<std::shared_ptr<const registration::FeatureDescription>> descriptions;
+  std::vector<int> end_row;    // per place: one past its last row in `descriptors`
+  std::vector<int> row_place;  // per row: the position of its place in `ids`
+  cv::Mat descriptors;         // every place's rows, one after the other
+
+  // How many places have an id below `before`.
+  std::size_t places_below(std::size_t before) const {
+    return static_cast<std::size_t>(std::lower_bound(ids.begin(), ids.end(), before) - ids.begin());
+  }
+};
+
+namespace {
+
+// cv::BFMatcher indexes train rows in 18 bits (IMGIDX_SHIFT): a larger store is searched in blocks.
+constexpr int kRowsPerSearch = 1 << 17;
+
+// Per query row, its two nearest stored rows (trainIdx in `stored`), nearest first.
+std::vector<std::vector<cv::DMatch>> two_nearest(const cv::Mat& query, const cv::Mat& stored) {
+  std::vector<std::vector<cv::DMatch>> best(static_cast<std::size_t>(query.rows));
+  const cv::BFMatcher matcher(cv::NORM_HAMMING);
+  for (int first = 0; first < stored.rows; first += kRowsPerSearch) {
+    const int last = std::min(stored.rows, first + kRowsPerSearch);
+    std::vector<std::vector<cv::DMatch>> knn;
+    matcher.knnMatch(query, stored.rowRange(first, last), knn, 2);
+    for (const auto& neighbours : knn)
+      for (cv::DMatch m : neighbours) {
+        m.trainIdx += first;
+        auto& kept = best[static_cast<std::size_t>(m.queryIdx)];
+        kept.push_back(m);
+        std::sort(kept.begin(), kept.end());  // DMatch orders by distance
+        if (kept.size() > 2) kept.pop_back();
+      }
+  }
+  return best;
+}
+
+// Per place (position in the store), the query descriptors whose nearest stored row is its own.
+std::vector<std::size_t> count_votes(const cv::Mat& query, const cv::Mat& stored,
+                                     const std::vector<int>& row_place, std::size_t place_count,
+                                     double ratio) {
+  std::vector<std::size_t> votes(place_count, 0);
+  const auto place_of = [&](const cv::DMatch& m) {
+    return static_cast<std::size_t>(row_place[static_cast<std::size_t>(m.trainIdx)]);
+  };
+  for (const auto& neighbours : two_nearest(query, stored)) {
+    if (neighbours.empty()) continue;
+    const std::size_t place = place_of(neighbours[0]);
+    // Two near rows of one place (repeated texture) still point to that place: the ratio test
+    // only weighs the best against a rival place.
+    if (neighbours.size() > 1 && place_of(neighbours[1]) != place &&
+        neighbours[0].distance >= ratio * neighbours[1].distance)
+      continue;
+    ++votes[place];
+  }
+  return votes;
+}
+
+// The first `count` rows: descriptions list the strongest corners first.
+cv::Mat strongest_rows(const cv::Mat& descriptors, int count) {
+  if (descriptors.rows <= count) return descriptors;  // also the empty (0-dimensional) matrix
+  return descriptors.rowRange(0, count);
+}
+
+}  // namespace
+
+OrbPlaceIndex::OrbPlaceIndex(const OrbPlaceParams& params)
+    : params_(params), store_(std::make_unique<Store>()) {
+  require(params.ratio > 0 && params.ratio <= 1, "ORB place index: ratio must be in (0, 1]");
+  require(params.descriptors_per_place > 0,
+          "ORB place index: descriptors_per_place must be positive");
+}
+
+OrbPlaceIndex::~OrbPlaceIndex() = default;
+
+void OrbPlaceIndex::add(std::size_t place,
+                        std::shared_ptr<const registration::FeatureDescription> features) {
+  require(features != nullptr,
+          "ORB place index: place " + std::to_string(place) + " has no features");
+  const OrbDescription& orb = as_orb(*features, "ORB place index");
+  Store& s = *store_;
+  require(s.ids.empty() || place > s.ids.back(),
+          "ORB place index: place " + std::to_string(place) + " added after place " +
+              (s.ids.empty() ? std::string() : std::to_string(s.ids.back())) +
+              " (ids must increase)");
+  const cv::Mat strongest = strongest_rows(orb.descriptors(), params_.descriptors_per_place);
+  if (strongest.rows > 0) s.descriptors.push_back(strongest);
+  s.row_place.insert(s.row_place.end(), static_cast<std::size_t>(strongest.rows),
+                     static_cast<int>(s.ids.size()));
+  s.end_row.push_back(s.descriptors.rows);
+  s.ids.push_back(place);
+  s.descriptions.push_back(std::move(features));
+}
+
+std::vector<registration::PlaceMatch> OrbPlaceIndex::query(
+    const registration::FeatureDescription& features, std::size_t before,
+    std::size_t max_results) const {
+  const cv::Mat query = strongest_rows(as_orb(features, "ORB place query").descriptors(),
+                                       params_.descriptors_per_place);
+  const Store& s = *store_;
+  const std::size_t candidates = s.places_below(before);
+  std::vector<registration::PlaceMatch> result;
+  if (candidates == 0 || query.rows == 0 || s.end_row[candidates - 1] == 0) return result;
+  const cv::Mat stored = s.descriptors.rowRange(0, s.end_row[candidates - 1]);
+  const std::vector<std::size_t> votes =
+      count_votes(query, stored, s.row_place, candidates, params_.ratio);
+  for (std::size_t k = 0; k < candidates; ++k)
+    if (votes[k] >= params_.min_votes) result.push_back({s.ids[k], static_cast<double>(votes[k])});
+  // Stable: equal votes keep the lower id first.
+  std::stable_sort(result.begin(), result.end(),
+                   [](const auto& a, const auto& b) { return a.score > b.score; });
+  if (result.size() > max_results) result.resize(max_results);
+  return result;
+}
+
+std::shared_ptr<const registration::FeatureDescription> OrbPlaceIndex::features_of(
+    std::size_t place) const {
+  const Store& s = *store_;
+  const std::size_t k = s.places_below(place);
+  require(k < s.ids.size() && s.ids[k] == place,
+          "ORB place index: no place " + std::to_string(place));
+  return s.descriptions[k];
+}
+
+std::size_t OrbPlaceIndex::places() const {
+  return store_->ids.size();
+}
+
+}  // namespace kartograf::features
