@@ -17,6 +17,15 @@ grep -q "^  slam_ate_rmse_m [0-9]" "$1/slam.log" || { echo "FAIL: no ATE"; exit 
 grep -q "input: 100 frames; camera fx 585 fy 585 cx 320 cy 240 (640x480, file '.*camera-intrinsics.txt'); depth 1000 units per metre" "$1/slam.err" || { cat "$1/slam.err"; echo "FAIL: input line"; exit 1; }
 grep -q '"depth_units_per_metre": 1000' "$1/slam/stats.json" && grep -q '"fx": 585' "$1/slam/stats.json" || { echo "FAIL: stats.json input"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-7scenes-slam ${KARTOGRAF_DATA_DIR})
+# With --features the statistics count loop candidates by appearance and frames seeded by features.
+add_test(NAME Cli.input_slam_with_features_on_7scenes
+  COMMAND sh -c [=[
+rm -rf "$1" && mkdir -p "$1" || exit 1
+"$0" slam "$2/7scenes_redkitchen" --frames 150 --features --no-map --out "$1/slam" > "$1/slam.log" 2> "$1/slam.err" || { cat "$1/slam.log" "$1/slam.err"; exit 1; }
+grep -q "^  slam_ate_rmse_m 0\.0[0-4]" "$1/slam.log" || { cat "$1/slam.log"; echo "FAIL: ATE"; exit 1; }
+grep -q '"appearance_candidates": [0-9]' "$1/slam/stats.json" || { echo "FAIL: no appearance_candidates"; exit 1; }
+grep -q '"from_features": [0-9]' "$1/slam/stats.json" || { echo "FAIL: no from_features count"; exit 1; }
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-7scenes-slam-features ${KARTOGRAF_DATA_DIR})
 add_test(NAME Cli.input_map_on_7scenes_frames_300_to_599
   COMMAND sh -c [=[
 rm -rf "$1" && mkdir -p "$1" || exit 1
@@ -40,7 +49,7 @@ grep -q "^  ate_rmse_m [0-9]" "$1/map.log" || { echo "FAIL: no map ATE"; exit 1;
 grep -q '"fx": 570.342205' "$1/map/report.json" || { echo "FAIL: report.json camera"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-sun3d ${KARTOGRAF_DATA_DIR})
 set_tests_properties(Cli.input_slam_on_7scenes_frames_300_to_599 Cli.input_map_on_7scenes_frames_300_to_599
-  Cli.input_slam_and_map_on_sun3d PROPERTIES TIMEOUT 600 ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+  Cli.input_slam_and_map_on_sun3d Cli.input_slam_with_features_on_7scenes PROPERTIES TIMEOUT 600 ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
 
 # A TUM folder (kartograf synth output without world.json and camera_intrinsics.json): the
 # default camera with a warning naming --camera; --camera tum-fr3 (fx 535.4, fy 539.2) printed and

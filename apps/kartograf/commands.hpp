@@ -105,6 +105,7 @@ struct SlamOptions {
   std::filesystem::path out_dir;
   bool no_loop_closure = false;
   bool no_map = false;
+  bool features = false;  // ORB features: loop candidates by appearance, odometry seeding
   double voxel_size = 0.02;
   bool force = false;  // replace an earlier run's folder
 };

@@ -5,18 +5,21 @@
 // same way (for `kartograf eval traj`). Wiring only.
 #include <cstdio>
 #include <filesystem>
+#include <memory>
 #include <optional>
 #include <ostream>
 #include <string>
 
 #include "commands.hpp"
 #include "interrupts.hpp"
+#include "kartograf/features/orb_front_end.hpp"
 #include "kartograf/formats/ply.hpp"
 #include "kartograf/formats/text_file.hpp"
 #include "kartograf/formats/top_view.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/mapping/slam.hpp"
 #include "kartograf/outputs/slam_stats.hpp"
+#include "kartograf/pipeline/map_pipeline.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
@@ -100,6 +103,9 @@ CLI::App* add_slam_command(CLI::App& app, SlamOptions& o) {
   command->add_flag("--no-loop-closure", o.no_loop_closure,
                     "Optimise odometry edges only (frame-to-frame and k-back)");
   command->add_flag("--no-map", o.no_map, "Skip the map (no second pass over the frames)");
+  command->add_flag("--features", o.features,
+                    "ORB features (as kartograf map): loop-closure candidates by appearance too, "
+                    "and the odometry seeded by features after large or rejected steps");
   command->add_option("--voxel", o.voxel_size, "Map voxel size [m]")
       ->check(finite_in(0.001, 10.0))
       ->capture_default_str();
@@ -118,6 +124,10 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   params.loop_closure = !o.no_loop_closure;
   params.build_map = !o.no_map;
   params.map.voxel_size = o.voxel_size;
+  if (o.features) {
+    params.features = std::make_shared<const features::OrbFrontEnd>(pipeline::map_orb_params());
+    params.odometry.features = params.features;
+  }
 
   ProgressBar bar(err, o.run.progress);
   const mapping::SlamObserver observer = slam_progress_observer(err, bar);
