@@ -186,10 +186,11 @@ std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
       places_->query(*j.features, j.frame - gap + 1, params_.max_appearance_candidates);
   for (const registration::PlaceMatch& place : similar) {
     // Places are keyframes' frame indices, in increasing order.
-    const auto found = std::lower_bound(
-        keyframes_.begin(), keyframes_.begin() + static_cast<std::ptrdiff_t>(query), place.place,
-        [](const Keyframe& k, std::size_t frame) { return k.frame < frame; });
-    if (found == keyframes_.end() || found->frame != place.place || !found->features) continue;
+    const auto earlier = keyframes_.begin() + static_cast<std::ptrdiff_t>(query);
+    const auto found =
+        std::lower_bound(keyframes_.begin(), earlier, place.place,
+                         [](const Keyframe& k, std::size_t frame) { return k.frame < frame; });
+    if (found == earlier || found->frame != place.place || !found->features) continue;
     const std::optional<registration::FeatureAlignment> aligned =
         features_->align(*j.features, *found->features);
     if (!aligned) continue;

@@ -42,14 +42,16 @@ RgbImage colour_or_grey(const registration::RgbdImages& frame) {
   return RgbImage(frame.depth.width(), frame.depth.height(), Rgb8{128, 128, 128});
 }
 
-// Median height of the points of one class, if any.
-std::optional<double> median_height(const semantic::LabelledViews& views, SemanticClass label) {
-  std::vector<double> z;
+// Median height along `up` (metres) of the points of one class, if any.
+std::optional<double> median_height(const semantic::LabelledViews& views, SemanticClass label,
+                                    const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ()) {
+  std::vector<double> heights;
   for (std::size_t i = 0; i < views.points().size(); ++i)
-    if (views.labels()[i] == label) z.push_back(views.points()[i].z());
-  if (z.empty()) return std::nullopt;
-  std::nth_element(z.begin(), z.begin() + static_cast<std::ptrdiff_t>(z.size() / 2), z.end());
-  return z[z.size() / 2];
+    if (views.labels()[i] == label) heights.push_back(views.points()[i].dot(up));
+  if (heights.empty()) return std::nullopt;
+  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
+  std::nth_element(heights.begin(), middle, heights.end());
+  return *middle;
 }
 
 PointCloud transformed(const PointCloud& cloud, const Eigen::Isometry3d& transform) {
@@ -181,18 +183,6 @@ struct ViewLabeller {
   }
 };
 
-// The floor's height along `up` (metres, world frame) from the pooled floor points.
-std::optional<double> floor_height_along(const semantic::LabelledViews& views,
-                                         const Eigen::Vector3d& up) {
-  std::vector<double> heights;
-  for (std::size_t i = 0; i < views.points().size(); ++i)
-    if (views.labels()[i] == SemanticClass::floor) heights.push_back(views.points()[i].dot(up));
-  if (heights.empty()) return std::nullopt;
-  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
-  std::nth_element(heights.begin(), middle, heights.end());
-  return *middle;
-}
-
 // Every label_step-th frame labelled with its own gravity estimate and pooled. Frames that cannot
 // find up alone (no floor or ceiling in sight: close to a wall, a kitchen counter) are labelled
 // again with the map's up and floor from the other views, through their SLAM pose.
@@ -218,7 +208,7 @@ void label_views(const compute::Context& context, const mapping::FrameSource& so
     if (observer.slam.on_progress) observer.slam.on_progress("views", i + 1, poses.size());
   }
   const Eigen::Vector3d up = views.up();
-  const std::optional<double> floor = floor_height_along(views, up);
+  const std::optional<double> floor = median_height(views, SemanticClass::floor, up);
   for (const auto& [i, failure] : retry) {
     if (views.views() == 0 || !floor) {
       views.skip(failure);

@@ -184,11 +184,6 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
                                                     const Eigen::Isometry3d& initial,
                                                     const RegistrationLimits& limits) {
   const std::size_t current = frames_.size();  // frames_ grows when track() ends
-  // Degenerate views: ICP keeps the initial guess in the weak directions while it solves.
-  IcpPrior prior{initial, se3::Matrix6d::Zero()};
-  if (geometry_.degeneracy.degenerate && params_.motion_prior > 0) {
-    prior.information = motion_prior_information(geometry_, params_.motion_prior);
-  }
   std::span<const CloudView> source_views;
   std::span<const CloudView> target_views;
   std::vector<CloudView> source_levels;
@@ -211,7 +206,13 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
     source_views = std::span<const CloudView>(source_levels).subspan(first, count);
     target_views = std::span<const CloudView>(target_levels).subspan(first, count);
   }
-  const IcpResult result = engine->align(source_views, target_views, initial, prior);
+  // Degenerate views: the motion model, as a prior, decides the weak directions while ICP
+  // solves; the other frames solve the pairs' system alone.
+  const IcpResult result =
+      geometry_.degeneracy.degenerate && params_.motion_prior > 0
+          ? engine->align(source_views, target_views, initial,
+                          {initial, motion_prior_information(geometry_, params_.motion_prior)})
+          : engine->align(source_views, target_views, initial);
   Attempt attempt;
   attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
   attempt.inlier_rmse = result.inlier_rmse;
