@@ -48,8 +48,26 @@ cat "$1/map.log"
 grep -q "^  ate_rmse_m [0-9]" "$1/map.log" || { echo "FAIL: no map ATE"; exit 1; }
 grep -q '"fx": 570.342205' "$1/map/report.json" || { echo "FAIL: report.json camera"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-sun3d ${KARTOGRAF_DATA_DIR})
+# map --poses: the map from a known trajectory (the sequence's ground truth, then the trajectory
+# that run wrote, matched by timestamp): nothing estimated, the ATE zero; a trajectory that lacks
+# the frames and a missing file are errors naming the input.
+add_test(NAME Cli.input_map_with_known_poses
+  COMMAND sh -c [=[
+rm -rf "$1" && mkdir -p "$1" || exit 1
+"$0" map "$2/sun3d_studyroom_fragment1" --poses groundtruth --out "$1/truth" > "$1/truth.log" 2> "$1/truth.err" || { cat "$1/truth.log" "$1/truth.err"; exit 1; }
+grep -q "^  ate_rmse_m 0.0000 " "$1/truth.log" || { cat "$1/truth.log"; echo "FAIL: ATE with ground-truth poses"; exit 1; }
+grep -q '"poses_given": true' "$1/truth/report.json" || { echo "FAIL: poses_given"; exit 1; }
+"$0" map "$2/sun3d_studyroom_fragment1" --poses "$1/truth/trajectory.txt" --out "$1/file" > "$1/file.log" 2> "$1/file.err" || { cat "$1/file.log" "$1/file.err"; exit 1; }
+grep -q "^  ate_rmse_m 0.0000 " "$1/file.log" || { cat "$1/file.log"; echo "FAIL: ATE with the trajectory file"; exit 1; }
+head -20 "$1/truth/trajectory.txt" > "$1/short.txt"
+"$0" map "$2/sun3d_studyroom_fragment1" --poses "$1/short.txt" --out "$1/short" > "$1/short.log" 2>&1 && { echo "FAIL: a short trajectory was accepted"; exit 1; }
+grep -q "short.txt' has no pose within 20 ms of frame" "$1/short.log" || { cat "$1/short.log"; echo "FAIL: message"; exit 1; }
+test ! -e "$1/short/report.json" || { echo "FAIL: partial output"; exit 1; }
+"$0" map "$2/sun3d_studyroom_fragment1" --poses "$1/none.txt" --out "$1/none" > "$1/none.log" 2>&1 && { echo "FAIL: a missing file was accepted"; exit 1; }
+grep -q "none.txt" "$1/none.log" || { cat "$1/none.log"; echo "FAIL: message"; exit 1; }
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-map-known-poses ${KARTOGRAF_DATA_DIR})
 set_tests_properties(Cli.input_slam_on_7scenes_frames_300_to_599 Cli.input_map_on_7scenes_frames_300_to_599
-  Cli.input_slam_and_map_on_sun3d Cli.input_slam_with_features_on_7scenes PROPERTIES TIMEOUT 600 ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+  Cli.input_slam_and_map_on_sun3d Cli.input_slam_with_features_on_7scenes Cli.input_map_with_known_poses PROPERTIES TIMEOUT 600 ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
 
 # A TUM folder (kartograf synth output without world.json and camera_intrinsics.json): the
 # default camera with a warning naming --camera; --camera tum-fr3 (fx 535.4, fy 539.2) printed and

@@ -31,7 +31,7 @@ RenderedSequence render_sequence(const synth::World& world,
   for (std::size_t i = 0; i < poses.size(); ++i) {
     synth::SyntheticFrame frame = synth::render(world, camera, poses[i], model, 100 + i);
     sequence.frames.push_back(
-        {std::move(frame.depth), std::move(frame.color), static_cast<double>(i) / 30.0});
+        {std::move(frame.depth), std::move(frame.color), static_cast<double>(i) / 30.0, poses[i]});
   }
   return sequence;
 }

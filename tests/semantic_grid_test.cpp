@@ -7,11 +7,14 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 #include <numbers>
 #include <queue>
 #include <random>
+#include <span>
 #include <vector>
 
 #include "kartograf/semantic/planning.hpp"
@@ -150,10 +153,10 @@ TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
   EXPECT_EQ(inside, 4 * 17);  // 4 rows of cells in the wall, 17 columns well inside the opening
 }
 
-// A table seen only by its edges (top dropped out), labelled unknown as M2 leaves it: the floor it
-// encloses is blocked. An L of unknown clutter in the open encloses nothing: the floor beside it
-// stays free.
-TEST(SemanticGrid, UnclassifiedOutlinesThatEncloseFloorBlockIt) {
+// A table seen only by its edges (top dropped out), its faces left unknown by the views: a free
+// standing piece of furniture size, so furniture, filled to its outline. A 3 m run of unknown
+// clutter is longer than furniture: it stays an unclassified obstacle, the floor beside it free.
+TEST(SemanticGrid, UnclassifiedOutlinesOfFurnitureSizeAreFurniture) {
   using C = SemanticClass;
   LabelledPoints s;
   s.box_face({0.012, 0.012, 0}, {4.012, 3.012, 0}, C::floor);
@@ -161,22 +164,155 @@ TEST(SemanticGrid, UnclassifiedOutlinesThatEncloseFloorBlockIt) {
   s.box_face({1.012, 1.812, 0.72}, {2.212, 1.812, 0.76}, C::unknown);
   s.box_face({1.012, 1.012, 0.72}, {1.012, 1.812, 0.76}, C::unknown);
   s.box_face({2.212, 1.012, 0.72}, {2.212, 1.812, 0.76}, C::unknown);
-  s.box_face({2.812, 0.512, 0.3}, {3.612, 0.512, 0.6}, C::unknown);  // an L of clutter
-  s.box_face({2.812, 0.512, 0.3}, {2.812, 1.312, 0.6}, C::unknown);
+  s.box_face({0.512, 2.512, 0.3}, {3.612, 2.512, 0.6}, C::unknown);  // a 3.1 m run of clutter
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   const auto at = [&](double x, double y) {
     const Eigen::Vector2i c = grid.cell_of({x, y});
     return std::pair{grid.classes(c.x(), c.y()), grid.weight(c.x(), c.y())};
   };
-  EXPECT_EQ(at(1.6, 1.4), std::pair(C::unknown, 0.0f));  // under the table
-  EXPECT_EQ(at(1.1, 1.1), std::pair(C::unknown, 0.0f));
-  EXPECT_EQ(at(3.2, 0.9), std::pair(C::floor, 1.0f));  // inside the L's corner
-  EXPECT_EQ(at(3.0, 2.5), std::pair(C::floor, 1.0f));
+  EXPECT_EQ(at(1.6, 1.4), std::pair(C::furniture, 0.0f));  // under the table
+  EXPECT_EQ(at(1.03, 1.1), std::pair(C::furniture, 0.0f));
+  EXPECT_EQ(at(2.0, 2.52), std::pair(C::unknown, 0.0f));  // the long run
+  EXPECT_EQ(at(2.0, 2.2), std::pair(C::floor, 1.0f));
+  EXPECT_EQ(at(3.0, 0.5), std::pair(C::floor, 1.0f));
+  // Without the furniture rule, the enclosed floor is still blocked as an unclassified obstacle;
+  // without any fill it is floor.
+  SemanticGridParams no_furniture;
+  no_furniture.furniture_max_extent = 0;
+  const SemanticGrid unclassified = build_semantic_grid(s.points, s.labels, no_furniture);
+  const Eigen::Vector2i under = unclassified.cell_of({1.6, 1.4});
+  EXPECT_EQ(unclassified.classes(under.x(), under.y()), C::unknown);
+  EXPECT_EQ(unclassified.weight(under.x(), under.y()), 0.0f);
   SemanticGridParams off;
   off.max_furniture_fill_area = 0;
   const SemanticGrid unfilled = build_semantic_grid(s.points, s.labels, off);
-  const Eigen::Vector2i under = unfilled.cell_of({1.6, 1.4});
   EXPECT_EQ(unfilled.classes(under.x(), under.y()), C::floor);
+}
+
+// A wall 0.2 m thick seen from both rooms: its inside, which no view sees, is wall; two walls
+// 1 m apart with nothing seen between (a closed shaft) are not joined.
+TEST(SemanticGrid, AWallsInsideBetweenItsTwoFacesIsWall) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 0.962, 0}, C::floor);      // south room
+  s.box_face({0.012, 1.262, 0}, {4.012, 2.262, 0}, C::floor);      // north room
+  s.box_face({0.012, 1.012, 0.02}, {4.012, 1.012, 1.4}, C::wall);  // the faces
+  s.box_face({0.012, 1.212, 0.02}, {4.012, 1.212, 1.4}, C::wall);
+  s.box_face({0.012, 2.312, 0.02}, {4.012, 2.312, 1.4}, C::wall);  // north room's far wall
+  s.box_face({0.012, 3.312, 0.02}, {4.012, 3.312, 1.4}, C::wall);  // 1 m beyond it
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  const auto at = [&](double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return grid.classes(c.x(), c.y());
+  };
+  EXPECT_EQ(at(2.0, 1.11), C::wall);
+  EXPECT_EQ(at(2.0, 2.8), C::unknown);
+  EXPECT_TRUE(std::isnan(grid.weight(grid.cell_of({2.0, 2.8}).x(), grid.cell_of({2.0, 2.8}).y())));
+  SemanticGridParams off;
+  off.max_wall_thickness = 0;
+  const SemanticGrid thin = build_semantic_grid(s.points, s.labels, off);
+  const Eigen::Vector2i inside = thin.cell_of({2.0, 1.11});
+  EXPECT_EQ(thin.classes(inside.x(), inside.y()), C::unknown);
+}
+
+// Two rooms' dividers meet a 1.4 m corridor at a T from either side, in line: the corridor between
+// their ends is no doorway (the walls across its line are the corridor's own).
+TEST(SemanticGrid, ACorridorBetweenTwoDividersInLineIsNoDoorway) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  constexpr double kSouth = 2.012, kNorth = 3.412, kDivider = 3.012, kEnd = 6.012;
+  s.box_face({0.012, 0.012, 0}, {kEnd, 5.412, 0}, C::floor);
+  for (const double y : {kSouth, kSouth + 0.2, kNorth, kNorth + 0.2})  // corridor walls, 0.2 m
+    s.box_face({0.012, y, 0.02}, {kEnd, y, 1.4}, C::wall);
+  for (const double x : {kDivider, kDivider + 0.2}) {  // the dividers' faces
+    s.box_face({x, 0.012, 0.02}, {x, kSouth, 1.4}, C::wall);
+    s.box_face({x, kNorth + 0.2, 0.02}, {x, 5.412, 1.4}, C::wall);
+  }
+  // The floor under the walls is not seen.
+  std::vector<std::size_t> keep;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    const Eigen::Vector3d& p = s.points[i];
+    const bool under_wall =
+        (p.y() > kSouth && p.y() < kSouth + 0.2) || (p.y() > kNorth && p.y() < kNorth + 0.2) ||
+        (p.x() > kDivider && p.x() < kDivider + 0.2 && (p.y() < kSouth || p.y() > kNorth + 0.2));
+    if (!(s.labels[i] == C::floor && under_wall)) keep.push_back(i);
+  }
+  LabelledPoints seen;
+  for (const std::size_t i : keep) seen.add(s.points[i], s.labels[i]);
+  const SemanticGrid grid = build_semantic_grid(seen.points, seen.labels);
+  for (const SemanticObject& o : grid.objects) {
+    if (o.kind != ObjectKind::doorway) continue;
+    EXPECT_FALSE(o.centre.y() > kSouth + 0.2 && o.centre.y() < kNorth)
+        << "a doorway across the corridor at (" << o.centre.transpose() << ")";
+  }
+}
+
+// Floor with a thin unseen strip (the shadow of a corner) and an unseen 0.5 m patch: the strip is
+// floor, the patch stays unobserved.
+TEST(SemanticGrid, ThinShadowsInTheFloorAreFloor) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 0.012; y <= 3.012; y += 0.02) {
+      const bool strip = std::fabs(x - y) < 0.06;  // a diagonal shadow ~0.08 m wide
+      const bool patch = x > 3.0 && x < 3.5 && y > 0.5 && y < 1.0;
+      if (!strip && !patch) s.add({x, y, 0}, C::floor);
+    }
+  }
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  const auto at = [&](double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return std::pair{grid.classes(c.x(), c.y()), std::isnan(grid.weight(c.x(), c.y()))};
+  };
+  EXPECT_EQ(at(1.52, 1.52), std::pair(C::floor, false));
+  EXPECT_EQ(at(3.27, 0.77), std::pair(C::unknown, true));
+  SemanticGridParams off;
+  off.max_floor_shadow = 0;
+  const SemanticGrid unfilled = build_semantic_grid(s.points, s.labels, off);
+  const Eigen::Vector2i c = unfilled.cell_of({1.52, 1.52});
+  EXPECT_TRUE(std::isnan(unfilled.weight(c.x(), c.y())));
+}
+
+// A streak of wall points in open floor from one view (edge artefacts along its rays) is no
+// obstacle when the points' views are known; seen from a second view it is.
+TEST(SemanticGrid, AnObstacleSeenByOneViewAloneIsNoise) {
+  using C = SemanticClass;
+  // Four views of a room's floor and west wall; the streak in the views `streaked`.
+  const auto streak_class = [](std::initializer_list<std::uint32_t> streaked, bool with_ids) {
+    LabelledPoints s;
+    std::vector<std::uint32_t> views;
+    for (std::uint32_t view = 0; view < 4; ++view) {
+      s.box_face({0.012, 0.012, 0}, {3.012, 3.012, 0}, C::floor, 0.04);
+      s.box_face({0.012, 0.012, 0.02}, {0.012, 3.012, 1.4}, C::wall, 0.04);
+      if (std::find(streaked.begin(), streaked.end(), view) != streaked.end())
+        s.box_face({1.012, 1.512, 0.2}, {2.012, 1.512, 0.5}, C::wall, 0.01);
+      views.resize(s.points.size(), view);
+    }
+    const SemanticGrid grid = build_semantic_grid(
+        s.points, s.labels, {}, {},
+        with_ids ? std::span<const std::uint32_t>(views) : std::span<const std::uint32_t>());
+    const Eigen::Vector2i wall = grid.cell_of({0.02, 1.5});
+    EXPECT_EQ(grid.classes(wall.x(), wall.y()), C::wall);
+    const Eigen::Vector2i c = grid.cell_of({1.5, 1.512});
+    return grid.classes(c.x(), c.y());
+  };
+  EXPECT_EQ(streak_class({2}, true), C::floor);
+  EXPECT_EQ(streak_class({2}, false), C::wall);  // views unknown: every point counts
+  EXPECT_EQ(streak_class({2, 3}, true), C::wall);
+
+  // One view alone (a single scan) keeps its obstacles.
+  LabelledPoints one;
+  one.box_face({0.012, 0.012, 0}, {3.012, 3.012, 0}, C::floor, 0.04);
+  one.box_face({1.012, 1.512, 0.2}, {2.012, 1.512, 0.5}, C::wall, 0.01);
+  const std::vector<std::uint32_t> single(one.points.size(), 0);
+  const SemanticGrid scan = build_semantic_grid(one.points, one.labels, {}, {}, single);
+  const Eigen::Vector2i c = scan.cell_of({1.5, 1.512});
+  EXPECT_EQ(scan.classes(c.x(), c.y()), C::wall);
+
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {1.012, 1.012, 0}, C::floor);
+  const std::vector<std::uint32_t> too_few(3, 0);
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(s.points, s.labels, {}, {}, too_few), "view ids");
 }
 
 TEST_F(SemanticGridRoom, DoorWallsAndFurnitureAreObjects) {

@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <optional>
 #include <random>
 
 #include "kartograf/eval/semantic_metrics.hpp"
@@ -114,6 +115,45 @@ PointImage wall_points(double depth, const Keep& keep, const Offset& offset) {
     }
   }
   return points;
+}
+
+// A board facing the camera at 2 m (rows 30-59), depth lost above it (rows 20-29, as on a
+// grazing table top), and what lies beyond that gap: a surface behind the board's plane ends the
+// board there (no cut); the image border leaves it open (cut above). A 4-row strip cut at its side
+// by the border is cut sideways only, not above and below.
+TEST(SemanticRegions, MissingDepthCutsARegionOnlyWhereItMayGoOn) {
+  auto measure = [](int first_row, int last_row, std::optional<double> beyond) {
+    const PointImage board = wall_points(
+        2.0, [&](int, int v) { return v >= first_row && v <= last_row; },
+        [](int, int) { return 0.0; });
+    const PointImage far = wall_points(
+        beyond.value_or(4.0),
+        [&](int, int v) { return beyond && (v < first_row - 10 || v > last_row + 10); },
+        [](int, int) { return 0.0; });
+    PointImage points = board;
+    RegionSegmentation regions{LabelImage(points.width(), points.height(), kUnlabeled),
+                               beyond ? 2 : 1};
+    NormalImage normals(points.width(), points.height(), Point4f(0, 0, -1, 0));
+    for (int v = 0; v < points.height(); ++v) {
+      for (int u = 0; u < points.width(); ++u) {
+        if (is_valid(board(u, v))) regions.labels(u, v) = 1;
+        if (is_valid(far(u, v))) points(u, v) = far(u, v), regions.labels(u, v) = 2;
+      }
+    }
+    const Eigen::Vector3d up(0, -1, 0);  // camera frame: y points down
+    return measure_regions(points, normals, regions, up)[0];
+  };
+  const RegionMeasurements ended = measure(30, 59, 4.0);
+  EXPECT_FALSE(ended.cut_above);
+  EXPECT_TRUE(ended.cut_below);  // the image's bottom edge
+  const RegionMeasurements open = measure(30, 59, std::nullopt);
+  EXPECT_TRUE(open.cut_above);
+  const RegionMeasurements hidden = measure(30, 59, 1.0);  // a nearer surface beyond the gap
+  EXPECT_FALSE(hidden.cut_above);
+  const RegionMeasurements strip = measure(40, 43, 4.0);
+  EXPECT_TRUE(strip.cut_sideways);
+  EXPECT_FALSE(strip.cut_above);
+  EXPECT_FALSE(strip.cut_below);
 }
 
 TEST(SemanticRegions, SparseReturnsFormOneRegionAcrossGaps) {
@@ -289,21 +329,23 @@ TEST(SemanticLabels, RecognisesCameraFrames) {
   EXPECT_FALSE(is_camera_frame(frame));
 }
 
+// A vertical region facing -x at x, from min_h to max_h (z up), width wide.
+RegionMeasurements vertical(Label id, double x, double min_h, double max_h, double width) {
+  RegionMeasurements r;
+  r.id = id;
+  r.orientation = RegionOrientation::vertical;
+  r.mean_normal = r.plane_normal = Eigen::Vector3d(-1, 0, 0);
+  r.centroid = Eigen::Vector3d(x, 0, 0.5 * (min_h + max_h));
+  r.min_height = min_h;
+  r.max_height = max_h;
+  r.width = width;
+  return r;
+}
+
 TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
   GravityEstimate gravity;
   gravity.floor_height = -1.0;
   gravity.ceiling_height = 1.6;
-  auto vertical = [](Label id, double x, double min_h, double max_h, double width) {
-    RegionMeasurements r;
-    r.id = id;
-    r.orientation = RegionOrientation::vertical;
-    r.mean_normal = r.plane_normal = Eigen::Vector3d(-1, 0, 0);
-    r.centroid = Eigen::Vector3d(x, 0, 0.5 * (min_h + max_h));
-    r.min_height = min_h;
-    r.max_height = max_h;
-    r.width = width;
-    return r;
-  };
   std::vector<RegionMeasurements> regions = {
       vertical(1, 3.0, -1.0, 1.6, 3.5),    // a whole wall
       vertical(2, 2.95, -1.0, 1.0, 0.85),  // a leaf 5 cm in front of it, 2 m high
@@ -321,7 +363,7 @@ TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
   EXPECT_EQ(classes[1], SemanticClass::door);
   EXPECT_EQ(classes[2],
             SemanticClass::wall);  // no leaf: a door-high piece next to a wall (jamb rule)
-  EXPECT_EQ(classes[3], SemanticClass::unknown);
+  EXPECT_EQ(classes[3], SemanticClass::furniture);  // stands on the floor, ends at 0.8 m
   EXPECT_EQ(classes[4], SemanticClass::wall);
 
   // Seen from the ceiling down to furniture that hides its foot: a wall; the same shape hidden
@@ -349,6 +391,32 @@ TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
   EXPECT_EQ(classify_regions(std::vector{lowered}, high_ceiling)[0], SemanticClass::ceiling);
   lowered.centroid.z() = 2.0;  // lintel height: not ceiling
   EXPECT_EQ(classify_regions(std::vector{lowered}, high_ceiling)[0], SemanticClass::unknown);
+}
+
+TEST(SemanticClassify, FurnitureStandsOnTheFloorAndEndsBelowTheCeiling) {
+  GravityEstimate gravity;
+  gravity.floor_height = -1.0;
+  gravity.ceiling_height = 1.6;
+  // Furniture: a table top 0.75 m up (facing up), the edge band below it (joins the top), a low
+  // face 3 m long (longer than furniture: unknown), a face cut above (may be a wall: unknown).
+  RegionMeasurements top;
+  top.id = 1;
+  top.orientation = RegionOrientation::horizontal;
+  top.mean_normal = top.plane_normal = Eigen::Vector3d::UnitZ();
+  top.centroid = Eigen::Vector3d(1.0, 0, -0.25);
+  top.min_height = top.max_height = -0.25;
+  top.width = 1.2;
+  top.neighbours = {2};
+  RegionMeasurements band = vertical(2, 1.4, -0.29, -0.25, 1.2);
+  band.neighbours = {1};
+  RegionMeasurements long_face = vertical(3, 2.0, -1.0, -0.5, 3.0);
+  RegionMeasurements cut_face = vertical(4, 2.5, -1.0, 0.2, 0.6);
+  cut_face.cut_above = true;
+  const auto furniture = classify_regions(std::vector{top, band, long_face, cut_face}, gravity);
+  EXPECT_EQ(furniture[0], SemanticClass::furniture);
+  EXPECT_EQ(furniture[1], SemanticClass::furniture);
+  EXPECT_EQ(furniture[2], SemanticClass::unknown);
+  EXPECT_EQ(furniture[3], SemanticClass::unknown);
 }
 
 class SemanticLabels : public testing::BackendTest {};
@@ -397,7 +465,8 @@ TEST(SemanticLabels, KnownUpLabelsAViewWithoutFloor) {
   const synth::SyntheticFrame probe = synth::render(world, k, pose, synth::NoiseModel::none(), 1);
   const double distance = probe.depth(80, 60) / 5000.0;
   ASSERT_GT(distance, 0.7);
-  pose = synth::camera_pose(start.translation() + (distance - 0.6) * pose.linear().col(2), yaw, 0.0);
+  pose =
+      synth::camera_pose(start.translation() + (distance - 0.6) * pose.linear().col(2), yaw, 0.0);
   const synth::SyntheticFrame frame = synth::render(world, k, pose, synth::NoiseModel::none(), 1);
   for (const SemanticClass c : frame.semantic.pixels()) {
     ASSERT_NE(c, SemanticClass::floor);  // the view is what the test needs

@@ -187,6 +187,7 @@ struct MapOptions {
   double resolution = 0.05;
   std::string room_method = "distance";
   bool no_features = false;
+  std::string poses;  // "groundtruth", a TUM trajectory file, or empty: estimate them
   bool force = false;
 };
 CLI::App* add_map_command(CLI::App& app, MapOptions& options);

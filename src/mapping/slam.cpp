@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <numbers>
 #include <optional>
 #include <string>
@@ -205,10 +206,12 @@ void colors_at_level(const RgbImage& color, int level, int width, int height, Rg
   }
 }
 
-// Second pass: every frame's points and normals at its optimised pose.
-PointCloud fuse_map(const compute::Context& context, const FrameSource& source,
-                    const std::vector<Eigen::Isometry3d>& poses, const SlamParams& params,
-                    const SlamObserver& observer, SlamResult& result) {
+// Second pass: every frame's points and normals at its pose (pose_of(i, images); a pose given
+// with the frames is resolved while they are read).
+PointCloud fuse_map(
+    const compute::Context& context, const FrameSource& source, std::size_t frames,
+    const std::function<Eigen::Isometry3d(std::size_t, const registration::RgbdImages&)>& pose_of,
+    const SlamParams& params, const SlamObserver& observer, SlamResult& result) {
   const registration::OdometryParams odometry = with_source_units(params.odometry, source);
   registration::RgbdPyramidBuilder builder(context, source.camera(), odometry.depth_range);
   // The level at most 320 pixels wide (half resolution of 640x480): averaged points with
@@ -221,7 +224,8 @@ PointCloud fuse_map(const compute::Context& context, const FrameSource& source,
   RgbImage level_colors;
   double fusing = 0;
   const FrameLoopTiming timing =
-      for_each_frame(source, 0, poses.size(), [&](std::size_t i, registration::RgbdImages& images) {
+      for_each_frame(source, 0, frames, [&](std::size_t i, registration::RgbdImages& images) {
+        const Eigen::Isometry3d pose = pose_of(i, images);
         const auto start = Clock::now();
         builder.build(images.depth, nullptr, frame);
         const registration::PyramidLevel& fused = frame.level(level);
@@ -229,9 +233,9 @@ PointCloud fuse_map(const compute::Context& context, const FrameSource& source,
         const NormalImage normals = fused.normals.to_image();
         const RgbImage* color = color_of(images);
         if (color) colors_at_level(*color, level, points.width(), points.height(), level_colors);
-        fusion.add(points, normals, color ? &level_colors : nullptr, poses[i]);
+        fusion.add(points, normals, color ? &level_colors : nullptr, pose);
         fusing += seconds_since(start);
-        report_progress(observer, "map", i + 1, poses.size());
+        report_progress(observer, "map", i + 1, frames);
       });
   result.timing.map_seconds = fusing;
   result.timing.load_seconds += timing.load_seconds;
@@ -346,8 +350,47 @@ SlamResult run_slam(const compute::Context& context, const FrameSource& source,
     record.residual_deg = se3::rotation_angle(residual) / kDegree;
   }
   if (params.build_map && total > 0) {
-    result.map = fuse_map(context, source, result.poses, params, observer, result);
+    const auto optimised = [&](std::size_t i, const registration::RgbdImages&) {
+      return result.poses[i];
+    };
+    result.map = fuse_map(context, source, total, optimised, params, observer, result);
   }
+  result.timing.total_seconds = seconds_since(start);
+  return result;
+}
+
+SlamResult run_with_known_poses(const compute::Context& context, const FrameSource& source,
+                                const KnownPoseLookup& pose_of, const SlamParams& params,
+                                const SlamObserver& observer) {
+  require(static_cast<bool>(pose_of), "slam with known poses: no pose lookup given");
+  const auto start = Clock::now();
+  SlamResult result;
+  result.poses_given = true;
+  std::optional<Eigen::Isometry3d> first_inverse;
+  // Expressed relative to the first frame, as estimated trajectories are.
+  const auto relative_pose = [&](std::size_t i, const registration::RgbdImages& images) {
+    const Eigen::Isometry3d pose = pose_of(i, images);
+    require(pose.matrix().allFinite() &&
+                (pose.linear().transpose() * pose.linear() - Eigen::Matrix3d::Identity())
+                        .cwiseAbs()
+                        .maxCoeff() < 1e-3,
+            "slam with known poses: the pose of frame " + std::to_string(i) +
+                " is not finite or not a rotation");
+    if (!first_inverse) first_inverse = pose.inverse();
+    const Eigen::Isometry3d relative = *first_inverse * pose;
+    result.poses.push_back(relative);
+    result.odometry.timestamps.push_back(images.timestamp);
+    return relative;
+  };
+  if (params.build_map) {
+    result.map = fuse_map(context, source, source.size(), relative_pose, params, observer, result);
+  } else {
+    result.timing.load_seconds =
+        for_each_frame(source, 0, source.size(), [&](std::size_t i, registration::RgbdImages& im) {
+          relative_pose(i, im);
+        }).load_seconds;
+  }
+  result.odometry.poses = result.poses;
   result.timing.total_seconds = seconds_since(start);
   return result;
 }

@@ -145,7 +145,8 @@ Json report_json(const pipeline::MapPipelineResult& r,
   std::size_t from_features = 0;
   for (const registration::OdometryFrame& f : r.slam.odometry.frames)
     from_features += f.from_features;
-  json["slam"] = {{"loop_candidates", r.slam.loop_candidates},
+  json["slam"] = {{"poses_given", r.slam.poses_given},
+                  {"loop_candidates", r.slam.loop_candidates},
                   {"appearance_candidates", r.slam.appearance_candidates},
                   {"loop_closures_accepted", accepted},
                   {"loop_closures_by_appearance", by_appearance},

@@ -125,6 +125,13 @@ void segment_rooms(const compute::Context& context, const MapPipelineParams& par
                    MapPipelineResult& result) {
   const semantic::SemanticGrid& grid = result.semantic;
   OccupancyGrid room_map = result.occupancy;
+  // Furniture stands inside rooms: it must not split one (a cabinet narrowing a corridor).
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      if (grid.classes(col, row) == SemanticClass::furniture)
+        room_map.cells(col, row) = CellState::free;
+    }
+  }
   if (params.rooms_end_at_doorways) {
     for (const semantic::SemanticObject& object : grid.objects) {
       if (object.kind != semantic::ObjectKind::doorway) continue;
@@ -267,7 +274,10 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
     slam_params.features = features;
     slam_params.odometry.features = features;
   }
-  result.slam = mapping::run_slam(context, source, slam_params, observer.slam);
+  result.slam = params.known_poses
+                    ? mapping::run_with_known_poses(context, source, params.known_poses,
+                                                    slam_params, observer.slam)
+                    : mapping::run_slam(context, source, slam_params, observer.slam);
 
   clock.start("views");
   semantic::LabelledViews views;
@@ -294,7 +304,8 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   result.planes = plane_map.planes(map_from_slam);
 
   clock.start("grid");
-  result.semantic = semantic::build_semantic_grid(views.points(), views.labels(), params.grid);
+  result.semantic = semantic::build_semantic_grid(views.points(), views.labels(), params.grid, {},
+                                                  views.view_ids());
   result.occupancy = semantic::to_occupancy_grid(result.semantic);
 
   clock.start("rooms");

@@ -14,7 +14,8 @@ namespace kartograf::pipeline {
 
 namespace detail = io::detail;
 
-SequenceFrameSource::SequenceFrameSource(const io::Sequence& sequence, std::optional<std::size_t> count)
+SequenceFrameSource::SequenceFrameSource(const io::Sequence& sequence,
+                                         std::optional<std::size_t> count)
     : sequence_(&sequence), count_(count && *count < sequence.size() ? *count : sequence.size()) {}
 
 registration::RgbdImages SequenceFrameSource::frame(std::size_t i) const {
@@ -23,7 +24,7 @@ registration::RgbdImages SequenceFrameSource::frame(std::size_t i) const {
   io::RgbdFrame frame = sequence_->frame(i);
   if (ground_truth_.size() <= i) ground_truth_.resize(i + 1);
   ground_truth_[i] = frame.pose;
-  return {std::move(frame.depth), std::move(frame.color), frame.timestamp};
+  return {std::move(frame.depth), std::move(frame.color), frame.timestamp, frame.pose};
 }
 
 void check_depth_usable(const io::Sequence& sequence, const geometry::DepthRange& range) {

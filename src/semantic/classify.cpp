@@ -149,6 +149,22 @@ class RegionRules {
     });
   }
 
+  // Stands on the floor and ends below the ceiling, within furniture size.
+  bool furniture_sized(const RegionMeasurements& r) const {
+    if (!levels_.floor || reaches_ceiling(r) || r.width > params_.furniture_max_width) return false;
+    const double top = height_above_floor(r.max_height);
+    return top >= params_.furniture_min_height && top <= params_.furniture_max_height &&
+           height_above_floor(r.min_height) >= -params_.reach_tolerance;
+  }
+  // A top or a shelf board (facing up), or an underside (facing down).
+  bool furniture_face(const RegionMeasurements& r) const {
+    if (!furniture_sized(r)) return false;
+    if (r.orientation == RegionOrientation::horizontal) return true;
+    // A side or a front: from the floor (seen there or hidden), and wholly in view above.
+    return r.orientation == RegionOrientation::vertical && !r.cut_above &&
+           (reaches_floor(r) || r.cut_below || r.occluded_below);
+  }
+
   bool beside(const RegionMeasurements& r, const std::vector<SemanticClass>& classes,
               SemanticClass wanted) const {
     return std::any_of(r.neighbours.begin(), r.neighbours.end(),
@@ -174,6 +190,26 @@ double relative_line_residual(const std::vector<double>& index, const std::vecto
   if (var_i <= 0 || var_t <= 0) return 1.0;
   const double cov = sit / n - (si / n) * (st / n);
   return std::sqrt(std::max(0.0, var_t - cov * cov / var_i) / var_t);
+}
+
+// Furniture faces among the regions left unknown, then the unknown regions of furniture size that
+// join them (a table's edge band, a cabinet's handle side), until nothing changes.
+void label_furniture(std::span<const RegionMeasurements> regions, const RegionRules& rules,
+                     std::vector<SemanticClass>& classes) {
+  for (std::size_t i = 0; i < regions.size(); ++i) {
+    if (classes[i] == SemanticClass::unknown && rules.furniture_face(regions[i]))
+      classes[i] = SemanticClass::furniture;
+  }
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t i = 0; i < regions.size(); ++i) {
+      if (classes[i] != SemanticClass::unknown || !rules.furniture_sized(regions[i]) ||
+          !rules.beside(regions[i], classes, SemanticClass::furniture))
+        continue;
+      classes[i] = SemanticClass::furniture;
+      changed = true;
+    }
+  }
 }
 
 }  // namespace
@@ -252,6 +288,7 @@ std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> 
         r.orientation == RegionOrientation::horizontal && r.mean_normal.dot(gravity.up) < 0;
     if (jamb || lintel) classes[i] = SemanticClass::wall;
   }
+  label_furniture(regions, rules, classes);
   return classes;
 }
 

@@ -211,6 +211,25 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
   return WallGap{from + open_from * dir, from + hit * dir};
 }
 
+// Whether a wall runs across the opening's line at `end` (stepping `back` out of the opening):
+// wall for more than a wall's thickness on both sides of the line. Then the "opening" crosses a
+// corridor from one wall to the wall opposite (two room dividers meeting it at a T from either
+// side line up across it), not a gap in one wall.
+bool wall_across(const SemanticGrid& grid, const Eigen::Vector2d& end, const Eigen::Vector2d& back,
+                 const Eigen::Vector2d& n) {
+  constexpr double kBeyondThickness = 0.5;  // m: walls are thinner than this
+  const double res = grid.resolution;
+  const Eigen::Vector2d in_wall = end + res * back;
+  for (const double side : {1.0, -1.0}) {
+    for (double t = res; t <= kBeyondThickness; t += res) {
+      if (!is_wall(grid, in_wall + side * t * n) &&
+          !is_wall(grid, in_wall + side * t * n + res * back))
+        return false;
+    }
+  }
+  return true;
+}
+
 // One must be able to pass through: no obstacle across the gap's middle on either side.
 bool passable_across(const SemanticGrid& grid, const SemanticGridParams& options,
                      const WallGap& gap, const Eigen::Vector2d& n) {
@@ -238,6 +257,7 @@ std::vector<WallGap> find_wall_gaps(const SemanticGrid& grid, const SemanticGrid
       const std::optional<WallGap> gap = opening_beyond_end(grid, options, from, dir, n);
       if (!gap) continue;
       if (floor_fraction(grid, gap->a, gap->b) < options.min_gap_floor_fraction) continue;
+      if (wall_across(grid, gap->a, -dir, n) || wall_across(grid, gap->b, dir, n)) continue;
       if (passable_across(grid, options, *gap, n)) gaps.push_back(*gap);
     }
   }
@@ -287,9 +307,8 @@ std::vector<Eigen::Vector2i> opening_cells(const SemanticGrid& grid, const Openi
 }
 
 // The doorway of one (merged) gap: its cells become door cells and a doorway object.
-void add_doorway(SemanticGrid& grid, const SemanticGridParams& options,
-                 const WallPointIndex& walls, const WallGap& gap, int& doorway_count,
-                 const AddObject& add_object) {
+void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const WallPointIndex& walls,
+                 const WallGap& gap, int& doorway_count, const AddObject& add_object) {
   const double res = grid.resolution;
   const Eigen::Vector2d centre = 0.5 * (gap.a + gap.b);
   // Its cells: passable cells inside the opening as its jambs measure it, else along the gap

@@ -18,6 +18,7 @@ void LabelledViews::add(const PointImage& points, const SemanticImage& labels,
     if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) continue;
     points_.push_back(sensor_to_world * p.head<3>().cast<double>());
     labels_.push_back(labels.data()[i]);
+    view_ids_.push_back(static_cast<std::uint32_t>(views_));
   }
   ++views_;
 }

@@ -400,6 +400,8 @@ void check_measurable(const PointImage& points, const NormalImage& normals,
           "measure_regions: trim_fraction must be in [0, 0.5)");
   require(params.occluder_relative_range >= 0 && params.occluder_relative_range < 1,
           "measure_regions: occluder_relative_range must be in [0, 1)");
+  require(params.max_gap_fraction >= 0 && params.max_gap_fraction <= 1,
+          "measure_regions: max_gap_fraction must be in [0, 1]");
 }
 
 // What measuring one region reads: the images and the parameters.
@@ -509,27 +511,95 @@ void measure_extent(const RegionInputs& in, const std::vector<int>& members,
   m.width = trimmed_extent(along, in.params.trim_fraction, low, high);
 }
 
+// What lies past a region's pixel (x, y) in direction (dx, dy), over any pixels without a point.
+enum class Beyond { border, hole, farther, nearer, same };
+
+// Past a gap, the first point compared with the region's plane extended along its ray: a point
+// in front of the plane hides where the surface goes; one on or behind it shows the surface in
+// view past the gap (a dropout) or ending within it (the grazing top behind a table's edge).
+Beyond compare_with_plane(const RegionMeasurements& m, const Eigen::Vector3d& q, double margin) {
+  const Eigen::Vector3d ray = q.normalized();
+  const double towards = m.plane_normal.dot(ray);
+  if (std::fabs(towards) < 0.1) return Beyond::hole;  // the plane seen edge-on: no verdict
+  const double on_plane = m.plane_normal.dot(m.centroid) / towards;
+  if (on_plane <= 0) return Beyond::hole;
+  return q.norm() < on_plane - margin ? Beyond::nearer : Beyond::farther;
+}
+
+Beyond look_beyond(const RegionInputs& in, const RegionMeasurements& m, int x, int y, int dx,
+                   int dy, double range) {
+  const PointImage& points = in.points;
+  const int max_gap = static_cast<int>(in.params.max_gap_fraction * std::max(in.w, in.h));
+  for (int step = 1; step <= max_gap + 1; ++step) {
+    const int qx = x + step * dx, qy = y + step * dy;
+    if (qx < 0 || qy < 0 || qx >= in.w || qy >= in.h) return Beyond::border;
+    const Point4f& q = points(qx, qy);
+    if (!is_valid(q)) continue;
+    const double margin = in.params.occluder_relative_range * range;
+    if (step > 1) return compare_with_plane(m, vec3(q), margin);
+    if (in.labels(qx, qy) != m.id && q.head<3>().norm() < range - margin) return Beyond::nearer;
+    return Beyond::same;
+  }
+  return Beyond::hole;  // a wider gap: unmeasured surface (glass, black, out of range)
+}
+
+// Which way a vertical region's surface runs towards an opening at (x + dx, y + dy): from the
+// region's own pixel on the other side, so that a short region (a table's edge band) cut at its
+// end is cut sideways, not above and below. Other regions, or no such pixel: by height alone.
+enum class Opening { up, down, sideways, by_height };
+
+Opening opening_direction(const RegionInputs& in, const RegionMeasurements& m, int x, int y, int dx,
+                          int dy) {
+  const int bx = x - dx, by = y - dy;
+  if (m.orientation != RegionOrientation::vertical || (dx == 0 && dy == 0) || bx < 0 || by < 0 ||
+      bx >= in.w || by >= in.h || in.labels(bx, by) != m.id)
+    return Opening::by_height;
+  const Eigen::Vector3d run = vec3(in.points(x, y)) - vec3(in.points(bx, by));
+  const double length = run.norm();
+  if (length <= 0) return Opening::by_height;
+  const double rise = run.dot(in.up) / length;
+  return rise > 0.5 ? Opening::up : rise < -0.5 ? Opening::down : Opening::sideways;
+}
+
 // Where the region meets the image border or a pixel without a point, the surface may go on
-// out of view: classify that spot by its height within the region.
+// out of view: classify that spot by its height within the region. Missing depth with a surface
+// on or behind the region's plane beyond it is no cut: a dropout inside the surface, or its own
+// edge (depth is lost along occluding edges and on grazing surfaces such as a table top).
 void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMeasurements& m) {
-  const int w = in.w, h = in.h;
+  const int w = in.w;
   const PointImage& points = in.points;
   const double band = std::max(0.1, 0.15 * m.height());
   for (const int i : members) {
     const int x = i % w, y = i / w;
-    bool open = x == 0 || y == 0 || x == w - 1 || y == h - 1, occluded = false;
     const double range = vec3(points(x, y)).norm();
-    for (const auto& [qx, qy] :
-         {std::pair{x - 1, y}, std::pair{x + 1, y}, std::pair{x, y - 1}, std::pair{x, y + 1}}) {
-      if (qx < 0 || qy < 0 || qx >= w || qy >= h) continue;
-      const Point4f& q = points(qx, qy);
-      open = open || !is_valid(q);
-      const bool nearer = q.head<3>().norm() < (1.0 - in.params.occluder_relative_range) * range;
-      occluded = occluded || (is_valid(q) && in.labels(qx, qy) != m.id && nearer);
+    bool open = false, occluded = false;
+    int open_dx = 0, open_dy = 0;
+    for (const auto& [dx, dy] :
+         {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
+      switch (look_beyond(in, m, x, y, dx, dy, range)) {
+        case Beyond::border:
+        case Beyond::hole:
+          open = true;
+          open_dx = dx, open_dy = dy;
+          break;
+        case Beyond::nearer:
+          // A nearer neighbour of another region hides what lies behind it.
+          occluded =
+              occluded || !is_valid(points(x + dx, y + dy)) || in.labels(x + dx, y + dy) != m.id;
+          if (!open) open_dx = dx, open_dy = dy;
+          break;
+        case Beyond::farther:
+        case Beyond::same:
+          break;
+      }
     }
     if (!open && !occluded) continue;
     const double height = vec3(points(x, y)).dot(in.up);
-    const bool top = height >= m.max_height - band, bottom = height <= m.min_height + band;
+    const Opening way = opening_direction(in, m, x, y, open_dx, open_dy);
+    const bool top =
+        height >= m.max_height - band && way != Opening::down && way != Opening::sideways;
+    const bool bottom =
+        height <= m.min_height + band && way != Opening::up && way != Opening::sideways;
     if (open) {
       m.cut_above = m.cut_above || top;
       m.cut_below = m.cut_below || bottom;
@@ -559,6 +629,8 @@ std::vector<RegionMeasurements> measure_regions(const PointImage& points,
     RegionMeasurements& m = out[r];
     const std::vector<int>& members = pixels.members[r];
     m.id = static_cast<Label>(r + 1);
+    require(!members.empty(), "measure_regions: region " + std::to_string(r + 1) + " of " +
+                                  std::to_string(n_regions) + " has no pixel");
     m.pixel_count = static_cast<int>(members.size());
     m.centroid /= m.pixel_count;
     m.mean_normal.normalize();

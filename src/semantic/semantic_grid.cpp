@@ -12,9 +12,9 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "kartograf/core/connected_components.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
-#include "kartograf/core/connected_components.hpp"
 #include "semantic/grid_doorways.hpp"
 
 namespace kartograf::semantic {
@@ -32,6 +32,8 @@ struct CellEvidence {
   std::array<int, 4> near_side{};
   float z_min = std::numeric_limits<float>::infinity();
   float z_max = -std::numeric_limits<float>::infinity();
+  int band_views = 0;           // views with band points here (when views are known)
+  std::int64_t last_view = -1;  // the view that added the last band point
   int band_total() const {
     int total = 0;
     for (std::size_t c = 0; c < band.size(); ++c) {
@@ -209,14 +211,86 @@ void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double m
   for (int row = 0; row < h; ++row) {
     for (int col = 0; col < w; ++col) {
       const SemanticClass c = grid.classes(col, row);
-      // Only floor and unobserved cells change: walls and doors keep their class.
-      if (!fill.at<std::uint8_t>(row, col) || furniture(col, row) ||
-          !(c == SemanticClass::floor || std::isnan(grid.weight(col, row))))
+      // Only floor changes: walls and doors keep their class, and what no view saw stays
+      // unknown (filling it made rooms leak where the views were few).
+      if (!fill.at<std::uint8_t>(row, col) || furniture(col, row) || c != SemanticClass::floor)
         continue;
       furniture(col, row) = 1;
       grid.classes(col, row) = SemanticClass::furniture;
       grid.weight(col, row) = furniture_weight;
     }
+  }
+}
+
+// Pieces of unclassified obstacle or furniture cells, closed over gaps of a few cells like
+// fill_furniture's, that are furniture sized and low: their unclassified cells become furniture.
+void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                               const SemanticGridParams& options, Image<std::uint8_t>& furniture) {
+  const int w = grid.width(), h = grid.height();
+  auto unclassified = [&](int col, int row) {
+    return grid.classes(col, row) == SemanticClass::unknown && grid.weight(col, row) == 0.0f;
+  };
+  cv::Mat mask(h, w, CV_8U);
+  for (int row = 0; row < h; ++row)
+    for (int col = 0; col < w; ++col)
+      mask.at<std::uint8_t>(row, col) = unclassified(col, row) || furniture(col, row) ? 255 : 0;
+  cv::Mat closed, pieces;
+  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  const int count = cv::connectedComponents(closed, pieces, 8, CV_32S);
+  std::vector<std::vector<cv::Point>> cells(static_cast<std::size_t>(count));
+  std::vector<float> top(static_cast<std::size_t>(count), -std::numeric_limits<float>::infinity());
+  for (int row = 0; row < h; ++row) {
+    for (int col = 0; col < w; ++col) {
+      const int piece = pieces.at<int>(row, col);
+      if (piece == 0 || !mask.at<std::uint8_t>(row, col)) continue;
+      cells[static_cast<std::size_t>(piece)].push_back({col, row});
+      top[static_cast<std::size_t>(piece)] =
+          std::max(top[static_cast<std::size_t>(piece)], evidence(col, row).z_max);
+    }
+  }
+  const double cell_area = grid.resolution * grid.resolution;
+  for (std::size_t k = 1; k < cells.size(); ++k) {
+    if (cells[k].empty() || top[k] - grid.floor_z > options.furniture_max_height) continue;
+    std::vector<cv::Point> hull;
+    cv::convexHull(cells[k], hull);
+    const cv::RotatedRect box = cv::minAreaRect(cells[k]);
+    const double extent = (std::max(box.size.width, box.size.height) + 1) * grid.resolution;
+    if (cv::contourArea(hull) * cell_area > options.max_furniture_fill_area ||
+        extent > options.furniture_max_extent)
+      continue;
+    for (const cv::Point& c : cells[k]) {
+      if (!unclassified(c.x, c.y)) continue;
+      furniture(c.x, c.y) = 1;
+      grid.classes(c.x, c.y) = SemanticClass::furniture;
+      grid.weight(c.x, c.y) = options.weights.of(SemanticClass::furniture);
+    }
+  }
+}
+
+// Unobserved runs along rows and columns with cells of class `ends` at both ends, at most
+// max_cells long, become `ends`: the inside of a wall seen from both sides; floor that the views
+// missed in a thin shadow behind a corner (a fan of them where the robot turns in place).
+void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells, float weight) {
+  auto is_end = [&](const Eigen::Vector2i& c) { return grid.classes(c.x(), c.y()) == ends; };
+  auto unobserved = [&](const Eigen::Vector2i& c) { return std::isnan(grid.weight(c.x(), c.y())); };
+  std::vector<Eigen::Vector2i> inside;
+  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const Eigen::Vector2i start(col, row);
+        if (!is_end(start) || !grid.contains(start + step) || !unobserved(start + step)) continue;
+        Eigen::Vector2i c = start + step;
+        int run = 0;
+        while (grid.contains(c) && unobserved(c) && run <= max_cells) c += step, ++run;
+        if (run > max_cells || !grid.contains(c) || !is_end(c)) continue;
+        for (Eigen::Vector2i k = start + step; k != c; k += step) inside.push_back(k);
+      }
+    }
+  }
+  for (const Eigen::Vector2i& c : inside) {
+    grid.classes(c.x(), c.y()) = ends;
+    grid.weight(c.x(), c.y()) = weight;
   }
 }
 
@@ -377,6 +451,7 @@ SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
 Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
                                     std::span<const Eigen::Vector3d> points,
                                     std::span<const SemanticClass> labels,
+                                    std::span<const std::uint32_t> view_ids,
                                     const SemanticGridParams& options) {
   const double res = options.resolution;
   Image<CellEvidence> evidence(grid.width(), grid.height());
@@ -397,6 +472,8 @@ Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
     if (c == SemanticClass::ceiling) continue;
     if (h >= options.band_min && h <= options.band_max) {
       ++e.band[index_of(c)];
+      const std::int64_t view = view_ids.empty() ? -1 : std::int64_t{view_ids[i]};
+      if (view != e.last_view) ++e.band_views, e.last_view = view;
       const Eigen::Vector2d local =
           p.head<2>() - grid.cell_center(cell) + Eigen::Vector2d::Constant(0.5 * res);
       const double m = options.spill_margin;
@@ -409,6 +486,14 @@ Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
     }
   }
   return evidence;
+}
+
+// Distinct views among ascending view ids (0 when none are given).
+int count_views(std::span<const std::uint32_t> view_ids) {
+  int views = 0;
+  for (std::size_t i = 0; i < view_ids.size(); ++i)
+    views += i == 0 || view_ids[i] != view_ids[i - 1];
+  return views;
 }
 
 // The most frequent class of a cell's band points (floor and ceiling aside; the first on ties).
@@ -437,7 +522,8 @@ ObstacleMasks classify_cells(SemanticGrid& grid, const Image<CellEvidence>& evid
       SemanticClass c = SemanticClass::unknown;
       float weight = kUnobserved;
       const int band = e.band_total();
-      if (band >= options.min_obstacle_points &&
+      const bool views_agree = e.last_view < 0 || e.band_views >= options.min_obstacle_views;
+      if (band >= options.min_obstacle_points && views_agree &&
           band >= options.min_obstacle_floor_ratio * e.floor) {
         c = dominant_band_class(e);
         weight = c == SemanticClass::unknown ? options.weights.unclassified_obstacle
@@ -628,9 +714,16 @@ void SemanticGridParams::validate() const {
   require(band_min >= 0 && band_min < band_max,
           "SemanticGridParams: need 0 <= band_min < band_max, got " + std::to_string(band_min) +
               " and " + std::to_string(band_max));
-  require(min_obstacle_points >= 1 && min_floor_points >= 1,
-          "SemanticGridParams: min_obstacle_points and min_floor_points must be >= 1");
+  require(min_obstacle_points >= 1 && min_floor_points >= 1 && min_obstacle_views >= 1,
+          "SemanticGridParams: min_obstacle_points, min_obstacle_views and min_floor_points must "
+          "be >= 1");
   require(margin >= 0, "SemanticGridParams: margin must be >= 0");
+  require(std::isfinite(furniture_max_extent) && furniture_max_extent >= 0 &&
+              std::isfinite(furniture_max_height) && furniture_max_height > 0,
+          "SemanticGridParams: furniture_max_extent must be >= 0 and furniture_max_height > 0");
+  require(std::isfinite(max_wall_thickness) && max_wall_thickness >= 0 &&
+              std::isfinite(max_floor_shadow) && max_floor_shadow >= 0,
+          "SemanticGridParams: max_wall_thickness and max_floor_shadow must be >= 0");
   require(min_door_width > 0 && min_door_width < max_door_width,
           "SemanticGridParams: need 0 < min_door_width < max_door_width");
   weights.validate();
@@ -662,11 +755,18 @@ const SemanticObject& SemanticGrid::object(int id) const {
 SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                  std::span<const SemanticClass> labels,
                                  const SemanticGridParams& options,
-                                 std::span<const ObjectDetection> detections) {
+                                 std::span<const ObjectDetection> detections,
+                                 std::span<const std::uint32_t> view_ids) {
   check_inputs(points, labels, options);
+  require(view_ids.empty() || view_ids.size() == points.size(),
+          "build_semantic_grid: " + std::to_string(view_ids.size()) + " view ids for " +
+              std::to_string(points.size()) + " points");
   SemanticGrid grid = empty_grid(points, labels, options);
-  const Image<CellEvidence> evidence = gather_evidence(grid, points, labels, options);
-  ObstacleMasks masks = classify_cells(grid, evidence, options);
+  const Image<CellEvidence> evidence = gather_evidence(grid, points, labels, view_ids, options);
+  // Fewer views than min_obstacle_views (one scan) ask for what they can give.
+  SemanticGridParams cell_options = options;
+  cell_options.min_obstacle_views = std::min(options.min_obstacle_views, count_views(view_ids));
+  ObstacleMasks masks = classify_cells(grid, evidence, cell_options);
   if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);
   if (options.remove_isolated_obstacles)
     remove_isolated_obstacles(grid, evidence, options, masks.leaf, masks.furniture);
@@ -676,11 +776,24 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                            std::vector<Eigen::Vector2i> cells) -> SemanticObject& {
     return append_object(grid, evidence, kind, label, name, std::move(cells));
   };
+  if (options.max_furniture_fill_area > 0 && options.furniture_max_extent > 0)
+    unclassified_to_furniture(grid, evidence, options, masks.furniture);
   if (options.max_furniture_fill_area > 0)
     fill_furniture(grid, masks.furniture, options.max_furniture_fill_area,
                    options.weights.of(SemanticClass::furniture));
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
+  const auto cells = [&](double metres) {
+    return static_cast<int>(std::floor(metres / options.resolution + 1e-9));
+  };
+  if (options.max_wall_thickness > 0) {
+    fill_unobserved_runs(grid, SemanticClass::wall, cells(options.max_wall_thickness),
+                         options.weights.of(SemanticClass::wall));
+  }
+  if (options.max_floor_shadow > 0) {
+    fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
+                         options.weights.of(SemanticClass::floor));
+  }
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);
   join_leftover_wall_cells(grid, evidence, walls);

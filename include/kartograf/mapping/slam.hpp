@@ -111,11 +111,24 @@ struct SlamResult {
   PoseGraphSummary final_graph;  // the last optimisation
   std::size_t graph_edges = 0;   // after pruning
   PointCloud map;                // empty unless build_map
+  bool poses_given = false;      // run_with_known_poses: nothing was estimated
   std::size_t map_voxels = 0;    // before the min_points filter
   SlamTimings timing;
 };
 
 SlamResult run_slam(const compute::Context& context, const FrameSource& source,
                     const SlamParams& params, const SlamObserver& observer = {});
+
+// A trajectory known beforehand (ground truth, another system's estimate): camera-to-world pose
+// of frame i (its images carry its timestamp and any ground truth); throws Error when it has none.
+using KnownPoseLookup =
+    std::function<Eigen::Isometry3d(std::size_t frame, const registration::RgbdImages& images)>;
+
+// The map from known poses, nothing estimated: poses (and odometry.poses) are pose_of's,
+// expressed relative to the first frame; the map is fused as run_slam's. Throws Error on a pose
+// that is not finite or not a rotation.
+SlamResult run_with_known_poses(const compute::Context& context, const FrameSource& source,
+                                const KnownPoseLookup& pose_of, const SlamParams& params,
+                                const SlamObserver& observer = {});
 
 }  // namespace kartograf::mapping

@@ -53,6 +53,9 @@ struct MapPipelineParams {
   // recovery from a lost frame (they fill slam.features and slam.odometry.features).
   bool features = true;
   features::OrbParams orb = map_orb_params();
+  // A trajectory known beforehand (e.g. ground truth): stage 1 only fuses the map at these poses
+  // (mapping::run_with_known_poses). Empty: SLAM estimates them.
+  mapping::KnownPoseLookup known_poses;
   std::size_t label_step = 5;           // views: every k-th frame
   int label_width = 320;                // views: decimated to at most this many pixels per row
   semantic::LabellingParams labelling;  // gravity.prior_up defaults to the camera's -y

@@ -3,6 +3,9 @@
 // verification and map fusion all turn host depth (and colour) into a FramePyramid, with the same
 // depth range and the same packing of colours.
 #include <cstdint>
+#include <optional>
+
+#include <Eigen/Geometry>
 
 #include "kartograf/compute/buffer.hpp"
 #include "kartograf/core/color.hpp"
@@ -17,6 +20,9 @@ struct RgbdImages {
   DepthImage depth;      // raw depth units (see geometry::DepthRange), 0 = no measurement
   RgbImage color;        // the depth camera's pixel grid; empty when the source has no colour
   double timestamp = 0;  // seconds
+  // The camera-to-world pose the data set gives with the frame (ground truth), if any: never
+  // used to estimate, only to run on a known trajectory or to score.
+  std::optional<Eigen::Isometry3d> ground_truth = std::nullopt;
 };
 
 // The first pyramid level (level l is about width / 2^l wide) at most max_width pixels wide: where

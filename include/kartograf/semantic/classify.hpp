@@ -64,6 +64,14 @@ struct ClassificationParams {
   double coplanar_wall_offset = 0.025;   // m
   double coplanar_wall_gap = 1.0;        // m
   double coplanar_wall_min_area = 0.05;  // m^2
+  // Furniture (tables, chairs, beds, cabinets, shelves): what is left that stands on the floor
+  // and ends below the ceiling: a horizontal face (a top, a seat, a shelf board) from
+  // furniture_min_height to furniture_max_height above the floor, a vertical face from the floor
+  // (or hidden there) up to at most furniture_max_height, and what joins them within that height.
+  // At most furniture_max_width wide: a longer face is part of the room (a wall seen in part).
+  double furniture_min_height = 0.15;  // m
+  double furniture_max_height = 2.1;   // m
+  double furniture_max_width = 2.5;    // m
 };
 
 // Classes per region (index = label - 1).

@@ -4,6 +4,7 @@
 // direction (each view's estimated up, weighted by the horizontal area that supported it: a view
 // that saw much floor and ceiling knows up better than one that saw a strip of floor).
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <string>
 #include <vector>
@@ -35,6 +36,8 @@ class LabelledViews {
 
   std::span<const Eigen::Vector3d> points() const { return points_; }
   std::span<const SemanticClass> labels() const { return labels_; }
+  // The view (0-based, in the order added) each point came from.
+  std::span<const std::uint32_t> view_ids() const { return view_ids_; }
   Eigen::Vector3d up() const;  // the voted up, unit (+z when no view voted)
   int views() const { return views_; }
   int skipped() const { return skipped_; }
@@ -43,6 +46,7 @@ class LabelledViews {
  private:
   std::vector<Eigen::Vector3d> points_;
   std::vector<SemanticClass> labels_;
+  std::vector<std::uint32_t> view_ids_;
   Eigen::Vector3d up_sum_ = Eigen::Vector3d::Zero();
   int views_ = 0, skipped_ = 0;
   std::string first_skip_reason_;

@@ -125,6 +125,10 @@ struct MeasureParams {
   double trim_fraction = 0.01;             // extremes ignore this fraction of points at each end
   int adjacency_radius = 4;                // pixels; bridges the unlabelled seam at creases
   double occluder_relative_range = 0.04;   // a neighbour this much nearer (x range) hides a cut
+  // Missing depth (dropouts, occluding edges, grazing surfaces) up to this fraction of the image's
+  // size, with a surface on or behind the region's plane beyond it, does not cut the region;
+  // wider gaps, the image border, or a nearer surface beyond (hiding it) do.
+  double max_gap_fraction = 1.0;
 };
 
 // One entry per region, index = label - 1. `up` must be a unit vector.

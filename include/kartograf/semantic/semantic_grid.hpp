@@ -72,6 +72,9 @@ struct SemanticGridParams {
   double band_max = 1.50;
   double ceiling_margin = 0.15;  // object heights count points below ceiling - this
   int min_obstacle_points = 2;   // per cell, fewer band points are noise
+  // ... seen by at least this many views (when the points' views are known): one view alone
+  // leaves streaks of edge artefacts along its rays (lateral noise at a wall's corner).
+  int min_obstacle_views = 2;
   // ... and at least this many band points per floor point: a free cell seen many times gathers
   // a few stray (flying, mixed) points that must not make it an obstacle.
   double min_obstacle_floor_ratio = 0.25;
@@ -85,6 +88,19 @@ struct SemanticGridParams {
   // filled to their convex hull when that is at most this area [m^2]; 0: off.
   // The same bound holds for floor enclosed by unclassified obstacles.
   double max_furniture_fill_area = 4.0;  // obstacle cells without an obstacle neighbour: specks
+  // Unclassified obstacles that stand free in a room as furniture does (a piece, closed over gaps
+  // of a few cells, whose hull is at most max_furniture_fill_area, at most furniture_max_extent
+  // long and whose points end furniture_max_height above the floor) are furniture: the views
+  // label faces, and a table's legs, edges and grazing top are too thin or too noisy for a
+  // region of their own. 0: off.
+  double furniture_max_extent = 2.5;  // m
+  double furniture_max_height = 2.1;  // m
+  // Unobserved cells between the two faces of a wall (wall cells at most this far apart along a
+  // row or a column, nothing seen between) are wall: its inside, which no view can see. 0: off.
+  double max_wall_thickness = 0.35;  // m
+  // Unobserved cells between floor cells this close along a row or a column are floor: the thin
+  // shadows behind corners that a camera turning in place leaves as a fan. 0: off.
+  double max_floor_shadow = 0.15;  // m
   int min_floor_points = 1;
   double margin = 0.25;          // metres of grid around the data
   double min_wall_length = 0.5;  // shorter straight wall pieces are not objects
@@ -153,12 +169,15 @@ struct SemanticGrid {
   const SemanticObject& object(int id) const;  // throws Error for an unknown id
 };
 
-// Builds the grid. points[i] has class labels[i]; non-finite points are skipped. Throws Error on
-// mismatched sizes, bad options, no finite point, or a bad detection.
+// Builds the grid. points[i] has class labels[i]; non-finite points are skipped. view_ids[i]
+// (optional; ascending, e.g. LabelledViews::view_ids()) names the view that saw points[i]: then an
+// obstacle cell must be seen by min_obstacle_views views (or by all, when there are fewer). Throws
+// Error on mismatched sizes, bad options, no finite point, or a bad detection.
 SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                  std::span<const SemanticClass> labels,
                                  const SemanticGridParams& options = {},
-                                 std::span<const ObjectDetection> detections = {});
+                                 std::span<const ObjectDetection> detections = {},
+                                 std::span<const std::uint32_t> view_ids = {});
 
 // ---- Exports (data only; io/ writes the files) -----------------------------------------------
 
