@@ -47,6 +47,9 @@ def row(runs, name):
     odometry = get(r, "evaluation", "odometry_trajectory", "ate_rmse_m")
     slam = get(r, "evaluation", "trajectory", "ate_rmse_m")
     ratio = "-" if not odometry or slam is None else f"{slam / odometry:.2f}"
+    if get(r, "slam", "poses_given"):  # --poses: nothing was estimated
+        odometry = slam = None
+        ratio = "poses given"
     labelled, unlabelled = get(r, "views", "labelled") or 0, get(r, "views", "unlabelled") or 0
     views = "-" if labelled + unlabelled == 0 else f"{100 * labelled / (labelled + unlabelled):.0f} %"
     ious = " / ".join(number(get(r, "evaluation", "classes", "iou", c)) for c in CLASSES)

@@ -11,7 +11,9 @@
 # defaults were tuned on (survey seed 1, 7-Scenes frames 0-299 within the 600).
 #   bash scripts/map-bench.sh [--out DIR] [--seeds "1 2 ... 10"] [--sets "survey tour-10 7scenes sun3d"]
 #                             [--kartograf BIN] [--data DIR (../shared/data)] [--jobs N (1)]
-#                             [--peers PYTHON]
+#                             [--peers PYTHON] [--poses groundtruth]
+# --poses groundtruth: every map from the sequences' ground-truth poses (`kartograf map --poses`):
+# the semantic stages judged apart from the SLAM's error (the ATE columns are then zero).
 # --peers: a python with open3d, opencv-contrib-python-headless and scipy (a venv); then the
 # odometry of Kartograf and of the peers (../shared/tools/peers/odometry_peers.py) runs on the
 # real sequences one after the other, alone on the machine, and a second table gives median
@@ -20,7 +22,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 out=build/map-bench seeds="1 2 3 4 5 6 7 8 9 10" sets="survey tour-10 7scenes sun3d"
-kartograf=build/apps/kartograf/kartograf data=../shared/data jobs=1 peers_python=""
+kartograf=build/apps/kartograf/kartograf data=../shared/data jobs=1 peers_python="" poses=""
 while [ $# -gt 0 ]; do
   case "$1" in
     --out) out="$2"; shift ;;
@@ -30,6 +32,7 @@ while [ $# -gt 0 ]; do
     --data) data="$2"; shift ;;
     --jobs) jobs="$2"; shift ;;
     --peers) peers_python="$2"; shift ;;
+    --poses) poses="$2"; shift ;;
     *) echo "map-bench.sh: unknown argument '$1' (see the comment at the top)" >&2; exit 2 ;;
   esac
   shift
@@ -60,7 +63,8 @@ seven_scenes_600() {
 map_one() {  # name, sequence, map arguments...
   local name="$1" sequence="$2"; shift 2
   echo "map-bench: mapping $name" >&2
-  "$kartograf" map "$sequence" --out "$out/runs/$name" --force --no-progress --backend cpu "$@" \
+  "$kartograf" map "$sequence" --out "$out/runs/$name" --force --no-progress --backend cpu \
+    ${poses:+--poses "$poses"} "$@" \
     >"$out/runs/$name.log" 2>&1 || echo "map-bench: $name failed (see $out/runs/$name.log)" >&2
 }
 
