@@ -88,6 +88,39 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
   EXPECT_GT(result.timing.total_seconds, 0.0);
 }
 
+// Known poses (the frames' ground truth): nothing estimated, the poses are the truth relative to
+// the first frame, the map is fused; a pose that is not a rotation is an error naming its frame.
+TEST(Slam, KnownPosesFuseTheMapWithoutEstimating) {
+  const testing::MemoryFrameSource source(out_and_back());
+  const compute::Context context = compute::Context::cpu();
+  const auto truth = [](std::size_t, const registration::RgbdImages& images) {
+    require(images.ground_truth.has_value(), "no ground truth");
+    return *images.ground_truth;
+  };
+  const mapping::SlamResult result =
+      mapping::run_with_known_poses(context, source, truth, loop_params());
+  EXPECT_TRUE(result.poses_given);
+  ASSERT_EQ(result.poses.size(), static_cast<std::size_t>(kFrames));
+  const std::vector<Eigen::Isometry3d>& expected = out_and_back().truth;
+  for (std::size_t i = 0; i < result.poses.size(); ++i) {
+    const Eigen::Isometry3d relative = expected[0].inverse() * expected[i];
+    EXPECT_LT((result.poses[i].matrix() - relative.matrix()).cwiseAbs().maxCoeff(), 1e-9) << i;
+  }
+  EXPECT_EQ(result.odometry.poses.size(), result.poses.size());
+  EXPECT_TRUE(result.loop_closures.empty());
+  EXPECT_GT(result.map.size(), 1000u);
+
+  const auto scaled = [&](std::size_t i, const registration::RgbdImages& images) {
+    Eigen::Isometry3d pose = truth(i, images);
+    if (i == 3) pose.linear() *= 1.1;
+    return pose;
+  };
+  EXPECT_ERROR_MENTIONS(mapping::run_with_known_poses(context, source, scaled, loop_params()),
+                        "frame 3", "not a rotation");
+  EXPECT_ERROR_MENTIONS(mapping::run_with_known_poses(context, source, {}, loop_params()),
+                        "no pose lookup");
+}
+
 // A source whose frame 5 cannot be read: the error reaches the caller, nothing hangs.
 class BrokenSource final : public mapping::FrameSource {
  public:
