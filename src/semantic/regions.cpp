@@ -511,8 +511,10 @@ void measure_extent(const RegionInputs& in, const std::vector<int>& members,
   m.width = trimmed_extent(along, in.params.trim_fraction, low, high);
 }
 
-// What lies past a region's pixel (x, y) in direction (dx, dy), over any pixels without a point.
-enum class Beyond { border, hole, farther, nearer, same };
+// What lies past a region's pixel (x, y) in direction (dx, dy), over any pixels without a point:
+// nothing seen (the border, a wide gap, a plane seen edge-on: the surface may go on), a nearer
+// surface of another region (hiding it), or the surface itself or what lies behind it (no cut).
+enum class Beyond { open, nearer, seen };
 
 // Past a gap, the first point compared with the region's plane extended along its ray: a point
 // in front of the plane hides where the surface goes; one on or behind it shows the surface in
@@ -520,10 +522,10 @@ enum class Beyond { border, hole, farther, nearer, same };
 Beyond compare_with_plane(const RegionMeasurements& m, const Eigen::Vector3d& q, double margin) {
   const Eigen::Vector3d ray = q.normalized();
   const double towards = m.plane_normal.dot(ray);
-  if (std::fabs(towards) < 0.1) return Beyond::hole;  // the plane seen edge-on: no verdict
+  if (std::fabs(towards) < 0.1) return Beyond::open;  // the plane seen edge-on: no verdict
   const double on_plane = m.plane_normal.dot(m.centroid) / towards;
-  if (on_plane <= 0) return Beyond::hole;
-  return q.norm() < on_plane - margin ? Beyond::nearer : Beyond::farther;
+  if (on_plane <= 0) return Beyond::open;
+  return q.norm() < on_plane - margin ? Beyond::nearer : Beyond::seen;
 }
 
 Beyond look_beyond(const RegionInputs& in, const RegionMeasurements& m, int x, int y, int dx,
@@ -532,15 +534,15 @@ Beyond look_beyond(const RegionInputs& in, const RegionMeasurements& m, int x, i
   const int max_gap = static_cast<int>(in.params.max_gap_fraction * std::max(in.w, in.h));
   for (int step = 1; step <= max_gap + 1; ++step) {
     const int qx = x + step * dx, qy = y + step * dy;
-    if (qx < 0 || qy < 0 || qx >= in.w || qy >= in.h) return Beyond::border;
+    if (qx < 0 || qy < 0 || qx >= in.w || qy >= in.h) return Beyond::open;
     const Point4f& q = points(qx, qy);
     if (!is_valid(q)) continue;
     const double margin = in.params.occluder_relative_range * range;
     if (step > 1) return compare_with_plane(m, vec3(q), margin);
     if (in.labels(qx, qy) != m.id && q.head<3>().norm() < range - margin) return Beyond::nearer;
-    return Beyond::same;
+    return Beyond::seen;
   }
-  return Beyond::hole;  // a wider gap: unmeasured surface (glass, black, out of range)
+  return Beyond::open;  // a wider gap: unmeasured surface (glass, black, out of range)
 }
 
 // Which way a vertical region's surface runs towards an opening at (x + dx, y + dy): from the
@@ -576,21 +578,13 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
     int open_dx = 0, open_dy = 0;
     for (const auto& [dx, dy] :
          {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-      switch (look_beyond(in, m, x, y, dx, dy, range)) {
-        case Beyond::border:
-        case Beyond::hole:
-          open = true;
-          open_dx = dx, open_dy = dy;
-          break;
-        case Beyond::nearer:
-          // A nearer neighbour of another region hides what lies behind it.
-          occluded =
-              occluded || !is_valid(points(x + dx, y + dy)) || in.labels(x + dx, y + dy) != m.id;
-          if (!open) open_dx = dx, open_dy = dy;
-          break;
-        case Beyond::farther:
-        case Beyond::same:
-          break;
+      const Beyond beyond = look_beyond(in, m, x, y, dx, dy, range);
+      if (beyond == Beyond::open) {
+        open = true;
+        open_dx = dx, open_dy = dy;
+      } else if (beyond == Beyond::nearer) {
+        occluded = true;  // a nearer surface of another region hides what lies behind it
+        if (!open) open_dx = dx, open_dy = dy;
       }
     }
     if (!open && !occluded) continue;

@@ -186,21 +186,38 @@ bool point_in_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2
   return inside;
 }
 
+// An obstacle the views could not name (weight 0, class unknown), as opposed to an unseen cell.
+bool is_unclassified_obstacle(const SemanticGrid& grid, int col, int row) {
+  return grid.classes(col, row) == SemanticClass::unknown && grid.weight(col, row) == 0.0f;
+}
+
+// The cells where selected(col, row) holds as an 8-bit mask (255), and that mask closed with a
+// size x size square (gaps of a few cells bridged).
+struct CellMask {
+  cv::Mat mask, closed;
+};
+
+template <typename Selected>
+CellMask closed_cell_mask(const SemanticGrid& grid, const Selected& selected, int size) {
+  CellMask m{cv::Mat(grid.height(), grid.width(), CV_8U), cv::Mat()};
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      m.mask.at<std::uint8_t>(row, col) = selected(col, row) ? 255 : 0;
+  cv::morphologyEx(m.mask, m.closed, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
+  return m;
+}
+
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
 // piece, closed over gaps of a few cells, is filled to its convex hull when that is at most
 // max_area: the robot cannot drive under it within its height band.
 void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double max_area,
                     float furniture_weight) {
   const int w = grid.width(), h = grid.height();
-  cv::Mat mask(h, w, CV_8U);
-  for (int row = 0; row < h; ++row)
-    for (int col = 0; col < w; ++col)
-      mask.at<std::uint8_t>(row, col) = furniture(col, row) ? 255 : 0;
-  cv::Mat closed;
-  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
+  const CellMask outlines = closed_cell_mask(
+      grid, [&](int col, int row) { return furniture(col, row) != 0; }, 7);
   std::vector<std::vector<cv::Point>> pieces;
-  cv::findContours(closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  cv::findContours(outlines.closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
   cv::Mat fill = cv::Mat::zeros(h, w, CV_8U);
   const double cell_area = grid.resolution * grid.resolution;
   for (const auto& piece : pieces) {
@@ -227,17 +244,12 @@ void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double m
 void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                                const SemanticGridParams& options, Image<std::uint8_t>& furniture) {
   const int w = grid.width(), h = grid.height();
-  auto unclassified = [&](int col, int row) {
-    return grid.classes(col, row) == SemanticClass::unknown && grid.weight(col, row) == 0.0f;
-  };
-  cv::Mat mask(h, w, CV_8U);
-  for (int row = 0; row < h; ++row)
-    for (int col = 0; col < w; ++col)
-      mask.at<std::uint8_t>(row, col) = unclassified(col, row) || furniture(col, row) ? 255 : 0;
-  cv::Mat closed, pieces;
-  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(7, 7)));
-  const int count = cv::connectedComponents(closed, pieces, 8, CV_32S);
+  auto unclassified = [&](int col, int row) { return is_unclassified_obstacle(grid, col, row); };
+  const CellMask obstacles = closed_cell_mask(
+      grid, [&](int col, int row) { return unclassified(col, row) || furniture(col, row); }, 7);
+  const cv::Mat& mask = obstacles.mask;
+  cv::Mat pieces;
+  const int count = cv::connectedComponents(obstacles.closed, pieces, 8, CV_32S);
   std::vector<std::vector<cv::Point>> cells(static_cast<std::size_t>(count));
   std::vector<float> top(static_cast<std::size_t>(count), -std::numeric_limits<float>::infinity());
   for (int row = 0; row < h; ++row) {
@@ -299,15 +311,10 @@ void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells,
 // Only closed loops count: an L of clutter along two walls encloses nothing.
 void fill_enclosed_by_unclassified(SemanticGrid& grid, double max_area, float weight) {
   const int w = grid.width(), h = grid.height();
-  cv::Mat mask(h, w, CV_8U);
-  for (int row = 0; row < h; ++row)
-    for (int col = 0; col < w; ++col)
-      mask.at<std::uint8_t>(row, col) =
-          grid.classes(col, row) == SemanticClass::unknown && grid.weight(col, row) == 0.0f ? 255
-                                                                                            : 0;
-  cv::Mat closed;
-  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
-                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(5, 5)));
+  cv::Mat closed =
+      closed_cell_mask(
+          grid, [&](int col, int row) { return is_unclassified_obstacle(grid, col, row); }, 5)
+          .closed;
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
   cv::findContours(closed, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_SIMPLE);
