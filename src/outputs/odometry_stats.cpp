@@ -55,6 +55,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["degenerate"] = frame.degenerate;
   json["photometric"] = frame.photometric;
   json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
+  json["step_frame"] = std::string(registration::to_string(frame.step_frame));
   json["previous"] = frame.previous ? registration_report_json(*frame.previous) : RunJson();
   json["reestimate"] = frame.reestimate ? registration_report_json(*frame.reestimate) : RunJson();
   json["seconds"] = frame.seconds;
@@ -69,7 +70,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["frames"] = counts.frames;
   json["keyframes"] = counts.keyframes;
   json["fallbacks"] = counts.fallbacks;
-  json["retried_from_identity"] = counts.retried_from_identity;
+  json["retried_from_other_starts"] = counts.retried_from_other_starts;
   json["from_features"] = counts.from_features;
   json["degenerate_frames"] = counts.degenerate_frames;
   json["photometric_frames"] = counts.photometric_frames;
@@ -95,7 +96,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
   counts.frames = frames.size();
   for (const registration::OdometryFrame& f : frames) {
     counts.fallbacks += f.fallback;
-    counts.retried_from_identity += f.retried;
+    counts.retried_from_other_starts += f.retried;
     counts.from_features += f.from_features;
     counts.keyframes += f.keyframe;
     counts.degenerate_frames += f.degenerate;

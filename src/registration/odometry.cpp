@@ -46,6 +46,9 @@ void validate(const OdometryParams& params) {
   require(params.icp_width > 0 && params.information_width > 0 && params.min_icp_level >= 0,
           "odometry: icp_width and information_width must be > 0, min_icp_level >= 0");
   require(params.motion_prior >= 0, "odometry: motion_prior must be >= 0");
+  require(params.recheck_correction_m > 0, "odometry: recheck_correction_m must be > 0");
+  require(params.recheck_fitness >= 0 && params.recheck_fitness <= 1,
+          "odometry: recheck_fitness must be in [0, 1]");
   require(params.feature_seed_m >= 0 && params.feature_seed_deg >= 0,
           "odometry: feature_seed_m and feature_seed_deg must be >= 0");
   require(params.keyframes.max_interval >= 1, "odometry: keyframes.max_interval must be >= 1");
@@ -68,6 +71,18 @@ bool is_identity(const Eigen::Isometry3d& pose) {
 }
 
 }  // namespace
+
+std::string_view to_string(StepFrame frame) {
+  switch (frame) {
+    case StepFrame::world:
+      return "world";
+    case StepFrame::camera:
+      return "camera";
+    case StepFrame::adaptive:
+      return "adaptive";
+  }
+  return "unknown";
+}
 
 IcpParams odometry_icp_params(OdometryMethod method) {
   IcpParams params;
@@ -306,22 +321,41 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   return frames_.back();
 }
 
-Eigen::Isometry3d RgbdOdometry::predict() const {
+Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame) const {
   const std::size_t n = poses_.size();  // the frame to predict
   if (params_.motion_model == MotionModel::still || n < 2) return Eigen::Isometry3d::Identity();
-  // Rotation: the last turn again, in the camera frame. Translation: the camera centre keeps its
-  // velocity (and, with `acceleration`, its change) in the world frame, so a camera that turns
-  // while the robot drives straight is predicted right.
+  // Rotation: the last turn again, in the camera frame. Translation: the camera centre's last
+  // step (with `acceleration`, changed as it changed before), in the world or the camera frame.
+  const auto step_of = [&](std::size_t to) -> Eigen::Vector3d {
+    const Eigen::Vector3d world = poses_[to].translation() - poses_[to - 1].translation();
+    return step_frame == StepFrame::camera
+               ? Eigen::Vector3d(poses_[to - 1].linear().transpose() * world)
+               : world;
+  };
+  Eigen::Vector3d step = step_of(n - 1);
+  if (params_.motion_model == MotionModel::acceleration && n >= 3) step += step - step_of(n - 2);
   const Eigen::Isometry3d& last = poses_[n - 1];
   const Eigen::Isometry3d& before = poses_[n - 2];
-  Eigen::Vector3d step = last.translation() - before.translation();
-  if (params_.motion_model == MotionModel::acceleration && n >= 3) {
-    step += step - (before.translation() - poses_[n - 3].translation());
-  }
   Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
   predicted.linear() = before.linear().transpose() * last.linear();
-  predicted.translation() = last.linear().transpose() * step;
+  predicted.translation() =
+      step_frame == StepFrame::camera ? step : last.linear().transpose() * step;
   return orthonormalized(predicted);
+}
+
+StepFrame RgbdOdometry::step_frame_in_use() const {
+  if (params_.step_frame != StepFrame::adaptive) return params_.step_frame;
+  return camera_step_error_ < world_step_error_ ? StepFrame::camera : StepFrame::world;
+}
+
+void RgbdOdometry::score_step_frames(const Eigen::Isometry3d& measured) {
+  // Over about the last 20 well-constrained frames.
+  constexpr double kKeep = 0.95;
+  const auto squared_error = [&](StepFrame frame) {
+    return (predict(frame).translation() - measured.translation()).squaredNorm();
+  };
+  world_step_error_ = kKeep * world_step_error_ + (1 - kKeep) * squared_error(StepFrame::world);
+  camera_step_error_ = kKeep * camera_step_error_ + (1 - kKeep) * squared_error(StepFrame::camera);
 }
 
 bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
@@ -332,7 +366,9 @@ bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
 RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& predicted,
                                                      OdometryFrame& frame) {
   const std::size_t previous = frame.index - 1;
-  // A large predicted motion may be beyond ICP's basin: start from the features' motion.
+  // A large predicted motion may be beyond ICP's basin: start from the features' motion. (Checking
+  // that one against other starts by fitness, when it fits poorly, picked wrong turns in rooms
+  // that look alike all round; docs/slam.md.)
   if (is_large(predicted)) {
     if (std::optional<Attempt> seeded = register_from_features()) {
       frame.from_features = true;
@@ -340,30 +376,69 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
     }
   }
   Attempt attempt = register_frames(previous, predicted, params_.frame_limits);
-  if (!attempt.report.accepted() && !is_identity(predicted)) {
-    // The motion model may have been wrong (a stop, a turn): start again from rest.
-    Attempt retry = register_frames(previous, Eigen::Isometry3d::Identity(), params_.frame_limits);
-    if (retry.report.accepted()) {
-      attempt = std::move(retry);
-      frame.retried = true;
-    }
-  }
-  if (!attempt.report.accepted()) {
-    if (std::optional<Attempt> seeded = register_from_features()) {
-      frame.from_features = true;
-      frame.retried = false;
-      return std::move(*seeded);
-    }
+  if (is_doubtful(attempt)) {
+    return best_of_other_starts(previous, predicted, std::move(attempt), frame);
   }
   return attempt;
 }
 
+bool RgbdOdometry::is_doubtful(const Attempt& attempt) const {
+  // Rejected, moved far from the prediction (the motion changed: a turn that stopped, a start, a
+  // stop, and a weakly constrained view may have let ICP settle in a neighbouring basin), or
+  // little overlap (the motion may be beyond the basin).
+  return !attempt.report.accepted() || attempt.report.correction_m > params_.recheck_correction_m ||
+         attempt.report.fitness < params_.recheck_fitness;
+}
+
+std::vector<Eigen::Isometry3d> RgbdOdometry::other_starts(
+    const Eigen::Isometry3d& predicted) const {
+  Eigen::Isometry3d turn_only = predicted;
+  turn_only.translation().setZero();
+  Eigen::Isometry3d step_only = Eigen::Isometry3d::Identity();
+  step_only.translation() = predicted.translation();
+  std::vector<Eigen::Isometry3d> starts = {Eigen::Isometry3d::Identity(), turn_only, step_only};
+  // Turns about the camera's vertical axis beyond the prediction: a robot's or a person's turn is
+  // the motion most often beyond ICP's basin.
+  for (const double degrees : params_.recheck_turns_deg) {
+    Eigen::Isometry3d turned = predicted;
+    turned.linear() =
+        predicted.linear() *
+        Eigen::AngleAxisd(degrees * kDegree, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    starts.push_back(turned);
+  }
+  return starts;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
+                                                         const Eigen::Isometry3d& predicted,
+                                                         Attempt first, OdometryFrame& frame) {
+  // The pair is the same for every start, so the fitness decides; the first stays on a tie.
+  Attempt best = std::move(first);
+  const auto consider = [&](Attempt other, bool seeded_by_features) {
+    if (!other.report.accepted()) return;
+    if (best.report.accepted() && other.report.fitness <= best.report.fitness) return;
+    best = std::move(other);
+    frame.retried = !seeded_by_features;
+    frame.from_features = seeded_by_features;
+  };
+  for (const Eigen::Isometry3d& start : other_starts(predicted)) {
+    if (is_identity(predicted.inverse() * start)) continue;  // where the first one started
+    consider(register_frames(previous, start, params_.frame_limits), false);
+  }
+  if (std::optional<Attempt> seeded = register_from_features()) consider(std::move(*seeded), true);
+  return best;
+}
+
 void RgbdOdometry::track_previous(OdometryFrame& frame) {
   const std::size_t n = frame.index;
-  const Eigen::Isometry3d predicted = predict();
+  frame.step_frame = step_frame_in_use();
+  const Eigen::Isometry3d predicted = predict(frame.step_frame);
   const Attempt attempt = attempt_previous(predicted, frame);
   frame.previous = attempt.report;
   frame.photometric = attempt.photometric;
+  if (attempt.report.accepted() && !geometry_.degeneracy.degenerate) {
+    score_step_frames(attempt.motion);
+  }
 
   RelativePose constraint{n - 1, n, predicted, {}, false};
   if (attempt.report.accepted()) {

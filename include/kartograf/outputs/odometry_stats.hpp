@@ -27,7 +27,7 @@ std::string sequence_input_json(const OpenedSequence& opened);
 
 // Counts over an odometry run's frames.
 struct OdometryFrameCounts {
-  std::size_t frames = 0, keyframes = 0, fallbacks = 0, retried_from_identity = 0,
+  std::size_t frames = 0, keyframes = 0, fallbacks = 0, retried_from_other_starts = 0,
               from_features = 0, degenerate_frames = 0, photometric_frames = 0, reestimates = 0,
               reestimates_rejected = 0;
 };

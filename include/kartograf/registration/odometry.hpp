@@ -14,10 +14,12 @@
 //   - degenerate (a wall and the floor, a corridor without ends): ICP solves with the motion model
 //     as a prior about the camera (motion_prior), which decides the weak directions, and image
 //     intensity measures them where it can (photometric_refinement, when certain enough);
-//   - rejected (too few pairs, RMSE, an implausible jump): ICP is retried from the identity; when
-//     that is rejected too and local features are given (features), ICP starts from the matched
-//     features' motion; when all are rejected, the frame takes the motion model's prediction and
-//     is flagged as a fallback (its pose-graph edge gets only the weak prior information).
+//   - doubtful (rejected for too few pairs, RMSE or an implausible jump; moved far from the
+//     prediction; little overlap): ICP runs again from other starts (rest, the predicted turn or
+//     step alone, the prediction turned about the vertical axis, the matched local features'
+//     motion when features are given) and the accepted one that fits best is kept; when all are
+//     rejected, the frame takes the motion model's prediction and is flagged as a fallback (its
+//     pose-graph edge gets only the weak prior information).
 //
 // Drift reduction (the paper's "iterative estimation every 5 images"): every k-th frame is
 // registered again against frame n-k, starting from the chained estimate T_{n-k}^-1 T_n. When the
@@ -37,6 +39,7 @@
 #include <cstddef>
 #include <memory>
 #include <optional>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -70,6 +73,14 @@ enum class OdometryMethod {
 IcpParams odometry_icp_params(OdometryMethod method);
 
 enum class MotionModel { still, velocity, acceleration };
+
+// The frame in which the motion model keeps the camera centre's step. world: a camera that pans
+// while its carrier walks straight (hand-held); camera: a camera fixed to a robot that drives
+// arcs, whose step turns with it; adaptive: whichever predicted the recent well-constrained
+// frames better (decides the free directions of degenerate frames, so a wrong choice drifts
+// sideways by the step times the turn per frame).
+enum class StepFrame { world, camera, adaptive };
+std::string_view to_string(StepFrame frame);
 
 struct KeyframePolicy {
   double min_translation = 0.15;  // metres from the last keyframe
@@ -109,6 +120,7 @@ struct OdometryParams {
   // identity; velocity: the last turn (camera frame) and the last step of the camera centre
   // (world frame); acceleration: that step changed as it changed from the one before.
   MotionModel motion_model = MotionModel::velocity;
+  StepFrame step_frame = StepFrame::adaptive;
   // Frame-to-frame acceptance; the correction is relative to the initial guess.
   RegistrationLimits frame_limits{200, 0.1, 0.02, false, 0.3, 20};
   // Re-estimation acceptance; the correction is relative to the chained estimate.
@@ -118,11 +130,20 @@ struct OdometryParams {
   double fallback_sigma_m = 0.05;
   double fallback_sigma_deg = 5;
   KeyframePolicy keyframes;
+  // A registration that was rejected, moved more than recheck_correction_m from the prediction
+  // (typical corrections are a few millimetres) or has a fitness under recheck_fitness is checked
+  // against ICP from rest, from the predicted turn alone, from its step alone, from the predicted
+  // motion turned about the camera's vertical axis by each of recheck_turns_deg, and from the
+  // features; the accepted one with the best fitness is kept (OdometryFrame::retried or
+  // from_features say which).
+  double recheck_correction_m = 0.03;
+  double recheck_fitness = 0.3;
+  std::vector<double> recheck_turns_deg = {-40, -20, 20, 40};
   // Local features (optional; the features layer's OrbFrontEnd): the current and the previous
   // frame's features are matched, and ICP starts from their motion, when the motion model
-  // predicts more than feature_seed_m or feature_seed_deg (beyond the coarsest ICP gate), or when
-  // ICP from the prediction and from rest were both rejected. Otherwise they cost nothing but a
-  // copy of each frame's images. Not for degenerate frames in general: features matched a few
+  // predicts more than feature_seed_m or feature_seed_deg (beyond the coarsest ICP gate), and as
+  // one of the other starts of a doubtful registration. Otherwise they cost nothing but a copy of
+  // each frame's images. Not for degenerate frames in general: features matched a few
   // centimetres off, worse than the motion model (survey seed 2: 8.5 cm ATE against 2.8).
   std::shared_ptr<const FeatureFrontEnd> features;
   double feature_seed_m = 0.25;
@@ -142,8 +163,8 @@ struct RelativePose {
 // Everything the odometry decided about one frame.
 struct OdometryFrame {
   std::size_t index = 0;
-  // Against frame index-1 (frame 0: none). When the first attempt was rejected and the retry from
-  // the identity accepted, this is the retry; `retried` says so.
+  // Against frame index-1 (frame 0: none). When a registration from another start than the
+  // prediction fitted better (OdometryParams::recheck_*), this is that one; `retried` says so.
   std::optional<RegistrationReport> previous;
   bool retried = false;
   // The accepted registration started from the matched features' motion (OdometryParams::features).
@@ -156,6 +177,8 @@ struct OdometryFrame {
   bool degenerate = false;
   bool photometric = false;
   double eigenvalue_ratio = 0;  // of the frame's geometric information
+  // The frame the prediction kept the camera centre's step in (OdometryParams::step_frame).
+  StepFrame step_frame = StepFrame::world;
   bool keyframe = false;
   double seconds = 0;  // processing time of track() (no file I/O)
 };
@@ -199,6 +222,12 @@ class RgbdOdometry {
   void track_previous(OdometryFrame& frame);
   // The registration against the previous frame, from the prediction, rest or the features.
   Attempt attempt_previous(const Eigen::Isometry3d& predicted, OdometryFrame& frame);
+  // A registration worth checking from other starts (OdometryParams::recheck_*).
+  bool is_doubtful(const Attempt& attempt) const;
+  std::vector<Eigen::Isometry3d> other_starts(const Eigen::Isometry3d& predicted) const;
+  // The best fit of `first` (from the prediction) and ICP from other_starts() and the features.
+  Attempt best_of_other_starts(std::size_t previous, const Eigen::Isometry3d& predicted,
+                               Attempt first, OdometryFrame& frame);
   bool is_large(const Eigen::Isometry3d& motion) const;
   // ICP against the previous frame from its matched features' motion (OdometryParams::features),
   // when accepted.
@@ -236,8 +265,15 @@ class RgbdOdometry {
   std::vector<RelativePose> constraints_;
   std::vector<std::size_t> keyframes_;
   std::unique_ptr<PlanarFrames> planar_;
-  // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses.
-  Eigen::Isometry3d predict() const;
+  // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses, with the step
+  // kept in the world or the camera frame.
+  Eigen::Isometry3d predict(StepFrame frame) const;
+  StepFrame step_frame_in_use() const;
+  // StepFrame::adaptive: each frame's mean squared step error (metres^2, decaying) of the two
+  // predictions on frames whose geometry measured every direction.
+  void score_step_frames(const Eigen::Isometry3d& measured);
+  double world_step_error_ = 0;
+  double camera_step_error_ = 0;
 };
 
 }  // namespace kartograf::registration
