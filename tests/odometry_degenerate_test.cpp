@@ -7,14 +7,18 @@
 // weak direction at the centroid instead of the camera moved it 4 cm sideways per frame); both
 // with and without the photometric refinement, which must not be needed there. Seed 2, frames
 // 140-170: a corridor entered while speeding up from 2 to 7 cm per frame, which only image
-// intensity can measure (the motion model keeps the old speed).
+// intensity can measure (the motion model keeps the old speed). Seed 7, frames 860-880, and seed 4,
+// frames 180-215: a turn that stops, and an arc into a view too faint for image intensity (the
+// odometry's other starts and the motion model's step frame).
 // Rendered at 640x480 with the Kinect noise model, as the survey is.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <ostream>
 #include <string>
+#include <utility>
 
 #include "kartograf/registration/odometry.hpp"
 #include "kartograf/synth/trajectory.hpp"
@@ -90,6 +94,61 @@ INSTANTIATE_TEST_SUITE_P(Survey, DegenerateViews,
                                            DegenerateStretch{5, 832, 28, false},
                                            DegenerateStretch{2, 140, 30, true}),
                          [](const auto& info) { return stretch_name(info.param); });
+
+// The largest error of a step (metres, degrees) when the stretch is tracked with `params`.
+std::pair<double, double> worst_step(const DegenerateStretch& stretch,
+                                     registration::OdometryParams params) {
+  const synth::World world = synth::make_building(stretch.seed);
+  const PinholeIntrinsics kinect{640, 480, 525, 525, 319.5, 239.5};
+  const testing::RenderedSequence sequence =
+      testing::render_sequence(world, survey_poses(world, stretch), kinect);
+  params.depth_range.units_per_metre = testing::kSynthUnitsPerMetre;
+  const compute::Context context = compute::Context::cpu();
+  registration::RgbdOdometry odometry(context, sequence.camera, params);
+  for (const auto& frame : sequence.frames) odometry.track(frame.depth, &frame.color);
+  const auto& poses = odometry.poses();
+  double metres = 0, degrees = 0;
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const Eigen::Isometry3d truth = sequence.truth[i - 1].inverse() * sequence.truth[i];
+    const Eigen::Isometry3d error = truth.inverse() * (poses[i - 1].inverse() * poses[i]);
+    metres = std::max(metres, error.translation().norm());
+    degrees = std::max(degrees, se3::rotation_angle(error) / kDegree);
+  }
+  return {metres, degrees};
+}
+
+// Seed 7, frames 860-880: the robot stops turning and drives on in a weakly constrained view
+// (eigenvalue ratio 0.08); ICP from the predicted turn settled 9 cm off at frame 871 and was
+// accepted. The registration moved 9.5 cm from the prediction, so it is run again from other
+// starts: from the predicted step alone it fits better and is right.
+TEST(DoubtfulRegistration, ATurnThatStopsIsFoundFromTheStepAlone) {
+  const DegenerateStretch stretch{7, 860, 20, true};
+  const auto [metres, degrees] = worst_step(stretch, {});
+  EXPECT_LT(metres, 0.01);
+  EXPECT_LT(degrees, 0.25);
+  registration::OdometryParams no_recheck;
+  no_recheck.recheck_correction_m = 1e3;
+  EXPECT_GT(worst_step(stretch, no_recheck).first, 0.05);
+}
+
+// Seed 4, frames 180-215: a robot driving an arc (2 degrees and 5 cm per frame, slowing down)
+// into a view of one wall and the floor that leaves the slide along them free and is too faint for
+// image intensity. The motion model decides it: keeping the step in the world frame drifted
+// sideways by the step times the turn, 1.1-1.7 cm per frame; the adaptive model has learnt from the
+// frames before that this camera's step turns with it.
+TEST(DoubtfulRegistration, ARobotsArcIsPredictedInTheCameraFrame) {
+  const DegenerateStretch stretch{4, 180, 36, true};
+  const auto [adaptive, adaptive_degrees] = worst_step(stretch, {});
+  registration::OdometryParams world;
+  world.step_frame = registration::StepFrame::world;
+  const double in_world = worst_step(stretch, world).first;
+  RecordProperty("worst_step_adaptive_m", std::to_string(adaptive));
+  RecordProperty("worst_step_world_m", std::to_string(in_world));
+  EXPECT_LT(adaptive,
+            0.012);  // measured 10.2 mm (the slowing down is not predicted), 16.3 in world
+  EXPECT_LT(adaptive_degrees, 0.25);
+  EXPECT_GT(in_world, adaptive + 0.003);
+}
 
 }  // namespace
 }  // namespace kartograf
