@@ -212,20 +212,29 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
 }
 
 // Whether a wall runs across the opening's line at `end` (stepping `back` out of the opening):
-// wall for more than a wall's thickness on both sides of the line. Then the "opening" crosses a
+// wall on both sides of the line for farther than a wall is thick. Then the "opening" crosses a
 // corridor from one wall to the wall opposite (two room dividers meeting it at a T from either
-// side line up across it), not a gap in one wall.
+// side line up across it), not a gap in one wall. A wall's face is ragged (unseen or floor cells
+// where it meets a divider, a cell of offset), so most of the cells beside the line within the
+// wall's first rows suffice; a wall seen end-on, a door's jamb, is wall for a thickness at most.
 bool wall_across(const SemanticGrid& grid, const Eigen::Vector2d& end, const Eigen::Vector2d& back,
                  const Eigen::Vector2d& n) {
   constexpr double kBeyondThickness = 0.5;  // m: walls are thinner than this
+  constexpr int kRows = 3;                  // the wall's rows looked at, from its face
+  constexpr double kMostly = 0.7;
   const double res = grid.resolution;
   const Eigen::Vector2d in_wall = end + res * back;
   for (const double side : {1.0, -1.0}) {
-    for (double t = res; t <= kBeyondThickness; t += res) {
-      if (!is_wall(grid, in_wall + side * t * n) &&
-          !is_wall(grid, in_wall + side * t * n + res * back))
-        return false;
+    int wall = 0, total = 0;
+    for (double t = res; t <= kBeyondThickness; t += res, ++total) {
+      for (int row = 0; row < kRows; ++row) {
+        if (is_wall(grid, in_wall + side * t * n + row * res * back)) {
+          ++wall;
+          break;
+        }
+      }
     }
+    if (wall < kMostly * total) return false;
   }
   return true;
 }
