@@ -150,7 +150,8 @@ TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
       }
     }
   }
-  EXPECT_EQ(inside, 4 * 17);  // 4 rows of cells in the wall, 17 columns well inside the opening
+  // 4 rows of cells in the wall; 16 or 17 columns well inside the opening, as the lattice falls.
+  EXPECT_GE(inside, 4 * 16);
 }
 
 // A table seen only by its edges (top dropped out), its faces left unknown by the views: a free
@@ -213,6 +214,74 @@ TEST(SemanticGrid, AWallsInsideBetweenItsTwoFacesIsWall) {
   const SemanticGrid thin = build_semantic_grid(s.points, s.labels, off);
   const Eigen::Vector2i inside = thin.cell_of({2.0, 1.11});
   EXPECT_EQ(thin.classes(inside.x(), inside.y()), C::unknown);
+}
+
+// Two rooms with a 0.2 m wall between them, seen from both sides, and outer walls seen from inside
+// only: the outer walls' hidden backs are wall to the inner wall's thickness, no further. With no
+// wall seen from both sides there is no thickness to give, and the backs stay unseen.
+TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);      // south room
+  s.box_face({0.012, 2.162, 0}, {4.012, 4.012, 0}, C::floor);      // north room
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);  // the wall between
+  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
+  s.box_face({0.012, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the outer north wall
+  const auto at = [](const SemanticGrid& grid, double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return std::pair{grid.classes(c.x(), c.y()), std::isnan(grid.weight(c.x(), c.y()))};
+  };
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(at(grid, 2.0, 4.012 + 0.12), std::pair(C::wall, false));
+  EXPECT_EQ(at(grid, 2.0, 4.012 + 0.23), std::pair(C::unknown, true));  // beyond 0.2 m
+  SemanticGridParams off;
+  off.back_one_sided_walls = false;
+  EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 2.0, 4.012 + 0.12),
+            std::pair(C::unknown, true));
+
+  LabelledPoints one_room;
+  for (std::size_t i = 0; i < s.points.size(); ++i) {
+    if (s.points[i].y() > 2.1) one_room.add(s.points[i], s.labels[i]);
+  }
+  const SemanticGrid alone = build_semantic_grid(one_room.points, one_room.labels);
+  EXPECT_EQ(at(alone, 2.0, 4.012 + 0.12), std::pair(C::unknown, true));
+}
+
+// Walls whose faces lie midway between the default lattice's cell boundaries (noisy points, as a
+// depth camera gives): the lattice moves so that each face lies on a boundary, the cell in front
+// of it free and the one behind it wall. Left on the default lattice, the cell across the face is
+// wall on both sides of it.
+TEST(SemanticGrid, CellBoundariesFollowTheWallFaces) {
+  using C = SemanticClass;
+  constexpr double kWest = 0.525, kEast = 4.025, kSouth = 0.525, kNorth = 3.025;
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.006);
+  LabelledPoints s;
+  s.box_face({kWest, kSouth, 0}, {kEast, kNorth, 0}, C::floor);
+  LabelledPoints walls;
+  walls.box_face({kWest, kSouth, 0.02}, {kWest, kNorth, 1.4}, C::wall);
+  walls.box_face({kEast, kSouth, 0.02}, {kEast, kNorth, 1.4}, C::wall);
+  walls.box_face({kWest, kSouth, 0.02}, {kEast, kSouth, 1.4}, C::wall);
+  walls.box_face({kWest, kNorth, 0.02}, {kEast, kNorth, 1.4}, C::wall);
+  for (const Eigen::Vector3d& p : walls.points)
+    s.add(p + Eigen::Vector3d(noise(rng), noise(rng), 0), C::wall);
+  const auto at = [](const SemanticGrid& grid, double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return grid.classes(c.x(), c.y());
+  };
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (int axis = 0; axis < 2; ++axis) {
+    const double cells = (kWest - grid.origin[axis]) / grid.resolution;
+    EXPECT_NEAR(cells, std::round(cells), 0.1) << "axis " << axis;
+  }
+  EXPECT_EQ(at(grid, kWest + 0.02, 1.5), C::floor);
+  EXPECT_EQ(at(grid, kWest - 0.02, 1.5), C::wall);
+  EXPECT_EQ(at(grid, 2.0, kNorth - 0.02), C::floor);
+  EXPECT_EQ(at(grid, 2.0, kNorth + 0.02), C::wall);
+  SemanticGridParams fixed;
+  fixed.align_cells_to_walls = false;
+  const SemanticGrid unaligned = build_semantic_grid(s.points, s.labels, fixed);
+  EXPECT_EQ(at(unaligned, kWest + 0.02, 1.5), C::wall);
 }
 
 // The doorways found across a 1.4 m corridor that two rooms' dividers meet at a T from either

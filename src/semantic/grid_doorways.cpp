@@ -273,16 +273,20 @@ std::vector<WallGap> find_wall_gaps(const SemanticGrid& grid, const SemanticGrid
   return gaps;
 }
 
-// Merges the gaps of the two faces of one wall (orienting each like the first): their ends are
-// the means of the merged gaps' ends.
+// Merges the gaps of the two faces of one wall (orienting each like the first): gaps less than half
+// a door apart along their line and at most a wall's thickness (and a cell) across it. Their ends
+// are the means of the merged gaps' ends.
 std::vector<WallGap> merge_face_gaps(const std::vector<WallGap>& gaps,
                                      const SemanticGridParams& options) {
   // Merged gaps hold sums until divided below.
   std::vector<WallGap> merged;
   for (WallGap gap : gaps) {
+    const Eigen::Vector2d u = (gap.b - gap.a).normalized();
     auto same = std::find_if(merged.begin(), merged.end(), [&](const WallGap& m) {
-      const Eigen::Vector2d centre = 0.5 * (m.a + m.b) / m.merged;
-      return (centre - 0.5 * (gap.a + gap.b)).norm() < 0.5 * options.min_door_width;
+      const Eigen::Vector2d offset = 0.5 * (m.a + m.b) / m.merged - 0.5 * (gap.a + gap.b);
+      const double across = std::fabs(offset.x() * u.y() - offset.y() * u.x());
+      return std::fabs(offset.dot(u)) < 0.5 * options.min_door_width &&
+             across <= options.max_wall_thickness + options.resolution;
     });
     if (same == merged.end()) {
       merged.push_back(gap);

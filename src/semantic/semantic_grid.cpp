@@ -16,9 +16,16 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
 #include "semantic/grid_doorways.hpp"
+#include "semantic/grid_walls.hpp"
 
 namespace kartograf::semantic {
 namespace {
+
+// Wall points must agree this much (mean resultant length) on where faces cross an axis before the
+// lattice moves for them: faces at unrelated offsets leave the lattice where it is.
+constexpr double kMinFacePhaseAgreement = 0.1;
+// Face cells of walls seen from both sides needed to measure a wall's thickness (1 m of wall).
+constexpr int kMinTwoSidedWallCells = 40;
 
 constexpr std::size_t index_of(SemanticClass c) {
   return static_cast<std::size_t>(c);
@@ -127,51 +134,6 @@ std::vector<std::vector<Eigen::Vector2i>> components(const Image<std::uint8_t>& 
     }
   }
   return out;
-}
-
-// Direction bin (8 bins over 180 degrees) of each wall cell: the direction of the longest run of
-// wall cells through it, when that run is at least twice as long as the run across it; -1 where
-// no direction dominates (corners, specks). Runs, not a local covariance, so that thick and noisy
-// wall bands still read as lines.
-Image<int> wall_direction_bins(const Image<SemanticClass>& classes) {
-  constexpr int kBins = 8;
-  constexpr int kReach = 10;  // cells each way
-  constexpr int kMinRun = 7;  // cells
-  auto is_wall = [&](int x, int y) {
-    return x >= 0 && y >= 0 && x < classes.width() && y < classes.height() &&
-           classes(x, y) == SemanticClass::wall;
-  };
-  std::array<Eigen::Vector2d, kBins> directions;
-  for (int b = 0; b < kBins; ++b)
-    directions[b] = {std::cos(b * std::numbers::pi / kBins),
-                     -std::sin(b * std::numbers::pi / kBins)};
-  Image<int> bins(classes.width(), classes.height(), -1);
-  for (int row = 0; row < classes.height(); ++row) {
-    for (int col = 0; col < classes.width(); ++col) {
-      if (!is_wall(col, row)) continue;
-      std::array<int, kBins> runs{};
-      for (int b = 0; b < kBins; ++b) {
-        int run = 1;
-        for (const double sign : {-1.0, 1.0}) {
-          int misses = 0;
-          for (int t = 1; t <= kReach; ++t) {
-            const Eigen::Vector2d p = Eigen::Vector2d(col, row) + sign * t * directions[b];
-            if (is_wall(static_cast<int>(std::lround(p.x())),
-                        static_cast<int>(std::lround(p.y())))) {
-              ++run, misses = 0;
-            } else if (++misses > 1) {
-              break;  // one missing cell is noise, two end the run
-            }
-          }
-        }
-        runs[b] = run;
-      }
-      const int best = static_cast<int>(std::max_element(runs.begin(), runs.end()) - runs.begin());
-      if (runs[best] >= kMinRun && runs[best] >= 2 * runs[(best + kBins / 2) % kBins])
-        bins(col, row) = best;
-    }
-  }
-  return bins;
 }
 
 bool point_in_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& polygon) {
@@ -435,7 +397,11 @@ SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
   require(std::isfinite(lo.x()),
           "build_semantic_grid: no finite point among " + std::to_string(points.size()));
   const double res = options.resolution;
-  grid.origin = ((lo.array() - options.margin) / res).floor() * res;
+  const Eigen::Vector2d phase =
+      options.align_cells_to_walls
+          ? detail::wall_face_phase(points, labels, grid.floor_z, options, kMinFacePhaseAgreement)
+          : Eigen::Vector2d::Zero();
+  grid.origin = (((lo - phase).array() - options.margin) / res).floor() * res + phase.array();
   const Eigen::Vector2i size =
       ((hi.array() + options.margin - grid.origin.array()) / res).ceil().cast<int>().max(1);
   require(static_cast<double>(size.x()) * size.y() < 1e8,
@@ -606,7 +572,7 @@ struct WallPieces {
 WallPieces add_straight_walls(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                               const SemanticGridParams& options,
                               const detail::AddObject& add_object) {
-  const Image<int> bins = wall_direction_bins(grid.classes);
+  const Image<int> bins = detail::wall_direction_bins(grid.classes);
   WallPieces walls{Image<int>(grid.width(), grid.height(), 0), {}};
   int wall_count = 0;
   for (int row = 0; row < grid.height(); ++row) {
@@ -800,6 +766,10 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   if (options.max_floor_shadow > 0) {
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
                          options.weights.of(SemanticClass::floor));
+  }
+  if (options.back_one_sided_walls && options.max_wall_thickness > 0) {
+    detail::back_one_sided_walls(grid, cells(options.max_wall_thickness), kMinTwoSidedWallCells,
+                                 options.weights.of(SemanticClass::wall));
   }
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);

@@ -98,6 +98,13 @@ struct SemanticGridParams {
   // Unobserved cells between the two faces of a wall (wall cells at most this far apart along a
   // row or a column, nothing seen between) are wall: its inside, which no view can see. 0: off.
   double max_wall_thickness = 0.35;  // m
+  // Walls seen from one side only (a building's outer walls) extend into the unseen cells behind
+  // them to the median thickness of the walls seen from both sides, when there are such walls:
+  // a wall is a solid, and its hidden back is no more traversable than its face.
+  bool back_one_sided_walls = true;
+  // The cell lattice is shifted (less than a cell) so that wall faces lie on cell boundaries where
+  // the wall points agree on such a shift: a face inside a cell makes it half wall, half room.
+  bool align_cells_to_walls = true;
   // Unobserved cells between floor cells this close along a row or a column are floor: the thin
   // shadows behind corners that a camera turning in place leaves as a fan. 0: off.
   double max_floor_shadow = 0.15;  // m

@@ -1,0 +1,165 @@
+#include "semantic/grid_walls.hpp"
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <complex>
+#include <numbers>
+#include <vector>
+
+namespace kartograf::semantic::detail {
+namespace {
+
+constexpr int kBins = 8;
+
+// Bin b's direction in cell coordinates (rows grow downwards, so the angle turns clockwise).
+Eigen::Vector2d bin_direction(int bin) {
+  const double angle = bin * std::numbers::pi / kBins;
+  return {std::cos(angle), -std::sin(angle)};
+}
+
+// The cell `steps` unit steps from `from` along `direction`, rounded to the nearest cell.
+Eigen::Vector2i cell_along(const Eigen::Vector2i& from, const Eigen::Vector2d& direction,
+                           int steps) {
+  const Eigen::Vector2d p = from.cast<double>() + steps * direction;
+  return {static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))};
+}
+
+bool has_class(const SemanticGrid& grid, const Eigen::Vector2i& c, SemanticClass wanted) {
+  return grid.contains(c) && grid.classes(c.x(), c.y()) == wanted &&
+         !std::isnan(grid.weight(c.x(), c.y()));
+}
+
+// Floor or furniture: what stands in front of a wall's face (or behind a wall seen from both
+// sides).
+bool free_or_furnished(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return has_class(grid, c, SemanticClass::floor) || has_class(grid, c, SemanticClass::furniture);
+}
+
+bool unobserved(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return grid.contains(c) && std::isnan(grid.weight(c.x(), c.y()));
+}
+
+// A straight walk from a wall's face (a wall cell with floor or furniture just in front) back
+// through the wall.
+struct FaceRun {
+  Eigen::Vector2i face;
+  Eigen::Vector2d back;  // unit direction into the wall
+  int wall_cells = 0;
+};
+
+// The runs back from every face, split by what lies behind the wall: floor (a wall seen from both
+// sides, whose run measures its thickness) or unseen cells (a wall seen from one side).
+struct FaceRuns {
+  std::vector<int> two_sided_cells;
+  std::vector<FaceRun> one_sided;
+};
+
+FaceRuns runs_from_faces(const SemanticGrid& grid, int max_cells) {
+  const Image<int> bins = wall_direction_bins(grid.classes);
+  FaceRuns runs;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      if (bins(col, row) < 0) continue;
+      const Eigen::Vector2d along = bin_direction(bins(col, row));
+      for (const double side : {-1.0, 1.0}) {
+        FaceRun run{{col, row}, side * Eigen::Vector2d(-along.y(), along.x()), 0};
+        if (!free_or_furnished(grid, cell_along(run.face, run.back, -1))) continue;
+        while (run.wall_cells <= max_cells &&
+               has_class(grid, cell_along(run.face, run.back, run.wall_cells), SemanticClass::wall))
+          ++run.wall_cells;
+        if (run.wall_cells > max_cells) continue;  // along another wall, not through this one
+        const Eigen::Vector2i behind = cell_along(run.face, run.back, run.wall_cells);
+        if (free_or_furnished(grid, behind)) runs.two_sided_cells.push_back(run.wall_cells);
+        if (unobserved(grid, behind)) runs.one_sided.push_back(run);
+      }
+    }
+  }
+  return runs;
+}
+
+}  // namespace
+
+Image<int> wall_direction_bins(const Image<SemanticClass>& classes) {
+  constexpr int kReach = 10;  // cells each way
+  constexpr int kMinRun = 7;  // cells
+  auto is_wall = [&](int x, int y) {
+    return x >= 0 && y >= 0 && x < classes.width() && y < classes.height() &&
+           classes(x, y) == SemanticClass::wall;
+  };
+  Image<int> bins(classes.width(), classes.height(), -1);
+  for (int row = 0; row < classes.height(); ++row) {
+    for (int col = 0; col < classes.width(); ++col) {
+      if (!is_wall(col, row)) continue;
+      std::array<int, kBins> runs{};
+      for (int b = 0; b < kBins; ++b) {
+        int run = 1;
+        for (const double sign : {-1.0, 1.0}) {
+          int misses = 0;
+          for (int t = 1; t <= kReach; ++t) {
+            const Eigen::Vector2d p = Eigen::Vector2d(col, row) + sign * t * bin_direction(b);
+            if (is_wall(static_cast<int>(std::lround(p.x())),
+                        static_cast<int>(std::lround(p.y())))) {
+              ++run, misses = 0;
+            } else if (++misses > 1) {
+              break;  // one missing cell is noise, two end the run
+            }
+          }
+        }
+        runs[b] = run;
+      }
+      const int best = static_cast<int>(std::max_element(runs.begin(), runs.end()) - runs.begin());
+      if (runs[best] >= kMinRun && runs[best] >= 2 * runs[(best + kBins / 2) % kBins])
+        bins(col, row) = best;
+    }
+  }
+  return bins;
+}
+
+Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
+                                std::span<const SemanticClass> labels, double floor_z,
+                                const SemanticGridParams& options, double min_agreement) {
+  const double res = options.resolution;
+  const double to_angle = 2 * std::numbers::pi / res;
+  std::array<std::complex<double>, 2> sum{};
+  std::size_t count = 0;
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    const double h = p.z() - floor_z;
+    if (labels[i] != SemanticClass::wall || !p.allFinite() || h < options.band_min ||
+        h > options.band_max)
+      continue;
+    for (int axis = 0; axis < 2; ++axis) sum[axis] += std::polar(1.0, to_angle * p[axis]);
+    ++count;
+  }
+  Eigen::Vector2d phase = Eigen::Vector2d::Zero();
+  for (int axis = 0; axis < 2; ++axis) {
+    if (count == 0 || std::abs(sum[axis]) < min_agreement * static_cast<double>(count)) continue;
+    const double offset = std::arg(sum[axis]) / to_angle;  // (-res / 2, res / 2]
+    phase[axis] = offset < 0 ? offset + res : offset;
+  }
+  return phase;
+}
+
+int back_one_sided_walls(SemanticGrid& grid, int max_cells, int min_samples, float weight) {
+  FaceRuns runs = runs_from_faces(grid, max_cells);
+  if (static_cast<int>(runs.two_sided_cells.size()) < std::max(min_samples, 1)) return 0;
+  auto middle = runs.two_sided_cells.begin() + runs.two_sided_cells.size() / 2;
+  std::nth_element(runs.two_sided_cells.begin(), middle, runs.two_sided_cells.end());
+  const int thickness = *middle;
+  std::vector<Eigen::Vector2i> backing;
+  for (const FaceRun& run : runs.one_sided) {
+    for (int t = run.wall_cells; t < thickness; ++t) {
+      const Eigen::Vector2i c = cell_along(run.face, run.back, t);
+      if (!unobserved(grid, c)) break;  // something seen there: it is no wall's hidden back
+      backing.push_back(c);
+    }
+  }
+  for (const Eigen::Vector2i& c : backing) {
+    grid.classes(c.x(), c.y()) = SemanticClass::wall;
+    grid.weight(c.x(), c.y()) = weight;
+  }
+  return thickness;
+}
+
+}  // namespace kartograf::semantic::detail

@@ -1,0 +1,35 @@
+#pragma once
+// The semantic grid's walls as solids (steps of build_semantic_grid): the cell lattice placed so
+// that wall faces fall on cell boundaries, each wall cell's run direction, and walls seen from
+// one side only given the thickness of those seen from both.
+#include <span>
+
+#include <Eigen/Core>
+
+#include "kartograf/semantic/semantic_grid.hpp"
+
+namespace kartograf::semantic::detail {
+
+// Per axis, the offset in [0, resolution) of the cell boundaries that puts the wall faces on them:
+// the circular mean, modulo the resolution, of the wall points' coordinate in the height band
+// above `floor_z`. Faces across an axis share a phase there; faces along it spread uniformly and
+// cancel. 0 on an axis where the points agree less than `min_agreement` (the mean resultant
+// length, 0..1): faces at unrelated offsets, which no lattice can serve at once.
+Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
+                                std::span<const SemanticClass> labels, double floor_z,
+                                const SemanticGridParams& options, double min_agreement);
+
+// Direction bin (8 bins over 180 degrees, bin b at angle b * pi / 8 in cell coordinates) of each
+// wall cell: the direction of the longest run of wall cells through it, when that run is at least
+// twice as long as the run across it; -1 where no direction dominates (corners, specks). Runs, not
+// a local covariance, so that thick and noisy wall bands still read as lines.
+Image<int> wall_direction_bins(const Image<SemanticClass>& classes);
+
+// Walls seen from one side (floor or furniture in front, nothing seen behind: a building's outer
+// walls, a wall of a room no view entered) are extended into the unseen cells behind them to the
+// median thickness of the walls seen from both sides (floor or furniture on both faces). Nothing
+// changes where fewer than `min_samples` cells measure a two-sided wall.
+// Returns the thickness used, in cells (0: none measured).
+int back_one_sided_walls(SemanticGrid& grid, int max_cells, int min_samples, float weight);
+
+}  // namespace kartograf::semantic::detail
