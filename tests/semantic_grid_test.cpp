@@ -190,6 +190,52 @@ TEST(SemanticGrid, UnclassifiedOutlinesOfFurnitureSizeAreFurniture) {
   EXPECT_EQ(unfilled.classes(under.x(), under.y()), C::floor);
 }
 
+// Three cabinets 0.2 m apart in a row along a wall, seen as unknown outlines: together 2.8 m, too
+// long for furniture when the gaps between them are bridged, so each is judged on its own.
+TEST(SemanticGrid, FurnitureInARowIsJudgedPieceByPiece) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 3.012, 0}, C::floor);
+  for (const double x0 : {0.512, 1.512, 2.512}) {  // 0.8 x 0.5 m each, 0.2 m apart
+    s.box_face({x0, 2.012, 0.3}, {x0 + 0.8, 2.012, 0.8}, C::unknown);
+    s.box_face({x0, 2.512, 0.3}, {x0 + 0.8, 2.512, 0.8}, C::unknown);
+    s.box_face({x0, 2.012, 0.3}, {x0, 2.512, 0.8}, C::unknown);
+    s.box_face({x0 + 0.8, 2.012, 0.3}, {x0 + 0.8, 2.512, 0.8}, C::unknown);
+  }
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double x : {0.9, 1.9, 2.9}) {
+    const Eigen::Vector2i c = grid.cell_of({x, 2.02});
+    EXPECT_EQ(grid.classes(c.x(), c.y()), C::furniture) << "the cabinet at x " << x;
+  }
+}
+
+// A cabinet 1 m wide standing 0.45 m in front of a wall, its front taken for a wall by the views
+// and the space behind it unseen: the front and the pocket behind it are furniture, the wall
+// stays a wall. Off, the front stays a wall.
+TEST(SemanticGrid, AShortFaceInFrontOfAWallWithAnUnseenPocketIsFurniture) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 0.012; y <= 3.012; y += 0.02) {
+      if (!(x > 1.0 && x < 2.0 && y > 2.57)) s.add({x, y, 0}, C::floor);  // unseen behind it
+    }
+  }
+  s.box_face({0.012, 3.012, 0.02}, {4.012, 3.012, 1.4}, C::wall);  // the wall
+  s.box_face({1.012, 2.562, 0.02}, {2.012, 2.562, 1.2}, C::wall);  // the cabinet's front
+  const auto at = [&](const SemanticGrid& grid, double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return grid.classes(c.x(), c.y());
+  };
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(at(grid, 1.5, 2.57), C::furniture);  // the front
+  EXPECT_EQ(at(grid, 1.5, 2.8), C::furniture);   // the pocket
+  EXPECT_EQ(at(grid, 0.5, 3.02), C::wall);
+  EXPECT_EQ(at(grid, 1.5, 3.02), C::wall);
+  SemanticGridParams off;
+  off.furniture_max_depth = 0;
+  EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 1.5, 2.57), C::wall);
+}
+
 // A wall 0.2 m thick seen from both rooms: its inside, which no view sees, is wall; two walls
 // 1 m apart with nothing seen between (a closed shaft) are not joined.
 TEST(SemanticGrid, AWallsInsideBetweenItsTwoFacesIsWall) {

@@ -16,6 +16,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
 #include "semantic/grid_doorways.hpp"
+#include "semantic/grid_furniture.hpp"
 #include "semantic/grid_walls.hpp"
 
 namespace kartograf::semantic {
@@ -201,43 +202,65 @@ void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double m
   }
 }
 
-// Pieces of unclassified obstacle or furniture cells, closed over gaps of a few cells like
-// fill_furniture's, that are furniture sized and low: their unclassified cells become furniture.
-void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                               const SemanticGridParams& options, Image<std::uint8_t>& furniture) {
-  const int w = grid.width(), h = grid.height();
-  auto unclassified = [&](int col, int row) { return is_unclassified_obstacle(grid, col, row); };
-  const CellMask obstacles = closed_cell_mask(
-      grid, [&](int col, int row) { return unclassified(col, row) || furniture(col, row); }, 7);
-  const cv::Mat& mask = obstacles.mask;
-  cv::Mat pieces;
-  const int count = cv::connectedComponents(obstacles.closed, pieces, 8, CV_32S);
-  std::vector<std::vector<cv::Point>> cells(static_cast<std::size_t>(count));
-  std::vector<float> top(static_cast<std::size_t>(count), -std::numeric_limits<float>::infinity());
-  for (int row = 0; row < h; ++row) {
-    for (int col = 0; col < w; ++col) {
-      const int piece = pieces.at<int>(row, col);
+// The pieces of `mask` closed with a size x size square (8-connected): each piece's cells of the
+// mask, and the highest point over them.
+struct MaskPieces {
+  std::vector<std::vector<cv::Point>> cells;
+  std::vector<float> top;
+};
+
+MaskPieces mask_pieces(const cv::Mat& mask, int size, const Image<CellEvidence>& evidence) {
+  cv::Mat closed, labels;
+  cv::morphologyEx(mask, closed, cv::MORPH_CLOSE,
+                   cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
+  const int count = cv::connectedComponents(closed, labels, 8, CV_32S);
+  MaskPieces pieces{
+      std::vector<std::vector<cv::Point>>(static_cast<std::size_t>(count)),
+      std::vector<float>(static_cast<std::size_t>(count), -std::numeric_limits<float>::infinity())};
+  for (int row = 0; row < mask.rows; ++row) {
+    for (int col = 0; col < mask.cols; ++col) {
+      const auto piece = static_cast<std::size_t>(labels.at<int>(row, col));
       if (piece == 0 || !mask.at<std::uint8_t>(row, col)) continue;
-      cells[static_cast<std::size_t>(piece)].push_back({col, row});
-      top[static_cast<std::size_t>(piece)] =
-          std::max(top[static_cast<std::size_t>(piece)], evidence(col, row).z_max);
+      pieces.cells[piece].push_back({col, row});
+      pieces.top[piece] = std::max(pieces.top[piece], evidence(col, row).z_max);
     }
   }
+  return pieces;
+}
+
+// Pieces of unclassified obstacle or furniture cells, closed over gaps of a few cells like
+// fill_furniture's, that are furniture sized and low: their unclassified cells become furniture.
+// A piece too large for furniture is looked at again closed over smaller gaps (pieces of furniture
+// along one wall join over the gaps between them), down to its cells as they are.
+void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                               const SemanticGridParams& options, Image<std::uint8_t>& furniture) {
+  auto unclassified = [&](int col, int row) { return is_unclassified_obstacle(grid, col, row); };
+  cv::Mat mask =
+      closed_cell_mask(
+          grid, [&](int col, int row) { return unclassified(col, row) || furniture(col, row); }, 1)
+          .mask;
   const double cell_area = grid.resolution * grid.resolution;
-  for (std::size_t k = 1; k < cells.size(); ++k) {
-    if (cells[k].empty() || top[k] - grid.floor_z > options.furniture_max_height) continue;
-    std::vector<cv::Point> hull;
-    cv::convexHull(cells[k], hull);
-    const cv::RotatedRect box = cv::minAreaRect(cells[k]);
-    const double extent = (std::max(box.size.width, box.size.height) + 1) * grid.resolution;
-    if (cv::contourArea(hull) * cell_area > options.max_furniture_fill_area ||
-        extent > options.furniture_max_extent)
-      continue;
-    for (const cv::Point& c : cells[k]) {
-      if (!unclassified(c.x, c.y)) continue;
-      furniture(c.x, c.y) = 1;
-      grid.classes(c.x, c.y) = SemanticClass::furniture;
-      grid.weight(c.x, c.y) = options.weights.of(SemanticClass::furniture);
+  for (const int size : {7, 3, 1}) {
+    const MaskPieces pieces = mask_pieces(mask, size, evidence);
+    mask.setTo(0);  // what is left for the next, smaller closing: the pieces too large
+    for (std::size_t k = 1; k < pieces.cells.size(); ++k) {
+      const std::vector<cv::Point>& cells = pieces.cells[k];
+      if (cells.empty() || pieces.top[k] - grid.floor_z > options.furniture_max_height) continue;
+      std::vector<cv::Point> hull;
+      cv::convexHull(cells, hull);
+      const cv::RotatedRect box = cv::minAreaRect(cells);
+      const double extent = (std::max(box.size.width, box.size.height) + 1) * grid.resolution;
+      if (cv::contourArea(hull) * cell_area > options.max_furniture_fill_area ||
+          extent > options.furniture_max_extent) {
+        for (const cv::Point& c : cells) mask.at<std::uint8_t>(c.y, c.x) = 255;
+        continue;
+      }
+      for (const cv::Point& c : cells) {
+        if (!unclassified(c.x, c.y)) continue;
+        furniture(c.x, c.y) = 1;
+        grid.classes(c.x, c.y) = SemanticClass::furniture;
+        grid.weight(c.x, c.y) = options.weights.of(SemanticClass::furniture);
+      }
     }
   }
 }
@@ -694,6 +717,8 @@ void SemanticGridParams::validate() const {
   require(std::isfinite(furniture_max_extent) && furniture_max_extent >= 0 &&
               std::isfinite(furniture_max_height) && furniture_max_height > 0,
           "SemanticGridParams: furniture_max_extent must be >= 0 and furniture_max_height > 0");
+  require(std::isfinite(furniture_max_depth) && furniture_max_depth >= 0,
+          "SemanticGridParams: furniture_max_depth must be >= 0");
   require(std::isfinite(max_wall_thickness) && max_wall_thickness >= 0 &&
               std::isfinite(max_floor_shadow) && max_floor_shadow >= 0,
           "SemanticGridParams: max_wall_thickness and max_floor_shadow must be >= 0");
@@ -749,6 +774,9 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                            std::vector<Eigen::Vector2i> cells) -> SemanticObject& {
     return append_object(grid, evidence, kind, label, name, std::move(cells));
   };
+  const auto cells = [&](double metres) {
+    return static_cast<int>(std::floor(metres / options.resolution + 1e-9));
+  };
   if (options.max_furniture_fill_area > 0 && options.furniture_max_extent > 0)
     unclassified_to_furniture(grid, evidence, options, masks.furniture);
   if (options.max_furniture_fill_area > 0)
@@ -756,12 +784,17 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                    options.weights.of(SemanticClass::furniture));
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
-  const auto cells = [&](double metres) {
-    return static_cast<int>(std::floor(metres / options.resolution + 1e-9));
-  };
   if (options.max_wall_thickness > 0) {
     fill_unobserved_runs(grid, SemanticClass::wall, cells(options.max_wall_thickness),
                          options.weights.of(SemanticClass::wall));
+  }
+  // After the furniture fills (no hull should span a front and its pocket) and the walls' insides
+  // (which are no pockets).
+  if (options.furniture_max_depth > 0 && options.furniture_max_extent > 0) {
+    detail::fronts_against_walls(grid, options.furniture_max_extent,
+                                 options.max_furniture_fill_area, cells(options.max_wall_thickness),
+                                 cells(options.furniture_max_depth),
+                                 options.weights.of(SemanticClass::furniture), masks.furniture);
   }
   if (options.max_floor_shadow > 0) {
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),

@@ -95,6 +95,10 @@ struct SemanticGridParams {
   // region of their own. 0: off.
   double furniture_max_extent = 2.5;  // m
   double furniture_max_height = 2.1;  // m
+  // A face of furniture size standing at most this far in front of a longer wall, with only
+  // unseen cells between (a cabinet's front that the views took for a wall, its top and sides
+  // hidden), is furniture, and so is the pocket behind it. 0: off.
+  double furniture_max_depth = 1.0;  // m
   // Unobserved cells between the two faces of a wall (wall cells at most this far apart along a
   // row or a column, nothing seen between) are wall: its inside, which no view can see. 0: off.
   double max_wall_thickness = 0.35;  // m
