@@ -231,6 +231,7 @@ TEST(SemanticGrid, AShortFaceInFrontOfAWallWithAnUnseenPocketIsFurniture) {
   EXPECT_EQ(at(grid, 1.5, 2.8), C::furniture);   // the pocket
   EXPECT_EQ(at(grid, 0.5, 3.02), C::wall);
   EXPECT_EQ(at(grid, 1.5, 3.02), C::wall);
+  EXPECT_EQ(grid.furniture_fronts, 1);
   SemanticGridParams off;
   off.furniture_max_depth = 0;
   EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 1.5, 2.57), C::wall);
@@ -280,6 +281,8 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   EXPECT_EQ(at(grid, 2.0, 4.012 + 0.12), std::pair(C::wall, false));
   EXPECT_EQ(at(grid, 2.0, 4.012 + 0.23), std::pair(C::unknown, true));  // beyond 0.2 m
+  ASSERT_TRUE(grid.wall_thickness.has_value());
+  EXPECT_NEAR(*grid.wall_thickness, 0.2, 0.051);
   SemanticGridParams off;
   off.back_one_sided_walls = false;
   EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 2.0, 4.012 + 0.12),
@@ -291,6 +294,7 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   }
   const SemanticGrid alone = build_semantic_grid(one_room.points, one_room.labels);
   EXPECT_EQ(at(alone, 2.0, 4.012 + 0.12), std::pair(C::unknown, true));
+  EXPECT_FALSE(alone.wall_thickness.has_value());
 }
 
 // Walls whose faces lie midway between the default lattice's cell boundaries (noisy points, as a

@@ -7,9 +7,9 @@
 #include <nlohmann/json.hpp>
 
 #include "formats/atomic_file.hpp"
-#include "outputs/json_array.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
+#include "outputs/json_array.hpp"
 
 namespace kartograf::io {
 
@@ -67,6 +67,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
     cells[std::string(to_string(static_cast<SemanticClass>(c)))] = d.cells_per_class[c];
   cells["unobserved"] = d.unobserved_cells;
   json["cells"] = std::move(cells);
+  json["inferred"] = {{"wall_thickness_m", d.wall_thickness ? Json(*d.wall_thickness) : Json()},
+                      {"furniture_fronts", d.furniture_fronts}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

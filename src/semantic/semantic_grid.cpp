@@ -791,18 +791,20 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   // After the furniture fills (no hull should span a front and its pocket) and the walls' insides
   // (which are no pockets).
   if (options.furniture_max_depth > 0 && options.furniture_max_extent > 0) {
-    detail::fronts_against_walls(grid, options.furniture_max_extent,
-                                 options.max_furniture_fill_area, cells(options.max_wall_thickness),
-                                 cells(options.furniture_max_depth),
-                                 options.weights.of(SemanticClass::furniture), masks.furniture);
+    grid.furniture_fronts = detail::fronts_against_walls(
+        grid, options.furniture_max_extent, options.max_furniture_fill_area,
+        cells(options.max_wall_thickness), cells(options.furniture_max_depth),
+        options.weights.of(SemanticClass::furniture), masks.furniture);
   }
   if (options.max_floor_shadow > 0) {
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
                          options.weights.of(SemanticClass::floor));
   }
   if (options.back_one_sided_walls && options.max_wall_thickness > 0) {
-    detail::back_one_sided_walls(grid, cells(options.max_wall_thickness), kMinTwoSidedWallCells,
-                                 options.weights.of(SemanticClass::wall));
+    const int thickness =
+        detail::back_one_sided_walls(grid, cells(options.max_wall_thickness), kMinTwoSidedWallCells,
+                                     options.weights.of(SemanticClass::wall));
+    if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
   }
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);
@@ -825,6 +827,8 @@ MapDescription describe(const SemanticGrid& grid) {
   d.width = grid.width(), d.height = grid.height();
   d.floor_z = grid.floor_z;
   d.ceiling_z = grid.ceiling_z;
+  d.wall_thickness = grid.wall_thickness;
+  d.furniture_fronts = grid.furniture_fronts;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

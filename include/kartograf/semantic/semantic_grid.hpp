@@ -163,6 +163,11 @@ struct SemanticGrid {
   Image<std::vector<int>> cell_objects;  // object ids over each cell
   std::vector<SemanticObject> objects;
   TraversabilityWeights weights;  // the table the cells were weighted with
+  // What the grid inferred beyond the views: the wall thickness measured on walls seen from both
+  // sides and given to walls seen from one side (none: too few two-sided walls, none backed), and
+  // the cabinet fronts the views had taken for walls.
+  std::optional<double> wall_thickness;  // m
+  int furniture_fronts = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -213,6 +218,8 @@ struct MapDescription {
   std::vector<std::pair<std::string, float>> class_weights;  // class name -> weight (NaN: unknown)
   std::array<int, kSemanticClassCount> cells_per_class{};
   int unobserved_cells = 0;
+  std::optional<double> wall_thickness;  // as SemanticGrid's
+  int furniture_fronts = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
