@@ -8,38 +8,22 @@
 #include <opencv2/core.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include "semantic/grid_cells.hpp"
+
 namespace kartograf::semantic::detail {
 namespace {
 
-bool unobserved(const SemanticGrid& grid, int col, int row) {
-  return std::isnan(grid.weight(col, row));
-}
-
 bool is_wall(const SemanticGrid& grid, int col, int row) {
-  return grid.classes(col, row) == SemanticClass::wall && !unobserved(grid, col, row);
+  return seen_as(grid, {col, row}, SemanticClass::wall);
 }
 
 // Unseen cells on a row or column run of unseen cells with wall cells at both ends, longer than
 // min_cells (a wall's inside) and at most max_cells: what lies between two faces.
 cv::Mat pockets_between_walls(const SemanticGrid& grid, int min_cells, int max_cells) {
   cv::Mat pockets = cv::Mat::zeros(grid.height(), grid.width(), CV_8U);
-  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
-    for (int row = 0; row < grid.height(); ++row) {
-      for (int col = 0; col < grid.width(); ++col) {
-        Eigen::Vector2i c = Eigen::Vector2i(col, row) + step;
-        if (!is_wall(grid, col, row) || !grid.contains(c) || !unobserved(grid, c.x(), c.y()))
-          continue;
-        int run = 0;
-        while (grid.contains(c) && unobserved(grid, c.x(), c.y()) && run <= max_cells)
-          c += step, ++run;
-        if (run <= min_cells || run > max_cells || !grid.contains(c) ||
-            !is_wall(grid, c.x(), c.y()))
-          continue;
-        for (Eigen::Vector2i k = Eigen::Vector2i(col, row) + step; k != c; k += step)
-          pockets.at<std::uint8_t>(k.y(), k.x()) = 255;
-      }
-    }
-  }
+  const auto wall_end = [&](const Eigen::Vector2i& c) { return is_wall(grid, c.x(), c.y()); };
+  for (const Eigen::Vector2i& k : unobserved_runs_between(grid, wall_end, min_cells, max_cells))
+    pockets.at<std::uint8_t>(k.y(), k.x()) = 255;
   return pockets;
 }
 
@@ -78,8 +62,7 @@ bool faces_floor(const SemanticGrid& grid, const std::vector<cv::Point>& cells) 
     for (const cv::Point d :
          {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
       const cv::Point n = c + d;
-      if (grid.contains({n.x, n.y}) && grid.classes(n.x, n.y) == SemanticClass::floor &&
-          !unobserved(grid, n.x, n.y)) {
+      if (seen_as(grid, {n.x, n.y}, SemanticClass::floor)) {
         ++facing;
         break;
       }

@@ -7,6 +7,8 @@
 #include <numbers>
 #include <vector>
 
+#include "semantic/grid_cells.hpp"
+
 namespace kartograf::semantic::detail {
 namespace {
 
@@ -25,19 +27,10 @@ Eigen::Vector2i cell_along(const Eigen::Vector2i& from, const Eigen::Vector2d& d
   return {static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))};
 }
 
-bool has_class(const SemanticGrid& grid, const Eigen::Vector2i& c, SemanticClass wanted) {
-  return grid.contains(c) && grid.classes(c.x(), c.y()) == wanted &&
-         !std::isnan(grid.weight(c.x(), c.y()));
-}
-
 // Floor or furniture: what stands in front of a wall's face (or behind a wall seen from both
 // sides).
 bool free_or_furnished(const SemanticGrid& grid, const Eigen::Vector2i& c) {
-  return has_class(grid, c, SemanticClass::floor) || has_class(grid, c, SemanticClass::furniture);
-}
-
-bool unobserved(const SemanticGrid& grid, const Eigen::Vector2i& c) {
-  return grid.contains(c) && std::isnan(grid.weight(c.x(), c.y()));
+  return seen_as(grid, c, SemanticClass::floor) || seen_as(grid, c, SemanticClass::furniture);
 }
 
 // A straight walk from a wall's face (a wall cell with floor or furniture just in front) back
@@ -66,7 +59,7 @@ FaceRuns runs_from_faces(const SemanticGrid& grid, int max_cells) {
         FaceRun run{{col, row}, side * Eigen::Vector2d(-along.y(), along.x()), 0};
         if (!free_or_furnished(grid, cell_along(run.face, run.back, -1))) continue;
         while (run.wall_cells <= max_cells &&
-               has_class(grid, cell_along(run.face, run.back, run.wall_cells), SemanticClass::wall))
+               seen_as(grid, cell_along(run.face, run.back, run.wall_cells), SemanticClass::wall))
           ++run.wall_cells;
         if (run.wall_cells > max_cells) continue;  // along another wall, not through this one
         const Eigen::Vector2i behind = cell_along(run.face, run.back, run.wall_cells);

@@ -15,6 +15,7 @@
 #include "kartograf/core/connected_components.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
+#include "semantic/grid_cells.hpp"
 #include "semantic/grid_doorways.hpp"
 #include "semantic/grid_furniture.hpp"
 #include "semantic/grid_walls.hpp"
@@ -269,23 +270,8 @@ void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& ev
 // max_cells long, become `ends`: the inside of a wall seen from both sides; floor that the views
 // missed in a thin shadow behind a corner (a fan of them where the robot turns in place).
 void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells, float weight) {
-  auto is_end = [&](const Eigen::Vector2i& c) { return grid.classes(c.x(), c.y()) == ends; };
-  auto unobserved = [&](const Eigen::Vector2i& c) { return std::isnan(grid.weight(c.x(), c.y())); };
-  std::vector<Eigen::Vector2i> inside;
-  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
-    for (int row = 0; row < grid.height(); ++row) {
-      for (int col = 0; col < grid.width(); ++col) {
-        const Eigen::Vector2i start(col, row);
-        if (!is_end(start) || !grid.contains(start + step) || !unobserved(start + step)) continue;
-        Eigen::Vector2i c = start + step;
-        int run = 0;
-        while (grid.contains(c) && unobserved(c) && run <= max_cells) c += step, ++run;
-        if (run > max_cells || !grid.contains(c) || !is_end(c)) continue;
-        for (Eigen::Vector2i k = start + step; k != c; k += step) inside.push_back(k);
-      }
-    }
-  }
-  for (const Eigen::Vector2i& c : inside) {
+  const auto is_end = [&](const Eigen::Vector2i& c) { return grid.classes(c.x(), c.y()) == ends; };
+  for (const Eigen::Vector2i& c : detail::unobserved_runs_between(grid, is_end, 0, max_cells)) {
     grid.classes(c.x(), c.y()) = ends;
     grid.weight(c.x(), c.y()) = weight;
   }

@@ -1,0 +1,45 @@
+#pragma once
+// Cell queries shared by the semantic grid's steps (semantic_grid.cpp, grid_walls.cpp,
+// grid_furniture.cpp).
+#include <cmath>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/semantic/semantic_grid.hpp"
+
+namespace kartograf::semantic::detail {
+
+// No view saw the cell (outside the grid: false).
+inline bool unobserved(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return grid.contains(c) && std::isnan(grid.weight(c.x(), c.y()));
+}
+
+// A seen cell of class `wanted` (outside the grid: false).
+inline bool seen_as(const SemanticGrid& grid, const Eigen::Vector2i& c, SemanticClass wanted) {
+  return grid.contains(c) && grid.classes(c.x(), c.y()) == wanted && !unobserved(grid, c);
+}
+
+// The unobserved cells on row and column runs of unobserved cells with cells where is_end holds at
+// both ends, longer than min_cells and at most max_cells (each cell once per run it lies on).
+template <typename IsEnd>
+std::vector<Eigen::Vector2i> unobserved_runs_between(const SemanticGrid& grid, const IsEnd& is_end,
+                                                     int min_cells, int max_cells) {
+  std::vector<Eigen::Vector2i> inside;
+  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const Eigen::Vector2i start(col, row);
+        if (!is_end(start) || !unobserved(grid, start + step)) continue;
+        Eigen::Vector2i c = start + step;
+        int run = 0;
+        while (unobserved(grid, c) && run <= max_cells) c += step, ++run;
+        if (run <= min_cells || run > max_cells || !grid.contains(c) || !is_end(c)) continue;
+        for (Eigen::Vector2i k = start + step; k != c; k += step) inside.push_back(k);
+      }
+    }
+  }
+  return inside;
+}
+
+}  // namespace kartograf::semantic::detail
