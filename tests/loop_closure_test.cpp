@@ -7,6 +7,7 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "icp_test_scene.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/mapping/loop_closure.hpp"
 #include "kartograf/synth/trajectory.hpp"
@@ -149,6 +150,48 @@ TEST_F(LoopClosureTest, RejectsAWrongCandidate) {
   EXPECT_FALSE(closure.report.accepted());
   RecordProperty("verdict", std::string(registration::to_string(closure.report.verdict)));
   RecordProperty("fitness", testing::scientific(closure.report.fitness));
+}
+
+// A wall and the floor, seen again 20 cm farther along the wall: ICP measures the distances to
+// the wall and the floor and the turn, not the slide along them. The loop keeps the estimate's
+// slide and gives the pose graph no information about it.
+TEST(LoopClosureWeakDirections, TheSlideAlongAWallIsLeftToTheEstimate) {
+  const testing::Scene wall_and_floor{
+      std::nullopt, {}, {{Eigen::Vector3d(0, 0, 1), 3.0}, {Eigen::Vector3d(0, 1, 0), 1.2}}};
+  const PinholeIntrinsics camera = testing::qvga_camera();
+  const Eigen::Isometry3d a = testing::reference_camera();
+  const Eigen::Isometry3d b = Eigen::Translation3d(0.2, 0, 0.05) * a;  // world x: along the wall
+  geometry::DepthRange range;
+  range.units_per_metre = 1000;
+  mapping::LoopClosureParams params;
+  params.verification.reject_degenerate = false;  // this view is degenerate by design
+  params.weak_direction_ratio = 0.01;
+  params.min_correction_m = 1;  // ICP slides along the wall (0.5 m here): let it, and see it undone
+  const compute::Context context = compute::Context::cpu();
+  LoopClosureDetector detector(context, camera, range, params);
+  detector.add_keyframe(0, testing::depth_of(testing::render(wall_and_floor, camera, a), 1000), 0);
+  detector.add_keyframe(100, testing::depth_of(testing::render(wall_and_floor, camera, b), 1000),
+                        1);
+  // The estimate is 4 cm off along the wall (free) and 3 cm off towards it (measured).
+  std::vector<Eigen::Isometry3d> poses(101, Eigen::Isometry3d::Identity());
+  poses[0] = a;
+  poses[100] = Eigen::Translation3d(0.04, 0, 0.03) * b;
+  LoopCandidate candidate;
+  candidate.query = 1;
+  candidate.query_frame = 100;
+  candidate.drift_allowance_m = 0.1;
+  const mapping::LoopClosure closure = detector.verify(candidate, poses);
+  ASSERT_TRUE(closure.report.accepted()) << registration::to_string(closure.report.verdict);
+  // The constraint's camera position, in the world of keyframe A.
+  const Eigen::Vector3d offset = (a * closure.constraint.motion).translation() - b.translation();
+  RecordProperty("offset_m", testing::scientific(offset.norm()));
+  EXPECT_NEAR(offset.x(), 0.04, 0.005);  // the estimate's slide, kept
+  EXPECT_NEAR(offset.z(), 0.0, 0.005);   // the distance to the wall, measured
+  // No information along the slide, in the edge's tangent coordinates (camera B's frame).
+  se3::Vector6d slide = se3::Vector6d::Zero();
+  slide.tail<3>() = b.linear().transpose() * Eigen::Vector3d::UnitX();
+  const se3::Matrix6d& information = closure.constraint.information;
+  EXPECT_LT(slide.dot(information * slide), 1e-6 * information.trace());
 }
 
 TEST_F(LoopClosureTest, ReportsBadInput) {

@@ -410,5 +410,17 @@ TEST(EdgeInformation, AddedErrorAddsCovariances) {
   EXPECT_TRUE(registration::with_added_error(information, 0, 0).isApprox(information, 1e-12));
 }
 
+TEST(EdgeInformation, AddedErrorKeepsFreeDirectionsFree) {
+  // An edge that measured nothing along x (a slide along a corridor): the added error must not
+  // invent information there, and the measured directions get theirs as without the free one.
+  se3::Matrix6d information = registration::prior_information(1e-3, 2e-3);
+  information(3, 3) = 0;
+  const se3::Matrix6d combined = registration::with_added_error(information, 2e-3, 3e-3);
+  ASSERT_TRUE(combined.allFinite());
+  EXPECT_NEAR(combined.row(3).norm(), 0.0, 1e-9);
+  EXPECT_NEAR(1.0 / combined(4, 4), 13e-6, 1e-12);
+  EXPECT_NEAR(1.0 / combined(0, 0), 5e-6, 1e-12);
+}
+
 }  // namespace
 }  // namespace kartograf

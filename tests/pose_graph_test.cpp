@@ -120,6 +120,24 @@ TEST(PoseGraph, FalseLoopClosureIsPruned) {
   }
 }
 
+// A loop edge with no information along x (left to the estimate): poses that disagree with it
+// only along x agree with it in every direction it measured.
+TEST(PoseGraph, MeasuredResidualIgnoresDirectionsWithoutInformation) {
+  std::vector<Eigen::Isometry3d> poses = {Eigen::Isometry3d::Identity(),
+                                          Eigen::Isometry3d(Eigen::Translation3d(1.0, 0, 0))};
+  mapping::PoseGraphEdge edge{0, 1, Eigen::Isometry3d(Eigen::Translation3d(1.1, 0, 0)),
+                              se3::Matrix6d::Identity(), true};
+  EXPECT_NEAR(mapping::measured_residual(edge, poses).metres, 0.1, 1e-9);  // fully measured
+  edge.information(3, 3) = 0;
+  EXPECT_NEAR(mapping::measured_residual(edge, poses).metres, 0.0, 1e-9);
+  // A disagreement along y is still seen, and a turn.
+  poses[1] = Eigen::Translation3d(1.0, 0.05, 0) * Eigen::AngleAxisd(0.02, Eigen::Vector3d::UnitZ());
+  const mapping::EdgeResidual residual = mapping::measured_residual(edge, poses);
+  EXPECT_NEAR(residual.metres, 0.05, 0.01);
+  EXPECT_NEAR(residual.radians, 0.02, 1e-9);
+  EXPECT_THROW(mapping::measured_residual({0, 2, {}, {}, true}, poses), Error);
+}
+
 TEST(PoseGraph, RejectsEdgesToMissingNodes) {
   mapping::PoseGraph graph;
   graph.add_node(Eigen::Isometry3d::Identity());

@@ -1,5 +1,6 @@
 #include "kartograf/mapping/pose_graph.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <cmath>
@@ -241,6 +242,24 @@ PoseGraphSummary optimize_pose_graph(PoseGraph& graph, const PoseGraphParams& op
   summary.converged = again.converged;
   summary.pruned_loop_closures = summary.pruned_edges.size();
   return summary;
+}
+
+EdgeResidual measured_residual(const PoseGraphEdge& edge,
+                               const std::vector<Eigen::Isometry3d>& poses) {
+  require(edge.from < poses.size() && edge.to < poses.size(),
+          "pose graph: edge " + std::to_string(edge.from) + " -> " + std::to_string(edge.to) +
+              " names a missing node (" + std::to_string(poses.size()) + " poses)");
+  const se3::Vector6d tangent =
+      se3::log(edge.measurement.inverse() * poses[edge.from].inverse() * poses[edge.to]);
+  const Eigen::SelfAdjointEigenSolver<se3::Matrix6d> eigen(edge.information);
+  const double largest = eigen.eigenvalues().maxCoeff();
+  se3::Vector6d measured = se3::Vector6d::Zero();
+  for (int k = 0; k < 6; ++k) {
+    if (!(eigen.eigenvalues()(k) > 1e-9 * largest)) continue;
+    const se3::Vector6d u = eigen.eigenvectors().col(k);
+    measured += u.dot(tangent) * u;
+  }
+  return {measured.tail<3>().norm(), measured.head<3>().norm()};
 }
 
 }  // namespace kartograf::mapping

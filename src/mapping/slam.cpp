@@ -168,11 +168,11 @@ class GraphState {
     for (std::size_t l = 0; l < loops_.size(); ++l) {
       if (dropped[l]) continue;
       const PoseGraphEdge& edge = loops_[l].edge;
-      const Eigen::Isometry3d residual =
-          edge.measurement.inverse() * poses[edge.from].inverse() * poses[edge.to];
-      const double excess =
-          std::max(residual.translation().norm() / consistency_.max_residual_m,
-                   se3::rotation_angle(residual) / (consistency_.max_residual_deg * kDegree));
+      const EdgeResidual residual = measured_residual(edge, poses);
+      const double limit_m = consistency_.max_residual_m +
+                             consistency_.baseline_fraction * edge.measurement.translation().norm();
+      const double excess = std::max(residual.metres / limit_m,
+                                     residual.radians / (consistency_.max_residual_deg * kDegree));
       if (excess > worst_excess) {
         worst_excess = excess;
         worst = l;
@@ -344,10 +344,9 @@ SlamResult run_slam(const compute::Context& context, const FrameSource& source,
     if (!record.closure.report.accepted()) continue;
     const PoseGraphEdge edge = edge_of(record.closure.constraint, true);
     record.chi2 = edge_chi2(final_poses, edge);
-    const Eigen::Isometry3d residual =
-        edge.measurement.inverse() * result.poses[edge.from].inverse() * result.poses[edge.to];
-    record.residual_m = residual.translation().norm();
-    record.residual_deg = se3::rotation_angle(residual) / kDegree;
+    const EdgeResidual residual = measured_residual(edge, result.poses);
+    record.residual_m = residual.metres;
+    record.residual_deg = residual.radians / kDegree;
   }
   if (params.build_map && total > 0) {
     const auto optimised = [&](std::size_t i, const registration::RgbdImages&) {

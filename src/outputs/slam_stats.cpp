@@ -35,6 +35,8 @@ RunJson loop_closure_json(const mapping::LoopClosureRecord& record) {
                     rotation.y(),
                     rotation.z(),
                     rotation.w()};
+  // Directions the loop left to the estimate (weak in the query's geometry): not measured.
+  json["free_directions"] = record.closure.free_directions;
   json["chi2"] = record.chi2;
   json["residual_m"] = record.residual_m;
   json["residual_deg"] = record.residual_deg;

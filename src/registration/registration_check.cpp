@@ -81,10 +81,13 @@ se3::Matrix6d prior_information(double sigma_rotation_rad, double sigma_translat
 
 se3::Matrix6d with_added_error(const se3::Matrix6d& information, double sigma_rotation_rad,
                                double sigma_translation_m) {
-  se3::Matrix6d covariance = information.ldlt().solve(se3::Matrix6d::Identity());
-  covariance.diagonal().head<3>().array() += sigma_rotation_rad * sigma_rotation_rad;
-  covariance.diagonal().tail<3>().array() += sigma_translation_m * sigma_translation_m;
-  const se3::Matrix6d result = covariance.ldlt().solve(se3::Matrix6d::Identity());
+  // (Omega^-1 + S)^-1 = (I + Omega S)^-1 Omega: no inverse of Omega, so an information that
+  // leaves directions free (zero eigenvalues) keeps them free.
+  se3::Vector6d added;
+  added << Eigen::Vector3d::Constant(sigma_rotation_rad * sigma_rotation_rad),
+      Eigen::Vector3d::Constant(sigma_translation_m * sigma_translation_m);
+  const se3::Matrix6d mixed = se3::Matrix6d::Identity() + information * added.asDiagonal();
+  const se3::Matrix6d result = mixed.partialPivLu().solve(information);
   return 0.5 * (result + result.transpose());
 }
 

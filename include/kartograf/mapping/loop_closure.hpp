@@ -30,7 +30,9 @@
 // degeneracy of j's geometry, geometric_information.hpp) and accepted only when it corrects the
 // estimate by less than min_correction_m + drift_fraction x path (and max_correction_deg). The
 // edge's information is that geometric information through `information`, with an error
-// proportional to the baseline added (baseline_error_fraction).
+// proportional to the baseline added (baseline_error_fraction). In the directions j's geometry
+// leaves nearly free (weak_direction_ratio) the edge keeps the expected motion and has no
+// information: ICP slides there to answers that fit as well as the right one.
 #include <cstddef>
 #include <memory>
 #include <span>
@@ -43,6 +45,7 @@
 #include "kartograf/core/point_image.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/registration/feature_front_end.hpp"
+#include "kartograf/registration/geometric_information.hpp"
 #include "kartograf/registration/icp.hpp"
 #include "kartograf/registration/odometry.hpp"
 #include "kartograf/registration/registration_check.hpp"
@@ -75,7 +78,11 @@ struct LoopClosureParams {
   // depth camera's calibration (7-Scenes: ICP between views 0.35-0.55 m apart, Kartograf's and
   // Open3D's alike, disagreed with the ground truth by 2-10 cm while consistent with each other).
   // Added to the edge as an independent error of this fraction of its translation and rotation.
-  double baseline_error_fraction = 0.05;
+  double baseline_error_fraction = 0.02;
+  // Directions whose balanced eigenvalue of the query's geometric information is below this
+  // fraction of the largest are left to the expected motion, with no information in the edge
+  // (0: ICP's answer in every direction).
+  double weak_direction_ratio = 0.03;
 };
 
 struct LoopCandidate {
@@ -99,6 +106,9 @@ struct LoopClosure {
   // From the match frame to the query frame (T_match^-1 T_query), for the pose graph; valid when
   // report.accepted().
   registration::RelativePose constraint;
+  // Directions the query's geometry left free (weak_direction_ratio): the constraint keeps the
+  // expected motion in them and has no information there.
+  std::size_t free_directions = 0;
 };
 
 class LoopClosureDetector {
@@ -147,6 +157,8 @@ class LoopClosureDetector {
   LoopCandidate candidate_between(std::size_t query, std::size_t match,
                                   std::span<const Eigen::Isometry3d> poses) const;
   static void require_pose(std::span<const Eigen::Isometry3d> poses, std::size_t frame);
+  // ICP of the built source_ (query) against target_ (match) from `initial`.
+  registration::IcpResult align(const Eigen::Isometry3d& initial);
 
   PinholeIntrinsics camera_;
   geometry::DepthRange range_;

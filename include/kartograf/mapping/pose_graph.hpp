@@ -60,4 +60,15 @@ PoseGraphSummary optimize_pose_graph(PoseGraph& graph, const PoseGraphParams& op
 // chi^2 = e^T Omega e of one edge at the current poses, e = log(Z^-1 T_i^-1 T_j).
 double edge_chi2(const PoseGraph& graph, const PoseGraphEdge& edge);
 
+// How far the poses disagree with an edge in the directions it measured: e = log(Z^-1 T_i^-1 T_j)
+// projected on the range of the edge's information (eigenvalues above 1e-9 x the largest). An
+// edge with no information in a direction (a loop closure that left it to the estimate) has no
+// say in it, so the poses moving there is no disagreement.
+struct EdgeResidual {
+  double metres = 0;   // |v| of the projected (omega, v)
+  double radians = 0;  // |omega|
+};
+EdgeResidual measured_residual(const PoseGraphEdge& edge,
+                               const std::vector<Eigen::Isometry3d>& poses);
+
 }  // namespace kartograf::mapping

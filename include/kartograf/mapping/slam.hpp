@@ -35,9 +35,14 @@
 namespace kartograf::mapping {
 
 // After an optimisation, a loop closure whose edge still disagrees with the poses by more than
-// this is inconsistent with the rest: dropped (the worst first) and the graph optimised again.
+// this, in the directions it measured (those its information constrains), is inconsistent with
+// the rest: dropped (the worst first) and the graph optimised again.
+// The translation limit grows with the loop's own translation: wide-baseline registrations carry
+// a systematic error (loop_closure.hpp's baseline_error_fraction; on 7-Scenes right loops were
+// 2-9 cm off the truth at baselines of 0.35-0.65 m) that a fixed limit takes for a wrong loop.
 struct LoopConsistency {
   double max_residual_m = 0.03;
+  double baseline_fraction = 0.05;  // of the loop's translation, added to max_residual_m
   double max_residual_deg = 2;
 };
 
@@ -86,7 +91,8 @@ OdometryRun run_odometry(const compute::Context& context, const FrameSource& sou
 struct LoopClosureRecord {
   LoopClosure closure;
   bool pruned = false;  // accepted, then removed by the pose graph as inconsistent
-  // Accepted ones, at the final poses: chi^2 of the edge, and how far the poses disagree with it.
+  // Accepted ones, at the final poses: chi^2 of the edge, and how far the poses disagree with it
+  // in the directions it measured.
   double chi2 = 0;
   double residual_m = 0;
   double residual_deg = 0;

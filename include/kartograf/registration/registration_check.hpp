@@ -75,7 +75,8 @@ se3::Matrix6d prior_information(double sigma_rotation_rad, double sigma_translat
 
 // Adds an independent error (standard deviations per axis) to an edge: covariances add, so
 // Omega' = (Omega^-1 + diag(sigma_rotation^2 x3, sigma_translation^2 x3))^-1. For errors that grow
-// with the motion itself, such as depth-calibration bias in wide-baseline registrations.
+// with the motion itself, such as depth-calibration bias in wide-baseline registrations. Omega may
+// be singular: the directions it leaves free stay free.
 se3::Matrix6d with_added_error(const se3::Matrix6d& information, double sigma_rotation_rad,
                                double sigma_translation_m);
 
