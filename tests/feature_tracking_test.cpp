@@ -127,5 +127,40 @@ TEST(FeatureTracking, LoopClosureFindsByAppearanceWhatTheDriftHides) {
   EXPECT_TRUE(blind.find_appearance_candidates(1, poses).empty());
 }
 
+// A loop found by pose whose ICP corrects the estimate by more than a loop may move without drift
+// (here 25 cm against 10 cm) must be seen by the features too: with matching views it is; with
+// the match's colour from elsewhere (features that see another place) it is unconfirmed; without
+// a feature front end it stands on ICP alone.
+TEST(FeatureTracking, ALargeLoopCorrectionNeedsTheFeaturesToAgree) {
+  const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
+  const testing::RenderedSequence views =
+      testing::render_sequence({tour[400].pose, tour[404].pose, tour[100].pose}, kKinect);
+  geometry::DepthRange range;
+  range.units_per_metre = testing::kSynthUnitsPerMetre;
+  mapping::LoopClosureParams params;
+  params.min_frame_gap = 1;
+  params.min_correction_m = 0.1;
+  std::vector<Eigen::Isometry3d> poses = {views.truth[0], views.truth[1]};
+  poses[1] = Eigen::Translation3d(0.2, 0.15, 0) * poses[1];
+  mapping::LoopCandidate candidate;
+  candidate.query = 1;
+  candidate.query_frame = 1;
+  candidate.drift_allowance_m = 0.5;
+  const compute::Context context = compute::Context::cpu();
+  const auto verdict = [&](std::shared_ptr<const features::OrbFrontEnd> front_end,
+                           const RgbImage& match_color) {
+    mapping::LoopClosureDetector detector(context, kKinect, range, params, front_end);
+    detector.add_keyframe(0, views.frames[0].depth, 0.0, &match_color);
+    detector.add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
+    const mapping::LoopClosure closure = detector.verify(candidate, poses);
+    EXPECT_GT(closure.report.correction_m, params.min_correction_m);
+    return closure.report.verdict;
+  };
+  using registration::RegistrationVerdict;
+  EXPECT_EQ(verdict(orb(), views.frames[0].color), RegistrationVerdict::accepted);
+  EXPECT_EQ(verdict(orb(), views.frames[2].color), RegistrationVerdict::unconfirmed);
+  EXPECT_EQ(verdict(nullptr, views.frames[2].color), RegistrationVerdict::accepted);
+}
+
 }  // namespace
 }  // namespace kartograf

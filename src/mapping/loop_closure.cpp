@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <optional>
 #include <span>
 #include <string>
 
@@ -35,6 +36,7 @@ void validate(const LoopClosureParams& p) {
   require(p.baseline_error_fraction >= 0, "loop closure: baseline_error_fraction must be >= 0");
   require(p.weak_direction_ratio >= 0 && p.weak_direction_ratio < 1,
           "loop closure: weak_direction_ratio must be in [0, 1)");
+  require(p.feature_agreement_m > 0, "loop closure: feature_agreement_m must be > 0");
   require(p.icp_width > 0 && p.information_width > 0 && p.min_icp_level >= 0,
           "loop closure: icp_width and information_width must be > 0, min_icp_level >= 0");
   require(p.min_overlap >= 0 && p.min_overlap <= 1, "loop closure: min_overlap must be in [0, 1]");
@@ -237,6 +239,11 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   LoopClosure closure;
   closure.candidate = candidate;
   closure.report = registration::judge_registration(result, expected, limits, geometry.degeneracy);
+  if (closure.report.accepted() && !candidate.by_appearance &&
+      closure.report.correction_m > params_.min_correction_m &&
+      !features_agree(query, match, result.source_to_target)) {
+    closure.report.verdict = registration::RegistrationVerdict::unconfirmed;
+  }
   // Where the query's geometry barely constrains a direction (along a corridor, along the line
   // where a wall meets the floor), ICP slides to answers that fit as well as the right one (on
   // the synthetic surveys 5-23 cm off the truth with fitness 0.5-0.8): the loop keeps the expected
@@ -257,6 +264,15 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
       fraction * motion.translation().norm());
   closure.constraint = {match.frame, query.frame, motion, information, false};
   return closure;
+}
+
+bool LoopClosureDetector::features_agree(const Keyframe& query, const Keyframe& match,
+                                         const Eigen::Isometry3d& motion) const {
+  if (!features_ || !query.features || !match.features) return true;
+  const std::optional<registration::FeatureAlignment> aligned =
+      features_->align(*query.features, *match.features);
+  return aligned && (aligned->source_to_target.translation() - motion.translation()).norm() <=
+                        params_.feature_agreement_m;
 }
 
 registration::IcpResult LoopClosureDetector::align(const Eigen::Isometry3d& initial) {

@@ -20,6 +20,8 @@ std::string_view to_string(RegistrationVerdict verdict) {
       return "degenerate";
     case RegistrationVerdict::implausible:
       return "implausible";
+    case RegistrationVerdict::unconfirmed:
+      return "unconfirmed";
   }
   return "unknown";
 }

@@ -83,6 +83,10 @@ struct LoopClosureParams {
   // fraction of the largest are left to the expected motion, with no information in the edge
   // (0: ICP's answer in every direction).
   double weak_direction_ratio = 0.03;
+  // A candidate by pose whose ICP corrected the estimate by more than min_correction_m leans on
+  // the drift allowance (5 % of a 40 m path is 2 m): with a feature front end, the features of
+  // the two keyframes must then find the same motion within this (else: unconfirmed).
+  double feature_agreement_m = 0.1;
 };
 
 struct LoopCandidate {
@@ -159,6 +163,10 @@ class LoopClosureDetector {
   static void require_pose(std::span<const Eigen::Isometry3d> poses, std::size_t frame);
   // ICP of the built source_ (query) against target_ (match) from `initial`.
   registration::IcpResult align(const Eigen::Isometry3d& initial);
+  // Whether the keyframes' features agree with `motion` (match <- query) within
+  // feature_agreement_m; true when either keyframe has none.
+  bool features_agree(const Keyframe& query, const Keyframe& match,
+                      const Eigen::Isometry3d& motion) const;
 
   PinholeIntrinsics camera_;
   geometry::DepthRange range_;

@@ -32,6 +32,7 @@ enum class RegistrationVerdict {
   high_rmse,
   degenerate,
   implausible,  // too far from the expected motion
+  unconfirmed,  // a second, independent measurement (e.g. local features) disagrees
 };
 std::string_view to_string(RegistrationVerdict verdict);
 
