@@ -15,9 +15,8 @@ namespace {
 using se3::Matrix6d;
 using se3::Vector6d;
 
-Vector6d edge_error(const PoseGraph& graph, const PoseGraphEdge& edge) {
-  return se3::log(edge.measurement.inverse() * graph.poses[edge.from].inverse() *
-                  graph.poses[edge.to]);
+Vector6d edge_error(const std::vector<Eigen::Isometry3d>& poses, const PoseGraphEdge& edge) {
+  return se3::log(edge.measurement.inverse() * poses[edge.from].inverse() * poses[edge.to]);
 }
 
 // First-order inverse right Jacobian of SE(3): I + ad(e) / 2.
@@ -84,7 +83,7 @@ LinearSystem build_system(const PoseGraph& graph, const PoseGraphParams& options
   triplets.reserve(graph.edges.size() * 4 * 36 + static_cast<std::size_t>(unknowns));
   Eigen::VectorXd gradient = Eigen::VectorXd::Zero(unknowns);
   for (const auto& edge : graph.edges) {
-    const Vector6d e = edge_error(graph, edge);
+    const Vector6d e = edge_error(graph.poses, edge);
     const double chi2 = e.dot(edge.information * e);
     const double w = robustify(chi2, edge.loop_closure, kernel).weight;
     const Matrix6d jr_inv = inverse_right_jacobian(e);
@@ -215,7 +214,7 @@ PoseGraphSummary graduated_optimization(PoseGraph& graph, const PoseGraphParams&
 }  // namespace
 
 double edge_chi2(const PoseGraph& graph, const PoseGraphEdge& edge) {
-  const Vector6d e = edge_error(graph, edge);
+  const Vector6d e = edge_error(graph.poses, edge);
   return e.dot(edge.information * e);
 }
 
@@ -249,8 +248,7 @@ EdgeResidual measured_residual(const PoseGraphEdge& edge,
   require(edge.from < poses.size() && edge.to < poses.size(),
           "pose graph: edge " + std::to_string(edge.from) + " -> " + std::to_string(edge.to) +
               " names a missing node (" + std::to_string(poses.size()) + " poses)");
-  const se3::Vector6d tangent =
-      se3::log(edge.measurement.inverse() * poses[edge.from].inverse() * poses[edge.to]);
+  const Vector6d tangent = edge_error(poses, edge);
   const Eigen::SelfAdjointEigenSolver<se3::Matrix6d> eigen(edge.information);
   const double largest = eigen.eigenvalues().maxCoeff();
   se3::Vector6d measured = se3::Vector6d::Zero();
