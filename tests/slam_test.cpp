@@ -76,7 +76,9 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
   RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
   RecordProperty("slam_ate_m", testing::scientific(slam_ate));
   EXPECT_LT(slam_ate, 0.01);
-  EXPECT_LE(slam_ate, odometry_ate * 1.05);
+  // The odometry's anchored re-estimates already hold this stretch to ~2 mm: the loops must not
+  // make it worse (measured: SLAM 2.15 mm, odometry 2.05 mm).
+  EXPECT_LE(slam_ate, odometry_ate * 1.1);
 
   ASSERT_GT(result.map.size(), 1000u);
   EXPECT_TRUE(result.map.has_normals());
@@ -86,6 +88,21 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
   for (const Eigen::Vector3f& n : result.map.normals) with_normal += n.norm() > 0.99f;
   EXPECT_GT(with_normal, result.map.size() * 8 / 10);  // edges and thin legs may have none
   EXPECT_GT(result.timing.total_seconds, 0.0);
+}
+
+// With the paper's re-estimation (against frame n-5) the odometry drifts more, and the loops
+// closing the way back onto the way out take at least 40 % of it out (measured: 4.1 -> 2.0 mm).
+TEST(Slam, LoopClosuresTakeOutTheOdometrysDrift) {
+  const testing::MemoryFrameSource source(out_and_back());
+  const compute::Context context = compute::Context::cpu();
+  mapping::SlamParams params = loop_params();
+  params.odometry.anchor = {0, 0, 0};
+  const mapping::SlamResult result = mapping::run_slam(context, source, params);
+  const double odometry_ate = testing::ate_rmse(result.odometry.poses, out_and_back().truth);
+  const double slam_ate = testing::ate_rmse(result.poses, out_and_back().truth);
+  RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
+  RecordProperty("slam_ate_m", testing::scientific(slam_ate));
+  EXPECT_LT(slam_ate, 0.6 * odometry_ate);
 }
 
 // Known poses (the frames' ground truth): nothing estimated, the poses are the truth relative to

@@ -85,6 +85,8 @@ struct SequenceRunOptions {
   std::string backend = "auto";
   std::string backend_source = "--backend";  // names the setting in errors
   int reestimate_interval = 5;
+  // The re-estimates' anchor bounds: metres, degrees, frames (registration::AnchorPolicy).
+  std::vector<double> anchor_bounds{0.4, 25, 100};
   bool progress = true;
 };
 

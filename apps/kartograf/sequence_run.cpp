@@ -51,9 +51,18 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   add_backend_option(command, o.backend, o.backend_source);
   command
       .add_option("--reestimate-every", o.reestimate_interval,
-                  "Re-register every k-th frame against frame n-k (the M3 paper's drift "
+                  "Re-register every k-th frame against the anchor (the M3 paper's drift "
                   "reduction; 0: off)")
       ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  command
+      .add_option(
+          "--anchor-bounds", o.anchor_bounds,
+          "The re-estimates' anchor is kept while the next re-estimate is within M "
+          "metres, DEG degrees and FRAMES frames of it (0,0,0: frame n-k, the paper's rule)")
+      ->expected(3)
+      ->delimiter(',')
+      ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
 }
@@ -89,6 +98,8 @@ registration::OdometryParams odometry_params(const SequenceRunOptions& options) 
                                                : registration::OdometryMethod::point_to_plane;
   params.icp = registration::odometry_icp_params(params.method);
   params.reestimate_interval = options.reestimate_interval;
+  params.anchor = {options.anchor_bounds.at(0), options.anchor_bounds.at(1),
+                   static_cast<int>(options.anchor_bounds.at(2))};
   return params;
 }
 

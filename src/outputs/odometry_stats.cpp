@@ -58,6 +58,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["step_frame"] = std::string(registration::to_string(frame.step_frame));
   json["previous"] = frame.previous ? registration_report_json(*frame.previous) : RunJson();
   json["reestimate"] = frame.reestimate ? registration_report_json(*frame.reestimate) : RunJson();
+  if (frame.reestimate) json["reestimate_anchor"] = frame.reestimate_anchor;
   json["seconds"] = frame.seconds;
   return json;
 }

@@ -22,13 +22,15 @@
 //     pose-graph edge gets only the weak prior information).
 //
 // Drift reduction (the paper's "iterative estimation every 5 images"): every k-th frame is
-// registered again against frame n-k, starting from the chained estimate T_{n-k}^-1 T_n. When the
-// re-estimate is accepted it replaces frame n's pose, and the correction is spread over frames
-// n-k+1..n-1 in proportion to their position (so the trajectory has no jump); chaining then
-// continues from the corrected pose. Every registration is kept as a RelativePose, so a pose graph
-// (mapping/) can use both the frame-to-frame and the k-back measurements. Only two earlier frames
-// are registered against (the previous one and the last multiple of k), so the odometry holds at
-// most three frame pyramids with the current one, whatever k.
+// registered again against an anchor, starting from the chained estimate T_a^-1 T_n. The paper's
+// anchor is frame n-k; here a re-estimated frame stays the anchor while the next re-estimate is
+// within AnchorPolicy's bounds of it (a hand-held camera that lingers is then registered against
+// one frame, not chained). When the re-estimate is accepted it replaces frame n's pose, and the
+// correction is spread over frames n-k+1..n-1 in proportion to their position (so the trajectory
+// has no jump); chaining then continues from the corrected pose. Every registration is kept as a
+// RelativePose, so a pose graph (mapping/) can use both the frame-to-frame and the anchor
+// measurements. Only two earlier frames are registered against (the previous one and the anchor),
+// so the odometry holds at most three frame pyramids with the current one, whatever k.
 //
 // Information of an edge: InformationModel applied to the geometric information, plus the weak
 // prior of an unmeasured step (fallback_sigma_*) so that no direction is entirely free.
@@ -88,6 +90,17 @@ struct KeyframePolicy {
   int max_interval = 30;  // frames
 };
 
+// The anchor of the re-estimates: held while the next re-estimate stays within these bounds of it,
+// so that a camera that lingers or sweeps back and forth is registered against one frame instead
+// of chaining a new registration error every k frames. All 0: the anchor is frame n-k, the M3
+// paper's rule. On 7-Scenes and SUN3D (the real sets; 0.2-0.8 m tried, docs/slam.md) 0.3-0.5 m
+// gave the lowest drift; registration errors grow with the baseline beyond that.
+struct AnchorPolicy {
+  double max_translation = 0.4;  // metres from the anchor
+  double max_rotation_deg = 25;
+  int max_interval = 100;  // frames
+};
+
 struct OdometryParams {
   OdometryMethod method = OdometryMethod::point_to_plane;
   IcpParams icp = odometry_icp_params(OdometryMethod::point_to_plane);  // keep it the method's
@@ -114,8 +127,10 @@ struct OdometryParams {
   bool depth_weighting = true;  // weight pairs by depth noise
   DepthWeightParams depth_weights;
   geometry::DepthRange depth_range;
-  // The paper's k: re-estimate every k-th frame against frame n-k (0: off).
+  // The paper's k: re-estimate every k-th frame against the anchor (frame n-k when the anchor
+  // policy's bounds are 0; 0: off).
   int reestimate_interval = 5;
+  AnchorPolicy anchor;
   // The prediction (initial guess, and the weak directions of degenerate frames): still: the
   // identity; velocity: the last turn (camera frame) and the last step of the camera centre
   // (world frame); acceleration: that step changed as it changed from the one before.
@@ -172,6 +187,7 @@ struct OdometryFrame {
   bool fallback = false;  // every attempt rejected: the pose comes from the motion model
   // Against frame index-k (every k-th frame).
   std::optional<RegistrationReport> reestimate;
+  std::size_t reestimate_anchor = 0;  // the frame it was registered against
   // The frame's geometry leaves some direction free: weak directions came from the prediction,
   // or from image intensity when `photometric`.
   bool degenerate = false;
@@ -205,7 +221,7 @@ class RgbdOdometry {
   const std::vector<std::size_t>& keyframes() const { return keyframes_; }
   const OdometryParams& params() const { return params_; }
   // Frame pyramids held: the current frame, the previous one and the anchor of the next
-  // re-estimate (at most 3, whatever reestimate_interval).
+  // re-estimate (at most 3, whatever reestimate_interval and the anchor policy).
   std::size_t kept_pyramids() const { return ring_.size(); }
 
  private:
@@ -234,6 +250,8 @@ class RgbdOdometry {
   std::optional<Attempt> register_from_features();
   void keep_images_for_features(const DepthImage& depth, const RgbImage* color);
   void reestimate(OdometryFrame& frame);
+  // Whether frame n, just re-estimated, becomes the next anchor (AnchorPolicy).
+  bool moves_anchor(std::size_t n) const;
   bool is_keyframe(const OdometryFrame& frame) const;
   FramePyramid& pyramid_of(std::size_t frame);
   // The slot holding `frame`'s pyramid, colour and plane samples; throws when it is not kept.
@@ -264,6 +282,7 @@ class RgbdOdometry {
   std::vector<OdometryFrame> frames_;
   std::vector<RelativePose> constraints_;
   std::vector<std::size_t> keyframes_;
+  std::size_t anchor_ = 0;  // the next re-estimate's anchor (AnchorPolicy)
   std::unique_ptr<PlanarFrames> planar_;
   // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses, with the step
   // kept in the world or the camera frame.
