@@ -51,6 +51,9 @@ void validate(const OdometryParams& params) {
           "odometry: recheck_fitness must be in [0, 1]");
   require(params.feature_seed_m >= 0 && params.feature_seed_deg >= 0,
           "odometry: feature_seed_m and feature_seed_deg must be >= 0");
+  require(params.feature_arbitration_m >= 0 && params.feature_arbitration_deg >= 0 &&
+              params.feature_arbitration_ratio > 0,
+          "odometry: feature_arbitration_m and _deg must be >= 0, feature_arbitration_ratio > 0");
   require(params.keyframes.max_interval >= 1, "odometry: keyframes.max_interval must be >= 1");
   require(params.anchor.max_translation >= 0 && params.anchor.max_rotation_deg >= 0 &&
               params.anchor.max_interval >= 0,
@@ -252,6 +255,7 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
       attempt.motion = refined.motion;
       attempt.photometric = true;
     }
+    attempt.photometric_rmse = refined.refined ? refined.rmse_after : refined.rmse_before;
   }
   return attempt;
 }
@@ -380,7 +384,31 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   if (is_doubtful(attempt)) {
     return best_of_other_starts(previous, predicted, std::move(attempt), frame);
   }
+  // Only where the images did not measure the weak directions themselves (a step beyond the
+  // refinement's basin, or too little texture): elsewhere they already had their say.
+  if (geometry_.degeneracy.degenerate && !attempt.photometric && attempt.photometric_rmse > 0) {
+    std::optional<Attempt> seeded = arbitrate_by_intensity(attempt);
+    if (seeded) {
+      frame.from_features = true;
+      return std::move(*seeded);
+    }
+  }
   return attempt;
+}
+
+std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
+    const Attempt& predicted) {
+  std::optional<Attempt> seeded = register_from_features();
+  if (!seeded || seeded->photometric_rmse <= 0) return {};
+  const Eigen::Isometry3d difference = seeded->motion.inverse() * predicted.motion;
+  if (difference.translation().norm() <= params_.feature_arbitration_m &&
+      se3::rotation_angle(difference) <= params_.feature_arbitration_deg * kDegree) {
+    return {};
+  }
+  if (seeded->photometric_rmse >= params_.feature_arbitration_ratio * predicted.photometric_rmse) {
+    return {};
+  }
+  return seeded;
 }
 
 bool RgbdOdometry::is_doubtful(const Attempt& attempt) const {

@@ -160,9 +160,18 @@ struct OdometryParams {
   // one of the other starts of a doubtful registration. Otherwise they cost nothing but a copy of
   // each frame's images. Not for degenerate frames in general: features matched a few
   // centimetres off, worse than the motion model (survey seed 2: 8.5 cm ATE against 2.8).
+  // But on a degenerate frame with colour whose weak directions the images did not measure
+  // (photometric refinement not kept), ICP from the features' motion is also run, and taken
+  // when it differs from the prediction's registration by more than feature_arbitration_m or
+  // _deg and its images agree better: a grey-level RMSE (after the photometric refinement of both)
+  // below feature_arbitration_ratio times the other's (a robot setting off from rest facing a wall,
+  // which the motion model takes for standing still).
   std::shared_ptr<const FeatureFrontEnd> features;
   double feature_seed_m = 0.25;
   double feature_seed_deg = 15;
+  double feature_arbitration_m = 0.05;
+  double feature_arbitration_deg = 2;
+  double feature_arbitration_ratio = 0.9;
 };
 
 // A measured (or, for fallbacks, predicted) motion between two frames, for a pose graph:
@@ -229,6 +238,8 @@ class RgbdOdometry {
     Eigen::Isometry3d motion = Eigen::Isometry3d::Identity();  // after degeneracy handling
     double inlier_rmse = 0;
     bool photometric = false;  // weak directions measured by intensity
+    // Grey-level RMSE of the images at the motion (degenerate frames with colour; 0: not measured).
+    double photometric_rmse = 0;
     RegistrationReport report;
   };
   // Registers the current frame against an earlier one.
@@ -245,6 +256,9 @@ class RgbdOdometry {
   Attempt best_of_other_starts(std::size_t previous, const Eigen::Isometry3d& predicted,
                                Attempt first, OdometryFrame& frame);
   bool is_large(const Eigen::Isometry3d& motion) const;
+  // A degenerate frame's registration from the prediction against ICP from the features' motion:
+  // the latter when the two disagree and its images agree better (photometric_rmse).
+  std::optional<Attempt> arbitrate_by_intensity(const Attempt& predicted);
   // ICP against the previous frame from its matched features' motion (OdometryParams::features),
   // when accepted.
   std::optional<Attempt> register_from_features();
