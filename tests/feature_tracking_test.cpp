@@ -90,14 +90,7 @@ TEST(FeatureTracking, OdometryFollowsStepsBeyondIcpsBasin) {
 const testing::RenderedSequence& survey_start() {
   static const testing::RenderedSequence sequence = [] {
     const synth::World world = synth::make_building(1);
-    synth::TourParams survey;
-    survey.survey = true;
-    survey.pitch_deg = 20;
-    const Trajectory tour =
-        synth::robot_tour(world, synth::tour_frames_needed(world, survey), survey);
-    std::vector<Eigen::Isometry3d> poses;
-    for (std::size_t i = 0; i <= 30; i += 10) poses.push_back(tour[i].pose);
-    return testing::render_sequence(world, poses, kKinect);
+    return testing::render_sequence(world, testing::survey_poses(world, 0, 4, 10), kKinect);
   }();
   return sequence;
 }

@@ -46,18 +46,6 @@ void PrintTo(const DegenerateStretch& s, std::ostream* out) {
   *out << stretch_name(s);
 }
 
-// The survey's poses first..first+count-1 in the building of `seed`.
-std::vector<Eigen::Isometry3d> survey_poses(const synth::World& world, const DegenerateStretch& s) {
-  synth::TourParams tour;
-  tour.survey = true;
-  tour.pitch_deg = 20;
-  const Trajectory trajectory =
-      synth::robot_tour(world, synth::tour_frames_needed(world, tour), tour);
-  std::vector<Eigen::Isometry3d> poses;
-  for (std::size_t i = s.first; i < s.first + s.count; ++i) poses.push_back(trajectory.at(i).pose);
-  return poses;
-}
-
 struct StepError {
   double metres = 0, degrees = 0;
 };
@@ -73,8 +61,8 @@ TrackedStretch track_stretch(const DegenerateStretch& stretch,
                              registration::OdometryParams params) {
   const synth::World world = synth::make_building(stretch.seed);
   const PinholeIntrinsics kinect{640, 480, 525, 525, 319.5, 239.5};
-  const testing::RenderedSequence sequence =
-      testing::render_sequence(world, survey_poses(world, stretch), kinect);
+  const testing::RenderedSequence sequence = testing::render_sequence(
+      world, testing::survey_poses(world, stretch.first, stretch.count), kinect);
   params.depth_range.units_per_metre = testing::kSynthUnitsPerMetre;
   params.photometric_refinement = stretch.photometric;
   const compute::Context context = compute::Context::cpu();

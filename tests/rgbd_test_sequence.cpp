@@ -4,6 +4,7 @@
 
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/synth/render.hpp"
+#include "kartograf/synth/trajectory.hpp"
 
 namespace kartograf::testing {
 
@@ -14,6 +15,18 @@ const synth::World& test_world() {
 
 PinholeIntrinsics qvga_kinect() {
   return {320, 240, 262.5, 262.5, 159.5, 119.5};
+}
+
+std::vector<Eigen::Isometry3d> survey_poses(const synth::World& world, std::size_t first,
+                                            std::size_t count, std::size_t stride) {
+  synth::TourParams tour;
+  tour.survey = true;
+  tour.pitch_deg = 20;
+  const Trajectory trajectory =
+      synth::robot_tour(world, synth::tour_frames_needed(world, tour), tour);
+  std::vector<Eigen::Isometry3d> poses;
+  for (std::size_t i = 0; i < count; ++i) poses.push_back(trajectory.at(first + i * stride).pose);
+  return poses;
 }
 
 RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,

@@ -20,6 +20,10 @@ inline constexpr double kSynthUnitsPerMetre = 5000.0;
 const synth::World& test_world();
 // 320x240, f = 262.5: the TUM Kinect at half resolution.
 PinholeIntrinsics qvga_kinect();
+// Poses first, first + stride, ... (count of them) of the survey through `world` (the demo's
+// recipe: `kartograf synth --survey --pitch 20`).
+std::vector<Eigen::Isometry3d> survey_poses(const synth::World& world, std::size_t first,
+                                            std::size_t count, std::size_t stride = 1);
 
 struct RenderedSequence {
   PinholeIntrinsics camera;
