@@ -101,7 +101,7 @@ CLI::App* add_slam_command(CLI::App& app, SlamOptions& o) {
   add_sequence_run_options(*command, o.run);
   command->add_option("--out", o.out_dir, "Output folder (created if missing)")->required();
   command->add_flag("--no-loop-closure", o.no_loop_closure,
-                    "Optimise odometry edges only (frame-to-frame and k-back)");
+                    "Optimise odometry edges only (frame-to-frame and anchor re-estimates)");
   command->add_flag("--no-map", o.no_map, "Skip the map (no second pass over the frames)");
   command->add_flag("--features", o.features,
                     "ORB features (as kartograf map): loop-closure candidates by appearance too, "

@@ -153,8 +153,8 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
       builder_(context, camera, params_.depth_range),
       engine_(context, params_.icp, finder_for(context, params_)) {
   validate(params_);
-  // The frame being tracked, the previous one and, with re-estimation, the last multiple of k:
-  // whatever k, no other frame is registered against again.
+  // The frame being tracked, the previous one and, with re-estimation, the anchor: whatever k and
+  // the anchor policy, no other frame is registered against again.
   const std::size_t slots = params_.reestimate_interval > 0 ? 3 : 2;
   // Per pixel and slot: points, normals and packed colours over the pyramid's levels (4/3 of the
   // finest), and the colour kept for photometric refinement.

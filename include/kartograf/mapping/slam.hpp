@@ -1,13 +1,13 @@
 #pragma once
 // The RGB-D SLAM pipeline (docs/methods.md M3 and the paper's future work): odometry with the
-// paper's k-back drift reduction, loop closure between keyframes, a pose graph over every frame,
-// and a fused map. Wiring only: the parts are registration/odometry.hpp, mapping/loop_closure.hpp,
-// mapping/pose_graph.hpp and mapping/map_fusion.hpp; frames come through a FrameSource, read one
-// ahead on a second thread.
+// paper's drift reduction (re-estimates against an anchor), loop closure between keyframes, a pose
+// graph over every frame, and a fused map. Wiring only: the parts are registration/odometry.hpp,
+// mapping/loop_closure.hpp, mapping/pose_graph.hpp and mapping/map_fusion.hpp; frames come through
+// a FrameSource, read one ahead on a second thread.
 //
 //   1. Every frame is tracked by RgbdOdometry. The pose graph has one node per frame and one edge
-//      per accepted registration (frame-to-frame and k-back, information from the frame's
-//      geometric information through the InformationModel) or motion-model fallback (a weak
+//      per accepted registration (frame-to-frame and anchor re-estimates, information from the
+//      frame's geometric information through the InformationModel) or motion-model fallback (a weak
 //      prior).
 //   2. Each new keyframe is matched against earlier keyframes (LoopClosureDetector with the
 //      current estimate). Verified loop closures become edges; after a keyframe that closed a

@@ -194,7 +194,7 @@ struct OdometryFrame {
   // The accepted registration started from the matched features' motion (OdometryParams::features).
   bool from_features = false;
   bool fallback = false;  // every attempt rejected: the pose comes from the motion model
-  // Against frame index-k (every k-th frame).
+  // Against the anchor (every k-th frame; frame index-k under the paper's rule).
   std::optional<RegistrationReport> reestimate;
   std::size_t reestimate_anchor = 0;  // the frame it was registered against
   // The frame's geometry leaves some direction free: weak directions came from the prediction,
