@@ -305,7 +305,7 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
 
   clock.start("grid");
   result.semantic = semantic::build_semantic_grid(views.points(), views.labels(), params.grid, {},
-                                                  views.view_ids());
+                                                  views.view_ids(), views.view_origins());
   result.occupancy = semantic::to_occupancy_grid(result.semantic);
 
   clock.start("rooms");

@@ -20,6 +20,7 @@ void LabelledViews::add(const PointImage& points, const SemanticImage& labels,
     labels_.push_back(labels.data()[i]);
     view_ids_.push_back(static_cast<std::uint32_t>(views_));
   }
+  origins_.push_back(sensor_to_world.translation());
   ++views_;
 }
 
@@ -40,6 +41,7 @@ Eigen::Matrix3d LabelledViews::make_up_z() {
 
 void LabelledViews::transform(const Eigen::Isometry3d& transform) {
   for (Eigen::Vector3d& p : points_) p = transform * p;
+  for (Eigen::Vector3d& o : origins_) o = transform * o;
 }
 
 }  // namespace kartograf::semantic

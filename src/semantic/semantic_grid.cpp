@@ -5,6 +5,7 @@
 #include <deque>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <sstream>
 #include <string>
 
@@ -17,6 +18,7 @@
 #include "kartograf/core/memory_budget.hpp"
 #include "semantic/grid_cells.hpp"
 #include "semantic/grid_doorways.hpp"
+#include "semantic/grid_free_space.hpp"
 #include "semantic/grid_furniture.hpp"
 #include "semantic/grid_walls.hpp"
 
@@ -28,6 +30,11 @@ namespace {
 constexpr double kMinFacePhaseAgreement = 0.1;
 // Face cells of walls seen from both sides needed to measure a wall's thickness (1 m of wall).
 constexpr int kMinTwoSidedWallCells = 40;
+// Furniture is judged seen through this far below its top: inside a table's 2-5 cm top.
+constexpr double kBelowTop = 0.015;
+// Wall cells whose points start this high above the floor, and that the views saw through below
+// them (to kBelowWall under their lowest point), stand on nothing: a table's edge, not a wall.
+constexpr double kRaisedWall = 0.3, kBelowWall = 0.05;
 
 constexpr std::size_t index_of(SemanticClass c) {
   return static_cast<std::size_t>(c);
@@ -172,33 +179,111 @@ CellMask closed_cell_mask(const SemanticGrid& grid, const Selected& selected, in
   return m;
 }
 
+// The height below which a piece of furniture cells must have been seen through for a cell to be
+// open floor: its top (the 90th percentile of its cells' highest points, a stray point aside),
+// less a little so that the slab judged lies inside a 2-5 cm table top.
+double check_height(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                    const std::vector<cv::Point>& cells) {
+  std::vector<float> tops;
+  for (const cv::Point& c : cells) {
+    const float top = evidence(c.x, c.y).z_max;
+    if (std::isfinite(top)) tops.push_back(top);
+  }
+  if (tops.empty()) return std::numeric_limits<double>::quiet_NaN();
+  const auto k = static_cast<long>(tops.size() * 9 / 10);
+  std::nth_element(tops.begin(), tops.begin() + k, tops.end());
+  return tops[static_cast<std::size_t>(k)] - grid.floor_z - kBelowTop;
+}
+
+// Whether the views saw through `cell` at every height below `height`: then it is floor beside
+// furniture, not under it.
+bool clear_below(const detail::BandFreeSpace* free_space, int col, int row, double height) {
+  return free_space && std::isfinite(height) && free_space->clear_below({col, row}, height);
+}
+
+// Wall cells that the views saw under (a table's edge or a shelf board the views took for a wall:
+// walls stand on the floor) become unclassified obstacles, for the furniture passes to judge.
+void raised_walls_to_unclassified(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                                  const detail::BandFreeSpace& free_space, float weight) {
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const double lowest = evidence(col, row).z_min - grid.floor_z;
+      if (grid.classes(col, row) != SemanticClass::wall || !(lowest >= kRaisedWall) ||
+          !free_space.clear_below({col, row}, lowest - kBelowWall))
+        continue;
+      grid.classes(col, row) = SemanticClass::unknown;
+      grid.weight(col, row) = weight;
+    }
+  }
+}
+
+// The rectangle around a piece's outline, turned to the outline's own directions (the length-
+// weighted mean of its edges' angles modulo 90 degrees): an L of a table's two edges gives the
+// table, where the smallest rectangle around an L may lie along its diagonal.
+std::vector<cv::Point> rectangle_around(const std::vector<cv::Point>& outline) {
+  double s = 0, c = 0;
+  for (std::size_t i = 0; i < outline.size(); ++i) {
+    const cv::Point d = outline[(i + 1) % outline.size()] - outline[i];
+    const double length = std::hypot(d.x, d.y), angle = std::atan2(d.y, d.x);
+    s += length * std::sin(4 * angle), c += length * std::cos(4 * angle);
+  }
+  const double angle = std::atan2(s, c) / 4;
+  const Eigen::Vector2d u(std::cos(angle), std::sin(angle)), v(-u.y(), u.x());
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const cv::Point& p : outline) {
+    const Eigen::Vector2d q(u.dot(Eigen::Vector2d(p.x, p.y)), v.dot(Eigen::Vector2d(p.x, p.y)));
+    lo = lo.cwiseMin(q), hi = hi.cwiseMax(q);
+  }
+  std::vector<cv::Point> corners;
+  for (const Eigen::Vector2d& q :
+       {lo, Eigen::Vector2d(hi.x(), lo.y()), hi, Eigen::Vector2d(lo.x(), hi.y())}) {
+    const Eigen::Vector2d p = q.x() * u + q.y() * v;
+    corners.push_back({static_cast<int>(std::lround(p.x())), static_cast<int>(std::lround(p.y()))});
+  }
+  return corners;
+}
+
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
 // piece, closed over gaps of a few cells, is filled to its convex hull when that is at most
-// max_area: the robot cannot drive under it within its height band.
-void fill_furniture(SemanticGrid& grid, Image<std::uint8_t>& furniture, double max_area,
-                    float furniture_weight) {
-  const int w = grid.width(), h = grid.height();
+// max_area: the robot cannot drive under it within its height band. Hull cells that rays crossed
+// at every height below the piece's top stay floor (the hull of an L or of two pieces spans open
+// floor).
+void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                    const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
+                    double max_area, float furniture_weight) {
   const CellMask outlines = closed_cell_mask(
       grid, [&](int col, int row) { return furniture(col, row) != 0; }, 7);
   std::vector<std::vector<cv::Point>> pieces;
   cv::findContours(outlines.closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
-  cv::Mat fill = cv::Mat::zeros(h, w, CV_8U);
   const double cell_area = grid.resolution * grid.resolution;
   for (const auto& piece : pieces) {
     std::vector<cv::Point> hull;
     cv::convexHull(piece, hull);
-    if (cv::contourArea(hull) * cell_area <= max_area) cv::fillConvexPoly(fill, hull, 255);
-  }
-  for (int row = 0; row < h; ++row) {
-    for (int col = 0; col < w; ++col) {
-      const SemanticClass c = grid.classes(col, row);
+    if (cv::contourArea(hull) * cell_area > max_area) continue;
+    if (free_space) hull = rectangle_around(piece);
+    const cv::Rect box = cv::boundingRect(hull) & cv::Rect(0, 0, grid.width(), grid.height());
+    cv::Mat fill = cv::Mat::zeros(box.height, box.width, CV_8U);
+    for (cv::Point& p : hull) p -= box.tl();
+    cv::fillConvexPoly(fill, hull, 255);
+    std::vector<cv::Point> cells, marked;
+    for (int y = 0; y < box.height; ++y) {
+      for (int x = 0; x < box.width; ++x) {
+        if (!fill.at<std::uint8_t>(y, x)) continue;
+        cells.push_back(box.tl() + cv::Point(x, y));
+        if (furniture(cells.back().x, cells.back().y)) marked.push_back(cells.back());
+      }
+    }
+    const double height = free_space ? check_height(grid, evidence, marked) : 0.0;
+    for (const cv::Point& c : cells) {
       // Only floor changes: walls and doors keep their class, and what no view saw stays
       // unknown (filling it made rooms leak where the views were few).
-      if (!fill.at<std::uint8_t>(row, col) || furniture(col, row) || c != SemanticClass::floor)
+      if (furniture(c.x, c.y) || grid.classes(c.x, c.y) != SemanticClass::floor ||
+          clear_below(free_space, c.x, c.y, height))
         continue;
-      furniture(col, row) = 1;
-      grid.classes(col, row) = SemanticClass::furniture;
-      grid.weight(col, row) = furniture_weight;
+      furniture(c.x, c.y) = 1;
+      grid.classes(c.x, c.y) = SemanticClass::furniture;
+      grid.weight(c.x, c.y) = furniture_weight;
     }
   }
 }
@@ -708,6 +793,10 @@ void SemanticGridParams::validate() const {
   require(std::isfinite(max_wall_thickness) && max_wall_thickness >= 0 &&
               std::isfinite(max_floor_shadow) && max_floor_shadow >= 0,
           "SemanticGridParams: max_wall_thickness and max_floor_shadow must be >= 0");
+  require(free_space_ray_stride >= 0, "SemanticGridParams: free_space_ray_stride must be >= 0");
+  positive(free_space_slab, "free_space_slab");
+  require(std::isfinite(free_space_end_margin) && free_space_end_margin >= 0,
+          "SemanticGridParams: free_space_end_margin must be >= 0");
   require(min_door_width > 0 && min_door_width < max_door_width,
           "SemanticGridParams: need 0 < min_door_width < max_door_width");
   weights.validate();
@@ -736,21 +825,45 @@ const SemanticObject& SemanticGrid::object(int id) const {
   return objects[static_cast<std::size_t>(id - 1)];
 }
 
+namespace {
+
+// Origins, when given, must name every view the points' ids refer to.
+void check_view_origins(std::span<const std::uint32_t> view_ids,
+                        std::span<const Eigen::Vector3d> view_origins) {
+  if (view_origins.empty()) return;
+  const std::uint32_t last =
+      view_ids.empty() ? 0 : *std::max_element(view_ids.begin(), view_ids.end());
+  require(!view_ids.empty() && last < view_origins.size(),
+          "build_semantic_grid: " + std::to_string(view_origins.size()) + " view origins for " +
+              (view_ids.empty() ? std::string("points without view ids")
+                                : "views up to " + std::to_string(last)));
+}
+
+}  // namespace
+
 SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                  std::span<const SemanticClass> labels,
                                  const SemanticGridParams& options,
                                  std::span<const ObjectDetection> detections,
-                                 std::span<const std::uint32_t> view_ids) {
+                                 std::span<const std::uint32_t> view_ids,
+                                 std::span<const Eigen::Vector3d> view_origins) {
   check_inputs(points, labels, options);
   require(view_ids.empty() || view_ids.size() == points.size(),
           "build_semantic_grid: " + std::to_string(view_ids.size()) + " view ids for " +
               std::to_string(points.size()) + " points");
+  check_view_origins(view_ids, view_origins);
   SemanticGrid grid = empty_grid(points, labels, options);
   const Image<CellEvidence> evidence = gather_evidence(grid, points, labels, view_ids, options);
   // Fewer views than min_obstacle_views (one scan) ask for what they can give.
   SemanticGridParams cell_options = options;
   cell_options.min_obstacle_views = std::min(options.min_obstacle_views, count_views(view_ids));
   ObstacleMasks masks = classify_cells(grid, evidence, cell_options);
+  std::optional<detail::BandFreeSpace> free_space;
+  if (options.free_space_ray_stride > 0 && !view_origins.empty()) {
+    free_space.emplace(detail::carve_band(grid, points, view_ids, view_origins, options));
+    raised_walls_to_unclassified(grid, evidence, *free_space,
+                                 options.weights.unclassified_obstacle);
+  }
   if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);
   if (options.remove_isolated_obstacles)
     remove_isolated_obstacles(grid, evidence, options, masks.leaf, masks.furniture);
@@ -765,9 +878,10 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   };
   if (options.max_furniture_fill_area > 0 && options.furniture_max_extent > 0)
     unclassified_to_furniture(grid, evidence, options, masks.furniture);
-  if (options.max_furniture_fill_area > 0)
-    fill_furniture(grid, masks.furniture, options.max_furniture_fill_area,
-                   options.weights.of(SemanticClass::furniture));
+  if (options.max_furniture_fill_area > 0) {
+    fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture,
+                   options.max_furniture_fill_area, options.weights.of(SemanticClass::furniture));
+  }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
   if (options.max_wall_thickness > 0) {

@@ -38,6 +38,8 @@ class LabelledViews {
   std::span<const SemanticClass> labels() const { return labels_; }
   // The view (0-based, in the order added) each point came from.
   std::span<const std::uint32_t> view_ids() const { return view_ids_; }
+  // Where each view saw from (its sensor's origin), in the points' frame.
+  std::span<const Eigen::Vector3d> view_origins() const { return origins_; }
   Eigen::Vector3d up() const;  // the voted up, unit (+z when no view voted)
   int views() const { return views_; }
   int skipped() const { return skipped_; }
@@ -47,6 +49,7 @@ class LabelledViews {
   std::vector<Eigen::Vector3d> points_;
   std::vector<SemanticClass> labels_;
   std::vector<std::uint32_t> view_ids_;
+  std::vector<Eigen::Vector3d> origins_;
   Eigen::Vector3d up_sum_ = Eigen::Vector3d::Zero();
   int views_ = 0, skipped_ = 0;
   std::string first_skip_reason_;

@@ -112,6 +112,14 @@ struct SemanticGridParams {
   // Unobserved cells between floor cells this close along a row or a column are floor: the thin
   // shadows behind corners that a camera turning in place leaves as a fan. 0: off.
   double max_floor_shadow = 0.15;  // m
+  // Free space from the views' rays (when their origins are known): every free_space_ray_stride-th
+  // point's ray marks the slabs (free_space_slab high, from band_min) of the cells it crosses,
+  // stopping free_space_end_margin x (1 + range) short of its point. Hull fills leave floor that
+  // rays crossed at the furniture's top height (the floor beside a table, not under it), and
+  // furniture grows over floor that no ray crossed there (a table top that grazing views dropped).
+  int free_space_ray_stride = 4;         // 0: no free space
+  double free_space_slab = 0.02;         // m
+  double free_space_end_margin = 0.025;  // m per m of range
   int min_floor_points = 1;
   double margin = 0.25;          // metres of grid around the data
   double min_wall_length = 0.5;  // shorter straight wall pieces are not objects
@@ -187,13 +195,15 @@ struct SemanticGrid {
 
 // Builds the grid. points[i] has class labels[i]; non-finite points are skipped. view_ids[i]
 // (optional; ascending, e.g. LabelledViews::view_ids()) names the view that saw points[i]: then an
-// obstacle cell must be seen by min_obstacle_views views (or by all, when there are fewer). Throws
-// Error on mismatched sizes, bad options, no finite point, or a bad detection.
+// obstacle cell must be seen by min_obstacle_views views (or by all, when there are fewer).
+// view_origins[v] (optional; with view_ids) is where view v saw from: its rays give free space.
+// Throws Error on mismatched sizes, bad options, no finite point, or a bad detection.
 SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
                                  std::span<const SemanticClass> labels,
                                  const SemanticGridParams& options = {},
                                  std::span<const ObjectDetection> detections = {},
-                                 std::span<const std::uint32_t> view_ids = {});
+                                 std::span<const std::uint32_t> view_ids = {},
+                                 std::span<const Eigen::Vector3d> view_origins = {});
 
 // ---- Exports (data only; io/ writes the files) -----------------------------------------------
 

@@ -1,0 +1,129 @@
+#include "grid_free_space.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdlib>
+#include <limits>
+#include <string>
+
+#include "kartograf/core/error.hpp"
+
+namespace kartograf::semantic::detail {
+
+BandFreeSpace::BandFreeSpace(const SemanticGrid& grid, double band_min, double slab_height)
+    : grid_(grid),
+      band_min_(band_min),
+      slab_height_(slab_height),
+      cells_(static_cast<std::size_t>(grid.width()) * static_cast<std::size_t>(grid.height())) {}
+
+// The segment, in lattice units (x along columns, y up the rows, z along the slabs), clipped to
+// the lattice; then walked voxel by voxel.
+void BandFreeSpace::add_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& end,
+                            double end_margin) {
+  const Eigen::Vector3d delta = end - origin;
+  const double length = delta.norm();
+  if (!(length > end_margin)) return;
+  const Eigen::Vector3d scale(grid_.resolution, grid_.resolution, slab_height_);
+  const Eigen::Vector3d base(grid_.origin.x(), grid_.origin.y(), grid_.floor_z + band_min_);
+  const Eigen::Vector3d a = (origin - base).cwiseQuotient(scale);
+  const Eigen::Vector3d d = (delta * ((length - end_margin) / length)).cwiseQuotient(scale);
+  const Eigen::Vector3d size(grid_.width(), grid_.height(), kSlabs);
+  double t0 = 0, t1 = 1;
+  for (int k = 0; k < 3; ++k) {
+    if (std::fabs(d[k]) < 1e-12) {
+      if (a[k] < 0 || a[k] >= size[k]) return;
+      continue;
+    }
+    double enter = -a[k] / d[k], leave = (size[k] - a[k]) / d[k];
+    if (enter > leave) std::swap(enter, leave);
+    t0 = std::max(t0, enter), t1 = std::min(t1, leave);
+  }
+  if (t0 < t1) walk(a + t0 * d, d, t0, t1);
+}
+
+// Voxel traversal (Amanatides and Woo) from `entry` (at parameter t0) to parameter t1.
+void BandFreeSpace::walk(const Eigen::Vector3d& entry, const Eigen::Vector3d& d, double t0,
+                         double t1) {
+  const int size[3] = {grid_.width(), grid_.height(), kSlabs};
+  int voxel[3], step[3];
+  double next[3], delta[3];
+  for (int k = 0; k < 3; ++k) {
+    voxel[k] = std::clamp(static_cast<int>(std::floor(entry[k])), 0, size[k] - 1);
+    step[k] = d[k] > 0 ? 1 : (d[k] < 0 ? -1 : 0);
+    delta[k] = step[k] != 0 ? 1.0 / std::fabs(d[k]) : std::numeric_limits<double>::infinity();
+    const double boundary = voxel[k] + (step[k] > 0 ? 1 : 0);
+    next[k] = step[k] != 0 ? t0 + (boundary - entry[k]) / d[k] : delta[k];
+  }
+  for (;;) {
+    Slabs& cell = cells_[static_cast<std::size_t>(size[1] - 1 - voxel[1]) *
+                             static_cast<std::size_t>(size[0]) +
+                         static_cast<std::size_t>(voxel[0])];
+    const std::uint64_t bit = std::uint64_t{1} << voxel[2];
+    cell.twice |= cell.once & bit;
+    cell.once |= bit;
+    const int axis =
+        next[0] <= next[1] ? (next[0] <= next[2] ? 0 : 2) : (next[1] <= next[2] ? 1 : 2);
+    if (next[axis] > t1) return;
+    voxel[axis] += step[axis];
+    if (voxel[axis] < 0 || voxel[axis] >= size[axis]) return;
+    next[axis] += delta[axis];
+  }
+}
+
+int BandFreeSpace::slab_of(double height) const {
+  return static_cast<int>(std::floor((height - band_min_) / slab_height_));
+}
+
+std::uint64_t BandFreeSpace::crossed_twice(const Eigen::Vector2i& cell) const {
+  return cells_[static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
+                static_cast<std::size_t>(cell.x())]
+      .twice;
+}
+
+bool BandFreeSpace::tracks(double height) const {
+  const double slab = std::floor((height - band_min_) / slab_height_);
+  return slab >= 0 && slab < kSlabs;
+}
+
+bool BandFreeSpace::observable(double height, double margin) const {
+  return tracks(height) && height < eye_height_ - margin;
+}
+
+bool BandFreeSpace::seen_through(const Eigen::Vector2i& cell, double height) const {
+  if (!grid_.contains(cell) || !tracks(height)) return false;
+  return (crossed_twice(cell) >> slab_of(height)) & 1u;
+}
+
+bool BandFreeSpace::clear_below(const Eigen::Vector2i& cell, double height) const {
+  const int top = std::min({slab_of(height), slab_of(eye_height_ - kEyeMargin), kSlabs - 1});
+  if (!grid_.contains(cell) || top < 0) return false;
+  const std::uint64_t slabs =
+      top == kSlabs - 1 ? ~std::uint64_t{0} : (std::uint64_t{1} << (top + 1)) - 1;
+  return (crossed_twice(cell) & slabs) == slabs;
+}
+
+BandFreeSpace carve_band(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
+                         std::span<const std::uint32_t> view_ids,
+                         std::span<const Eigen::Vector3d> view_origins,
+                         const SemanticGridParams& options) {
+  BandFreeSpace free_space(grid, options.band_min, options.free_space_slab);
+  auto stride = static_cast<std::size_t>(options.free_space_ray_stride);
+  if (const char* e = std::getenv("KG_STRIDE")) stride = std::stoul(e);  // TEMP
+  for (std::size_t i = 0; i < points.size(); i += stride) {
+    const Eigen::Vector3d& end = points[i];
+    if (!end.allFinite() || view_ids[i] >= view_origins.size()) continue;
+    const Eigen::Vector3d& origin = view_origins[view_ids[i]];
+    // The depth's noise grows with range: the last few centimetres may lie behind the surface.
+    const double margin = options.free_space_end_margin * (1 + (end - origin).norm());
+    free_space.add_ray(origin, end, margin);
+  }
+  std::vector<double> eyes;
+  for (const Eigen::Vector3d& o : view_origins) eyes.push_back(o.z() - grid.floor_z);
+  if (!eyes.empty()) {
+    std::nth_element(eyes.begin(), eyes.begin() + eyes.size() / 2, eyes.end());
+    free_space.set_eye_height(eyes[eyes.size() / 2]);
+  }
+  return free_space;
+}
+
+}  // namespace kartograf::semantic::detail

@@ -1,0 +1,63 @@
+#pragma once
+// Where the views saw through the robot's height band: each pooled point's ray, from its view's
+// origin to just short of the point, marks the height slabs of the cells it crosses as seen
+// through (a step of build_semantic_grid). A table top that grazing views dropped is never seen
+// through, while the floor around it is crossed at the top's height by rays to farther surfaces:
+// this tells the floor under a table from the floor beside it, which point counts cannot.
+#include <cstdint>
+#include <span>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/semantic/semantic_grid.hpp"
+
+namespace kartograf::semantic::detail {
+
+class BandFreeSpace {
+ public:
+  static constexpr int kSlabs = 64;  // one bit each in a cell's masks
+  // Heights this close below the views' median eye height count as unobserved: few rays pass them.
+  static constexpr double kEyeMargin = 0.1;
+
+  // Slabs of slab_height from band_min above the grid's floor.
+  BandFreeSpace(const SemanticGrid& grid, double band_min, double slab_height);
+
+  // Marks the slabs crossed by the segment origin -> end, stopping end_margin short of the end
+  // (the surface it hit, with its noise). World coordinates, z up.
+  void add_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, double end_margin);
+
+  // Whether the slab holding `height` (above the floor) is tracked at all.
+  bool tracks(double height) const;
+  // Whether rays cross `height` over open floor: tracked, and below the views' median eye height
+  // by margin (cameras look down across what is below them; above them few rays pass).
+  bool observable(double height, double margin = kEyeMargin) const;
+  void set_eye_height(double height) { eye_height_ = height; }
+  // Whether at least two rays crossed `cell` at `height` above the floor (one may be noise).
+  bool seen_through(const Eigen::Vector2i& cell, double height) const;
+  // Whether `cell` was seen through at every observable height from the band's bottom up to
+  // `height`: nothing stands there below it. False when no such height is observable.
+  bool clear_below(const Eigen::Vector2i& cell, double height) const;
+
+ private:
+  struct Slabs {
+    std::uint64_t once = 0, twice = 0;  // crossed at least once / twice
+  };
+  void walk(const Eigen::Vector3d& entry, const Eigen::Vector3d& d, double t0, double t1);
+  int slab_of(double height) const;
+  std::uint64_t crossed_twice(const Eigen::Vector2i& cell) const;
+
+  const SemanticGrid& grid_;
+  double band_min_, slab_height_;
+  double eye_height_ = 0;     // above the floor
+  std::vector<Slabs> cells_;  // row-major, as the grid's cells
+};
+
+// The free space of the points' rays (every ray_stride-th point of each view), from the view
+// origins (view_origins[view_ids[i]]).
+BandFreeSpace carve_band(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
+                         std::span<const std::uint32_t> view_ids,
+                         std::span<const Eigen::Vector3d> view_origins,
+                         const SemanticGridParams& options);
+
+}  // namespace kartograf::semantic::detail

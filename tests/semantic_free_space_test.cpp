@@ -1,0 +1,180 @@
+// The semantic grid's free space from the views' rays: scenes of boxes seen by a depth camera
+// (rays cast from each view's origin, grazing returns dropped as a Kinect drops them) show that
+// the floor under a table whose top no view returned is furniture while the floor beside it is
+// free, that a table's edges taken for walls are furniture, and that a hull spanning open floor
+// leaves it floor. Without the views' origins the grid cannot tell these apart.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <numbers>
+#include <optional>
+#include <span>
+#include <vector>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/semantic/semantic_grid.hpp"
+#include "test_support_core.hpp"
+
+namespace kartograf::semantic {
+namespace {
+
+using C = SemanticClass;
+
+// An axis-aligned box whose top face (+z) and sides return the given classes.
+struct Box {
+  Eigen::Vector3d lo, hi;
+  SemanticClass top, sides;
+};
+
+struct Hit {
+  double t = std::numeric_limits<double>::infinity();
+  int axis = 0;  // of the face entered
+  const Box* box = nullptr;
+};
+
+// Where the ray origin + t d enters `box` (slab method), if it does in front of the origin.
+std::optional<Hit> enter(const Box& box, const Eigen::Vector3d& origin, const Eigen::Vector3d& d) {
+  double t0 = 0, t1 = std::numeric_limits<double>::infinity();
+  int axis = -1;
+  for (int k = 0; k < 3; ++k) {
+    if (std::fabs(d[k]) < 1e-12) {
+      if (origin[k] < box.lo[k] || origin[k] > box.hi[k]) return std::nullopt;
+      continue;
+    }
+    double a = (box.lo[k] - origin[k]) / d[k], b = (box.hi[k] - origin[k]) / d[k];
+    if (a > b) std::swap(a, b);
+    if (a > t0) t0 = a, axis = k;
+    t1 = std::min(t1, b);
+  }
+  if (t0 > t1 || axis < 0) return std::nullopt;
+  return Hit{t0, axis, &box};
+}
+
+struct Views {
+  std::vector<Eigen::Vector3d> points;
+  std::vector<SemanticClass> labels;
+  std::vector<std::uint32_t> ids;
+  std::vector<Eigen::Vector3d> origins;
+};
+
+constexpr double kStep = 0.25 * std::numbers::pi / 180;  // a 320-pixel-wide view's spacing
+
+// Each origin looks all round (0.25 degree steps, 60 degrees down to 5 up); returns more grazing
+// than 75 degrees from a face's normal are dropped, as a structured-light camera drops them.
+Views look(const std::vector<Box>& scene, const std::vector<Eigen::Vector3d>& origins) {
+  Views v;
+  const double grazing = std::cos(75.0 * std::numbers::pi / 180);
+  for (const Eigen::Vector3d& origin : origins) {
+    for (int az = 0; az < 4 * 360; ++az) {
+      for (int el = -4 * 60; el <= 4 * 5; ++el) {
+        const double a = az * kStep, e = el * kStep;
+        const Eigen::Vector3d d(std::cos(e) * std::cos(a), std::cos(e) * std::sin(a), std::sin(e));
+        Hit nearest;
+        for (const Box& box : scene) {
+          const std::optional<Hit> hit = enter(box, origin, d);
+          if (hit && hit->t < nearest.t) nearest = *hit;
+        }
+        if (!nearest.box || std::fabs(d[nearest.axis]) < grazing) continue;
+        v.points.push_back(origin + nearest.t * d);
+        v.labels.push_back(nearest.axis == 2 ? nearest.box->top : nearest.box->sides);
+        v.ids.push_back(static_cast<std::uint32_t>(v.origins.size()));
+      }
+    }
+    v.origins.push_back(origin);
+  }
+  return v;
+}
+
+// A 5 x 4 m room: floor and four walls 2.5 m high.
+std::vector<Box> room() {
+  return {{{0, 0, -0.05}, {5, 4, 0}, C::floor, C::floor},
+          {{-0.1, -0.1, 0}, {0, 4.1, 2.5}, C::wall, C::wall},
+          {{5, -0.1, 0}, {5.1, 4.1, 2.5}, C::wall, C::wall},
+          {{0, -0.1, 0}, {5, 0, 2.5}, C::wall, C::wall},
+          {{0, 4, 0}, {5, 4.1, 2.5}, C::wall, C::wall}};
+}
+
+// Every ray of these views: a sweep at 0.25 degree steps is as dense as a 320-pixel view, and the
+// grid's default (every 4th ray) is set for views that overlap as a sequence's do.
+SemanticGridParams every_ray() {
+  SemanticGridParams p;
+  p.free_space_ray_stride = 1;
+  return p;
+}
+
+SemanticClass class_at(const SemanticGrid& grid, double x, double y) {
+  const Eigen::Vector2i c = grid.cell_of({x, y});
+  return grid.classes(c.x(), c.y());
+}
+
+// A 5 x 4 m room with a 1.2 x 0.8 m table (top 0.72-0.76 m, 5 cm legs) seen from six places at
+// 1 m height, all over 1 m from it: its top is too grazing to return, its edges come back as
+// "wall" (as the views label a 4 cm strip cut by the image), its legs as unknown.
+TEST(SemanticGridFreeSpace, TheFloorUnderATableWhoseTopNoViewReturnedIsFurniture) {
+  std::vector<Box> scene = room();
+  scene.push_back({{2.0, 1.6, 0.72}, {3.2, 2.4, 0.76}, C::unknown, C::wall});
+  for (const double x : {2.04, 3.11})
+    for (const double y : {1.64, 2.31})
+      scene.push_back({{x, y, 0}, {x + 0.05, y + 0.05, 0.72}, C::unknown, C::unknown});
+  const Views v = look(
+      scene,
+      {{0.8, 0.5, 1}, {4.4, 0.5, 1}, {4.4, 3.5, 1}, {0.8, 3.5, 1}, {0.6, 2.0, 1}, {4.6, 2.0, 1}});
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  EXPECT_EQ(class_at(grid, 2.6, 2.0), C::furniture);   // under the middle of the top
+  EXPECT_EQ(class_at(grid, 2.1, 1.7), C::furniture);   // under a corner
+  EXPECT_EQ(class_at(grid, 2.01, 2.0), C::furniture);  // the west edge, returned as wall
+  EXPECT_EQ(class_at(grid, 2.6, 1.3), C::floor);       // 0.3 m beside it
+  EXPECT_EQ(class_at(grid, 1.6, 2.0), C::floor);
+  EXPECT_EQ(class_at(grid, 3.6, 2.0), C::floor);
+
+  // Without the origins the edges are walls around floor.
+  const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
+  EXPECT_EQ(class_at(blind, 2.01, 2.0), C::wall);
+  EXPECT_EQ(class_at(blind, 2.6, 2.0), C::floor);
+}
+
+// An L of two low benches (0.45 m): the convex hull of the piece spans the open floor in the L's
+// corner, which the views saw through at every height below the benches' top: it stays floor.
+// Without the origins the hull makes it furniture.
+TEST(SemanticGridFreeSpace, AHullOverOpenFloorLeavesItFloor) {
+  std::vector<Box> scene = room();
+  scene.push_back({{1.0, 1.0, 0}, {2.6, 1.3, 0.45}, C::furniture, C::furniture});
+  scene.push_back({{1.0, 1.3, 0}, {1.3, 2.8, 0.45}, C::furniture, C::furniture});
+  const Views v = look(
+      scene,
+      {{2.6, 2.6, 1}, {3.8, 3.2, 1}, {4.2, 0.5, 1}, {0.4, 3.5, 1}, {2.0, 3.4, 1}, {3.4, 1.8, 1}});
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  EXPECT_EQ(class_at(grid, 1.8, 1.15), C::furniture);  // the benches
+  EXPECT_EQ(class_at(grid, 1.15, 2.0), C::furniture);
+  EXPECT_EQ(class_at(grid, 1.7, 1.7), C::floor);  // the open corner inside the hull
+  EXPECT_EQ(class_at(grid, 1.5, 2.0), C::floor);
+
+  const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
+  EXPECT_EQ(class_at(blind, 1.7, 1.7), C::furniture);
+}
+
+// Bad free-space options and origins that do not match the views are refused.
+TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
+  const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  const std::vector<SemanticClass> labels(3, C::floor);
+  const std::vector<std::uint32_t> ids{0, 1, 2};
+  const std::vector<Eigen::Vector3d> two{{0, 0, 1}, {1, 1, 1}};
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(points, labels, {}, {}, ids, two), "origins");
+  EXPECT_ERROR_MENTIONS(build_semantic_grid(points, labels, {}, {}, {}, two), "origins");
+  SemanticGridParams p;
+  p.free_space_slab = 0;
+  EXPECT_THROW(p.validate(), Error);
+  p = {};
+  p.free_space_ray_stride = -1;
+  EXPECT_THROW(p.validate(), Error);
+  p = {};
+  p.free_space_end_margin = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(p.validate(), Error);
+}
+
+}  // namespace
+}  // namespace kartograf::semantic
