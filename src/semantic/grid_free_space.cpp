@@ -94,11 +94,13 @@ bool BandFreeSpace::seen_through(const Eigen::Vector2i& cell, double height) con
   return (crossed_twice(cell) >> slab_of(height)) & 1u;
 }
 
-bool BandFreeSpace::clear_below(const Eigen::Vector2i& cell, double height) const {
-  const int top = std::min({slab_of(height), slab_of(eye_height_ - kEyeMargin), kSlabs - 1});
-  if (!grid_.contains(cell) || top < 0) return false;
-  const std::uint64_t slabs =
+bool BandFreeSpace::clear_between(const Eigen::Vector2i& cell, double low, double high) const {
+  const int bottom = std::max(slab_of(low), 0);
+  const int top = std::min({slab_of(high), slab_of(eye_height_ - kEyeMargin), kSlabs - 1});
+  if (!grid_.contains(cell) || top < bottom) return false;
+  const std::uint64_t upto =
       top == kSlabs - 1 ? ~std::uint64_t{0} : (std::uint64_t{1} << (top + 1)) - 1;
+  const std::uint64_t slabs = upto & ~((std::uint64_t{1} << bottom) - 1);
   return (crossed_twice(cell) & slabs) == slabs;
 }
 

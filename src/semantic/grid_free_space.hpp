@@ -35,9 +35,13 @@ class BandFreeSpace {
   void set_eye_height(double height) { eye_height_ = height; }
   // Whether at least two rays crossed `cell` at `height` above the floor (one may be noise).
   bool seen_through(const Eigen::Vector2i& cell, double height) const;
-  // Whether `cell` was seen through at every observable height from the band's bottom up to
-  // `height`: nothing stands there below it. False when no such height is observable.
-  bool clear_below(const Eigen::Vector2i& cell, double height) const;
+  // Whether `cell` was seen through at every observable height from `low` (clamped to the band's
+  // bottom) up to `high`. False when no such height is observable.
+  bool clear_between(const Eigen::Vector2i& cell, double low, double high) const;
+  // ... from the band's bottom: nothing stands there below `height`.
+  bool clear_below(const Eigen::Vector2i& cell, double height) const {
+    return clear_between(cell, band_min_, height);
+  }
 
  private:
   struct Slabs {

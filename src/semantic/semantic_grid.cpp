@@ -1,6 +1,7 @@
 #include "kartograf/semantic/semantic_grid.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cstdint>
 #include <deque>
 #include <limits>
@@ -32,6 +33,8 @@ constexpr double kMinFacePhaseAgreement = 0.1;
 constexpr int kMinTwoSidedWallCells = 40;
 // Furniture is judged seen through this far below its top: inside a table's 2-5 cm top.
 constexpr double kBelowTop = 0.015;
+// ... and down to this much further: a top's thickness, whatever the noise on its highest points.
+constexpr double kTopDepth = 0.04;
 // Wall cells whose points start this high above the floor, and that the views saw through below
 // them (to kBelowWall under their lowest point), stand on nothing: a table's edge, not a wall.
 constexpr double kRaisedWall = 0.3, kBelowWall = 0.05;
@@ -179,26 +182,34 @@ CellMask closed_cell_mask(const SemanticGrid& grid, const Selected& selected, in
   return m;
 }
 
-// The height below which a piece of furniture cells must have been seen through for a cell to be
-// open floor: its top (the 90th percentile of its cells' highest points, a stray point aside),
-// less a little so that the slab judged lies inside a 2-5 cm table top.
-double check_height(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                    const std::vector<cv::Point>& cells) {
+// The tops of a piece of furniture (its cells' highest points above the floor, less a little so
+// that the slab judged lies inside a 2-5 cm table top): the median and the 90th percentile, which
+// differ where a table joins a taller cabinet.
+std::array<double, 2> piece_tops(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                                 const std::vector<cv::Point>& cells) {
   std::vector<float> tops;
   for (const cv::Point& c : cells) {
     const float top = evidence(c.x, c.y).z_max;
     if (std::isfinite(top)) tops.push_back(top);
   }
-  if (tops.empty()) return std::numeric_limits<double>::quiet_NaN();
-  const auto k = static_cast<long>(tops.size() * 9 / 10);
-  std::nth_element(tops.begin(), tops.begin() + k, tops.end());
-  return tops[static_cast<std::size_t>(k)] - grid.floor_z - kBelowTop;
+  const double none = std::numeric_limits<double>::quiet_NaN();
+  if (tops.empty()) return {none, none};
+  std::sort(tops.begin(), tops.end());
+  const double base = grid.floor_z + kBelowTop;
+  return {tops[tops.size() / 2] - base, tops[tops.size() * 9 / 10] - base};
 }
 
-// Whether the views saw through `cell` at every height below `height`: then it is floor beside
-// furniture, not under it.
-bool clear_below(const detail::BandFreeSpace* free_space, int col, int row, double height) {
-  return free_space && std::isfinite(height) && free_space->clear_below({col, row}, height);
+// Whether a piece of furniture with these tops leaves `cell` open floor: the views saw through it
+// in the few centimetres under each top (where a table's top stands), or, for a top above what
+// they observe (a tall shelf), at every height they observe below it.
+bool open_beside(const detail::BandFreeSpace& free_space, const std::array<double, 2>& tops,
+                 const cv::Point& cell) {
+  return std::all_of(tops.begin(), tops.end(), [&](double top) {
+    if (!std::isfinite(top)) return false;
+    return free_space.observable(top)
+               ? free_space.clear_between({cell.x, cell.y}, top - kTopDepth, top)
+               : free_space.clear_below({cell.x, cell.y}, top);
+  });
 }
 
 // Wall cells that the views saw under (a table's edge or a shelf board the views took for a wall:
@@ -245,10 +256,10 @@ std::vector<cv::Point> rectangle_around(const std::vector<cv::Point>& outline) {
 }
 
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
-// piece, closed over gaps of a few cells, is filled to its convex hull when that is at most
-// max_area: the robot cannot drive under it within its height band. Hull cells that rays crossed
-// at every height below the piece's top stay floor (the hull of an L or of two pieces spans open
-// floor).
+// piece, closed over gaps of a few cells, whose convex hull is at most max_area is filled: the
+// robot cannot drive under it within its height band. Without free space its hull is filled; with
+// it, the rectangle around it, but for the cells that the views saw through just under the piece's
+// tops (open floor in the hull of an L or of two pieces, the shadow behind a table).
 void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                     const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
                     double max_area, float furniture_weight) {
@@ -274,12 +285,12 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
         if (furniture(cells.back().x, cells.back().y)) marked.push_back(cells.back());
       }
     }
-    const double height = free_space ? check_height(grid, evidence, marked) : 0.0;
+    const std::array<double, 2> tops = piece_tops(grid, evidence, marked);
     for (const cv::Point& c : cells) {
       // Only floor changes: walls and doors keep their class, and what no view saw stays
       // unknown (filling it made rooms leak where the views were few).
       if (furniture(c.x, c.y) || grid.classes(c.x, c.y) != SemanticClass::floor ||
-          clear_below(free_space, c.x, c.y, height))
+          (free_space && open_beside(*free_space, tops, c)))
         continue;
       furniture(c.x, c.y) = 1;
       grid.classes(c.x, c.y) = SemanticClass::furniture;
