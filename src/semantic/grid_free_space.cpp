@@ -2,11 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstdlib>
 #include <limits>
-#include <string>
-
-#include "kartograf/core/error.hpp"
 
 namespace kartograf::semantic::detail {
 
@@ -80,18 +76,9 @@ std::uint64_t BandFreeSpace::crossed_twice(const Eigen::Vector2i& cell) const {
       .twice;
 }
 
-bool BandFreeSpace::tracks(double height) const {
-  const double slab = std::floor((height - band_min_) / slab_height_);
-  return slab >= 0 && slab < kSlabs;
-}
-
-bool BandFreeSpace::observable(double height, double margin) const {
-  return tracks(height) && height < eye_height_ - margin;
-}
-
-bool BandFreeSpace::seen_through(const Eigen::Vector2i& cell, double height) const {
-  if (!grid_.contains(cell) || !tracks(height)) return false;
-  return (crossed_twice(cell) >> slab_of(height)) & 1u;
+bool BandFreeSpace::observable(double height) const {
+  const int slab = slab_of(height);
+  return slab >= 0 && slab < kSlabs && height < eye_height_ - kEyeMargin;
 }
 
 bool BandFreeSpace::clear_between(const Eigen::Vector2i& cell, double low, double high) const {
@@ -109,8 +96,7 @@ BandFreeSpace carve_band(const SemanticGrid& grid, std::span<const Eigen::Vector
                          std::span<const Eigen::Vector3d> view_origins,
                          const SemanticGridParams& options) {
   BandFreeSpace free_space(grid, options.band_min, options.free_space_slab);
-  auto stride = static_cast<std::size_t>(options.free_space_ray_stride);
-  if (const char* e = std::getenv("KG_STRIDE")) stride = std::stoul(e);  // TEMP
+  const auto stride = static_cast<std::size_t>(options.free_space_ray_stride);
   for (std::size_t i = 0; i < points.size(); i += stride) {
     const Eigen::Vector3d& end = points[i];
     if (!end.allFinite() || view_ids[i] >= view_origins.size()) continue;

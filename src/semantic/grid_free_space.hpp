@@ -27,16 +27,14 @@ class BandFreeSpace {
   // (the surface it hit, with its noise). World coordinates, z up.
   void add_ray(const Eigen::Vector3d& origin, const Eigen::Vector3d& end, double end_margin);
 
-  // Whether the slab holding `height` (above the floor) is tracked at all.
-  bool tracks(double height) const;
-  // Whether rays cross `height` over open floor: tracked, and below the views' median eye height
-  // by margin (cameras look down across what is below them; above them few rays pass).
-  bool observable(double height, double margin = kEyeMargin) const;
+  // Whether rays cross `height` (above the floor) over open floor: within the tracked slabs, and
+  // kEyeMargin below the views' median eye height (cameras look down across what is below them;
+  // above them few rays pass).
+  bool observable(double height) const;
   void set_eye_height(double height) { eye_height_ = height; }
-  // Whether at least two rays crossed `cell` at `height` above the floor (one may be noise).
-  bool seen_through(const Eigen::Vector2i& cell, double height) const;
-  // Whether `cell` was seen through at every observable height from `low` (clamped to the band's
-  // bottom) up to `high`. False when no such height is observable.
+  // Whether `cell` was seen through (crossed by at least two rays: one may be noise) at every
+  // observable height from `low` (clamped to the band's bottom) up to `high`. False when no such
+  // height is observable.
   bool clear_between(const Eigen::Vector2i& cell, double low, double high) const;
   // ... from the band's bottom: nothing stands there below `height`.
   bool clear_below(const Eigen::Vector2i& cell, double height) const {
@@ -57,8 +55,8 @@ class BandFreeSpace {
   std::vector<Slabs> cells_;  // row-major, as the grid's cells
 };
 
-// The free space of the points' rays (every ray_stride-th point of each view), from the view
-// origins (view_origins[view_ids[i]]).
+// The free space of the rays of every free_space_ray_stride-th point, each from its view's origin
+// (view_origins[view_ids[i]]).
 BandFreeSpace carve_band(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
                          std::span<const std::uint32_t> view_ids,
                          std::span<const Eigen::Vector3d> view_origins,

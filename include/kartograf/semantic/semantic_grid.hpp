@@ -114,9 +114,9 @@ struct SemanticGridParams {
   double max_floor_shadow = 0.15;  // m
   // Free space from the views' rays (when their origins are known): every free_space_ray_stride-th
   // point's ray marks the slabs (free_space_slab high, from band_min) of the cells it crosses,
-  // stopping free_space_end_margin x (1 + range) short of its point. Hull fills leave floor that
-  // rays crossed at the furniture's top height (the floor beside a table, not under it), and
-  // furniture grows over floor that no ray crossed there (a table top that grazing views dropped).
+  // stopping free_space_end_margin x (1 + range) short of its point. Wall cells seen through below
+  // them are no walls (a table's edge), and furniture fills the rectangle around its pieces but
+  // for the floor seen through just under their tops (beside a table, not under it).
   int free_space_ray_stride = 4;         // 0: no free space
   double free_space_slab = 0.02;         // m
   double free_space_end_margin = 0.025;  // m per m of range
