@@ -109,11 +109,12 @@ TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
   EXPECT_EQ(class_at(kX1 + 0.2, 1.5), SemanticClass::unknown);
 }
 
-// A doorway in a 0.2 m thick wall, both faces and the reveals seen: its opening is measured on the
-// jambs' points, finer than the cells, and its cells fill the wall's thickness, no more.
-TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
+// A doorway in a wall `thickness` thick, both faces and the reveals seen: its opening is measured
+// on the jambs' points, finer than the cells, and its cells fill the wall's thickness, no more.
+// A 0.1 m wall measures a hair under two cells: still a wall's thickness.
+void expect_doorway_spans_the_wall(double thickness) {
   using C = SemanticClass;
-  constexpr double kFace0 = 3.012, kFace1 = 3.212;  // the wall's faces (y)
+  const double kFace0 = 3.012, kFace1 = kFace0 + thickness;  // the wall's faces (y)
   LabelledPoints s;
   s.box_face({kX0, kY0, 0}, {kX1, kFace0, 0}, C::floor);             // room
   s.box_face({kX0, kFace1, 0}, {kX1, kHallY1, 0}, C::floor);         // hall
@@ -123,7 +124,7 @@ TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
     s.box_face({kDoorX1, y, 0.02}, {kX1, y, kHeight}, C::wall);
   }
   for (const double x : {kDoorX0, kDoorX1})  // the reveals
-    s.box_face({x, kFace0, 0.02}, {x, kFace1, 2.0}, C::wall);
+    s.box_face({x, kFace0, 0.02}, {x, kFace1, 2.0}, C::wall, 0.01);
   s.box_face({kX0, kY0, 0.02}, {kX0, kHallY1, kHeight}, C::wall);  // west and east
   s.box_face({kX1, kY0, 0.02}, {kX1, kHallY1, kHeight}, C::wall);
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
@@ -150,8 +151,14 @@ TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
       }
     }
   }
-  // 4 rows of cells in the wall; 16 or 17 columns well inside the opening, as the lattice falls.
-  EXPECT_GE(inside, 4 * 16);
+  // The rows of cells in the wall; 16 or 17 columns well inside the opening, as the lattice falls.
+  const int rows = static_cast<int>(std::floor((thickness - 0.01) / grid.resolution));
+  EXPECT_GE(inside, rows * 16);
+}
+
+TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
+  expect_doorway_spans_the_wall(0.2);
+  expect_doorway_spans_the_wall(0.0995);
 }
 
 // A table seen only by its edges (top dropped out), its faces left unknown by the views: a free
@@ -297,6 +304,25 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   EXPECT_FALSE(alone.wall_thickness.has_value());
 }
 
+// A room's floor and its four walls, seen from inside, the wall points with Gaussian noise of
+// `sigma` across and along the floor (as a depth camera gives them).
+LabelledPoints noisy_room(const Eigen::Vector2d& lo, const Eigen::Vector2d& hi, double sigma,
+                          unsigned seed) {
+  using C = SemanticClass;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, sigma);
+  LabelledPoints s;
+  s.box_face({lo.x(), lo.y(), 0}, {hi.x(), hi.y(), 0}, C::floor);
+  LabelledPoints walls;
+  walls.box_face({lo.x(), lo.y(), 0.02}, {lo.x(), hi.y(), 1.4}, C::wall);
+  walls.box_face({hi.x(), lo.y(), 0.02}, {hi.x(), hi.y(), 1.4}, C::wall);
+  walls.box_face({lo.x(), lo.y(), 0.02}, {hi.x(), lo.y(), 1.4}, C::wall);
+  walls.box_face({lo.x(), hi.y(), 0.02}, {hi.x(), hi.y(), 1.4}, C::wall);
+  for (const Eigen::Vector3d& p : walls.points)
+    s.add(p + Eigen::Vector3d(noise(rng), noise(rng), 0), C::wall);
+  return s;
+}
+
 // Walls whose faces lie midway between the default lattice's cell boundaries (noisy points, as a
 // depth camera gives): the lattice moves so that each face lies on a boundary, the cell in front
 // of it free and the one behind it wall. Left on the default lattice, the cell across the face is
@@ -304,17 +330,7 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
 TEST(SemanticGrid, CellBoundariesFollowTheWallFaces) {
   using C = SemanticClass;
   constexpr double kWest = 0.525, kEast = 4.025, kSouth = 0.525, kNorth = 3.025;
-  std::mt19937 rng(7);
-  std::normal_distribution<double> noise(0.0, 0.006);
-  LabelledPoints s;
-  s.box_face({kWest, kSouth, 0}, {kEast, kNorth, 0}, C::floor);
-  LabelledPoints walls;
-  walls.box_face({kWest, kSouth, 0.02}, {kWest, kNorth, 1.4}, C::wall);
-  walls.box_face({kEast, kSouth, 0.02}, {kEast, kNorth, 1.4}, C::wall);
-  walls.box_face({kWest, kSouth, 0.02}, {kEast, kSouth, 1.4}, C::wall);
-  walls.box_face({kWest, kNorth, 0.02}, {kEast, kNorth, 1.4}, C::wall);
-  for (const Eigen::Vector3d& p : walls.points)
-    s.add(p + Eigen::Vector3d(noise(rng), noise(rng), 0), C::wall);
+  const LabelledPoints s = noisy_room({kWest, kSouth}, {kEast, kNorth}, 0.006, 7);
   const auto at = [](const SemanticGrid& grid, double x, double y) {
     const Eigen::Vector2i c = grid.cell_of({x, y});
     return grid.classes(c.x(), c.y());
@@ -332,6 +348,45 @@ TEST(SemanticGrid, CellBoundariesFollowTheWallFaces) {
   fixed.align_cells_to_walls = false;
   const SemanticGrid unaligned = build_semantic_grid(s.points, s.labels, fixed);
   EXPECT_EQ(at(unaligned, kWest + 0.02, 1.5), C::wall);
+}
+
+// A room seen from inside, its walls' points as noisy as a depth camera's at 4 m (2 cm): a face's
+// points spread over the cells on both sides of it, so the cell in front of the face holds as many
+// wall points as the one behind it. The face, measured along the wall, puts the cells whose centres
+// lie in the room on the floor and those behind the face in the wall; by each cell's own points
+// most cells in front of the faces are wall.
+TEST(SemanticGrid, NoisyWallFacesAreMeasuredAlongTheWall) {
+  using C = SemanticClass;
+  constexpr double kWest = 0.512, kEast = 4.012, kSouth = 0.512, kNorth = 3.012;
+  const LabelledPoints s = noisy_room({kWest, kSouth}, {kEast, kNorth}, 0.02, 11);
+  // Probes along each wall (not near the corners): the cell 3.5 cm in front of the face and the
+  // one 3.5 cm behind it (a cell's centre is at most 2.5 cm from a point in it).
+  const auto wrong = [&](const SemanticGrid& grid) {
+    int in_front_wall = 0, behind_not_wall = 0;
+    const auto at = [&](double x, double y) {
+      const Eigen::Vector2i c = grid.cell_of({x, y});
+      return grid.classes(c.x(), c.y());
+    };
+    for (double t = 0.3; t <= 0.7; t += 0.05) {
+      const double x = kWest + t * (kEast - kWest), y = kSouth + t * (kNorth - kSouth);
+      for (const auto& [front, behind] :
+           {std::pair{at(kWest + 0.035, y), at(kWest - 0.035, y)},
+            std::pair{at(kEast - 0.035, y), at(kEast + 0.035, y)},
+            std::pair{at(x, kSouth + 0.035), at(x, kSouth - 0.035)},
+            std::pair{at(x, kNorth - 0.035), at(x, kNorth + 0.035)}}) {
+        in_front_wall += front != C::floor;
+        behind_not_wall += behind != C::wall;
+      }
+    }
+    return std::pair{in_front_wall, behind_not_wall};
+  };
+  // One probe in 36 may fall on a bulge of noise two cells deep, judged from its outer cell only.
+  const auto [in_front, behind] = wrong(build_semantic_grid(s.points, s.labels));
+  EXPECT_LE(in_front, 1);
+  EXPECT_EQ(behind, 0);
+  SemanticGridParams off;
+  off.place_wall_faces = false;
+  EXPECT_GT(wrong(build_semantic_grid(s.points, s.labels, off)).first, 18);  // of 36 probes
 }
 
 // The doorways found across a 1.4 m corridor that two rooms' dividers meet at a T from either
@@ -430,7 +485,7 @@ TEST(SemanticGrid, AnObstacleSeenByOneViewAloneIsNoise) {
     const SemanticGrid grid = build_semantic_grid(
         s.points, s.labels, {}, {},
         with_ids ? std::span<const std::uint32_t>(views) : std::span<const std::uint32_t>());
-    const Eigen::Vector2i wall = grid.cell_of({0.02, 1.5});
+    const Eigen::Vector2i wall = grid.cell_of({0.0, 1.5});  // just behind the face
     EXPECT_EQ(grid.classes(wall.x(), wall.y()), C::wall);
     const Eigen::Vector2i c = grid.cell_of({1.5, 1.512});
     return grid.classes(c.x(), c.y());

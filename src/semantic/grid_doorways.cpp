@@ -6,52 +6,19 @@
 #include <optional>
 #include <utility>
 
+#include "semantic/grid_wall_points.hpp"
 #include "semantic/quantile.hpp"
 
 namespace kartograf::semantic::detail {
 namespace {
 
-// The wall-labelled points in the robot's height band, by cell (compressed rows): doorway jambs
-// are measured on them, finer than the cells.
-class WallPointIndex {
- public:
-  WallPointIndex(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
-                 std::span<const SemanticClass> labels, const SemanticGridParams& options)
-      : grid_(grid), start_(static_cast<std::size_t>(grid.width()) * grid.height() + 1, 0) {
-    const auto in_band = [&](std::size_t i) {
-      const double h = points[i].z() - grid.floor_z;
-      return labels[i] == SemanticClass::wall && points[i].allFinite() && h >= options.band_min &&
-             h <= options.band_max;
-    };
-    const auto slot = [&](std::size_t i) {
-      const Eigen::Vector2i c = grid.cell_of(points[i].head<2>());
-      return static_cast<std::size_t>(c.y()) * grid.width() + c.x();
-    };
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (in_band(i)) ++start_[slot(i) + 1];
-    }
-    for (std::size_t k = 1; k < start_.size(); ++k) start_[k] += start_[k - 1];
-    points_.resize(start_.back());
-    std::vector<std::size_t> next(start_.begin(), start_.end() - 1);
-    for (std::size_t i = 0; i < points.size(); ++i) {
-      if (in_band(i)) points_[next[slot(i)]++] = points[i].head<2>();
-    }
-  }
-  std::span<const Eigen::Vector2d> in_cell(const Eigen::Vector2i& c) const {
-    const std::size_t k = static_cast<std::size_t>(c.y()) * grid_.width() + c.x();
-    return {points_.data() + start_[k], start_[k + 1] - start_[k]};
-  }
-
- private:
-  const SemanticGrid& grid_;
-  std::vector<std::size_t> start_;
-  std::vector<Eigen::Vector2d> points_;
-};
-
 // How far beyond an opening's ends, and how far either side of its line, its jambs are looked
 // for [m] (walls are at most kMaxWallThickness thick).
 constexpr double kJambDepth = 0.15;
 constexpr double kMaxWallThickness = 0.3;
+// Thinner than any wall (a stud partition is 7 cm or more); not a cell count, since a 10 cm wall
+// measures 2 cells give or take a millimetre.
+constexpr double kMinWallThickness = 0.05;
 
 // An opening found between two collinear wall pieces: its two ends on the wall line.
 struct WallGap {
@@ -150,7 +117,7 @@ std::optional<Opening> measure_jambs(const SemanticGrid& grid, const WallPointIn
   const bool plausible = measured_width >= 0.75 * options.min_door_width &&
                          measured_width <= 1.25 * options.max_door_width &&
                          std::fabs(measured_width - width) <= 2 * kInside &&
-                         o.across_max - o.across_min >= 2 * res &&
+                         o.across_max - o.across_min >= kMinWallThickness &&
                          o.across_max - o.across_min <= kMaxWallThickness;
   if (!plausible) return std::nullopt;
   return o;
@@ -352,10 +319,8 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Wa
 }  // namespace
 
 void add_gap_doorways(SemanticGrid& grid, const SemanticGridParams& options,
-                      std::span<const Eigen::Vector3d> points,
-                      std::span<const SemanticClass> labels, const std::vector<int>& wall_ids,
+                      const WallPointIndex& walls, const std::vector<int>& wall_ids,
                       const AddObject& add_object) {
-  const WallPointIndex walls(grid, points, labels, options);
   int doorway_count = 0;
   for (const WallGap& gap : merge_face_gaps(find_wall_gaps(grid, options, wall_ids), options))
     add_doorway(grid, options, walls, gap, doorway_count, add_object);

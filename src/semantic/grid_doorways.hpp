@@ -9,6 +9,7 @@
 #include <Eigen/Core>
 
 #include "kartograf/semantic/semantic_grid.hpp"
+#include "semantic/grid_wall_points.hpp"
 
 namespace kartograf::semantic::detail {
 
@@ -19,11 +20,10 @@ using AddObject = std::function<SemanticObject&(ObjectKind, SemanticClass, const
 // Doorways as gaps of door width in a wall line (the walls `wall_ids`), with observed floor along
 // the gap and no obstacle across its middle. The two faces of a wall give one gap each; gaps whose
 // centres are closer than half the smallest door width merge. Each doorway's cells become door
-// cells; its opening is measured on the wall-labelled `points` in the height band where enough
+// cells; its opening is measured on the wall points in the height band (`walls`) where enough
 // are there.
 void add_gap_doorways(SemanticGrid& grid, const SemanticGridParams& options,
-                      std::span<const Eigen::Vector3d> points,
-                      std::span<const SemanticClass> labels, const std::vector<int>& wall_ids,
+                      const WallPointIndex& walls, const std::vector<int>& wall_ids,
                       const AddObject& add_object);
 
 }  // namespace kartograf::semantic::detail

@@ -134,12 +134,17 @@ Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
   return phase;
 }
 
-int back_one_sided_walls(SemanticGrid& grid, int max_cells, int min_samples, float weight) {
+int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples) {
   FaceRuns runs = runs_from_faces(grid, max_cells);
   if (static_cast<int>(runs.two_sided_cells.size()) < std::max(min_samples, 1)) return 0;
   auto middle = runs.two_sided_cells.begin() + runs.two_sided_cells.size() / 2;
   std::nth_element(runs.two_sided_cells.begin(), middle, runs.two_sided_cells.end());
-  const int thickness = *middle;
+  return *middle;
+}
+
+void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, float weight) {
+  if (thickness <= 0) return;
+  const FaceRuns runs = runs_from_faces(grid, max_cells);
   std::vector<Eigen::Vector2i> backing;
   for (const FaceRun& run : runs.one_sided) {
     for (int t = run.wall_cells; t < thickness; ++t) {
@@ -152,7 +157,6 @@ int back_one_sided_walls(SemanticGrid& grid, int max_cells, int min_samples, flo
     grid.classes(c.x(), c.y()) = SemanticClass::wall;
     grid.weight(c.x(), c.y()) = weight;
   }
-  return thickness;
 }
 
 }  // namespace kartograf::semantic::detail

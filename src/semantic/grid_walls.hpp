@@ -25,11 +25,13 @@ Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
 // a local covariance, so that thick and noisy wall bands still read as lines.
 Image<int> wall_direction_bins(const Image<SemanticClass>& classes);
 
+// The median thickness, in cells, of the walls seen from both sides (floor or furniture on both
+// faces; runs of at most max_cells); 0 where fewer than `min_samples` cells measure one.
+int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples);
+
 // Walls seen from one side (floor or furniture in front, nothing seen behind: a building's outer
-// walls, a wall of a room no view entered) are extended into the unseen cells behind them to the
-// median thickness of the walls seen from both sides (floor or furniture on both faces). Nothing
-// changes where fewer than `min_samples` cells measure a two-sided wall.
-// Returns the thickness used, in cells (0: none measured).
-int back_one_sided_walls(SemanticGrid& grid, int max_cells, int min_samples, float weight);
+// walls, a wall of a room no view entered) are extended into the unseen cells behind them to
+// `thickness` cells (nothing changes for 0).
+void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, float weight);
 
 }  // namespace kartograf::semantic::detail

@@ -84,6 +84,9 @@ struct SemanticGridParams {
   double spill_margin = 0.02;
   double spill_fraction = 0.8;
   bool remove_isolated_obstacles = true;
+  // Wall cells beside floor are judged on the wall's face, measured on the wall points along a
+  // stretch of it: a cell whose centre lies on the room's side of the face is floor.
+  bool place_wall_faces = true;
   // Furniture outlines (legs, edges: a table top drops out at grazing views) are closed and
   // filled to their convex hull when that is at most this area [m^2]; 0: off.
   // The same bound holds for floor enclosed by unclassified obstacles.

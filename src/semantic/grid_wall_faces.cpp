@@ -1,0 +1,106 @@
+#include "semantic/grid_wall_faces.hpp"
+
+#include <algorithm>
+#include <array>
+#include <optional>
+#include <vector>
+
+#include "semantic/grid_cells.hpp"
+
+namespace kartograf::semantic::detail {
+namespace {
+
+// The face is measured on the wall points of this many cells on either side of the one judged,
+// along the face, in the rows of cells on both sides of it and one row further into the wall.
+constexpr int kFaceStretch = 3;
+// ... and needs this many of them within a cell of the face.
+constexpr std::size_t kMinFacePoints = 20;
+
+// One wall cell facing one floor cell: the boundary between them and the axes there [m].
+struct Boundary {
+  Eigen::Vector2d point, out, along;  // out: from the wall cell to the floor cell
+};
+
+Boundary boundary_between(const SemanticGrid& grid, const Eigen::Vector2i& wall,
+                          const Eigen::Vector2i& floor) {
+  const Eigen::Vector2d a = grid.cell_center(wall), b = grid.cell_center(floor);
+  const Eigen::Vector2d out = (b - a).normalized();
+  return {0.5 * (a + b), out, Eigen::Vector2d(-out.y(), out.x())};
+}
+
+double median(std::vector<double>& values) {
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+// The face's offset along `out` from the boundary [m]: the median of the nearby wall points'
+// offsets within a cell of it, twice (from the boundary, then from the first estimate), so that
+// the other face of a thin wall stays out. Empty with too few points.
+std::optional<double> face_offset(const SemanticGrid& grid, const WallPointIndex& walls,
+                                  const Eigen::Vector2i& wall, const Eigen::Vector2i& step,
+                                  const Boundary& b) {
+  const double res = grid.resolution;
+  const Eigen::Vector2i across(-step.y(), step.x());
+  std::vector<double> offsets;
+  for (int k = -kFaceStretch; k <= kFaceStretch; ++k) {
+    for (int row = -1; row <= 1; ++row) {
+      const Eigen::Vector2i c = wall + k * across + row * step;
+      if (!grid.contains(c)) continue;
+      for (const Eigen::Vector2d& p : walls.in_cell(c)) offsets.push_back(b.out.dot(p - b.point));
+    }
+  }
+  double face = 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    std::vector<double> near;
+    for (const double s : offsets)
+      if (std::fabs(s - face) <= res) near.push_back(s);
+    if (near.size() < kMinFacePoints) return std::nullopt;
+    face = median(near);
+  }
+  return face;
+}
+
+// A wall cell or one no view saw (the inside of a wall, or behind it).
+bool wall_or_unseen(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return grid.contains(c) &&
+         (unobserved(grid, c) || grid.classes(c.x(), c.y()) == SemanticClass::wall);
+}
+
+}  // namespace
+
+int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
+                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights) {
+  const double res = grid.resolution;
+  const std::array<Eigen::Vector2i, 4> steps = {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
+                                                Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)};
+  int moved = 0;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2i c(col, row);
+      if (!seen_as(grid, c, SemanticClass::wall) || !floor_seen(col, row)) continue;
+      for (const Eigen::Vector2i& step : steps) {
+        // Two cells of wall stay behind (a wall is thicker than a cell; one cell of it lets the
+        // rooms leak diagonally), so the two faces of a thin wall never both move in. In scan
+        // order: the first face judged wins.
+        if (!seen_as(grid, c + step, SemanticClass::floor) || !wall_or_unseen(grid, c - step) ||
+            !wall_or_unseen(grid, c - 2 * step))
+          continue;
+        const std::optional<double> face =
+            face_offset(grid, walls, c, step, boundary_between(grid, c, c + step));
+        if (!face || *face >= -0.5 * res) continue;  // the cell's centre is inside the wall
+        grid.classes(col, row) = SemanticClass::floor, grid.weight(col, row) = weights.floor;
+        const Eigen::Vector2i behind = c - step;
+        if (*face > -1.5 * res && unobserved(grid, behind)) {
+          grid.classes(behind.x(), behind.y()) = SemanticClass::wall;
+          grid.weight(behind.x(), behind.y()) = weights.wall;
+        }
+        ++moved;
+        break;
+      }
+    }
+  }
+  return moved;
+}
+
+}  // namespace kartograf::semantic::detail
