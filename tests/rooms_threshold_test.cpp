@@ -203,6 +203,40 @@ TEST(GrowRooms, SmallFragmentsJoinTheRoomTheyTouch) {
   EXPECT_EQ(rooms(13, 1), 4);
 }
 
+// An open door's leaf in a corridor that no view saw round (a diagonal strip of unknown cells
+// from the corridor's wall) is no obstacle to the rooms; the unknown outside (it reaches the map's
+// border) and an unseen patch larger than the limit stay unknown.
+TEST(GrowRooms, SmallUnseenIslandsAreFree) {
+  // A corridor 8 x 1.6 m (160 x 32 cells) inside walls, the outside unknown all round.
+  OccupancyGrid map = testing::carve_map(170, 42, {{5, 5, 165, 37}});
+  for (int y = 0; y < 42; ++y) {
+    for (int x = 0; x < 170; ++x) {
+      const bool wall = (x == 4 || x == 165) && y >= 4 && y <= 37;
+      const bool wall_row = (y == 4 || y == 37) && x >= 4 && x <= 165;
+      if (wall || wall_row)
+        map.cells(x, y) = CellState::occupied;
+      else if (x < 4 || x > 165 || y < 4 || y > 37)
+        map.cells(x, y) = CellState::unknown;
+    }
+  }
+  // The leaf: 3 cells wide, from the south wall at x = 40 up and east for 16 rows (0.8 m).
+  for (int k = 0; k < 16; ++k)
+    for (int w = 0; w < 3; ++w) map.cells(40 + k + w, 36 - k) = CellState::unknown;
+  // An unseen patch of 1 m^2 (20 x 20 cells) at the corridor's east end.
+  for (int y = 10; y < 30; ++y)
+    for (int x = 140; x < 160; ++x) map.cells(x, y) = CellState::unknown;
+  OccupancyGrid freed = map;
+  EXPECT_EQ(rooms::free_unseen_islands(freed, 0.5), 48u);
+  EXPECT_EQ(freed.cells(41, 36), CellState::free);
+  EXPECT_EQ(freed.cells(55, 22), CellState::free);
+  EXPECT_EQ(freed.cells(150, 20), CellState::unknown);  // 1 m^2: larger than the limit
+  EXPECT_EQ(freed.cells(0, 0), CellState::unknown);     // the outside
+  EXPECT_EQ(freed.cells(4, 20), CellState::occupied);   // walls stay
+  OccupancyGrid all = map;
+  EXPECT_EQ(rooms::free_unseen_islands(all, 1.01), 48u + 400u);
+  EXPECT_ERROR_MENTIONS(rooms::free_unseen_islands(map, -1.0), "largest island");
+}
+
 TEST(GrowRooms, ClearanceIsTheDistanceToTheNearestObstacle) {
   const OccupancyGrid map = testing::carve_map(9, 5, {{1, 1, 8, 4}});
   const Image<float> c = rooms::clearance(map);

@@ -132,6 +132,9 @@ void segment_rooms(const compute::Context& context, const MapPipelineParams& par
         room_map.cells(col, row) = CellState::free;
     }
   }
+  // Before the doorways are closed: a doorway's cells are no unseen island.
+  if (params.room_unseen_island_m2 > 0)
+    rooms::free_unseen_islands(room_map, params.room_unseen_island_m2);
   if (params.rooms_end_at_doorways) {
     for (const semantic::SemanticObject& object : grid.objects) {
       if (object.kind != semantic::ObjectKind::doorway) continue;
@@ -247,6 +250,8 @@ void MapPipelineParams::validate() const {
   require(label_width >= 64, "MapPipelineParams: label_width must be >= 64 pixels");
   require(room_fragment_area_m2 >= 0 && std::isfinite(room_fragment_area_m2),
           "MapPipelineParams: room_fragment_area_m2 must be finite and >= 0");
+  require(room_unseen_island_m2 >= 0 && std::isfinite(room_unseen_island_m2),
+          "MapPipelineParams: room_unseen_island_m2 must be finite and >= 0");
   planes.validate();
   plane_map.validate();
   grid.validate();

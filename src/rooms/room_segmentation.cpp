@@ -106,6 +106,37 @@ std::size_t extend_rooms_over_enclosed(LabelImage& rooms, const Image<std::uint8
   return taken;
 }
 
+std::size_t free_unseen_islands(OccupancyGrid& map, double max_area_m2) {
+  require(std::isfinite(max_area_m2) && max_area_m2 >= 0,
+          "free_unseen_islands: the largest island must be a finite area >= 0 m^2");
+  const int width = map.width(), height = map.height();
+  const double cell_area = map.resolution * map.resolution;
+  const auto unknown = [&](std::uint32_t i) {
+    return map.cells(static_cast<int>(i % width), static_cast<int>(i / width)) ==
+           CellState::unknown;
+  };
+  std::vector<std::uint8_t> seen(static_cast<std::size_t>(width) * height, 0);
+  std::size_t freed = 0;
+  for (std::uint32_t start = 0; start < seen.size(); ++start) {
+    if (seen[start] || !unknown(start)) continue;
+    std::vector<std::uint32_t> island{start};
+    seen[start] = 1;
+    bool border = false;
+    for (std::size_t k = 0; k < island.size(); ++k) {
+      const int x = static_cast<int>(island[k] % width), y = static_cast<int>(island[k] / width);
+      border |= x == 0 || y == 0 || x == width - 1 || y == height - 1;
+      detail::for_each_neighbour8(island[k], width, height, [&](std::uint32_t n) {
+        if (!seen[n] && unknown(n)) seen[n] = 1, island.push_back(n);
+      });
+    }
+    if (border || static_cast<double>(island.size()) * cell_area > max_area_m2) continue;
+    for (const std::uint32_t i : island)
+      map.cells(static_cast<int>(i % width), static_cast<int>(i / width)) = CellState::free;
+    freed += island.size();
+  }
+  return freed;
+}
+
 int merge_room_fragments(LabelImage& rooms, double cell_area_m2, double max_area_m2) {
   require(cell_area_m2 > 0 && max_area_m2 >= 0,
           "merge_room_fragments: cell area must be positive and the area limit not negative");

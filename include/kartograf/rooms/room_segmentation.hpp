@@ -70,6 +70,12 @@ void grow_rooms(LabelImage& rooms, const OccupancyGrid& map);
 // reaches it first. Components no room touches stay 0. Returns how many cells were taken.
 std::size_t extend_rooms_over_enclosed(LabelImage& rooms, const Image<std::uint8_t>& fillable);
 
+// Unknown cells in islands of at most max_area_m2 (8-connected components of unknown cells that do
+// not reach the map's border) become free: what no view saw inside a room (the shadow of an open
+// door's leaf or of a chair) must not narrow it for a segmentation that splits at narrowings.
+// Returns how many cells became free.
+std::size_t free_unseen_islands(OccupancyGrid& map, double max_area_m2);
+
 // Rooms smaller than max_area_m2 that touch another room directly (4-neighbours, no wall or
 // doorway between) are fragments of it: each joins the neighbour it shares the longest border
 // with, smallest fragment first. Rooms behind walls and doorways stay, however small. Returns the
