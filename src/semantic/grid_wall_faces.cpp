@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "semantic/grid_cells.hpp"
+#include "semantic/quantile.hpp"
 
 namespace kartograf::semantic::detail {
 namespace {
@@ -26,12 +27,6 @@ Boundary boundary_between(const SemanticGrid& grid, const Eigen::Vector2i& wall,
   const Eigen::Vector2d a = grid.cell_center(wall), b = grid.cell_center(floor);
   const Eigen::Vector2d out = (b - a).normalized();
   return {0.5 * (a + b), out, Eigen::Vector2d(-out.y(), out.x())};
-}
-
-double median(std::vector<double>& values) {
-  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
-  std::nth_element(values.begin(), middle, values.end());
-  return *middle;
 }
 
 // The face's offset along `out` from the boundary [m]: the median of the nearby wall points'
@@ -56,7 +51,7 @@ std::optional<double> face_offset(const SemanticGrid& grid, const WallPointIndex
     for (const double s : offsets)
       if (std::fabs(s - face) <= res) near.push_back(s);
     if (near.size() < kMinFacePoints) return std::nullopt;
-    face = median(near);
+    face = quantile(near, 0.5);
   }
   return face;
 }
