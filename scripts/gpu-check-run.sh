@@ -76,8 +76,11 @@ if [ "$mode" = device ] && command -v nvidia-smi >/dev/null; then
     --format=csv -lms 250 >"$out/clocks.csv" 2>&1 &
   clocks_pid=$!
 fi
+# The odometry sequence is as long as the frames the bundle carries (its MANIFEST says how many).
+frames=(); sequence_frames="$(sed -n 's/^odometry frames: //p' "$bundle/MANIFEST" 2>/dev/null)"
+[ -n "$sequence_frames" ] && [ "$mode" = device ] && frames=(--frames "$sequence_frames")
 timeout 360 "$bundle/bin/kartograf_gpu_check" --data "$work/data" --out "$out" --backends "$available" \
-  "${quick[@]}"
+  "${quick[@]}" "${frames[@]}"
 benchmark=$?
 [ -n "$clocks_pid" ] && kill "$clocks_pid" 2>/dev/null
 echo "== done in $((SECONDS - started)) s: conformance tests $([ $conformance = 0 ] && echo passed || echo "FAILED ($conformance)") on $available; benchmark $([ $benchmark = 0 ] && echo passed || echo "FAILED ($benchmark)")"

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <map>
 
 #include "frame_ops.hpp"
 #include "kartograf/compute/buffer.hpp"
@@ -112,6 +113,7 @@ std::vector<Eigen::Isometry3d> track_sequence(const compute::Context& context, c
                                               SequenceResult* result) {
   registration::RgbdOdometry odometry(context, set.camera, registration::OdometryParams{});
   std::vector<double> wall, device;
+  std::map<std::string, double> per_command;  // summed over the frames after the first
   context.take_device_timings();
   for (const RgbdFrame& frame : set.frames) {
     const auto start = std::chrono::steady_clock::now();
@@ -121,8 +123,11 @@ std::vector<Eigen::Isometry3d> track_sequence(const compute::Context& context, c
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start)
             .count());
     double total = 0;
-    for (const compute::DeviceTiming& timing : context.take_device_timings())
+    for (const compute::DeviceTiming& timing : context.take_device_timings()) {
       total += timing.milliseconds;
+      if (result && &frame != &set.frames.front())
+        per_command[timing.command] += timing.milliseconds;
+    }
     device.push_back(total);
   }
   if (result) {
@@ -130,6 +135,8 @@ std::vector<Eigen::Isometry3d> track_sequence(const compute::Context& context, c
     result->frames = static_cast<int>(set.frames.size());
     result->wall_ms_per_frame = median({wall.begin() + 1, wall.end()});
     result->device_ms_per_frame = median({device.begin() + 1, device.end()});
+    for (const auto& [command, ms] : per_command)
+      result->command_ms_per_frame[command] = ms / static_cast<double>(set.frames.size() - 1);
   }
   return odometry.poses();
 }

@@ -41,6 +41,19 @@ std::string cell(const Results& results, const OperationResult* row) {
   return text;
 }
 
+// The commands that take most of a sequence's device time, largest first: where one backend spends
+// more than another shows here.
+void print_top_commands(std::ostream& out, const std::map<std::string, double>& command_ms) {
+  std::vector<std::pair<double, std::string>> ranked;
+  for (const auto& [command, ms] : command_ms) ranked.emplace_back(ms, command);
+  std::sort(ranked.rbegin(), ranked.rend());
+  if (ranked.size() > 8) ranked.resize(8);
+  if (ranked.empty()) return;
+  out << "    device ms/frame by command:";
+  for (const auto& [ms, command] : ranked) out << " " << command << " " << fixed(ms, 3);
+  out << "\n";
+}
+
 }  // namespace
 
 void print_table(std::ostream& out, const Results& results) {
@@ -91,6 +104,7 @@ void print_table(std::ostream& out, const Results& results) {
           << fixed(s.max_rotation_difference_deg, 4) << " deg";
     }
     out << "\n";
+    print_top_commands(out, s.command_ms_per_frame);
   }
   for (const std::string& note : results.notes) out << "note: " << note << "\n";
 }
@@ -124,7 +138,8 @@ void write_json(const std::filesystem::path& path, const Results& results) {
                                  {"wall_ms_per_frame", s.wall_ms_per_frame},
                                  {"device_ms_per_frame", s.device_ms_per_frame},
                                  {"max_translation_difference_m", s.max_translation_difference_m},
-                                 {"max_rotation_difference_deg", s.max_rotation_difference_deg}});
+                                 {"max_rotation_difference_deg", s.max_rotation_difference_deg},
+                                 {"command_ms_per_frame", s.command_ms_per_frame}});
   }
   json["notes"] = results.notes;
   std::ofstream out(path);

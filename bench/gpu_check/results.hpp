@@ -23,6 +23,7 @@ struct SequenceResult {
   double wall_ms_per_frame = 0, device_ms_per_frame = 0;
   double max_translation_difference_m = -1;  // against the CPU backend's poses; -1: not compared
   double max_rotation_difference_deg = -1;
+  std::map<std::string, double> command_ms_per_frame;  // device time per command, mean per frame
 };
 
 struct BackendResult {
