@@ -32,11 +32,8 @@ KG_PUSH_PARAMS(IcpSumsParams);
 #include "kernels/work_group/group_sums.h"
 
 // Source point i's pair, when it has one that counts; `considered` counts i when it is valid and
-// selected (as load_pair in icp_sums.cl and icp_sums_cpu.cpp). The frame is read here, for each
-// pair that gets this far, not once before the loop: held across the loop its 20 doubles cost
-// registers (NVIDIA's Vulkan sums were 2.5x OpenCL's in the GPU check's run 8, as OpenCL's were
-// before issue 22 made the same change there).
-bool load_pair(uint i, inout double considered, out IcpFrame frame, out IcpPair pair) {
+// selected (as load_pair in icp_sums.cl and icp_sums_cpu.cpp).
+bool load_pair(uint i, IcpFrame frame, inout double considered, out IcpPair pair) {
   int entry = int(i);
   if (params.has_correspondences != 0u) entry = correspondences[i];
   if (!icp_is_selected(entry)) return false;
@@ -50,19 +47,18 @@ bool load_pair(uint i, inout double considered, out IcpFrame frame, out IcpPair 
   if (!(weight > 0.0)) return false;
   const vec4 q = target[j];
   if (kg_isnan(q.x)) return false;
-  frame = KG_ICP_READ_FRAME(frame_values);
   pair = icp_pair(p, q, uint(j), weight, frame);
   return icp_pair_in_range(pair, frame);
 }
 
 void main() {
   for (uint k = 0; k < KG_MAX_SUMS; ++k) sums[k] = 0.0;
+  const IcpFrame frame = KG_ICP_READ_FRAME(frame_values);
   double considered = 0.0;
   const uint stride = gl_NumWorkGroups.x * KG_ICP_SUMS_LOCAL_X;
   for (uint i = gl_GlobalInvocationID.x; i < params.pair_count; i += stride) {
-    IcpFrame frame;
     IcpPair pair;
-    if (!load_pair(i, considered, frame, pair)) continue;
+    if (!load_pair(i, frame, considered, pair)) continue;
 #ifdef KG_ICP_WITH_NORMALS
     const vec4 normal = target_normals[pair.target_index];
     if (!kg_isnan(normal.x)) icp_add_point_to_plane(KG_ACCUMULATOR_ARG(sums) pair, normal, frame, params.robust_kernel);
