@@ -9,11 +9,11 @@
 #                                   call: carry [".gpu-check"], command
 #                                   "bash scripts/gpu-check.sh --run", results under $OUT
 # Options: --build-dir DIR (default build), --bundle DIR (default .gpu-check), --out DIR (results;
-# default $OUT, else build-dir/gpu-check-out), --frames N (odometry frames, default 30),
+# default $OUT, else build-dir/gpu-check-out), --frames N (odometry frames, default 60),
 # --no-build (take the binaries as they are in the build folder).
 set -euo pipefail
 cd "$(dirname "$0")/.."
-mode=bundle build_dir=build bundle=.gpu-check out="${OUT:-}" frames=30 build=1
+mode=bundle build_dir=build bundle=.gpu-check out="${OUT:-}" frames=60 build=1
 while [ $# -gt 0 ]; do
   case "$1" in
     --local) mode=local ;;
