@@ -25,8 +25,9 @@ Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
 // a local covariance, so that thick and noisy wall bands still read as lines.
 Image<int> wall_direction_bins(const Image<SemanticClass>& classes);
 
-// The median thickness, in cells, of the walls seen from both sides (floor or furniture on both
-// faces; runs of at most max_cells); 0 where fewer than `min_samples` cells measure one.
+// The thickness, in cells, of the walls seen from both sides (floor or furniture on both faces;
+// runs of 2 to max_cells cells): the lower tercile of the runs across them; 0 where fewer than
+// `min_samples` runs measure one.
 int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples);
 
 // Walls seen from one side (floor or furniture in front, nothing seen behind: a building's outer
