@@ -109,28 +109,47 @@ TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
   EXPECT_EQ(class_at(kX1 + 0.2, 1.5), SemanticClass::unknown);
 }
 
-// A doorway in a wall `thickness` thick, both faces and the reveals seen: its opening is measured
-// on the jambs' points, finer than the cells, and its cells fill the wall's thickness, no more.
-// A 0.1 m wall measures a hair under two cells: still a wall's thickness.
-void expect_doorway_spans_the_wall(double thickness) {
+// A room and a hall with a wall `thickness` thick between them (faces at y = 3.012 and beyond),
+// both faces and the doorway's reveals seen. With `ragged_ends`, the wall has a 5 cm strip that no
+// view saw 10-15 cm from each jamb.
+LabelledPoints doorway_scene(double thickness, bool ragged_ends) {
   using C = SemanticClass;
-  const double kFace0 = 3.012, kFace1 = kFace0 + thickness;  // the wall's faces (y)
+  const double kFace0 = 3.012, kFace1 = kFace0 + thickness;
   LabelledPoints s;
   s.box_face({kX0, kY0, 0}, {kX1, kFace0, 0}, C::floor);             // room
   s.box_face({kX0, kFace1, 0}, {kX1, kHallY1, 0}, C::floor);         // hall
   s.box_face({kDoorX0, kFace0, 0}, {kDoorX1, kFace1, 0}, C::floor);  // doorway floor
-  for (const double y : {kFace0, kFace1}) {                          // both faces
-    s.box_face({kX0, y, 0.02}, {kDoorX0, y, kHeight}, C::wall);
-    s.box_face({kDoorX1, y, 0.02}, {kX1, y, kHeight}, C::wall);
+  const double strip = ragged_ends ? 0.05 : 0.0, stub = ragged_ends ? 0.10 : 0.0;
+  for (const double y : {kFace0, kFace1}) {  // both faces
+    s.box_face({kX0, y, 0.02}, {kDoorX0 - stub - strip, y, kHeight}, C::wall);
+    s.box_face({kDoorX1 + stub + strip, y, 0.02}, {kX1, y, kHeight}, C::wall);
+    if (!ragged_ends) continue;
+    s.box_face({kDoorX0 - stub, y, 0.02}, {kDoorX0, y, kHeight}, C::wall);
+    s.box_face({kDoorX1, y, 0.02}, {kDoorX1 + stub, y, kHeight}, C::wall);
   }
   for (const double x : {kDoorX0, kDoorX1})  // the reveals
     s.box_face({x, kFace0, 0.02}, {x, kFace1, 2.0}, C::wall, 0.01);
   s.box_face({kX0, kY0, 0.02}, {kX0, kHallY1, kHeight}, C::wall);  // west and east
   s.box_face({kX1, kY0, 0.02}, {kX1, kHallY1, kHeight}, C::wall);
-  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  return s;
+}
+
+std::vector<const SemanticObject*> doorways(const SemanticGrid& grid) {
   std::vector<const SemanticObject*> doors;
   for (const auto& o : grid.objects)
     if (o.kind == ObjectKind::doorway) doors.push_back(&o);
+  return doors;
+}
+
+// A doorway in a wall `thickness` thick: its opening is measured on the jambs' points, finer than
+// the cells, and its cells fill the wall's thickness, no more. A 0.1 m wall measures a hair under
+// two cells: still a wall's thickness.
+void expect_doorway_spans_the_wall(double thickness) {
+  using C = SemanticClass;
+  const double kFace0 = 3.012, kFace1 = kFace0 + thickness;  // the wall's faces (y)
+  const LabelledPoints s = doorway_scene(thickness, false);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  const std::vector<const SemanticObject*> doors = doorways(grid);
   ASSERT_EQ(doors.size(), 1u);
   EXPECT_NEAR(doors[0]->width, kDoorX1 - kDoorX0, 0.03);
   EXPECT_NEAR(doors[0]->centre.x(), 0.5 * (kDoorX0 + kDoorX1), 0.02);
@@ -159,6 +178,19 @@ void expect_doorway_spans_the_wall(double thickness) {
 TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
   expect_doorway_spans_the_wall(0.2);
   expect_doorway_spans_the_wall(0.0995);
+}
+
+// A doorway whose wall has a 5 cm strip that no view saw 10-15 cm from each jamb (as a wall's end
+// comes out with drift: ragged): each wall piece ends at its strip, and the walk from its end
+// meets the stub beyond it before a door's width. The stub is still the piece's end, so the walk
+// goes on across the opening; stopping there found no doorway.
+TEST(SemanticGrid, ADoorwayBeyondANotchInTheWallsEndIsFound) {
+  const LabelledPoints s = doorway_scene(0.2, true);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  const std::vector<const SemanticObject*> doors = doorways(grid);
+  ASSERT_EQ(doors.size(), 1u);
+  EXPECT_NEAR(doors[0]->width, kDoorX1 - kDoorX0, 0.03);
+  EXPECT_NEAR(doors[0]->centre.x(), 0.5 * (kDoorX0 + kDoorX1), 0.02);
 }
 
 // A table seen only by its edges (top dropped out), its faces left unknown by the views: a free

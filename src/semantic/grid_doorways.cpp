@@ -152,7 +152,8 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
                                           const Eigen::Vector2d& from, const Eigen::Vector2d& dir,
                                           const Eigen::Vector2d& n) {
   const double res = grid.resolution;
-  // Leave this piece's own end (noisy, up to 0.3 m), cross the opening, meet wall again.
+  // Leave this piece's own end (noisy, up to 0.3 m: wall cells, and notches narrower than a door
+  // between them), cross the opening, meet wall again.
   double open_from = -1, hit = -1;
   for (double t = 0.5 * res; t <= 0.3 + options.max_door_width + res; t += 0.5 * res) {
     const Eigen::Vector2d p = from + t * dir;
@@ -168,8 +169,12 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
       continue;
     }
     if (wall_here) {
-      if (t - open_from >= options.min_door_width && t - open_from <= options.max_door_width)
-        hit = t;
+      const double width = t - open_from;
+      if (width < options.min_door_width && t <= 0.3) {
+        open_from = -1;  // a notch in the piece's ragged end, not an opening: leave it further
+        continue;
+      }
+      if (width >= options.min_door_width && width <= options.max_door_width) hit = t;
       break;
     }
     if (grid.weight(c.x(), c.y()) == 0.0f) break;  // furniture or another obstacle
