@@ -8,6 +8,7 @@
 
 #include <opencv2/imgproc.hpp>
 
+#include "kartograf/core/connected_components.hpp"
 #include "kartograf/core/error.hpp"
 #include "rooms/grid_neighbours.hpp"
 
@@ -110,29 +111,33 @@ std::size_t free_unseen_islands(OccupancyGrid& map, double max_area_m2) {
   require(std::isfinite(max_area_m2) && max_area_m2 >= 0,
           "free_unseen_islands: the largest island must be a finite area >= 0 m^2");
   const int width = map.width(), height = map.height();
-  const double cell_area = map.resolution * map.resolution;
-  const auto unknown = [&](std::uint32_t i) {
-    return map.cells(static_cast<int>(i % width), static_cast<int>(i / width)) ==
-           CellState::unknown;
-  };
-  std::vector<std::uint8_t> seen(static_cast<std::size_t>(width) * height, 0);
-  std::size_t freed = 0;
-  for (std::uint32_t start = 0; start < seen.size(); ++start) {
-    if (seen[start] || !unknown(start)) continue;
-    std::vector<std::uint32_t> island{start};
-    seen[start] = 1;
-    bool border = false;
-    for (std::size_t k = 0; k < island.size(); ++k) {
-      const int x = static_cast<int>(island[k] % width), y = static_cast<int>(island[k] / width);
-      border |= x == 0 || y == 0 || x == width - 1 || y == height - 1;
-      detail::for_each_neighbour8(island[k], width, height, [&](std::uint32_t n) {
-        if (!seen[n] && unknown(n)) seen[n] = 1, island.push_back(n);
-      });
+  Image<std::uint8_t> unknown(width, height, 0);
+  for (int y = 0; y < height; ++y)
+    for (int x = 0; x < width; ++x) unknown(x, y) = map.cells(x, y) == CellState::unknown;
+  const LabelImage islands = label_connected_components(unknown, {Connectivity::eight, 1});
+  // Per island: its cells, and whether it reaches the border (then it is the outside).
+  std::vector<std::size_t> cells(1, 0);
+  std::vector<std::uint8_t> border(1, 0);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const Label island = islands(x, y);
+      if (island == 0) continue;
+      if (island >= cells.size()) cells.resize(island + 1, 0), border.resize(island + 1, 0);
+      ++cells[island];
+      border[island] |= x == 0 || y == 0 || x == width - 1 || y == height - 1;
     }
-    if (border || static_cast<double>(island.size()) * cell_area > max_area_m2) continue;
-    for (const std::uint32_t i : island)
-      map.cells(static_cast<int>(i % width), static_cast<int>(i / width)) = CellState::free;
-    freed += island.size();
+  }
+  const double cell_area = map.resolution * map.resolution;
+  std::size_t freed = 0;
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      const Label island = islands(x, y);
+      if (island == 0 || border[island] ||
+          static_cast<double>(cells[island]) * cell_area > max_area_m2)
+        continue;
+      map.cells(x, y) = CellState::free;
+      ++freed;
+    }
   }
   return freed;
 }
