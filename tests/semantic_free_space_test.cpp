@@ -61,9 +61,16 @@ struct Views {
 
 constexpr double kStep = 0.25 * std::numbers::pi / 180;  // a 320-pixel-wide view's spacing
 
+// A structured-light camera's depth step: returns beyond `beyond` metres come back `short_by`
+// nearer along the ray (its disparity is quantised: steps of about z^2 / 315 m, 5 cm at 4 m).
+struct DepthStep {
+  double beyond = std::numeric_limits<double>::infinity(), short_by = 0;
+};
+
 // Each origin looks all round (0.25 degree steps, 60 degrees down to 5 up); returns more grazing
 // than 75 degrees from a face's normal are dropped, as a structured-light camera drops them.
-Views look(const std::vector<Box>& scene, const std::vector<Eigen::Vector3d>& origins) {
+Views look(const std::vector<Box>& scene, const std::vector<Eigen::Vector3d>& origins,
+           const DepthStep& step = {}) {
   Views v;
   const double grazing = std::cos(75.0 * std::numbers::pi / 180);
   for (const Eigen::Vector3d& origin : origins) {
@@ -77,7 +84,8 @@ Views look(const std::vector<Box>& scene, const std::vector<Eigen::Vector3d>& or
           if (hit && hit->t < nearest.t) nearest = *hit;
         }
         if (!nearest.box || std::fabs(d[nearest.axis]) < grazing) continue;
-        v.points.push_back(origin + nearest.t * d);
+        const double t = nearest.t > step.beyond ? nearest.t - step.short_by : nearest.t;
+        v.points.push_back(origin + t * d);
         v.labels.push_back(nearest.axis == 2 ? nearest.box->top : nearest.box->sides);
         v.ids.push_back(static_cast<std::uint32_t>(v.origins.size()));
       }
@@ -157,6 +165,37 @@ TEST(SemanticGridFreeSpace, AHullOverOpenFloorLeavesItFloor) {
   EXPECT_EQ(class_at(blind, 1.7, 1.7), C::furniture);
 }
 
+// Two views 4.4 m from the room's east wall (x = 5) read it 8 cm short, as a depth step does: a
+// layer of wall points a cell in front of it, with a cell of floor between. Three views nearby
+// see through that layer at every height: it is floor, and the wall behind it stays wall.
+// Without the origins, or with the option off, the layer is a wall of its own.
+TEST(SemanticGridFreeSpace, AFarWallsLayerThatNearerViewsSeeThroughIsFloor) {
+  const std::vector<Eigen::Vector3d> far{{0.6, 1.2, 1}, {0.6, 2.8, 1}};
+  const std::vector<Eigen::Vector3d> near{{4.0, 1.0, 1}, {4.0, 3.0, 1}, {2.5, 2.0, 1}};
+  Views v = look(room(), far, {3.5, 0.08});
+  const Views close = look(room(), near);
+  for (std::size_t i = 0; i < close.points.size(); ++i) {
+    v.points.push_back(close.points[i]);
+    v.labels.push_back(close.labels[i]);
+    v.ids.push_back(close.ids[i] + static_cast<std::uint32_t>(far.size()));
+  }
+  v.origins.insert(v.origins.end(), near.begin(), near.end());
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  for (const double y : {1.5, 2.0, 2.5}) {
+    EXPECT_EQ(class_at(grid, 4.925, y), C::floor) << "the layer at y " << y;
+    EXPECT_EQ(class_at(grid, 4.975, y), C::floor) << "the cell between at y " << y;
+    EXPECT_EQ(class_at(grid, 5.025, y), C::wall) << "the wall at y " << y;
+  }
+
+  SemanticGridParams off = every_ray();
+  off.seen_through_wall_range = 0;
+  const SemanticGrid layered = build_semantic_grid(v.points, v.labels, off, {}, v.ids, v.origins);
+  EXPECT_EQ(class_at(layered, 4.925, 2.0), C::wall);
+  const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
+  EXPECT_EQ(class_at(blind, 4.925, 2.0), C::wall);
+}
+
 // Bad free-space options and origins that do not match the views are refused.
 TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
   const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
@@ -173,6 +212,9 @@ TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
   EXPECT_THROW(p.validate(), Error);
   p = {};
   p.free_space_end_margin = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(p.validate(), Error);
+  p = {};
+  p.seen_through_wall_range = -1;
   EXPECT_THROW(p.validate(), Error);
 }
 

@@ -91,6 +91,82 @@ bool BandFreeSpace::clear_between(const Eigen::Vector2i& cell, double low, doubl
   return (crossed_twice(cell) & slabs) == slabs;
 }
 
+namespace {
+
+// A cell no view saw among the cell's 4 neighbours: the cell is a wall's face, whose points may
+// lie on its far side (a face on the cell boundary), seen through but for them. The wall faces'
+// placement judges it.
+bool beside_unobserved(const SemanticGrid& grid, const Eigen::Vector2i& cell) {
+  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
+                                      Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
+    const Eigen::Vector2i n = cell + step;
+    if (grid.contains(n) && std::isnan(grid.weight(n.x(), n.y()))) return true;
+  }
+  return false;
+}
+
+// Furniture (in the mask) or an unclassified obstacle among the cell's 8 neighbours.
+bool beside_furniture(const SemanticGrid& grid, const Image<std::uint8_t>& furniture,
+                      const Eigen::Vector2i& cell) {
+  for (int dy = -1; dy <= 1; ++dy) {
+    for (int dx = -1; dx <= 1; ++dx) {
+      const Eigen::Vector2i n = cell + Eigen::Vector2i(dx, dy);
+      if (!grid.contains(n)) continue;
+      const bool unclassified =
+          grid.classes(n.x(), n.y()) == SemanticClass::unknown && grid.weight(n.x(), n.y()) == 0.0f;
+      if (furniture(n.x(), n.y()) || unclassified) return true;
+    }
+  }
+  return false;
+}
+
+}  // namespace
+
+Image<float> nearest_wall_ranges(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
+                                 std::span<const SemanticClass> labels,
+                                 std::span<const std::uint32_t> view_ids,
+                                 std::span<const Eigen::Vector3d> view_origins,
+                                 const SemanticGridParams& options) {
+  Image<float> nearest(grid.width(), grid.height(), std::numeric_limits<float>::infinity());
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Eigen::Vector3d& p = points[i];
+    const double h = p.z() - grid.floor_z;
+    if (labels[i] != SemanticClass::wall || !p.allFinite() || h < options.band_min ||
+        h > options.band_max || view_ids[i] >= view_origins.size())
+      continue;
+    const Eigen::Vector2i c = grid.cell_of(p.head<2>());
+    if (!grid.contains(c)) continue;
+    float& range = nearest(c.x(), c.y());
+    range = std::min(range, static_cast<float>((p - view_origins[view_ids[i]]).norm()));
+  }
+  return nearest;
+}
+
+int free_seen_through_walls(SemanticGrid& grid, const BandFreeSpace& free_space,
+                            const Image<float>& nearest_wall_range,
+                            const Image<std::uint8_t>& floor_seen,
+                            const Image<std::uint8_t>& furniture,
+                            const SemanticGridParams& options) {
+  std::vector<Eigen::Vector2i> freed;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2i cell(col, row);
+      if (grid.classes(col, row) != SemanticClass::wall || !floor_seen(col, row) ||
+          !(nearest_wall_range(col, row) >= options.seen_through_wall_range) ||
+          !free_space.clear_throughout(cell) || beside_unobserved(grid, cell) ||
+          beside_furniture(grid, furniture, cell))
+        continue;
+      freed.push_back(cell);
+    }
+  }
+  // Judged on the cells as classified, then changed: a freed cell does not free its neighbours.
+  for (const Eigen::Vector2i& c : freed) {
+    grid.classes(c.x(), c.y()) = SemanticClass::floor;
+    grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::floor);
+  }
+  return static_cast<int>(freed.size());
+}
+
 BandFreeSpace carve_band(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
                          std::span<const std::uint32_t> view_ids,
                          std::span<const Eigen::Vector3d> view_origins,

@@ -40,6 +40,10 @@ class BandFreeSpace {
   bool clear_below(const Eigen::Vector2i& cell, double height) const {
     return clear_between(cell, band_min_, height);
   }
+  // ... at every observable height.
+  bool clear_throughout(const Eigen::Vector2i& cell) const {
+    return clear_below(cell, eye_height_);
+  }
 
  private:
   struct Slabs {
@@ -54,6 +58,29 @@ class BandFreeSpace {
   double eye_height_ = 0;     // above the floor
   std::vector<Slabs> cells_;  // row-major, as the grid's cells
 };
+
+// Per cell: the range from its view's origin to the nearest wall point in the robot's height band
+// (infinity where there is none). Views as carve_band takes them.
+Image<float> nearest_wall_ranges(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
+                                 std::span<const SemanticClass> labels,
+                                 std::span<const std::uint32_t> view_ids,
+                                 std::span<const Eigen::Vector3d> view_origins,
+                                 const SemanticGridParams& options);
+
+// Wall cells whose wall points were all measured from seen_through_wall_range or farther, in which
+// the views saw floor and which they saw through (twice) at every height they observe, are floor;
+// not next to a cell no view saw (a wall's face, which the faces' placement judges) or to
+// furniture or an unclassified obstacle (a table's edge or leg takes part of a cell only, and rays
+// pass beside it). Returns how many. A depth camera's error grows with range (a structured-light
+// camera's disparity steps are about z^2 / 315 m: 5 cm at 4 m), and puts a far wall's points in a
+// layer a cell or more in front of it, which nearer views see through. Points from nearer views
+// are not overruled: two copies of a wall in a map that drifted are each seen through from the
+// other copy's views, and a gap in either lets the rooms leak.
+int free_seen_through_walls(SemanticGrid& grid, const BandFreeSpace& free_space,
+                            const Image<float>& nearest_wall_range,
+                            const Image<std::uint8_t>& floor_seen,
+                            const Image<std::uint8_t>& furniture,
+                            const SemanticGridParams& options);
 
 // The free space of the rays of every free_space_ray_stride-th point, each from its view's origin
 // (view_origins[view_ids[i]]).

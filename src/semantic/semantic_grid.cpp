@@ -819,6 +819,8 @@ void SemanticGridParams::validate() const {
   positive(free_space_slab, "free_space_slab");
   require(std::isfinite(free_space_end_margin) && free_space_end_margin >= 0,
           "SemanticGridParams: free_space_end_margin must be >= 0");
+  require(std::isfinite(seen_through_wall_range) && seen_through_wall_range >= 0,
+          "SemanticGridParams: seen_through_wall_range must be >= 0");
   require(min_door_width > 0 && min_door_width < max_door_width,
           "SemanticGridParams: need 0 < min_door_width < max_door_width");
   weights.validate();
@@ -931,6 +933,12 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
     free_space.emplace(detail::carve_band(grid, points, view_ids, view_origins, options));
     raised_walls_to_unclassified(grid, evidence, *free_space,
                                  options.weights.unclassified_obstacle);
+    if (options.seen_through_wall_range > 0) {
+      detail::free_seen_through_walls(
+          grid, *free_space,
+          detail::nearest_wall_ranges(grid, points, labels, view_ids, view_origins, options),
+          floor_seen(evidence, options), masks.furniture, options);
+    }
   }
   if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);
   if (options.remove_isolated_obstacles)

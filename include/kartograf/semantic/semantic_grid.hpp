@@ -120,6 +120,11 @@ struct SemanticGridParams {
   // stopping free_space_end_margin x (1 + range) short of its point. Wall cells seen through below
   // them are no walls (a table's edge), and furniture fills the rectangle around its pieces but
   // for the floor seen through just under their tops (beside a table, not under it).
+  // Wall cells whose wall points all come from views at least this far, seen through at every
+  // height the views observe (a far wall's points that the depth camera's error put in front of
+  // it), with floor seen in them and no furniture beside them, are floor [m]. 0: off. At 3 m the
+  // free space's own end margin, free_space_end_margin x (1 + range), is two cells.
+  double seen_through_wall_range = 3.0;
   int free_space_ray_stride = 4;         // 0: no free space
   double free_space_slab = 0.02;         // m
   double free_space_end_margin = 0.025;  // m per m of range
