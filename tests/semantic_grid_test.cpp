@@ -12,6 +12,7 @@
 #include <initializer_list>
 #include <limits>
 #include <numbers>
+#include <optional>
 #include <queue>
 #include <random>
 #include <span>
@@ -249,18 +250,27 @@ TEST(SemanticGrid, FurnitureInARowIsJudgedPieceByPiece) {
 }
 
 // A cabinet 1 m wide standing 0.45 m in front of a wall, its front taken for a wall by the views
-// and the space behind it unseen: the front and the pocket behind it are furniture, the wall
-// stays a wall. Off, the front stays a wall.
-TEST(SemanticGrid, AShortFaceInFrontOfAWallWithAnUnseenPocketIsFurniture) {
-  using C = SemanticClass;
+// (and its sides too with `sides_seen`), the space behind it unseen.
+LabelledPoints cabinet_scene(bool sides_seen) {
   LabelledPoints s;
   for (double x = 0.012; x <= 4.012; x += 0.02) {
     for (double y = 0.012; y <= 3.012; y += 0.02) {
-      if (!(x > 1.0 && x < 2.0 && y > 2.57)) s.add({x, y, 0}, C::floor);  // unseen behind it
+      if (!(x > 1.0 && x < 2.0 && y > 2.57)) s.add({x, y, 0}, SemanticClass::floor);
     }
   }
-  s.box_face({0.012, 3.012, 0.02}, {4.012, 3.012, 1.4}, C::wall);  // the wall
-  s.box_face({1.012, 2.562, 0.02}, {2.012, 2.562, 1.2}, C::wall);  // the cabinet's front
+  s.box_face({0.012, 3.012, 0.02}, {4.012, 3.012, 1.4}, SemanticClass::wall);  // the wall
+  s.box_face({1.012, 2.562, 0.02}, {2.012, 2.562, 1.2}, SemanticClass::wall);  // the front
+  if (sides_seen) {
+    s.box_face({1.012, 2.562, 0.02}, {1.012, 3.012, 1.2}, SemanticClass::wall);
+    s.box_face({2.012, 2.562, 0.02}, {2.012, 3.012, 1.2}, SemanticClass::wall);
+  }
+  return s;
+}
+
+// The cabinet's front, the pocket behind it (and a side, where `side` is given) are furniture and
+// the wall stays a wall; with the fronts off, the front stays a wall.
+void expect_cabinet_found(const LabelledPoints& s, std::optional<Eigen::Vector2d> side) {
+  using C = SemanticClass;
   const auto at = [&](const SemanticGrid& grid, double x, double y) {
     const Eigen::Vector2i c = grid.cell_of({x, y});
     return grid.classes(c.x(), c.y());
@@ -268,12 +278,26 @@ TEST(SemanticGrid, AShortFaceInFrontOfAWallWithAnUnseenPocketIsFurniture) {
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   EXPECT_EQ(at(grid, 1.5, 2.57), C::furniture);  // the front
   EXPECT_EQ(at(grid, 1.5, 2.8), C::furniture);   // the pocket
+  if (side) {
+    EXPECT_EQ(at(grid, side->x(), side->y()), C::furniture);
+  }
   EXPECT_EQ(at(grid, 0.5, 3.02), C::wall);
   EXPECT_EQ(at(grid, 1.5, 3.02), C::wall);
   EXPECT_EQ(grid.furniture_fronts, 1);
   SemanticGridParams off;
   off.furniture_max_depth = 0;
   EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 1.5, 2.57), C::wall);
+}
+
+TEST(SemanticGrid, AShortFaceInFrontOfAWallWithAnUnseenPocketIsFurniture) {
+  expect_cabinet_found(cabinet_scene(false), std::nullopt);
+}
+
+// Its sides seen as walls too join the front to the wall behind into one piece, so no front
+// stands apart. The pocket's box has one side that runs on as a wall past its corners (the back)
+// and floor beyond the opposite one: the front, the sides and the pocket are furniture.
+TEST(SemanticGrid, ACabinetWhoseSidesJoinTheWallBehindIsFurniture) {
+  expect_cabinet_found(cabinet_scene(true), Eigen::Vector2d(1.02, 2.8));
 }
 
 // A wall 0.2 m thick seen from both rooms: its inside, which no view sees, is wall; two walls

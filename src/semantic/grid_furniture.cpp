@@ -1,8 +1,12 @@
 #include "semantic/grid_furniture.hpp"
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <set>
+#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -93,48 +97,211 @@ Surroundings surroundings(const SemanticGrid& grid, const cv::Mat& wall_labels,
   return around;
 }
 
+// Cells of a joined front's pocket, each way (0.15 m at 5 cm cells).
+constexpr int kMinPocketCells = 3;
+
+// One side of a pocket's box: the line of cells just outside it, from `from` in steps of `along`
+// (`length` cells), and the step out of the box.
+struct BoxSide {
+  cv::Point from, along, out;
+  int length;
+};
+
+std::array<BoxSide, 4> sides_of(const cv::Rect& box) {
+  const int x0 = box.x, y0 = box.y, x1 = box.x + box.width - 1, y1 = box.y + box.height - 1;
+  return {BoxSide{{x0 - 1, y0}, {0, 1}, {-1, 0}, box.height},
+          BoxSide{{x1 + 1, y0}, {0, 1}, {1, 0}, box.height},
+          BoxSide{{x0, y0 - 1}, {1, 0}, {0, -1}, box.width},
+          BoxSide{{x0, y1 + 1}, {1, 0}, {0, 1}, box.width}};
+}
+
+// Whether the side's line goes on as wall past both of the box's corners (1-2 cells beyond them):
+// the wall behind a cabinet runs on; its sides and front stop at its corners.
+bool runs_on_past_corners(const SemanticGrid& grid, const BoxSide& side) {
+  const auto wall_within = [&](cv::Point corner, cv::Point step) {
+    for (int k = 1; k <= 2; ++k)
+      if (is_wall(grid, (corner + k * step).x, (corner + k * step).y)) return true;
+    return false;
+  };
+  const cv::Point first = side.from - side.along, last = side.from + side.length * side.along;
+  return wall_within(first, -side.along) && wall_within(last, side.along);
+}
+
+// Whether most cells of a side's line have floor within 3 cells beyond it: a front faces the room.
+bool floor_beyond(const SemanticGrid& grid, const BoxSide& side) {
+  int facing = 0;
+  for (int k = 0; k < side.length; ++k) {
+    for (int d = 1; d <= 3; ++d) {
+      const cv::Point c = side.from + k * side.along + d * side.out;
+      if (seen_as(grid, {c.x, c.y}, SemanticClass::floor)) {
+        ++facing;
+        break;
+      }
+    }
+  }
+  return 2 * facing > side.length;
+}
+
+// The wall cells around a pocket but for its back: the front and sides of a cabinet whose faces
+// the views took for walls, joined to the wall behind it. Empty unless exactly one side of the
+// pocket's box runs on as a wall past its corners, and the side opposite faces floor.
+std::vector<cv::Point> front_and_sides(const SemanticGrid& grid,
+                                       const std::vector<cv::Point>& pocket) {
+  const cv::Rect box = cv::boundingRect(pocket);
+  // A cabinet's inside is a few cells each way; a sliver of unseen cells in a noisy wall is not.
+  if (box.width < kMinPocketCells || box.height < kMinPocketCells) return {};
+  const std::array<BoxSide, 4> sides = sides_of(box);
+  int back = -1;
+  if (std::getenv("KG_FDBG") && pocket.size() > 50) {
+    for (int s = 0; s < 4; ++s) {
+      const BoxSide& d = sides[s];
+      std::string line;
+      for (int k = -5; k < d.length + 5; ++k) {
+        const cv::Point c = d.from + k * d.along;
+        line += k == 0 || k == d.length ? '|' : ' ';
+        line += is_wall(grid, c.x, c.y) ? '#'
+                                        : (seen_as(grid, {c.x, c.y}, SemanticClass::floor)
+                                               ? '.'
+                                               : (std::isnan(grid.weight(c.x, c.y)) ? '?' : 'o'));
+      }
+      std::fprintf(stderr, "  side %d runs %d floor_beyond %d: %s\n", s,
+                   int(runs_on_past_corners(grid, d)), int(floor_beyond(grid, d)), line.c_str());
+    }
+    for (int row = box.y - 6; row <= box.y + box.height + 5; ++row) {
+      std::string line;
+      for (int col = box.x - 6; col <= box.x + box.width + 5; ++col) {
+        const bool in =
+            col >= box.x && col < box.x + box.width && row >= box.y && row < box.y + box.height;
+        char ch =
+            is_wall(grid, col, row)
+                ? '#'
+                : (seen_as(grid, {col, row}, SemanticClass::floor)
+                       ? '.'
+                       : (std::isnan(grid.weight(col, row))
+                              ? '?'
+                              : (grid.classes(col, row) == SemanticClass::furniture ? 'f' : 'o')));
+        if (in && ch == '?') ch = 'p';
+        line += ch;
+      }
+      std::fprintf(stderr, "  %s\n", line.c_str());
+    }
+  }
+  for (int s = 0; s < 4; ++s) {
+    if (!runs_on_past_corners(grid, sides[static_cast<std::size_t>(s)])) continue;
+    if (back >= 0) return {};
+    back = s;
+  }
+  if (back < 0 || !floor_beyond(grid, sides[static_cast<std::size_t>(back ^ 1)])) return {};
+  // Two cells out on the front and the sides (a face's noise spills into the cell in front of it);
+  // nothing from the back's line on.
+  int x0 = box.x - 2, x1 = box.x + box.width + 1, y0 = box.y - 2, y1 = box.y + box.height + 1;
+  if (back == 0) x0 = box.x;
+  if (back == 1) x1 = box.x + box.width - 1;
+  if (back == 2) y0 = box.y;
+  if (back == 3) y1 = box.y + box.height - 1;
+  std::vector<cv::Point> cells;
+  for (int row = y0; row <= y1; ++row)
+    for (int col = x0; col <= x1; ++col)
+      if (is_wall(grid, col, row)) cells.push_back({col, row});
+  return cells;
+}
+
+}  // namespace
+
+namespace {
+
+// The wall pieces of the grid (8-neighbours) and which are longer than furniture.
+struct WallPieces {
+  Pieces pieces;
+  std::vector<bool> long_wall, front_like;  // by label; front_like: furniture sized, facing floor
+};
+
+WallPieces wall_pieces(const SemanticGrid& grid, double max_extent, double max_area) {
+  cv::Mat wall_mask(grid.height(), grid.width(), CV_8U);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      wall_mask.at<std::uint8_t>(row, col) = is_wall(grid, col, row) ? 255 : 0;
+  WallPieces w{pieces_of(wall_mask), {}, {}};
+  w.long_wall.resize(w.pieces.cells.size());
+  w.front_like.resize(w.pieces.cells.size());
+  for (std::size_t k = 1; k < w.pieces.cells.size(); ++k) {
+    const bool sized = furniture_sized(w.pieces.cells[k], grid.resolution, max_extent, max_area);
+    w.front_like[k] = sized && faces_floor(grid, w.pieces.cells[k]);
+    w.long_wall[k] = !sized;
+  }
+  return w;
+}
+
+// A furniture-sized pocket beside a longer wall and no door (beside a door, a pocket is a wall's
+// inside behind its leaf, not behind furniture); `around` gets what it touches.
+bool backed_pocket(const SemanticGrid& grid, const WallPieces& walls,
+                   const std::vector<cv::Point>& pocket, double max_extent, double max_area,
+                   Surroundings& around) {
+  if (!furniture_sized(pocket, grid.resolution, max_extent, max_area)) return false;
+  around = surroundings(grid, walls.pieces.labels, pocket);
+  return !around.door && std::any_of(around.walls.begin(), around.walls.end(),
+                                     [&](int w) { return walls.long_wall[w]; });
+}
+
+void mark_furniture(SemanticGrid& grid, const std::vector<cv::Point>& cells, float weight,
+                    Image<std::uint8_t>& furniture) {
+  for (const cv::Point& c : cells) {
+    grid.classes(c.x, c.y) = SemanticClass::furniture;
+    grid.weight(c.x, c.y) = weight;
+    furniture(c.x, c.y) = 1;
+  }
+}
+
 }  // namespace
 
 int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
                          int min_depth_cells, int max_depth_cells, float weight,
                          Image<std::uint8_t>& furniture) {
-  cv::Mat wall_mask(grid.height(), grid.width(), CV_8U);
-  for (int row = 0; row < grid.height(); ++row)
-    for (int col = 0; col < grid.width(); ++col)
-      wall_mask.at<std::uint8_t>(row, col) = is_wall(grid, col, row) ? 255 : 0;
-  const Pieces walls = pieces_of(wall_mask);
+  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
   const Pieces pockets = pieces_of(pockets_between_walls(grid, min_depth_cells, max_depth_cells));
-  // Wall pieces that may be a front (furniture sized, facing the room) and those that are walls
-  // for certain (longer than furniture).
-  std::vector<bool> front_like(walls.cells.size()), long_wall(walls.cells.size());
-  for (std::size_t w = 1; w < walls.cells.size(); ++w) {
-    const bool sized = furniture_sized(walls.cells[w], grid.resolution, max_extent, max_area);
-    front_like[w] = sized && faces_floor(grid, walls.cells[w]);
-    long_wall[w] = !sized;
-  }
   int fronts = 0;
   std::vector<cv::Point> to_furniture;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
-    if (!furniture_sized(pockets.cells[p], grid.resolution, max_extent, max_area)) continue;
-    const Surroundings around = surroundings(grid, walls.labels, pockets.cells[p]);
-    if (around.door) continue;  // a wall's inside behind a door leaf, not behind furniture
+    Surroundings around;
+    if (!backed_pocket(grid, walls, pockets.cells[p], max_extent, max_area, around)) continue;
     const std::set<int>& beside = around.walls;
-    const bool front =
-        std::any_of(beside.begin(), beside.end(), [&](int w) { return front_like[w]; });
-    const bool backed =
-        std::any_of(beside.begin(), beside.end(), [&](int w) { return long_wall[w]; });
-    if (!front || !backed) continue;
+    if (std::none_of(beside.begin(), beside.end(), [&](int w) { return walls.front_like[w]; }))
+      continue;
     ++fronts;
     to_furniture.insert(to_furniture.end(), pockets.cells[p].begin(), pockets.cells[p].end());
-    for (const int w : beside)
-      if (front_like[w])
-        to_furniture.insert(to_furniture.end(), walls.cells[w].begin(), walls.cells[w].end());
+    for (const int w : beside) {
+      if (walls.front_like[w])
+        to_furniture.insert(to_furniture.end(), walls.pieces.cells[w].begin(),
+                            walls.pieces.cells[w].end());
+    }
   }
-  for (const cv::Point& c : to_furniture) {
-    grid.classes(c.x, c.y) = SemanticClass::furniture;
-    grid.weight(c.x, c.y) = weight;
-    furniture(c.x, c.y) = 1;
+  mark_furniture(grid, to_furniture, weight, furniture);
+  return fronts;
+}
+
+int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
+                                int max_depth_cells, float weight, Image<std::uint8_t>& furniture) {
+  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
+  const Pieces pockets = pieces_of(pockets_between_walls(grid, 1, max_depth_cells));
+  int fronts = 0;
+  std::vector<cv::Point> to_furniture;
+  for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
+    Surroundings around;
+    const std::vector<cv::Point>& pocket = pockets.cells[p];
+    if (!backed_pocket(grid, walls, pocket, max_extent, max_area, around)) continue;
+    const std::vector<cv::Point> joined = front_and_sides(grid, pocket);
+    if (std::getenv("KG_FDBG")) {
+      const cv::Rect b = cv::boundingRect(pocket);
+      const Eigen::Vector2d w = grid.cell_center({b.x, b.y});
+      std::fprintf(stderr, "POCKET %d %d %dx%d at %.2f %.2f n%zu joined %zu\n", b.x, b.y, b.width,
+                   b.height, w.x(), w.y(), pocket.size(), joined.size());
+    }
+    if (joined.empty()) continue;
+    ++fronts;
+    to_furniture.insert(to_furniture.end(), pocket.begin(), pocket.end());
+    to_furniture.insert(to_furniture.end(), joined.begin(), joined.end());
   }
+  mark_furniture(grid, to_furniture, weight, furniture);
   return fronts;
 }
 

@@ -17,4 +17,14 @@ int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
                          int min_depth_cells, int max_depth_cells, float weight,
                          Image<std::uint8_t>& furniture);
 
+// A cabinet against a wall whose front and sides the views took for walls, joined to the wall
+// behind it: a furniture-sized pocket of unseen cells (rows or columns of at least two cells
+// between wall cells, at most `max_depth_cells`), no door beside it, whose box has exactly one side
+// that runs on as a wall past both corners (the wall behind; a wall's inside between two faces has
+// two such sides) and floor beyond the opposite side (the front faces the room). The pocket and the
+// wall cells around it up to two cells out, but for the back's line, become furniture. Runs after
+// fronts_against_walls and the walls' insides. Returns the number of fronts.
+int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
+                                int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
+
 }  // namespace kartograf::semantic::detail

@@ -885,6 +885,10 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
         cells(options.max_wall_thickness), cells(options.furniture_max_depth),
         options.weights.of(SemanticClass::furniture), masks.furniture);
+    grid.furniture_fronts += detail::joined_fronts_against_walls(
+        grid, options.furniture_max_extent, options.max_furniture_fill_area,
+        cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
+        masks.furniture);
   }
   if (options.max_floor_shadow > 0) {
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
