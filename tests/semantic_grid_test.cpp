@@ -369,6 +369,22 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   EXPECT_FALSE(alone.wall_thickness.has_value());
 }
 
+// With an outer east wall too, the block where the two outer walls meet, which no view sees, is
+// wall as thick as their backs; without the backs it stays unseen.
+TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {
+  using C = SemanticClass;
+  LabelledPoints s = two_rooms_with_a_wall_between();
+  s.box_face({4.012, 0.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the outer east wall
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 4.012 + 0.12, 2.0), std::pair(C::wall, false));           // its back
+  EXPECT_EQ(class_at(grid, 4.012 + 0.02, 4.012 + 0.02), std::pair(C::wall, false));  // the corner
+  EXPECT_EQ(class_at(grid, 4.012 + 0.23, 4.012 + 0.12), std::pair(C::unknown, true));  // beyond
+  SemanticGridParams off;
+  off.back_one_sided_walls = false;
+  EXPECT_EQ(class_at(build_semantic_grid(s.points, s.labels, off), 4.012 + 0.12, 4.012 + 0.12),
+            std::pair(C::unknown, true));
+}
+
 // Rows of wall one cell thick with floor on both sides (a face's spill, a face seen twice), more of
 // them than runs across the real wall: they measure no wall's thickness, and the outer wall's
 // hidden back is still as thick as the wall seen from both sides. The median of every run gave

@@ -165,4 +165,44 @@ void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, floa
   }
 }
 
+namespace {
+
+// Wall cells in a row from `cell` (not counted) in steps of `step`, up to `enough`.
+int wall_run(const SemanticGrid& grid, Eigen::Vector2i cell, const Eigen::Vector2i& step,
+             int enough) {
+  int run = 0;
+  for (cell += step; run < enough && seen_as(grid, cell, SemanticClass::wall); cell += step) ++run;
+  return run;
+}
+
+// Whether wall runs on for `enough` cells from the cell one way or the other along `step`'s axis.
+bool wall_either_way(const SemanticGrid& grid, const Eigen::Vector2i& cell,
+                     const Eigen::Vector2i& step, int enough) {
+  return wall_run(grid, cell, step, enough) >= enough ||
+         wall_run(grid, cell, -step, enough) >= enough;
+}
+
+}  // namespace
+
+void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
+  constexpr int kArm = 3;  // cells of wall along each arm of the corner
+  // A block k cells square fills from its inner corner along anti-diagonals: 2k - 1 rounds.
+  for (int round = 0; round < 2 * thickness - 1; ++round) {
+    std::vector<Eigen::Vector2i> corners;
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const Eigen::Vector2i c(col, row);
+        if (unobserved(grid, c) && wall_either_way(grid, c, {1, 0}, kArm) &&
+            wall_either_way(grid, c, {0, 1}, kArm))
+          corners.push_back(c);
+      }
+    }
+    if (corners.empty()) return;
+    for (const Eigen::Vector2i& c : corners) {
+      grid.classes(c.x(), c.y()) = SemanticClass::wall;
+      grid.weight(c.x(), c.y()) = weight;
+    }
+  }
+}
+
 }  // namespace kartograf::semantic::detail

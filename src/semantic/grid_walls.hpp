@@ -35,4 +35,9 @@ int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_sa
 // `thickness` cells (nothing changes for 0).
 void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, float weight);
 
+// The hidden blocks where two walls meet at a corner, which no room sees: an unseen cell with wall
+// running on for at least 3 cells along its row one way and along its column one way is wall;
+// repeated until a block `thickness` cells square is filled (nothing changes for 0).
+void fill_wall_corners(SemanticGrid& grid, int thickness, float weight);
+
 }  // namespace kartograf::semantic::detail

@@ -910,6 +910,8 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         {options.weights.of(SemanticClass::floor), options.weights.of(SemanticClass::wall)});
   }
   detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
+  if (options.back_one_sided_walls)
+    detail::fill_wall_corners(grid, thickness, options.weights.of(SemanticClass::wall));
   if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
 }
 

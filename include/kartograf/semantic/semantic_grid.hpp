@@ -106,8 +106,9 @@ struct SemanticGridParams {
   // row or a column, nothing seen between) are wall: its inside, which no view can see. 0: off.
   double max_wall_thickness = 0.35;  // m
   // Walls seen from one side only (a building's outer walls) extend into the unseen cells behind
-  // them to the median thickness of the walls seen from both sides, when there are such walls:
-  // a wall is a solid, and its hidden back is no more traversable than its face.
+  // them to the thickness of the walls seen from both sides, when there are such walls, and the
+  // unseen block where two walls meet at a corner is wall: a wall is a solid, and its hidden back
+  // is no more traversable than its face.
   bool back_one_sided_walls = true;
   // The cell lattice is shifted (less than a cell) so that wall faces lie on cell boundaries where
   // the wall points agree on such a shift: a face inside a cell makes it half wall, half room.
