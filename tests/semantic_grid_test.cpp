@@ -376,13 +376,35 @@ TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {
   LabelledPoints s = two_rooms_with_a_wall_between();
   s.box_face({4.012, 0.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the outer east wall
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
-  EXPECT_EQ(class_at(grid, 4.012 + 0.12, 2.0), std::pair(C::wall, false));           // its back
-  EXPECT_EQ(class_at(grid, 4.012 + 0.02, 4.012 + 0.02), std::pair(C::wall, false));  // the corner
+  EXPECT_EQ(class_at(grid, 4.012 + 0.12, 2.0), std::pair(C::wall, false));             // its back
+  EXPECT_EQ(class_at(grid, 4.012 + 0.02, 4.012 + 0.02), std::pair(C::wall, false));    // the corner
   EXPECT_EQ(class_at(grid, 4.012 + 0.23, 4.012 + 0.12), std::pair(C::unknown, true));  // beyond
   SemanticGridParams off;
   off.back_one_sided_walls = false;
   EXPECT_EQ(class_at(build_semantic_grid(s.points, s.labels, off), 4.012 + 0.12, 4.012 + 0.12),
             std::pair(C::unknown, true));
+}
+
+// Walls 0.15 m thick (seen from both rooms) and a cabinet standing apart 0.4 m in front of the
+// outer north wall: the unseen run behind its front (7 cells) is no deeper than the insides the
+// grid fills (0.35 m), but deeper than these walls' insides, so it is the cabinet's pocket.
+TEST(SemanticGrid, APocketDeeperThanTheWallsInsidesIsACabinets) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.952, 0}, C::floor);  // south room
+  s.box_face({0.012, 2.122, 0}, {4.012, 3.602, 0}, C::floor);  // north room, but behind the front
+  s.box_face({0.012, 3.622, 0}, {0.992, 4.012, 0}, C::floor);
+  s.box_face({2.032, 3.622, 0}, {4.012, 4.012, 0}, C::floor);
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);  // the wall between
+  s.box_face({0.012, 2.112, 0.02}, {4.012, 2.112, 1.4}, C::wall);
+  s.box_face({0.012, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the outer north wall
+  s.box_face({1.012, 3.612, 0.02}, {2.012, 3.612, 1.2}, C::wall);  // the cabinet's front
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.5, 3.8).first, C::furniture);   // the pocket
+  EXPECT_EQ(class_at(grid, 1.5, 3.62).first, C::furniture);  // the front
+  EXPECT_EQ(class_at(grid, 2.0, 2.04).first, C::wall);       // the inside of the wall between
+  EXPECT_EQ(class_at(grid, 0.5, 4.02).first, C::wall);
+  EXPECT_EQ(grid.furniture_fronts, 1);
 }
 
 // Rows of wall one cell thick with floor on both sides (a face's spill, a face seen twice), more of

@@ -305,4 +305,30 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
   return fronts;
 }
 
+Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, double max_area,
+                                  int min_cells, int max_cells) {
+  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
+  const auto front = [&](const Eigen::Vector2i& c) {
+    return grid.contains(c) &&
+           walls.front_like[static_cast<std::size_t>(walls.pieces.labels.at<int>(c.y(), c.x()))];
+  };
+  Image<std::uint8_t> pockets(grid.width(), grid.height(), 0);
+  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const Eigen::Vector2i start(col, row);
+        if (!is_wall(grid, col, row) || !unobserved(grid, start + step)) continue;
+        Eigen::Vector2i end = start + step;
+        int run = 0;
+        while (unobserved(grid, end) && run <= max_cells) end += step, ++run;
+        if (run <= min_cells || run > max_cells || !grid.contains(end) ||
+            !is_wall(grid, end.x(), end.y()) || !(front(start) || front(end)))
+          continue;
+        for (Eigen::Vector2i k = start + step; k != end; k += step) pockets(k.x(), k.y()) = 1;
+      }
+    }
+  }
+  return pockets;
+}
+
 }  // namespace kartograf::semantic::detail

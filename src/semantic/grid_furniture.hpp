@@ -27,4 +27,11 @@ int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
 int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
                                 int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
 
+// The unseen cells on row and column runs of more than `min_cells` and at most `max_cells` unseen
+// cells between two wall cells of which one belongs to a piece that may be a cabinet's front
+// (furniture sized, most of it facing floor): what the walls' insides fill must leave to
+// fronts_against_walls when the walls are thinner than the run.
+Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, double max_area,
+                                  int min_cells, int max_cells);
+
 }  // namespace kartograf::semantic::detail

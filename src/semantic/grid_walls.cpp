@@ -49,7 +49,8 @@ struct FaceRuns {
   std::vector<FaceRun> one_sided;
 };
 
-FaceRuns runs_from_faces(const SemanticGrid& grid, int max_cells) {
+// With `through_unseen`, the walk goes on through cells no view saw (a wall's inside).
+FaceRuns runs_from_faces(const SemanticGrid& grid, int max_cells, bool through_unseen = false) {
   const Image<int> bins = wall_direction_bins(grid.classes);
   FaceRuns runs;
   for (int row = 0; row < grid.height(); ++row) {
@@ -59,8 +60,11 @@ FaceRuns runs_from_faces(const SemanticGrid& grid, int max_cells) {
       for (const double side : {-1.0, 1.0}) {
         FaceRun run{{col, row}, side * Eigen::Vector2d(-along.y(), along.x()), 0};
         if (!free_or_furnished(grid, cell_along(run.face, run.back, -1))) continue;
+        const auto inside = [&](const Eigen::Vector2i& c) {
+          return seen_as(grid, c, SemanticClass::wall) || (through_unseen && unobserved(grid, c));
+        };
         while (run.wall_cells <= max_cells &&
-               seen_as(grid, cell_along(run.face, run.back, run.wall_cells), SemanticClass::wall))
+               inside(cell_along(run.face, run.back, run.wall_cells)))
           ++run.wall_cells;
         if (run.wall_cells > max_cells) continue;  // along another wall, not through this one
         const Eigen::Vector2i behind = cell_along(run.face, run.back, run.wall_cells);
@@ -135,12 +139,13 @@ Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
   return phase;
 }
 
-int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples) {
+int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples,
+                             bool through_unseen) {
   // A run of one cell is a stray row of wall cells with floor on both sides (a face's spill, a
   // duplicated face), not a wall's cross-section: 30-50 % of the runs on the synthetic surveys,
   // enough to move the median.
   std::vector<double> runs;
-  for (int cells : runs_from_faces(grid, max_cells).two_sided_cells)
+  for (int cells : runs_from_faces(grid, max_cells, through_unseen).two_sided_cells)
     if (cells >= 2) runs.push_back(cells);
   if (static_cast<int>(runs.size()) < std::max(min_samples, 1)) return 0;
   // Drift and noise only widen a wall (two faces seen from views a centimetre or two apart), and a

@@ -27,8 +27,10 @@ Image<int> wall_direction_bins(const Image<SemanticClass>& classes);
 
 // The thickness, in cells, of the walls seen from both sides (floor or furniture on both faces;
 // runs of 2 to max_cells cells): the lower tercile of the runs across them; 0 where fewer than
-// `min_samples` runs measure one.
-int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples);
+// `min_samples` runs measure one. With `through_unseen`, a run goes on through the cells no view
+// saw (the inside of a wall seen from both sides, before it is filled).
+int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples,
+                             bool through_unseen = false);
 
 // Walls seen from one side (floor or furniture in front, nothing seen behind: a building's outer
 // walls, a wall of a room no view entered) are extended into the unseen cells behind them to

@@ -366,9 +366,11 @@ void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& ev
 // Unobserved runs along rows and columns with cells of class `ends` at both ends, at most
 // max_cells long, become `ends`: the inside of a wall seen from both sides; floor that the views
 // missed in a thin shadow behind a corner (a fan of them where the robot turns in place).
-void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells, float weight) {
+void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells, float weight,
+                          const Image<std::uint8_t>* keep = nullptr) {
   const auto is_end = [&](const Eigen::Vector2i& c) { return grid.classes(c.x(), c.y()) == ends; };
   for (const Eigen::Vector2i& c : detail::unobserved_runs_between(grid, is_end, 0, max_cells)) {
+    if (keep && (*keep)(c.x(), c.y())) continue;
     grid.classes(c.x(), c.y()) = ends;
     grid.weight(c.x(), c.y()) = weight;
   }
@@ -874,17 +876,31 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
                            const detail::WallPointIndex& wall_points,
                            const SemanticGridParams& options, ObstacleMasks& masks) {
   const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
-  if (options.max_wall_thickness > 0) {
-    fill_unobserved_runs(grid, SemanticClass::wall, cells(options.max_wall_thickness),
-                         options.weights.of(SemanticClass::wall));
+  const bool fronts = options.furniture_max_depth > 0 && options.furniture_max_extent > 0;
+  // The walls' thickness across their unseen insides: an unseen run between a furniture-sized face
+  // and a wall, deeper than a wall's inside (by a cell, for noise), is what a cabinet hid, and the
+  // insides' fill leaves it to the fronts.
+  const int max_wall = cells(options.max_wall_thickness);
+  const int across =
+      max_wall > 0 ? detail::two_sided_wall_thickness(grid, max_wall, kMinTwoSidedWallCells, true)
+                   : 0;
+  const int min_pocket = across > 0 ? std::min(across - 1, max_wall) : max_wall;
+  std::optional<Image<std::uint8_t>> pockets;
+  if (fronts && min_pocket < max_wall) {
+    pockets = detail::front_pockets(grid, options.furniture_max_extent,
+                                    options.max_furniture_fill_area, min_pocket, max_wall);
+  }
+  if (max_wall > 0) {
+    fill_unobserved_runs(grid, SemanticClass::wall, max_wall,
+                         options.weights.of(SemanticClass::wall), pockets ? &*pockets : nullptr);
   }
   // After the furniture fills (no hull should span a front and its pocket) and the walls' insides
   // (which are no pockets).
-  if (options.furniture_max_depth > 0 && options.furniture_max_extent > 0) {
+  if (fronts) {
     grid.furniture_fronts = detail::fronts_against_walls(
-        grid, options.furniture_max_extent, options.max_furniture_fill_area,
-        cells(options.max_wall_thickness), cells(options.furniture_max_depth),
-        options.weights.of(SemanticClass::furniture), masks.furniture);
+        grid, options.furniture_max_extent, options.max_furniture_fill_area, min_pocket,
+        cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
+        masks.furniture);
     grid.furniture_fronts += detail::joined_fronts_against_walls(
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
         cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
@@ -897,7 +913,6 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   // The walls' thickness is measured before their faces are placed: a wall's two faces, seen
   // from views whose poses differ by a centimetre or two, lose a row to the placement often
   // enough to move the median (0.15 -> 0.10 m on a survey with the SLAM's poses).
-  const int max_wall = cells(options.max_wall_thickness);
   const int thickness =
       options.back_one_sided_walls && max_wall > 0
           ? detail::two_sided_wall_thickness(grid, max_wall, kMinTwoSidedWallCells)
