@@ -20,11 +20,24 @@ inline bool seen_as(const SemanticGrid& grid, const Eigen::Vector2i& c, Semantic
   return grid.contains(c) && grid.classes(c.x(), c.y()) == wanted && !unobserved(grid, c);
 }
 
+// An obstacle the views could not name (weight 0, class unknown), as opposed to an unseen cell.
+inline bool unclassified_obstacle(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::unknown &&
+         grid.weight(c.x(), c.y()) == 0.0f;
+}
+
+// Any run's two ends.
+struct AnyEnds {
+  bool operator()(const Eigen::Vector2i&, const Eigen::Vector2i&) const { return true; }
+};
+
 // The unobserved cells on row and column runs of unobserved cells with cells where is_end holds at
-// both ends, longer than min_cells and at most max_cells (each cell once per run it lies on).
-template <typename IsEnd>
+// both ends, longer than min_cells and at most max_cells, whose two ends `accept` takes (each cell
+// once per run it lies on).
+template <typename IsEnd, typename Accept = AnyEnds>
 std::vector<Eigen::Vector2i> unobserved_runs_between(const SemanticGrid& grid, const IsEnd& is_end,
-                                                     int min_cells, int max_cells) {
+                                                     int min_cells, int max_cells,
+                                                     const Accept& accept = {}) {
   std::vector<Eigen::Vector2i> inside;
   for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
     for (int row = 0; row < grid.height(); ++row) {
@@ -34,7 +47,9 @@ std::vector<Eigen::Vector2i> unobserved_runs_between(const SemanticGrid& grid, c
         Eigen::Vector2i c = start + step;
         int run = 0;
         while (unobserved(grid, c) && run <= max_cells) c += step, ++run;
-        if (run <= min_cells || run > max_cells || !grid.contains(c) || !is_end(c)) continue;
+        if (run <= min_cells || run > max_cells || !grid.contains(c) || !is_end(c) ||
+            !accept(start, c))
+          continue;
         for (Eigen::Vector2i k = start + step; k != c; k += step) inside.push_back(k);
       }
     }

@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "semantic/grid_cells.hpp"
+
 namespace kartograf::semantic::detail {
 
 BandFreeSpace::BandFreeSpace(const SemanticGrid& grid, double band_min, double slab_height)
@@ -99,8 +101,7 @@ namespace {
 bool beside_unobserved(const SemanticGrid& grid, const Eigen::Vector2i& cell) {
   for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
                                       Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
-    const Eigen::Vector2i n = cell + step;
-    if (grid.contains(n) && std::isnan(grid.weight(n.x(), n.y()))) return true;
+    if (unobserved(grid, cell + step)) return true;
   }
   return false;
 }
@@ -111,10 +112,8 @@ bool beside_furniture(const SemanticGrid& grid, const Image<std::uint8_t>& furni
   for (int dy = -1; dy <= 1; ++dy) {
     for (int dx = -1; dx <= 1; ++dx) {
       const Eigen::Vector2i n = cell + Eigen::Vector2i(dx, dy);
-      if (!grid.contains(n)) continue;
-      const bool unclassified =
-          grid.classes(n.x(), n.y()) == SemanticClass::unknown && grid.weight(n.x(), n.y()) == 0.0f;
-      if (furniture(n.x(), n.y()) || unclassified) return true;
+      if (grid.contains(n) && (furniture(n.x(), n.y()) || unclassified_obstacle(grid, n)))
+        return true;
     }
   }
   return false;

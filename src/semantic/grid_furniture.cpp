@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <set>
-#include <string>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -152,40 +149,6 @@ std::vector<cv::Point> front_and_sides(const SemanticGrid& grid,
   if (box.width < kMinPocketCells || box.height < kMinPocketCells) return {};
   const std::array<BoxSide, 4> sides = sides_of(box);
   int back = -1;
-  if (std::getenv("KG_FDBG") && pocket.size() > 50) {
-    for (int s = 0; s < 4; ++s) {
-      const BoxSide& d = sides[s];
-      std::string line;
-      for (int k = -5; k < d.length + 5; ++k) {
-        const cv::Point c = d.from + k * d.along;
-        line += k == 0 || k == d.length ? '|' : ' ';
-        line += is_wall(grid, c.x, c.y) ? '#'
-                                        : (seen_as(grid, {c.x, c.y}, SemanticClass::floor)
-                                               ? '.'
-                                               : (std::isnan(grid.weight(c.x, c.y)) ? '?' : 'o'));
-      }
-      std::fprintf(stderr, "  side %d runs %d floor_beyond %d: %s\n", s,
-                   int(runs_on_past_corners(grid, d)), int(floor_beyond(grid, d)), line.c_str());
-    }
-    for (int row = box.y - 6; row <= box.y + box.height + 5; ++row) {
-      std::string line;
-      for (int col = box.x - 6; col <= box.x + box.width + 5; ++col) {
-        const bool in =
-            col >= box.x && col < box.x + box.width && row >= box.y && row < box.y + box.height;
-        char ch =
-            is_wall(grid, col, row)
-                ? '#'
-                : (seen_as(grid, {col, row}, SemanticClass::floor)
-                       ? '.'
-                       : (std::isnan(grid.weight(col, row))
-                              ? '?'
-                              : (grid.classes(col, row) == SemanticClass::furniture ? 'f' : 'o')));
-        if (in && ch == '?') ch = 'p';
-        line += ch;
-      }
-      std::fprintf(stderr, "  %s\n", line.c_str());
-    }
-  }
   for (int s = 0; s < 4; ++s) {
     if (!runs_on_past_corners(grid, sides[static_cast<std::size_t>(s)])) continue;
     if (back >= 0) return {};
@@ -205,10 +168,6 @@ std::vector<cv::Point> front_and_sides(const SemanticGrid& grid,
       if (is_wall(grid, col, row)) cells.push_back({col, row});
   return cells;
 }
-
-}  // namespace
-
-namespace {
 
 // The wall pieces of the grid (8-neighbours) and which are longer than furniture.
 struct WallPieces {
@@ -290,12 +249,6 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
     const std::vector<cv::Point>& pocket = pockets.cells[p];
     if (!backed_pocket(grid, walls, pocket, max_extent, max_area, around)) continue;
     const std::vector<cv::Point> joined = front_and_sides(grid, pocket);
-    if (std::getenv("KG_FDBG")) {
-      const cv::Rect b = cv::boundingRect(pocket);
-      const Eigen::Vector2d w = grid.cell_center({b.x, b.y});
-      std::fprintf(stderr, "POCKET %d %d %dx%d at %.2f %.2f n%zu joined %zu\n", b.x, b.y, b.width,
-                   b.height, w.x(), w.y(), pocket.size(), joined.size());
-    }
     if (joined.empty()) continue;
     ++fronts;
     to_furniture.insert(to_furniture.end(), pocket.begin(), pocket.end());
@@ -312,22 +265,14 @@ Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, d
     return grid.contains(c) &&
            walls.front_like[static_cast<std::size_t>(walls.pieces.labels.at<int>(c.y(), c.x()))];
   };
+  const auto wall_end = [&](const Eigen::Vector2i& c) { return is_wall(grid, c.x(), c.y()); };
+  const auto front_at_either_end = [&](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    return front(a) || front(b);
+  };
   Image<std::uint8_t> pockets(grid.width(), grid.height(), 0);
-  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
-    for (int row = 0; row < grid.height(); ++row) {
-      for (int col = 0; col < grid.width(); ++col) {
-        const Eigen::Vector2i start(col, row);
-        if (!is_wall(grid, col, row) || !unobserved(grid, start + step)) continue;
-        Eigen::Vector2i end = start + step;
-        int run = 0;
-        while (unobserved(grid, end) && run <= max_cells) end += step, ++run;
-        if (run <= min_cells || run > max_cells || !grid.contains(end) ||
-            !is_wall(grid, end.x(), end.y()) || !(front(start) || front(end)))
-          continue;
-        for (Eigen::Vector2i k = start + step; k != end; k += step) pockets(k.x(), k.y()) = 1;
-      }
-    }
-  }
+  for (const Eigen::Vector2i& k :
+       unobserved_runs_between(grid, wall_end, min_cells, max_cells, front_at_either_end))
+    pockets(k.x(), k.y()) = 1;
   return pockets;
 }
 

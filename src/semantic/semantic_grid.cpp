@@ -161,11 +161,6 @@ bool point_in_polygon(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2
   return inside;
 }
 
-// An obstacle the views could not name (weight 0, class unknown), as opposed to an unseen cell.
-bool is_unclassified_obstacle(const SemanticGrid& grid, int col, int row) {
-  return grid.classes(col, row) == SemanticClass::unknown && grid.weight(col, row) == 0.0f;
-}
-
 // The cells where selected(col, row) holds as an 8-bit mask (255), and that mask closed with a
 // size x size square (gaps of a few cells bridged).
 struct CellMask {
@@ -332,7 +327,9 @@ MaskPieces mask_pieces(const cv::Mat& mask, int size, const Image<CellEvidence>&
 // along one wall join over the gaps between them), down to its cells as they are.
 void unclassified_to_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                                const SemanticGridParams& options, Image<std::uint8_t>& furniture) {
-  auto unclassified = [&](int col, int row) { return is_unclassified_obstacle(grid, col, row); };
+  auto unclassified = [&](int col, int row) {
+    return detail::unclassified_obstacle(grid, {col, row});
+  };
   cv::Mat mask =
       closed_cell_mask(
           grid, [&](int col, int row) { return unclassified(col, row) || furniture(col, row); }, 1)
@@ -381,10 +378,10 @@ void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells,
 // Only closed loops count: an L of clutter along two walls encloses nothing.
 void fill_enclosed_by_unclassified(SemanticGrid& grid, double max_area, float weight) {
   const int w = grid.width(), h = grid.height();
-  cv::Mat closed =
-      closed_cell_mask(
-          grid, [&](int col, int row) { return is_unclassified_obstacle(grid, col, row); }, 5)
-          .closed;
+  const auto unclassified = [&](int col, int row) {
+    return detail::unclassified_obstacle(grid, {col, row});
+  };
+  cv::Mat closed = closed_cell_mask(grid, unclassified, 5).closed;
   std::vector<std::vector<cv::Point>> contours;
   std::vector<cv::Vec4i> hierarchy;
   cv::findContours(closed, contours, hierarchy, cv::RETR_CCOMP, cv::CHAIN_APPROX_SIMPLE);
