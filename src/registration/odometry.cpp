@@ -247,10 +247,15 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   // ...or from the images, when there are colours.
   const RgbImage& target_color = colors_[slot_of(target)];
   if (params_.photometric_refinement && color_ && !color_->empty() && !target_color.empty()) {
-    const std::vector<se3::Vector6d> directions = weak_directions(geometry_, ratio);
+    const std::vector<se3::Vector6d> directions =
+        weak_directions(geometry_, std::max(ratio, params_.photometric_direction_ratio));
+    const double pairs =
+        params_.photometric_geometry_weight * static_cast<double>(geometry_.points);
+    const se3::Matrix6d held = edge_information(geometry_.information, attempt.inlier_rmse,
+                                                {pairs, params_.information.min_sigma});
     const PhotometricResult refined = refine_photometrically(
         *depth_, *color_, target_color, builder_.camera(), params_.depth_range.units_per_metre,
-        attempt.motion, directions, params_.photometric);
+        attempt.motion, directions, params_.photometric, held);
     if (refined.refined) {
       attempt.motion = refined.motion;
       attempt.photometric = true;

@@ -176,6 +176,55 @@ double motion_sigma(const Sums& sums, std::span<const se3::Vector6d> directions)
   return std::isfinite(sigma) ? sigma : std::numeric_limits<double>::infinity();
 }
 
+// The start's own information on the amounts of the directions, in the photometric cost's units
+// (grey levels^2): it holds the refinement to the start as far as the start was measured.
+struct Prior {
+  Eigen::MatrixXd information;
+  Eigen::VectorXd amounts;  // moved so far, from the start
+
+  Prior(const se3::Matrix6d& start_information, std::span<const se3::Vector6d> directions,
+        double intensity_sigma) {
+    const auto n = static_cast<Eigen::Index>(directions.size());
+    Eigen::MatrixXd along(6, n);
+    for (Eigen::Index k = 0; k < n; ++k) along.col(k) = directions[static_cast<std::size_t>(k)];
+    information = intensity_sigma * intensity_sigma * along.transpose() * start_information * along;
+    amounts = Eigen::VectorXd::Zero(n);
+  }
+  // Mean cost per residual, as the photometric cost is compared.
+  double cost(const Eigen::VectorXd& a, std::size_t count) const {
+    return count ? 0.5 * a.dot(information * a) / static_cast<double>(count) : 0.0;
+  }
+};
+
+double mean_cost(const Sums& sums) {
+  return sums.count ? sums.cost / static_cast<double>(sums.count) : 0.0;
+}
+
+// Robust Gauss-Newton from `motion` (updated), a step kept only if it lowers the mean cost.
+Sums descend(const std::vector<Sample>& samples, const Textured& target, const PinholeIntrinsics& k,
+             std::span<const se3::Vector6d> directions, const PhotometricParams& params,
+             Eigen::Isometry3d& motion, Prior& prior) {
+  Sums sums = evaluate(samples, target, k, motion, directions, params.huber_levels);
+  for (int iteration = 0; iteration < params.iterations && sums.count >= params.min_pixels;
+       ++iteration) {
+    const Eigen::VectorXd delta =
+        -(sums.jtj + prior.information).ldlt().solve(sums.jtr + prior.information * prior.amounts);
+    if (!delta.allFinite()) break;
+    const Eigen::Isometry3d candidate = step(motion, directions, delta);
+    Sums next = evaluate(samples, target, k, candidate, directions, params.huber_levels);
+    // Compare mean costs: a step may move residuals in or out of the image.
+    if (next.count < params.min_pixels ||
+        mean_cost(next) + prior.cost(prior.amounts + delta, next.count) >=
+            mean_cost(sums) + prior.cost(prior.amounts, sums.count)) {
+      break;
+    }
+    motion = candidate;
+    prior.amounts += delta;
+    sums = std::move(next);
+  }
+  return sums;
+}
+
 }  // namespace
 
 PhotometricResult refine_photometrically(const DepthImage& source_depth,
@@ -183,7 +232,8 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
                                          const PinholeIntrinsics& camera, double units_per_metre,
                                          const Eigen::Isometry3d& source_to_target,
                                          std::span<const se3::Vector6d> directions,
-                                         const PhotometricParams& params) {
+                                         const PhotometricParams& params,
+                                         const se3::Matrix6d& start_information) {
   const auto same_size = [&](int w, int h) { return w == camera.width && h == camera.height; };
   require(same_size(source_depth.width(), source_depth.height()) &&
               same_size(source_color.width(), source_color.height()) &&
@@ -197,9 +247,10 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
   PhotometricResult result;
   result.motion = source_to_target;
   if (directions.empty()) return result;
+  Prior prior(start_information, directions, params.intensity_sigma);
   const GreyImage source_grey = grey_of(source_color);
   const GreyImage target_grey = grey_of(target_color);
-  double start_cost = 0, end_cost = 0;  // mean robust costs of the fine pass
+  double start_cost = 0, end_cost = 0;  // mean costs of the fine pass
   // Coarse (wide basin), then fine (sharp minimum).
   for (const int passes : {params.blur_passes, 1}) {
     const Textured source(blurred(source_grey, passes));
@@ -207,30 +258,17 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
     const std::vector<Sample> samples =
         samples_of(source_depth, source, camera, units_per_metre, params);
     if (samples.size() < params.min_pixels) return result;
-    Sums sums = evaluate(samples, target, camera, result.motion, directions, params.huber_levels);
     if (passes == 1) {
       const Sums original =
           evaluate(samples, target, camera, source_to_target, directions, params.huber_levels);
-      start_cost = original.count ? original.cost / original.count : 0.0;
+      start_cost = mean_cost(original);
       result.rmse_before = original.count ? std::sqrt(original.squared / original.count) : 0.0;
     }
-    for (int iteration = 0; iteration < params.iterations && sums.count >= params.min_pixels;
-         ++iteration) {
-      const Eigen::VectorXd delta = -sums.jtj.ldlt().solve(sums.jtr);
-      if (!delta.allFinite()) break;
-      const Eigen::Isometry3d candidate = step(result.motion, directions, delta);
-      Sums next = evaluate(samples, target, camera, candidate, directions, params.huber_levels);
-      // Compare mean costs: a step may move residuals in or out of the image.
-      if (next.count < params.min_pixels ||
-          next.cost / next.count >= sums.cost / std::max<std::size_t>(sums.count, 1)) {
-        break;
-      }
-      result.motion = candidate;
-      sums = std::move(next);
-    }
+    Sums sums = descend(samples, target, camera, directions, params, result.motion, prior);
     if (passes == 1) {
+      sums.jtj += prior.information;
       result.sigma_m = motion_sigma(sums, directions);
-      end_cost = sums.count ? sums.cost / sums.count : 0.0;
+      end_cost = mean_cost(sums) + prior.cost(prior.amounts, sums.count);
       result.pixels = sums.count;
       result.rmse_after = sums.count ? std::sqrt(sums.squared / sums.count) : 0.0;
     }

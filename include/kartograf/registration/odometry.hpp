@@ -116,6 +116,20 @@ struct OdometryParams {
   // (photometric_refinement.hpp) instead of taking the prediction.
   bool photometric_refinement = true;
   PhotometricParams photometric;
+  // The directions it measures: balanced eigenvalue below this x the largest, about the centroid
+  // (geometric_information.hpp's weak_directions), so the degenerate ones and those the geometry
+  // barely constrains. The motion prior pulls the latter toward the prediction as well: on survey
+  // seed 4 ICP's answer was 0.2 degrees and 1 cm off in them, the degenerate direction alone could
+  // not be refined to the truth, and the refinement of that one direction moved 1.6 cm away
+  // from it instead. Each stays held to ICP's answer by ICP's own information there
+  // (photometric_geometry_weight).
+  double photometric_direction_ratio = 0.2;
+  // ICP's answer as the refinement's prior: the geometric information of the frame's points (the
+  // information_width level) with the inlier RMSE as their noise, times this per point, against
+  // the images' pixels at PhotometricParams::intensity_sigma (0: the images alone). Without it
+  // the stripes and fine grain of the synthetic surveys' textures (aliased by the renderer's
+  // point sampling) drew the refined directions 0.4 degrees off on seed 8.
+  double photometric_geometry_weight = 10;
   // Degenerate frames: ICP solves with the motion model as a prior (geometric_information.hpp's
   // motion_prior_information), isotropic about the camera, this many times the mean direction's
   // information: it decides the directions the geometry leaves free and barely moves the others

@@ -12,6 +12,11 @@
 // back-projected source pixel and d_k the given tangent directions (right perturbation, tangent
 // (omega, v), geometric_information.hpp's weak_directions). Gauss-Newton on s with Huber weights
 // (huber_levels grey levels); a step is kept only if it lowers the robust cost.
+//
+// start_information (tangent coordinates of source_to_target, 1/m^2 and 1/rad^2) is what the
+// start was already measured to: the amounts s pay 0.5 s^T D^T Omega D s intensity_sigma^2 on top
+// of the robust cost, so directions the start knows well move only where the images disagree
+// with it clearly. Zero: the images alone.
 #include <cstddef>
 #include <span>
 
@@ -36,6 +41,10 @@ struct PhotometricParams {
   // measurement: on the synthetic surveys, floors with texture gave 0.04-0.2 mm, a grey floor or
   // a weak wood grain under the sensor noise 3-8 mm, with answers 2-17 cm wrong.
   double max_sigma_m = 0.001;
+  // The grey-level noise a residual is taken to have when start_information is weighed against
+  // the images. Set once (the synthetic camera has 2 levels per channel); the weight of the other
+  // side, OdometryParams::photometric_geometry_weight, was chosen on the surveys.
+  double intensity_sigma = 4.0;
 };
 
 struct PhotometricResult {
@@ -51,11 +60,11 @@ struct PhotometricResult {
 
 // The depth is in depth units (units_per_metre) on the camera's grid; both colour images too.
 // Throws Error on mismatched sizes.
-PhotometricResult refine_photometrically(const DepthImage& source_depth,
-                                         const RgbImage& source_color, const RgbImage& target_color,
-                                         const PinholeIntrinsics& camera, double units_per_metre,
-                                         const Eigen::Isometry3d& source_to_target,
-                                         std::span<const se3::Vector6d> directions,
-                                         const PhotometricParams& params = {});
+PhotometricResult refine_photometrically(
+    const DepthImage& source_depth, const RgbImage& source_color, const RgbImage& target_color,
+    const PinholeIntrinsics& camera, double units_per_metre,
+    const Eigen::Isometry3d& source_to_target, std::span<const se3::Vector6d> directions,
+    const PhotometricParams& params = {},
+    const se3::Matrix6d& start_information = se3::Matrix6d::Zero());
 
 }  // namespace kartograf::registration
