@@ -251,11 +251,13 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
         weak_directions(geometry_, std::max(ratio, params_.photometric_direction_ratio));
     const double pairs =
         params_.photometric_geometry_weight * static_cast<double>(geometry_.points);
-    const se3::Matrix6d held = edge_information(geometry_.information, attempt.inlier_rmse,
-                                                {pairs, params_.information.min_sigma});
-    const PhotometricResult refined = refine_photometrically(
-        *depth_, *color_, target_color, builder_.camera(), params_.depth_range.units_per_metre,
-        attempt.motion, directions, params_.photometric, held);
+    const se3::Matrix6d held =
+        edge_information(constrained_information(geometry_, ratio), attempt.inlier_rmse,
+                         {pairs, params_.information.min_sigma});
+    const PhotometricResult refined =
+        refine_photometrically(*depth_, *color_, target_color, builder_.camera(),
+                               params_.depth_range.units_per_metre, attempt.motion, directions,
+                               params_.photometric, held, weak_directions(geometry_, ratio).size());
     if (refined.refined) {
       attempt.motion = refined.motion;
       attempt.photometric = true;

@@ -160,14 +160,18 @@ std::vector<Sample> samples_of(const DepthImage& depth, const Textured& source,
   return samples;
 }
 
-// PhotometricResult::sigma_m of the last sums.
-double motion_sigma(const Sums& sums, std::span<const se3::Vector6d> directions) {
+// PhotometricResult::sigma_m of the last sums: the images' own uncertainty in the first
+// `measured` directions, the others held where they are (by the start's information).
+double motion_sigma(const Sums& sums, std::span<const se3::Vector6d> directions,
+                    std::size_t measured) {
+  measured = std::min(measured, directions.size());
   if (sums.count <= directions.size()) return std::numeric_limits<double>::infinity();
   const double variance = sums.squared / static_cast<double>(sums.count - directions.size());
-  const Eigen::MatrixXd covariance =
-      variance * sums.jtj.ldlt().solve(Eigen::MatrixXd::Identity(sums.jtj.rows(), sums.jtj.cols()));
+  const auto m = static_cast<Eigen::Index>(measured);
+  const Eigen::MatrixXd block = sums.jtj.topLeftCorner(m, m);
+  const Eigen::MatrixXd covariance = variance * block.ldlt().solve(Eigen::MatrixXd::Identity(m, m));
   double sigma = 0;
-  for (std::size_t d = 0; d < directions.size(); ++d) {
+  for (std::size_t d = 0; d < measured; ++d) {
     const auto k = static_cast<Eigen::Index>(d);
     // A point 2 m ahead moves by |v| + 2 |omega| at most per unit of this direction.
     const double size = directions[d].tail<3>().norm() + 2.0 * directions[d].head<3>().norm();
@@ -233,7 +237,8 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
                                          const Eigen::Isometry3d& source_to_target,
                                          std::span<const se3::Vector6d> directions,
                                          const PhotometricParams& params,
-                                         const se3::Matrix6d& start_information) {
+                                         const se3::Matrix6d& start_information,
+                                         std::size_t measured_directions) {
   const auto same_size = [&](int w, int h) { return w == camera.width && h == camera.height; };
   require(same_size(source_depth.width(), source_depth.height()) &&
               same_size(source_color.width(), source_color.height()) &&
@@ -266,8 +271,7 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
     }
     Sums sums = descend(samples, target, camera, directions, params, result.motion, prior);
     if (passes == 1) {
-      sums.jtj += prior.information;
-      result.sigma_m = motion_sigma(sums, directions);
+      result.sigma_m = motion_sigma(sums, directions, measured_directions);
       end_cost = mean_cost(sums) + prior.cost(prior.amounts, sums.count);
       result.pixels = sums.count;
       result.rmse_after = sums.count ? std::sqrt(sums.squared / sums.count) : 0.0;

@@ -26,9 +26,10 @@ Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
 Image<int> wall_direction_bins(const Image<SemanticClass>& classes);
 
 // The thickness, in cells, of the walls seen from both sides (floor or furniture on both faces;
-// runs of 2 to max_cells cells): the lower tercile of the runs across them; 0 where fewer than
-// `min_samples` runs measure one. With `through_unseen`, a run goes on through the cells no view
-// saw (the inside of a wall seen from both sides, before it is filled).
+// runs of 2 to max_cells cells): the k whose runs of k and k + 1 cells are the most (a wall k
+// cells thick covers either, by where its faces fall); 0 where fewer than `min_samples` runs
+// measure one. With `through_unseen`, a run goes on through the cells no view saw (the inside of
+// a wall seen from both sides, before it is filled).
 int two_sided_wall_thickness(const SemanticGrid& grid, int max_cells, int min_samples,
                              bool through_unseen = false);
 

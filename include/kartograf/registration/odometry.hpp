@@ -121,14 +121,15 @@ struct OdometryParams {
   // barely constrains. The motion prior pulls the latter toward the prediction as well: on survey
   // seed 4 ICP's answer was 0.2 degrees and 1 cm off in them, the degenerate direction alone could
   // not be refined to the truth, and the refinement of that one direction moved 1.6 cm away
-  // from it instead. Each stays held to ICP's answer by ICP's own information there
-  // (photometric_geometry_weight).
+  // from it instead. Only the degenerate ones must be measured by the images (the sigma gate);
+  // the others stay held to ICP's answer by what ICP measured (photometric_geometry_weight).
   double photometric_direction_ratio = 0.2;
   // ICP's answer as the refinement's prior: the geometric information of the frame's points (the
-  // information_width level) with the inlier RMSE as their noise, times this per point, against
-  // the images' pixels at PhotometricParams::intensity_sigma (0: the images alone). Without it
-  // the stripes and fine grain of the synthetic surveys' textures (aliased by the renderer's
-  // point sampling) drew the refined directions 0.4 degrees off on seed 8.
+  // information_width level) without its degenerate directions (which came from the motion
+  // model), with the inlier RMSE as their noise, times this per point, against the images' pixels
+  // at PhotometricParams::intensity_sigma (0: the images alone). Without it the stripes and fine
+  // grain of the synthetic surveys' textures (aliased by the renderer's point sampling) drew the
+  // refined directions 11 cm off on seed 8.
   double photometric_geometry_weight = 10;
   // Degenerate frames: ICP solves with the motion model as a prior (geometric_information.hpp's
   // motion_prior_information), isotropic about the camera, this many times the mean direction's

@@ -16,7 +16,9 @@
 // start_information (tangent coordinates of source_to_target, 1/m^2 and 1/rad^2) is what the
 // start was already measured to: the amounts s pay 0.5 s^T D^T Omega D s intensity_sigma^2 on top
 // of the robust cost, so directions the start knows well move only where the images disagree
-// with it clearly. Zero: the images alone.
+// with it clearly. Zero: the images alone. PhotometricResult::sigma_m (and so `refined`) is the
+// images' own uncertainty in the first measured_directions directions, given the others: those
+// the start knows (the geometry's weak but not free ones) need not be measured by the images.
 #include <cstddef>
 #include <span>
 
@@ -53,8 +55,9 @@ struct PhotometricResult {
   std::size_t pixels = 0;  // residuals of the last evaluation
   double rmse_before = 0;  // grey levels, at the given motion (fine pass)
   double rmse_after = 0;
-  // The refined motion's standard deviation, as the largest over the directions of the metres
-  // it moves a point 2 m in front of the camera: rmse_after^2 (J^T W J)^-1 of the fine pass.
+  // The refined motion's standard deviation, as the largest over the measured directions of the
+  // metres it moves a point 2 m in front of the camera: rmse_after^2 (J^T W J)^-1 of the fine
+  // pass, over those directions.
   double sigma_m = 0;
 };
 
@@ -65,6 +68,7 @@ PhotometricResult refine_photometrically(
     const PinholeIntrinsics& camera, double units_per_metre,
     const Eigen::Isometry3d& source_to_target, std::span<const se3::Vector6d> directions,
     const PhotometricParams& params = {},
-    const se3::Matrix6d& start_information = se3::Matrix6d::Zero());
+    const se3::Matrix6d& start_information = se3::Matrix6d::Zero(),
+    std::size_t measured_directions = 6);
 
 }  // namespace kartograf::registration
