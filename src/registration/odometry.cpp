@@ -247,17 +247,19 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   // ...or from the images, when there are colours.
   const RgbImage& target_color = colors_[slot_of(target)];
   if (params_.photometric_refinement && color_ && !color_->empty() && !target_color.empty()) {
+    // Ascending eigenvalues: the degenerate directions come first, and the images must measure
+    // those; the barely constrained ones after them are held by what ICP measured.
     const std::vector<se3::Vector6d> directions =
         weak_directions(geometry_, std::max(ratio, params_.photometric_direction_ratio));
+    const std::size_t degenerate = weak_directions(geometry_, ratio).size();
     const double pairs =
         params_.photometric_geometry_weight * static_cast<double>(geometry_.points);
     const se3::Matrix6d held =
         edge_information(constrained_information(geometry_, ratio), attempt.inlier_rmse,
                          {pairs, params_.information.min_sigma});
-    const PhotometricResult refined =
-        refine_photometrically(*depth_, *color_, target_color, builder_.camera(),
-                               params_.depth_range.units_per_metre, attempt.motion, directions,
-                               params_.photometric, held, weak_directions(geometry_, ratio).size());
+    const PhotometricResult refined = refine_photometrically(
+        *depth_, *color_, target_color, builder_.camera(), params_.depth_range.units_per_metre,
+        attempt.motion, directions, params_.photometric, held, degenerate);
     if (refined.refined) {
       attempt.motion = refined.motion;
       attempt.photometric = true;
