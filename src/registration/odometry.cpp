@@ -380,26 +380,27 @@ bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
 RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& predicted,
                                                      OdometryFrame& frame) {
   const std::size_t previous = frame.index - 1;
-  // A large predicted motion may be beyond ICP's basin: start from the features' motion. (Checking
-  // that one against other starts by fitness, when it fits poorly, picked wrong turns in rooms
-  // that look alike all round; docs/slam.md.)
-  if (is_large(predicted)) {
-    if (std::optional<Attempt> seeded = register_from_features()) {
-      frame.from_features = true;
-      return std::move(*seeded);
-    }
-  }
+  // A large predicted motion may be beyond ICP's basin: ICP from the features' motion as well,
+  // kept unless the pair agrees better with ICP from the prediction (features matched on a
+  // repeated texture, a tile or two over, or on too little; docs/slam.md). Other starts are not
+  // weighed against the features: by fitness they picked wrong turns in rooms that look alike.
+  std::optional<Attempt> seeded;
+  if (is_large(predicted)) seeded = register_from_features();
   Attempt attempt = register_frames(previous, predicted, params_.frame_limits);
+  if (seeded) {
+    if (agrees_better(attempt, *seeded)) return attempt;
+    frame.from_features = true;
+    return std::move(*seeded);
+  }
   if (is_doubtful(attempt)) {
     return best_of_other_starts(previous, predicted, std::move(attempt), frame);
   }
   // Only where the images did not measure the weak directions themselves (a step beyond the
   // refinement's basin, or too little texture): elsewhere they already had their say.
   if (geometry_.degeneracy.degenerate && !attempt.photometric && attempt.photometric_rmse > 0) {
-    std::optional<Attempt> seeded = arbitrate_by_intensity(attempt);
-    if (seeded) {
+    if (std::optional<Attempt> arbitrated = arbitrate_by_intensity(attempt)) {
       frame.from_features = true;
-      return std::move(*seeded);
+      return std::move(*arbitrated);
     }
   }
   return attempt;
@@ -408,16 +409,23 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
     const Attempt& predicted) {
   std::optional<Attempt> seeded = register_from_features();
-  if (!seeded || seeded->photometric_rmse <= 0) return {};
-  const Eigen::Isometry3d difference = seeded->motion.inverse() * predicted.motion;
+  if (!seeded || !agrees_better(*seeded, predicted)) return {};
+  return seeded;
+}
+
+bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incumbent) const {
+  if (!challenger.report.accepted()) return false;
+  const Eigen::Isometry3d difference = challenger.motion.inverse() * incumbent.motion;
   if (difference.translation().norm() <= params_.feature_arbitration_m &&
       se3::rotation_angle(difference) <= params_.feature_arbitration_deg * kDegree) {
-    return {};
+    return false;
   }
-  if (seeded->photometric_rmse >= params_.feature_arbitration_ratio * predicted.photometric_rmse) {
-    return {};
+  if (challenger.report.degenerate || incumbent.report.degenerate) {
+    return challenger.photometric_rmse > 0 && incumbent.photometric_rmse > 0 &&
+           challenger.photometric_rmse <
+               params_.feature_arbitration_ratio * incumbent.photometric_rmse;
   }
-  return seeded;
+  return challenger.report.fitness > incumbent.report.fitness;
 }
 
 bool RgbdOdometry::is_doubtful(const Attempt& attempt) const {

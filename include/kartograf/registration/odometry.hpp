@@ -171,9 +171,11 @@ struct OdometryParams {
   std::vector<double> recheck_turns_deg = {-40, -20, 20, 40};
   // Local features (optional; the features layer's OrbFrontEnd): the current and the previous
   // frame's features are matched, and ICP starts from their motion, when the motion model
-  // predicts more than feature_seed_m or feature_seed_deg (beyond the coarsest ICP gate), and as
-  // one of the other starts of a doubtful registration. Otherwise they cost nothing but a copy of
-  // each frame's images. Not for degenerate frames in general: features matched a few
+  // predicts more than feature_seed_m or feature_seed_deg (beyond the coarsest ICP gate; ICP from
+  // the prediction is run too and kept where the pair agrees better with it, as below: features
+  // matched on a repeated texture are accepted a tile over), and as one of the other starts of a
+  // doubtful registration. Otherwise they cost nothing but a copy of each frame's images. Not
+  // for degenerate frames in general: features matched a few
   // centimetres off, worse than the motion model (survey seed 2: 8.5 cm ATE against 2.8).
   // But on a degenerate frame with colour whose weak directions the images did not measure
   // (photometric refinement not kept), ICP from the features' motion is also run, and taken
@@ -271,6 +273,11 @@ class RgbdOdometry {
   Attempt best_of_other_starts(std::size_t previous, const Eigen::Isometry3d& predicted,
                                Attempt first, OdometryFrame& frame);
   bool is_large(const Eigen::Isometry3d& motion) const;
+  // Whether the pair agrees better with `challenger` (accepted) than with `incumbent`, ICP from
+  // two starts, when they differ by more than feature_arbitration_m or _deg: on a degenerate
+  // pair the images (grey-level RMSE below feature_arbitration_ratio times the other's), since
+  // the fitness cannot tell a slide along the free direction; otherwise the fitness.
+  bool agrees_better(const Attempt& challenger, const Attempt& incumbent) const;
   // A degenerate frame's registration from the prediction against ICP from the features' motion:
   // the latter when the two disagree and its images agree better (photometric_rmse).
   std::optional<Attempt> arbitrate_by_intensity(const Attempt& predicted);
