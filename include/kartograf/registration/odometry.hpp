@@ -175,8 +175,8 @@ struct OdometryParams {
   // the prediction is run too and kept where the pair agrees better with it, as below: features
   // matched on a repeated texture are accepted a tile over), and as one of the other starts of a
   // doubtful registration. Otherwise they cost nothing but a copy of each frame's images. Not
-  // for degenerate frames in general: features matched a few
-  // centimetres off, worse than the motion model (survey seed 2: 8.5 cm ATE against 2.8).
+  // for degenerate frames in general: features matched a few centimetres off, worse than the
+  // motion model (survey seed 2: 8.5 cm ATE against 2.8).
   // But on a degenerate frame with colour whose weak directions the images did not measure
   // (photometric refinement not kept), ICP from the features' motion is also run, and taken
   // when it differs from the prediction's registration by more than feature_arbitration_m or
