@@ -3,16 +3,32 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <string>
 
+#include "kartograf/core/memory_budget.hpp"
 #include "semantic/grid_cells.hpp"
 
 namespace kartograf::semantic::detail {
+
+namespace {
+
+std::size_t cell_count(const SemanticGrid& grid) {
+  const double bytes = static_cast<double>(grid.width()) * grid.height() *
+                       (2 * sizeof(std::uint64_t) + BandFreeSpace::kSlabs * sizeof(std::uint16_t));
+  require_fits_in_memory(bytes, "build_semantic_grid: the free space of a grid of " +
+                                    std::to_string(grid.width()) + " x " +
+                                    std::to_string(grid.height()) + " cells");
+  return static_cast<std::size_t>(grid.width()) * static_cast<std::size_t>(grid.height());
+}
+
+}  // namespace
 
 BandFreeSpace::BandFreeSpace(const SemanticGrid& grid, double band_min, double slab_height)
     : grid_(grid),
       band_min_(band_min),
       slab_height_(slab_height),
-      cells_(static_cast<std::size_t>(grid.width()) * static_cast<std::size_t>(grid.height())) {}
+      cells_(cell_count(grid)),
+      passes_(cells_.size() * kSlabs, 0) {}
 
 // The segment, in lattice units (x along columns, y up the rows, z along the slabs), clipped to
 // the lattice; then walked voxel by voxel.
@@ -53,9 +69,12 @@ void BandFreeSpace::walk(const Eigen::Vector3d& entry, const Eigen::Vector3d& d,
     next[k] = step[k] != 0 ? t0 + (boundary - entry[k]) / d[k] : delta[k];
   }
   for (;;) {
-    Slabs& cell = cells_[static_cast<std::size_t>(size[1] - 1 - voxel[1]) *
-                             static_cast<std::size_t>(size[0]) +
-                         static_cast<std::size_t>(voxel[0])];
+    const std::size_t index =
+        static_cast<std::size_t>(size[1] - 1 - voxel[1]) * static_cast<std::size_t>(size[0]) +
+        static_cast<std::size_t>(voxel[0]);
+    Slabs& cell = cells_[index];
+    std::uint16_t& passes = passes_[index * kSlabs + static_cast<std::size_t>(voxel[2])];
+    if (passes < 65535) ++passes;
     const std::uint64_t bit = std::uint64_t{1} << voxel[2];
     cell.twice |= cell.once & bit;
     cell.once |= bit;
@@ -76,6 +95,15 @@ std::uint64_t BandFreeSpace::crossed_twice(const Eigen::Vector2i& cell) const {
   return cells_[static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
                 static_cast<std::size_t>(cell.x())]
       .twice;
+}
+
+int BandFreeSpace::passes(const Eigen::Vector2i& cell, double height) const {
+  const int slab = slab_of(height);
+  if (!grid_.contains(cell) || slab < 0 || slab >= kSlabs) return 0;
+  const std::size_t index =
+      static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
+      static_cast<std::size_t>(cell.x());
+  return passes_[index * kSlabs + static_cast<std::size_t>(slab)];
 }
 
 bool BandFreeSpace::observable(double height) const {

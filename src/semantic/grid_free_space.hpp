@@ -3,7 +3,8 @@
 // origin to just short of the point, marks the height slabs of the cells it crosses as seen
 // through (a step of build_semantic_grid). A table top that grazing views dropped is never seen
 // through, while the floor around it is crossed at the top's height by rays to farther surfaces:
-// this tells the floor under a table from the floor beside it, which point counts cannot.
+// this tells the floor under a table from the floor beside it, which point counts cannot. Each
+// voxel (cell by slab) also counts the rays that crossed it (grid_phantoms.hpp).
 #include <cstdint>
 #include <span>
 #include <vector>
@@ -44,6 +45,8 @@ class BandFreeSpace {
   bool clear_throughout(const Eigen::Vector2i& cell) const {
     return clear_below(cell, eye_height_);
   }
+  // How many rays crossed the voxel of `cell` at `height` (saturating; 0 outside the slabs).
+  int passes(const Eigen::Vector2i& cell, double height) const;
 
  private:
   struct Slabs {
@@ -55,8 +58,9 @@ class BandFreeSpace {
 
   const SemanticGrid& grid_;
   double band_min_, slab_height_;
-  double eye_height_ = 0;     // above the floor
-  std::vector<Slabs> cells_;  // row-major, as the grid's cells
+  double eye_height_ = 0;              // above the floor
+  std::vector<Slabs> cells_;           // row-major, as the grid's cells
+  std::vector<std::uint16_t> passes_;  // per cell, kSlabs counts of rays (saturating)
 };
 
 // Per cell: the range from its view's origin to the nearest wall point in the robot's height band

@@ -21,6 +21,7 @@
 #include "semantic/grid_doorways.hpp"
 #include "semantic/grid_free_space.hpp"
 #include "semantic/grid_furniture.hpp"
+#include "semantic/grid_phantoms.hpp"
 #include "semantic/grid_wall_faces.hpp"
 #include "semantic/grid_walls.hpp"
 
@@ -252,15 +253,15 @@ std::vector<cv::Point> rectangle_around(const std::vector<cv::Point>& outline) {
 }
 
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
-// piece, closed over gaps of a few cells, whose convex hull is at most max_area is filled: the
+// piece, closed over gaps of join_cells, whose convex hull is at most max_area is filled: the
 // robot cannot drive under it within its height band. Without free space its hull is filled; with
 // it, the rectangle around it, but for the cells that the views saw through just under the piece's
 // tops (open floor in the hull of an L or of two pieces, the shadow behind a table).
 void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                     const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
-                    double max_area, float furniture_weight) {
+                    int join_cells, double max_area, float furniture_weight) {
   const CellMask outlines = closed_cell_mask(
-      grid, [&](int col, int row) { return furniture(col, row) != 0; }, 7);
+      grid, [&](int col, int row) { return furniture(col, row) != 0; }, join_cells);
   std::vector<std::vector<cv::Point>> pieces;
   cv::findContours(outlines.closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
   const double cell_area = grid.resolution * grid.resolution;
@@ -535,11 +536,13 @@ SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
   return grid;
 }
 
-// What the points say about each cell of `grid`.
+// What the points say about each cell of `grid`; phantom points (phantom[i] != 0; empty: none)
+// say nothing.
 Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
                                     std::span<const Eigen::Vector3d> points,
                                     std::span<const SemanticClass> labels,
                                     std::span<const std::uint32_t> view_ids,
+                                    std::span<const std::uint8_t> phantom,
                                     const SemanticGridParams& options) {
   const double res = options.resolution;
   Image<CellEvidence> evidence(grid.width(), grid.height());
@@ -548,7 +551,7 @@ Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
                                    : std::numeric_limits<double>::infinity();
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d& p = points[i];
-    if (!p.allFinite()) continue;
+    if (!p.allFinite() || (!phantom.empty() && phantom[i])) continue;
     const Eigen::Vector2i cell = grid.cell_of(p.head<2>());
     CellEvidence& e = evidence(cell.x(), cell.y());
     const double h = p.z() - grid.floor_z;
@@ -816,6 +819,11 @@ void SemanticGridParams::validate() const {
           "SemanticGridParams: max_wall_thickness and max_floor_shadow must be >= 0");
   require(free_space_ray_stride >= 0, "SemanticGridParams: free_space_ray_stride must be >= 0");
   positive(free_space_slab, "free_space_slab");
+  positive(furniture_join_gap, "furniture_join_gap");
+  require(std::isfinite(phantom_pass_ratio) && phantom_pass_ratio >= 0,
+          "SemanticGridParams: phantom_pass_ratio must be >= 0");
+  require(std::isfinite(phantom_margin) && phantom_margin >= 0,
+          "SemanticGridParams: phantom_margin must be >= 0");
   require(std::isfinite(free_space_end_margin) && free_space_end_margin >= 0,
           "SemanticGridParams: free_space_end_margin must be >= 0");
   require(std::isfinite(seen_through_wall_range) && seen_through_wall_range >= 0,
@@ -941,14 +949,20 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
               std::to_string(points.size()) + " points");
   check_view_origins(view_ids, view_origins);
   SemanticGrid grid = empty_grid(points, labels, options);
-  const Image<CellEvidence> evidence = gather_evidence(grid, points, labels, view_ids, options);
+  std::optional<detail::BandFreeSpace> free_space;
+  if (options.free_space_ray_stride > 0 && !view_origins.empty())
+    free_space.emplace(detail::carve_band(grid, points, view_ids, view_origins, options));
+  const std::vector<std::uint8_t> phantom =
+      free_space && options.phantom_pass_ratio > 0
+          ? detail::phantom_points(grid, points, labels, *free_space, options)
+          : std::vector<std::uint8_t>();
+  const Image<CellEvidence> evidence =
+      gather_evidence(grid, points, labels, view_ids, phantom, options);
   // Fewer views than min_obstacle_views (one scan) ask for what they can give.
   SemanticGridParams cell_options = options;
   cell_options.min_obstacle_views = std::min(options.min_obstacle_views, count_views(view_ids));
   ObstacleMasks masks = classify_cells(grid, evidence, cell_options);
-  std::optional<detail::BandFreeSpace> free_space;
-  if (options.free_space_ray_stride > 0 && !view_origins.empty()) {
-    free_space.emplace(detail::carve_band(grid, points, view_ids, view_origins, options));
+  if (free_space) {
     raised_walls_to_unclassified(grid, evidence, *free_space,
                                  options.weights.unclassified_obstacle);
     if (options.seen_through_wall_range > 0) {
@@ -971,7 +985,9 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   if (options.max_furniture_fill_area > 0 && options.furniture_max_extent > 0)
     unclassified_to_furniture(grid, evidence, options, masks.furniture);
   if (options.max_furniture_fill_area > 0) {
-    fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture,
+    const int join_cells =
+        std::max(1, static_cast<int>(std::lround(options.furniture_join_gap / options.resolution)));
+    fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture, join_cells,
                    options.max_furniture_fill_area, options.weights.of(SemanticClass::furniture));
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)

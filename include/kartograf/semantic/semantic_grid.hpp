@@ -91,6 +91,9 @@ struct SemanticGridParams {
   // filled to their convex hull when that is at most this area [m^2]; 0: off.
   // The same bound holds for floor enclosed by unclassified obstacles.
   double max_furniture_fill_area = 4.0;  // obstacle cells without an obstacle neighbour: specks
+  // A piece of furniture's outline is closed over gaps up to this long [m] before it is filled:
+  // without phantom points (below) a table is its legs and the edge of its top nearest the views.
+  double furniture_join_gap = 0.75;
   // Unclassified obstacles that stand free in a room as furniture does (a piece, closed over gaps
   // of a few cells, whose hull is at most max_furniture_fill_area, at most furniture_max_extent
   // long and whose points end furniture_max_height above the floor) are furniture: the views
@@ -129,6 +132,12 @@ struct SemanticGridParams {
   int free_space_ray_stride = 4;         // 0: no free space
   double free_space_slab = 0.02;         // m
   double free_space_end_margin = 0.025;  // m per m of range
+  // Phantom points, the mixed pixels a depth camera returns on an object's outline, floating in the
+  // air behind it: a band point (not wall or door) whose voxel of the free space above, and the
+  // voxels phantom_margin beside it, the rays crossed more than phantom_pass_ratio times as often
+  // as points fell in it gives no evidence (semantic/grid_phantoms.hpp). 0: off.
+  double phantom_pass_ratio = 4;
+  double phantom_margin = 0.02;  // m
   int min_floor_points = 1;
   double margin = 0.25;          // metres of grid around the data
   double min_wall_length = 0.5;  // shorter straight wall pieces are not objects
