@@ -193,6 +193,42 @@ TEST(SemanticGridFreeSpace, MixedPixelsBehindATableMakeNoObstacle) {
   EXPECT_GT(furniture_off_the_table(phantoms), 50);
 }
 
+// Four tables like the one above in a 2 x 2 block, 0.6 m apart, in a 7 x 6 m room: closed over
+// the 0.75 m join gap their outlines are one piece of 6.6 m^2, too large for furniture; judged
+// again over 0.35 m gaps each table is filled, and the aisles between them stay floor.
+TEST(SemanticGridFreeSpace, TablesTooCloseToTellApartAtTheJoinGapAreJudgedOneByOne) {
+  std::vector<Box> scene = {{{0, 0, -0.05}, {7, 6, 0}, C::floor, C::floor},
+                            {{-0.1, -0.1, 0}, {0, 6.1, 2.5}, C::wall, C::wall},
+                            {{7, -0.1, 0}, {7.1, 6.1, 2.5}, C::wall, C::wall},
+                            {{0, -0.1, 0}, {7, 0, 2.5}, C::wall, C::wall},
+                            {{0, 6, 0}, {7, 6.1, 2.5}, C::wall, C::wall}};
+  for (const double x0 : {2.0, 3.8}) {
+    for (const double y0 : {1.9, 3.3}) {
+      scene.push_back({{x0, y0, 0.72}, {x0 + 1.2, y0 + 0.8, 0.76}, C::unknown, C::wall});
+      for (const double x : {x0 + 0.04, x0 + 1.11})
+        for (const double y : {y0 + 0.04, y0 + 0.71})
+          scene.push_back({{x, y, 0}, {x + 0.05, y + 0.05, 0.72}, C::unknown, C::unknown});
+    }
+  }
+  const Views v = look(scene, {{0.8, 0.6, 1},
+                               {6.2, 0.6, 1},
+                               {6.2, 5.4, 1},
+                               {0.8, 5.4, 1},
+                               {0.6, 3.0, 1},
+                               {6.4, 3.0, 1},
+                               {3.5, 0.6, 1},
+                               {3.5, 5.4, 1}});
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  for (const double x : {2.6, 4.4}) {
+    for (const double y : {2.3, 3.7}) {
+      EXPECT_EQ(class_at(grid, x, y), C::furniture) << "the table at " << x << ", " << y;
+    }
+  }
+  EXPECT_EQ(class_at(grid, 3.5, 2.3), C::floor);  // the aisles between them
+  EXPECT_EQ(class_at(grid, 2.6, 3.0), C::floor);
+}
+
 // An L of two low benches (0.45 m): the convex hull of the piece spans the open floor in the L's
 // corner, which the views saw through at every height below the benches' top: it stays floor.
 // Without the origins the hull makes it furniture.

@@ -252,47 +252,74 @@ std::vector<cv::Point> rectangle_around(const std::vector<cv::Point>& outline) {
   return corners;
 }
 
+// Fills one piece of furniture (its outline `piece`): without free space its hull; with it, the
+// rectangle around it, but for the cells that the views saw through just under the piece's tops
+// (open floor in the hull of an L or of two pieces, the shadow behind a table).
+void fill_piece(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
+                const std::vector<cv::Point>& piece, std::vector<cv::Point> hull,
+                float furniture_weight) {
+  if (free_space) hull = rectangle_around(piece);
+  const cv::Rect box = cv::boundingRect(hull) & cv::Rect(0, 0, grid.width(), grid.height());
+  cv::Mat fill = cv::Mat::zeros(box.height, box.width, CV_8U);
+  for (cv::Point& p : hull) p -= box.tl();
+  cv::fillConvexPoly(fill, hull, 255);
+  std::vector<cv::Point> cells, marked;
+  for (int y = 0; y < box.height; ++y) {
+    for (int x = 0; x < box.width; ++x) {
+      if (!fill.at<std::uint8_t>(y, x)) continue;
+      cells.push_back(box.tl() + cv::Point(x, y));
+      if (furniture(cells.back().x, cells.back().y)) marked.push_back(cells.back());
+    }
+  }
+  const std::array<double, 2> tops = piece_tops(grid, evidence, marked);
+  for (const cv::Point& c : cells) {
+    // Only floor changes: walls and doors keep their class, and what no view saw stays
+    // unknown (filling it made rooms leak where the views were few).
+    if (furniture(c.x, c.y) || grid.classes(c.x, c.y) != SemanticClass::floor ||
+        (free_space && open_beside(*free_space, tops, c)))
+      continue;
+    furniture(c.x, c.y) = 1;
+    grid.classes(c.x, c.y) = SemanticClass::furniture;
+    grid.weight(c.x, c.y) = furniture_weight;
+  }
+}
+
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
-// piece, closed over gaps of join_cells, whose convex hull is at most max_area is filled: the
-// robot cannot drive under it within its height band. Without free space its hull is filled; with
-// it, the rectangle around it, but for the cells that the views saw through just under the piece's
-// tops (open floor in the hull of an L or of two pieces, the shadow behind a table).
+// piece, closed over gaps of join_gap, whose convex hull is at most max_area is filled
+// (fill_piece): the robot cannot drive under it within its height band. The marked cells of a
+// piece too large (the tables and cabinets of a room joined into one) are judged again closed
+// over kJoinAgainGap.
 void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                     const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
-                    int join_cells, double max_area, float furniture_weight) {
-  const CellMask outlines = closed_cell_mask(
-      grid, [&](int col, int row) { return furniture(col, row) != 0; }, join_cells);
-  std::vector<std::vector<cv::Point>> pieces;
-  cv::findContours(outlines.closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+                    double join_gap, double max_area, float furniture_weight) {
+  constexpr double kJoinAgainGap = 0.35;  // m: the join gap before phantom points were dropped
+  const auto cells_of = [&](double gap) {
+    return std::max(1, static_cast<int>(std::lround(gap / grid.resolution)));
+  };
+  cv::Mat left = closed_cell_mask(
+                     grid, [&](int col, int row) { return furniture(col, row) != 0; }, 1)
+                     .mask;
   const double cell_area = grid.resolution * grid.resolution;
-  for (const auto& piece : pieces) {
-    std::vector<cv::Point> hull;
-    cv::convexHull(piece, hull);
-    if (cv::contourArea(hull) * cell_area > max_area) continue;
-    if (free_space) hull = rectangle_around(piece);
-    const cv::Rect box = cv::boundingRect(hull) & cv::Rect(0, 0, grid.width(), grid.height());
-    cv::Mat fill = cv::Mat::zeros(box.height, box.width, CV_8U);
-    for (cv::Point& p : hull) p -= box.tl();
-    cv::fillConvexPoly(fill, hull, 255);
-    std::vector<cv::Point> cells, marked;
-    for (int y = 0; y < box.height; ++y) {
-      for (int x = 0; x < box.width; ++x) {
-        if (!fill.at<std::uint8_t>(y, x)) continue;
-        cells.push_back(box.tl() + cv::Point(x, y));
-        if (furniture(cells.back().x, cells.back().y)) marked.push_back(cells.back());
-      }
-    }
-    const std::array<double, 2> tops = piece_tops(grid, evidence, marked);
-    for (const cv::Point& c : cells) {
-      // Only floor changes: walls and doors keep their class, and what no view saw stays
-      // unknown (filling it made rooms leak where the views were few).
-      if (furniture(c.x, c.y) || grid.classes(c.x, c.y) != SemanticClass::floor ||
-          (free_space && open_beside(*free_space, tops, c)))
+  std::vector<int> sizes{cells_of(join_gap)};
+  if (cells_of(kJoinAgainGap) < sizes.front()) sizes.push_back(cells_of(kJoinAgainGap));
+  for (const int size : sizes) {
+    cv::Mat closed;
+    cv::morphologyEx(left, closed, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
+    std::vector<std::vector<cv::Point>> pieces;
+    cv::findContours(closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+    cv::Mat too_large = cv::Mat::zeros(left.size(), CV_8U);
+    for (std::size_t k = 0; k < pieces.size(); ++k) {
+      std::vector<cv::Point> hull;
+      cv::convexHull(pieces[k], hull);
+      if (cv::contourArea(hull) * cell_area > max_area) {
+        cv::drawContours(too_large, pieces, static_cast<int>(k), 255, cv::FILLED);
         continue;
-      furniture(c.x, c.y) = 1;
-      grid.classes(c.x, c.y) = SemanticClass::furniture;
-      grid.weight(c.x, c.y) = furniture_weight;
+      }
+      fill_piece(grid, evidence, free_space, furniture, pieces[k], hull, furniture_weight);
     }
+    cv::bitwise_and(left, too_large, left);
   }
 }
 
@@ -985,10 +1012,9 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   if (options.max_furniture_fill_area > 0 && options.furniture_max_extent > 0)
     unclassified_to_furniture(grid, evidence, options, masks.furniture);
   if (options.max_furniture_fill_area > 0) {
-    const int join_cells =
-        std::max(1, static_cast<int>(std::lround(options.furniture_join_gap / options.resolution)));
-    fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture, join_cells,
-                   options.max_furniture_fill_area, options.weights.of(SemanticClass::furniture));
+    fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture,
+                   options.furniture_join_gap, options.max_furniture_fill_area,
+                   options.weights.of(SemanticClass::furniture));
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
