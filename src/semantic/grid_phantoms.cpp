@@ -1,7 +1,6 @@
 #include "semantic/grid_phantoms.hpp"
 
 #include <algorithm>
-#include <array>
 #include <cmath>
 #include <cstddef>
 #include <limits>
