@@ -74,7 +74,7 @@ void BandFreeSpace::walk(const Eigen::Vector3d& entry, const Eigen::Vector3d& d,
         static_cast<std::size_t>(voxel[0]);
     Slabs& cell = cells_[index];
     std::uint16_t& passes = passes_[index * kSlabs + static_cast<std::size_t>(voxel[2])];
-    if (passes < 65535) ++passes;
+    if (passes < std::numeric_limits<std::uint16_t>::max()) ++passes;
     const std::uint64_t bit = std::uint64_t{1} << voxel[2];
     cell.twice |= cell.once & bit;
     cell.once |= bit;
@@ -97,13 +97,18 @@ std::uint64_t BandFreeSpace::crossed_twice(const Eigen::Vector2i& cell) const {
       .twice;
 }
 
-int BandFreeSpace::passes(const Eigen::Vector2i& cell, double height) const {
+std::optional<std::size_t> BandFreeSpace::voxel(const Eigen::Vector2i& cell, double height) const {
   const int slab = slab_of(height);
-  if (!grid_.contains(cell) || slab < 0 || slab >= kSlabs) return 0;
+  if (!grid_.contains(cell) || slab < 0 || slab >= kSlabs) return std::nullopt;
   const std::size_t index =
       static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
       static_cast<std::size_t>(cell.x());
-  return passes_[index * kSlabs + static_cast<std::size_t>(slab)];
+  return index * kSlabs + static_cast<std::size_t>(slab);
+}
+
+int BandFreeSpace::passes(const Eigen::Vector2i& cell, double height) const {
+  const std::optional<std::size_t> v = voxel(cell, height);
+  return v ? passes_[*v] : 0;
 }
 
 bool BandFreeSpace::observable(double height) const {

@@ -5,7 +5,9 @@
 // through, while the floor around it is crossed at the top's height by rays to farther surfaces:
 // this tells the floor under a table from the floor beside it, which point counts cannot. Each
 // voxel (cell by slab) also counts the rays that crossed it (grid_phantoms.hpp).
+#include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -45,6 +47,10 @@ class BandFreeSpace {
   bool clear_throughout(const Eigen::Vector2i& cell) const {
     return clear_below(cell, eye_height_);
   }
+  // The index of the voxel (cell by slab) of `cell` at `height` above the floor, among
+  // voxel_count(); none outside the grid and the slabs.
+  std::optional<std::size_t> voxel(const Eigen::Vector2i& cell, double height) const;
+  std::size_t voxel_count() const { return cells_.size() * kSlabs; }
   // How many rays crossed the voxel of `cell` at `height` (saturating; 0 outside the slabs).
   int passes(const Eigen::Vector2i& cell, double height) const;
 

@@ -1,9 +1,9 @@
 #include "semantic/grid_phantoms.hpp"
 
 #include <algorithm>
-#include <cmath>
 #include <cstddef>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include "kartograf/core/memory_budget.hpp"
@@ -12,43 +12,35 @@ namespace kartograf::semantic::detail {
 
 namespace {
 
-std::size_t voxel_count(const SemanticGrid& grid) {
-  const double voxels = static_cast<double>(grid.width()) * grid.height() * BandFreeSpace::kSlabs;
-  require_fits_in_memory(voxels * sizeof(std::uint16_t),
-                         "build_semantic_grid: the phantom points' counts for a grid of " +
-                             std::to_string(grid.width()) + " x " + std::to_string(grid.height()) +
-                             " cells");
-  return static_cast<std::size_t>(voxels);
-}
-
-// Band points by voxel (the free space's cells and slabs), saturating.
+// Band points by voxel (the free space's), saturating.
 class VoxelHits {
  public:
-  VoxelHits(const SemanticGrid& grid, const SemanticGridParams& options)
-      : grid_(grid), options_(options), hits_(voxel_count(grid), 0) {}
+  VoxelHits(const SemanticGrid& grid, const BandFreeSpace& free_space)
+      : grid_(grid), free_space_(free_space), hits_(checked_size(grid, free_space), 0) {}
 
-  // The voxel's index, or none outside the grid and the slabs.
-  std::ptrdiff_t index(const Eigen::Vector3d& p) const {
-    const Eigen::Vector2i c = grid_.cell_of(p.head<2>());
-    const double slab =
-        std::floor((p.z() - grid_.floor_z - options_.band_min) / options_.free_space_slab);
-    if (!grid_.contains(c) || !(slab >= 0 && slab < BandFreeSpace::kSlabs)) return -1;
-    return (static_cast<std::ptrdiff_t>(c.y()) * grid_.width() + c.x()) * BandFreeSpace::kSlabs +
-           static_cast<std::ptrdiff_t>(slab);
-  }
   void add(const Eigen::Vector3d& p) {
-    const std::ptrdiff_t i = index(p);
-    if (i >= 0 && hits_[static_cast<std::size_t>(i)] < std::numeric_limits<std::uint16_t>::max())
-      ++hits_[static_cast<std::size_t>(i)];
+    const std::optional<std::size_t> v = voxel(p);
+    if (v && hits_[*v] < std::numeric_limits<std::uint16_t>::max()) ++hits_[*v];
   }
   int at(const Eigen::Vector3d& p) const {
-    const std::ptrdiff_t i = index(p);
-    return i >= 0 ? hits_[static_cast<std::size_t>(i)] : 0;
+    const std::optional<std::size_t> v = voxel(p);
+    return v ? hits_[*v] : 0;
   }
 
  private:
+  static std::size_t checked_size(const SemanticGrid& grid, const BandFreeSpace& free_space) {
+    require_fits_in_memory(static_cast<double>(free_space.voxel_count()) * sizeof(std::uint16_t),
+                           "build_semantic_grid: the phantom points' counts for a grid of " +
+                               std::to_string(grid.width()) + " x " +
+                               std::to_string(grid.height()) + " cells");
+    return free_space.voxel_count();
+  }
+  std::optional<std::size_t> voxel(const Eigen::Vector3d& p) const {
+    return free_space_.voxel(grid_.cell_of(p.head<2>()), p.z() - grid_.floor_z);
+  }
+
   const SemanticGrid& grid_;
-  const SemanticGridParams& options_;
+  const BandFreeSpace& free_space_;
   std::vector<std::uint16_t> hits_;
 };
 
@@ -78,7 +70,7 @@ std::vector<std::uint8_t> phantom_points(const SemanticGrid& grid,
     return points[i].allFinite() && labels[i] != SemanticClass::floor &&
            labels[i] != SemanticClass::ceiling && h >= options.band_min && h <= options.band_max;
   };
-  VoxelHits hits(grid, options);
+  VoxelHits hits(grid, free_space);
   for (std::size_t i = 0; i < points.size(); ++i)
     if (in_band(i)) hits.add(points[i]);
   std::vector<std::uint8_t> phantom(points.size(), 0);
