@@ -193,16 +193,6 @@ TEST_P(IcpSumsTest, IdentityPairingWithoutOptionalBuffers) {
   check_against_reference(context(), h, "identity pairing");
 }
 
-Eigen::Isometry3d read_pose(const std::filesystem::path& path) {
-  std::ifstream in(path);
-  Eigen::Matrix4d m;
-  for (int r = 0; r < 4; ++r) {
-    for (int c = 0; c < 4; ++c) in >> m(r, c);
-  }
-  EXPECT_FALSE(in.fail()) << path;
-  return orthonormalized_pose(m);
-}
-
 TEST_P(IcpSumsTest, MatchesReferenceOnSevenScenesFramePair) {
   // Frame 0 -> frame 10 with the ground-truth relative pose and projective association, as the
   // first ICP iteration on real Kinect data would see them.
@@ -218,8 +208,8 @@ TEST_P(IcpSumsTest, MatchesReferenceOnSevenScenesFramePair) {
   h.source.assign(source.pixels().begin(), source.pixels().end());
   h.target.assign(target.pixels().begin(), target.pixels().end());
   h.normals.assign(normals.pixels().begin(), normals.pixels().end());
-  h.transform = read_pose(frames / "frame-000010.pose.txt").inverse() *
-                read_pose(frames / "frame-000000.pose.txt");
+  h.transform = testing::read_pose(frames / "frame-000010.pose.txt").inverse() *
+                testing::read_pose(frames / "frame-000000.pose.txt");
   h.max_distance = 0.05;
   h.correspondences.assign(h.source.size(), -1);
   for (std::size_t i = 0; i < h.source.size(); ++i) {

@@ -4,10 +4,12 @@
 #include <cstdlib>
 #include <fstream>
 #include <iterator>
+#include <sstream>
 
 #include <unistd.h>
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/pose.hpp"
 
 namespace kartograf::testing {
 
@@ -36,6 +38,16 @@ std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path) {
 std::string read_text(const std::filesystem::path& path) {
   const std::vector<std::uint8_t> bytes = read_bytes(path);
   return std::string(bytes.begin(), bytes.end());
+}
+
+Eigen::Isometry3d read_pose(const std::filesystem::path& path) {
+  std::istringstream in(read_text(path));
+  Eigen::Matrix4d m;
+  for (int r = 0; r < 4; ++r) {
+    for (int c = 0; c < 4; ++c) in >> m(r, c);
+  }
+  EXPECT_FALSE(in.fail()) << path;
+  return orthonormalized_pose(m);
 }
 
 void write_file(const std::filesystem::path& path, std::string_view contents) {

@@ -12,6 +12,8 @@
 #include <string_view>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 namespace kartograf::testing {
 
 // ../shared/data (or KARTOGRAF_DATA_DIR): fails the test if missing.
@@ -26,6 +28,9 @@ std::vector<std::uint8_t> read_bytes(const std::filesystem::path& path);
 std::string read_text(const std::filesystem::path& path);
 void write_file(const std::filesystem::path& path, std::string_view contents);
 void write_file(const std::filesystem::path& path, const std::vector<std::uint8_t>& contents);
+
+// A 4x4 camera-to-world matrix in a text file (7-Scenes' frame-XXXXXX.pose.txt), orthonormalised.
+Eigen::Isometry3d read_pose(const std::filesystem::path& path);
 
 // The message of the kartograf::Error that f throws; a test failure (and "") if it throws nothing.
 // Any other exception escapes and fails the test too.

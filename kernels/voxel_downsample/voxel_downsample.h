@@ -168,19 +168,6 @@ KG_INLINE uint voxel_color_channel(int64_t sum, int64_t count, uint channel) {
 // ---- Pass 1 (insert): the shader declares keys, first and status.
 #if !defined(VULKAN) || defined(KG_VOXEL_INSERT_PASS)
 
-// The slot of key (inserted where it was absent), or -1 when the table is full.
-KG_FORCE_INLINE int voxel_insert_key(KG_BUFFER_PARAM(uint64_t, keys) uint64_t key,
-                                     uint capacity_log2) {
-  uint slot = voxel_slot(key, capacity_log2);
-  const uint capacity = 1u << capacity_log2;
-  for (uint probe = 0u; probe < capacity; ++probe) {
-    const uint64_t found = kg_atomic_cas_u64(keys, slot, KG_EMPTY_VOXEL_KEY, key);
-    if (found == KG_EMPTY_VOXEL_KEY || found == key) return KG_INT(slot);
-    slot = voxel_next_slot(slot, capacity_log2);
-  }
-  return -1;
-}
-
 // Point i (p, and its normal n where has_normals): its slot, or -1 for an invalid point or an
 // error.
 KG_FORCE_INLINE int voxel_insert_point(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(uint, first)

@@ -13,6 +13,7 @@ layout(std430, binding = 5) buffer Status { uint status[]; };  // KG_VOXEL_STATU
 
 // After the buffers: the rule reads and writes them.
 #define KG_VOXEL_INSERT_PASS
+#define KG_VOXEL_HASH_INSERT
 #include "kernels/voxel_downsample/voxel_downsample.h"
 
 layout(local_size_x = KG_VOXEL_DOWNSAMPLE_LOCAL_X) in;

@@ -51,6 +51,44 @@ KG_INLINE uint voxel_next_slot(uint slot, uint capacity_log2) {
   return (slot + 1u) & ((1u << capacity_log2) - 1u);
 }
 
+// ---- Insert and find: GLSL shaders that use them declare the table as a buffer named `keys`
+// (writable, with GL_EXT_shader_atomic_int64, to insert) and define KG_VOXEL_HASH_INSERT or
+// KG_VOXEL_HASH_FIND before the include.
+#if !defined(VULKAN) || defined(KG_VOXEL_HASH_INSERT)
+
+// The slot of key (inserted where it was absent), or -1 when the table is full.
+KG_FORCE_INLINE int voxel_insert_key(KG_BUFFER_PARAM(uint64_t, keys) uint64_t key,
+                                     uint capacity_log2) {
+  uint slot = voxel_slot(key, capacity_log2);
+  const uint capacity = 1u << capacity_log2;
+  for (uint probe = 0u; probe < capacity; ++probe) {
+    const uint64_t found = kg_atomic_cas_u64(keys, slot, KG_EMPTY_VOXEL_KEY, key);
+    if (found == KG_EMPTY_VOXEL_KEY || found == key) return KG_INT(slot);
+    slot = voxel_next_slot(slot, capacity_log2);
+  }
+  return -1;
+}
+
+#endif
+
+#if !defined(VULKAN) || defined(KG_VOXEL_HASH_FIND)
+
+// The slot of key, or -1 when it is not in the table.
+KG_FORCE_INLINE int voxel_find_key(KG_BUFFER_PARAM(const uint64_t, keys) uint64_t key,
+                                   uint capacity_log2) {
+  uint slot = voxel_slot(key, capacity_log2);
+  const uint capacity = 1u << capacity_log2;
+  for (uint probe = 0u; probe < capacity; ++probe) {
+    const uint64_t found = keys[slot];
+    if (found == key) return KG_INT(slot);
+    if (found == KG_EMPTY_VOXEL_KEY) return -1;
+    slot = voxel_next_slot(slot, capacity_log2);
+  }
+  return -1;
+}
+
+#endif
+
 KG_RULES_END
 
 #endif

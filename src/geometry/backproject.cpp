@@ -23,10 +23,7 @@ std::uint32_t first_unit_at_least(double metres, double units) {
 
 }  // namespace
 
-DepthBackprojector::DepthBackprojector(const compute::Context& context,
-                                       const PinholeIntrinsics& intrinsics, const DepthRange& range)
-    : context_(&context), intrinsics_(intrinsics), range_(range) {
-  intrinsics.validate("depth back-projection intrinsics");
+DepthUnits valid_depth_units(const DepthRange& range) {
   require(std::isfinite(range.units_per_metre) && range.units_per_metre > 0,
           "depth back-projection: units_per_metre must be positive, got " +
               std::to_string(range.units_per_metre));
@@ -34,11 +31,24 @@ DepthBackprojector::DepthBackprojector(const compute::Context& context,
               range.min_metres >= 0 && range.min_metres <= range.max_metres,
           "depth back-projection: need 0 <= min_metres <= max_metres, got " +
               std::to_string(range.min_metres) + " and " + std::to_string(range.max_metres));
-  min_units_ = std::max<std::uint32_t>(1, first_unit_at_least(range.min_metres, range.units_per_metre));
+  DepthUnits units;
+  units.min =
+      std::max<std::uint32_t>(1, first_unit_at_least(range.min_metres, range.units_per_metre));
   // The largest d with d / units <= max is one below the first with d / units > max.
-  const std::uint32_t above = first_unit_at_least(
-      std::nextafter(range.max_metres, std::numeric_limits<double>::infinity()), range.units_per_metre);
-  max_units_ = std::min<std::uint32_t>(0xffff, above == 0 ? 0 : above - 1);
+  const std::uint32_t above =
+      first_unit_at_least(std::nextafter(range.max_metres, std::numeric_limits<double>::infinity()),
+                          range.units_per_metre);
+  units.max = std::min<std::uint32_t>(0xffff, above == 0 ? 0 : above - 1);
+  return units;
+}
+
+DepthBackprojector::DepthBackprojector(const compute::Context& context,
+                                       const PinholeIntrinsics& intrinsics, const DepthRange& range)
+    : context_(&context), intrinsics_(intrinsics), range_(range) {
+  intrinsics.validate("depth back-projection intrinsics");
+  const DepthUnits units = valid_depth_units(range);
+  min_units_ = units.min;
+  max_units_ = units.max;
 
   const double metres_per_unit = 1.0 / range.units_per_metre;
   metres_per_unit_ = static_cast<float>(metres_per_unit);
@@ -64,10 +74,11 @@ void DepthBackprojector::run(const compute::DeviceImage<std::uint16_t>& depth,
   if (points.width() != width || points.height() != height) {
     points = compute::DeviceImage<Point4f>(*context_, width, height);
   }
-  const kernels::BackprojectParams params{static_cast<std::uint32_t>(width), static_cast<std::uint32_t>(height),
-                                 min_units_, max_units_, metres_per_unit_};
-  compute::dispatch(*context_, kBackprojectKernel, {depth.buffer(), device_factors_, points.buffer()},
-                    params,
+  const kernels::BackprojectParams params{static_cast<std::uint32_t>(width),
+                                          static_cast<std::uint32_t>(height), min_units_,
+                                          max_units_, metres_per_unit_};
+  compute::dispatch(*context_, kBackprojectKernel,
+                    {depth.buffer(), device_factors_, points.buffer()}, params,
                     {compute::groups_for(width, kBackprojectKernel.local_x),
                      compute::groups_for(height, kBackprojectKernel.local_y)});
 }

@@ -18,6 +18,14 @@ struct DepthRange {
   double max_metres = 10.0;
 };
 
+// The inclusive range of raw depth values that count as valid (never 0); Error when the range
+// is not a finite 0 <= min <= max with positive units.
+struct DepthUnits {
+  std::uint32_t min = 1;
+  std::uint32_t max = 0xffff;
+};
+DepthUnits valid_depth_units(const DepthRange& range);
+
 // Back-projects depth frames of one camera; the per-camera tables live on the device.
 class DepthBackprojector {
  public:

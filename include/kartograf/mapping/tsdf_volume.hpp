@@ -1,0 +1,126 @@
+#pragma once
+// A truncated signed distance field (TSDF) with colour, fused frame by frame on the compute
+// context's device (CPU, Vulkan or OpenCL; the rules are kernels/tsdf/tsdf.h), as KinectFusion
+// and its successors (voxel hashing: Niessner et al. 2013) keep a 3-D map.
+//
+// Space is cut into blocks of 8^3 voxels of voxel_size; only blocks near an observed surface
+// exist (a hash table from block coordinates to a pool of max_blocks blocks). Integrating a depth
+// frame at a pose (camera to world):
+//   - every valid pixel's surface point allocates the blocks within +-truncation of it;
+//   - every voxel of those blocks in front of the camera is projected into the depth image, and
+//     where the measured depth d is at most `truncation` in front of it (d - z >= -truncation,
+//     z the voxel centre's depth) the value min(1, (d - z) / truncation) joins the voxel's running
+//     mean with weight 1 (the weight stops growing at max_weight, so the field can follow change);
+//     the pixel's colour joins the colour's mean the same way.
+// Ray casting marches each pixel's ray through the field (steps bounded by the field's value) to
+// the first change from + to -, placed by linear interpolation of the trilinear field.
+//
+// The field lives on the device from frame to frame; only the status counters (20 bytes) come back
+// per frame. A full pool or table is an Error that names the budget; the frame that hit it may be
+// partly fused (the blocks that fitted).
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "kartograf/compute/buffer.hpp"
+#include "kartograf/compute/context.hpp"
+#include "kartograf/core/color.hpp"
+#include "kartograf/core/intrinsics.hpp"
+#include "kartograf/core/point_image.hpp"
+#include "kartograf/geometry/backproject.hpp"
+
+namespace kartograf::mapping {
+
+inline constexpr int kTsdfBlockSide = 8;
+inline constexpr std::size_t kTsdfBlockVoxels = 512;
+
+struct TsdfVolumeParams {
+  double voxel_size = 0.01;  // metres
+  // Metres either side of the surface that the field describes; at most one block's side
+  // (8 voxels) and at least one voxel. 4 voxels by default.
+  double truncation = 0.04;
+  double max_weight = 64;
+  // The pool: 12 bytes a voxel, 6 KiB a block; 16384 blocks (96 MiB) fit every device's largest
+  // buffer (Vulkan guarantees 128 MiB) and hold about 170 m^2 of surface at 1 cm voxels.
+  std::size_t max_blocks = 1 << 14;
+  int touch_step = 1;  // pixels between the depth samples that allocate blocks
+
+  // Throws Error naming the field that is out of range.
+  void validate() const;
+};
+
+struct TsdfVoxel {
+  float tsdf = 1;           // signed distance / truncation, in [-1, 1]; + in front of the surface
+  float weight = 0;         // 0: never observed
+  std::uint32_t color = 0;  // mean colour, 0xBBGGRR
+};
+
+// A host copy of the field: the blocks in increasing key order (z, then y, then x), each with its
+// 512 voxels (x fastest, then y, then z).
+struct TsdfBlocks {
+  double voxel_size = 0;
+  double truncation = 0;
+  std::vector<Eigen::Vector3i> coords;  // block coordinates: voxels 8 b .. 8 b + 7
+  std::vector<TsdfVoxel> voxels;        // kTsdfBlockVoxels per block
+
+  std::size_t size() const { return coords.size(); }
+  // The block with these coordinates, or -1.
+  std::ptrdiff_t find(const Eigen::Vector3i& block) const;
+  // The voxel (integral voxel coordinates), or nullptr where no block holds it.
+  const TsdfVoxel* voxel(const Eigen::Vector3i& v) const;
+};
+
+// What one integration did.
+struct TsdfIntegration {
+  std::size_t active_blocks = 0;  // blocks the frame touched
+  std::size_t total_blocks = 0;   // blocks in the volume after it
+};
+
+class TsdfVolume {
+ public:
+  TsdfVolume(const compute::Context& context, const TsdfVolumeParams& params);
+
+  // Fuses a depth frame (and its colour, 0xBBGGRR per pixel, registered to the depth; null: no
+  // colour) seen from camera_to_world. Throws Error on a size mismatch, a pose that is not a
+  // finite rigid motion, or a full pool/table (naming max_blocks).
+  TsdfIntegration integrate(const compute::DeviceImage<std::uint16_t>& depth,
+                            const compute::Buffer<std::uint32_t>* colors,
+                            const PinholeIntrinsics& camera, const geometry::DepthRange& range,
+                            const Eigen::Isometry3d& camera_to_world);
+  // The same from host images (colour may be empty).
+  TsdfIntegration integrate(const DepthImage& depth, const RgbImage& color,
+                            const PinholeIntrinsics& camera, const geometry::DepthRange& range,
+                            const Eigen::Isometry3d& camera_to_world);
+
+  // The surface each pixel sees from camera_to_world between range.min_metres and max_metres:
+  // points in the camera's frame (invalid where none), and with `colors` each point's colour.
+  void raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,
+               const Eigen::Isometry3d& camera_to_world, compute::DeviceImage<Point4f>& points,
+               compute::Buffer<std::uint32_t>* colors = nullptr) const;
+  PointImage raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,
+                     const Eigen::Isometry3d& camera_to_world) const;
+
+  std::size_t block_count() const { return block_count_; }
+  const TsdfVolumeParams& params() const { return params_; }
+  TsdfBlocks download() const;
+
+ private:
+  const compute::Context* context_;
+  TsdfVolumeParams params_;
+  unsigned capacity_log2_ = 0;
+  std::uint32_t stamp_ = 0;
+  std::size_t block_count_ = 0;
+  compute::Buffer<std::uint64_t> keys_;         // the table: block keys
+  compute::Buffer<std::uint32_t> slot_blocks_;  // the table: pool index per slot
+  compute::Buffer<std::uint32_t> stamps_;       // the table: last frame that touched the slot
+  compute::Buffer<std::uint64_t> block_keys_;   // the pool: key per block
+  compute::Buffer<std::uint32_t> active_;       // this frame's blocks
+  compute::Buffer<std::uint32_t> status_;
+  compute::Buffer<TsdfVoxel> voxels_;  // the pool: 512 per block
+};
+
+}  // namespace kartograf::mapping

@@ -1,0 +1,48 @@
+// OpenCL wrapper of kernels/tsdf/tsdf.h.
+#include "kernels/tsdf/tsdf.h"
+
+__kernel void tsdf_touch(__global const ushort* depth, __global ulong* keys, __global uint* stamps,
+                         __global uint* status, const TsdfParams params) {
+  const uint x = get_global_id(0) * params.step;
+  const uint y = get_global_id(1) * params.step;
+  if (x >= params.width || y >= params.height) return;
+  tsdf_touch_pixel(keys, stamps, status, x, y, depth[y * params.width + x], params);
+}
+
+__kernel void tsdf_assign(__global const ulong* keys, __global uint* slot_blocks,
+                          __global ulong* block_keys, __global const uint* stamps,
+                          __global uint* active_blocks, __global uint* status,
+                          const TsdfParams params) {
+  const uint slot = get_global_id(0);
+  if (slot >= params.count) return;
+  tsdf_assign_slot(keys, slot_blocks, block_keys, stamps, active_blocks, status, slot, params);
+}
+
+__kernel void tsdf_integrate(__global const ushort* depth, __global const uint* colors,
+                             __global const uint* active_blocks, __global const ulong* block_keys,
+                             __global TsdfVoxel* voxels, const TsdfParams params) {
+  const uint i = get_global_id(0);
+  if (i >= params.count) return;
+  const uint block = active_blocks[i / KG_TSDF_BLOCK_VOXELS];
+  const uint cell = i % KG_TSDF_BLOCK_VOXELS;
+  const float3 c = tsdf_voxel_in_camera(block_keys[block], cell, params);
+  const int pixel = tsdf_pixel_of(c, params);
+  if (pixel < 0) return;
+  const uint color = params.has_color != 0u ? colors[pixel] : 0u;
+  const uint v = block * KG_TSDF_BLOCK_VOXELS + cell;
+  voxels[v] = tsdf_fuse(voxels[v], depth[pixel], c.z, color, params);
+}
+
+__kernel void tsdf_raycast(__global const ulong* keys, __global const uint* slot_blocks,
+                           __global const TsdfVoxel* voxels, __global float4* points,
+                           __global uint* colors, const TsdfParams params) {
+  const uint x = get_global_id(0);
+  const uint y = get_global_id(1);
+  if (x >= params.width || y >= params.height) return;
+  const uint index = y * params.width + x;
+  const float min_depth = (float)params.min_units * params.metres_per_unit;
+  const float max_depth = (float)params.max_units * params.metres_per_unit;
+  const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, min_depth, max_depth, params);
+  points[index] = p;
+  if (params.has_color != 0u) colors[index] = tsdf_color_at(keys, slot_blocks, voxels, p, params);
+}

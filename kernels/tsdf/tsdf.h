@@ -1,0 +1,375 @@
+// The truncated signed distance field (rules in include/kartograf/mapping/tsdf_volume.hpp): voxel
+// blocks of 8^3 voxels, found through the open-addressing table of kernels/voxel_hash (one key
+// per block), each block's voxels at its pool index. Per frame (src/mapping/tsdf_volume.cpp):
+//   1 touch      every valid depth pixel (every `step`-th) inserts the blocks that the box of
+//                +-truncation around its surface point overlaps, and stamps their slots
+//   2 assign     every table slot whose block has no pool index yet takes the next one; every
+//                stamped slot appends its block to the frame's active list
+//   3 integrate  every voxel of the active blocks: projected into the depth image, the
+//                projective distance d - z, truncated and divided by the truncation, joins the
+//                voxel's weighted mean (as its colour does), where d - z >= -truncation
+// Ray casting reads the field: every pixel's ray marches through the blocks to the first change
+// from + to -, refined on the trilinear field, and returns the point in the camera's frame.
+// Voxel v of a block at block coordinates b is at world (8 b + v + 0.5) x voxel_size (its centre).
+#ifndef KARTOGRAF_KERNELS_TSDF_H
+#define KARTOGRAF_KERNELS_TSDF_H
+#include "kernels/tsdf/tsdf_voxel.h"
+#include "kernels/voxel_hash/voxel_hash.h"
+
+#define KG_TSDF_LOCAL_X 64
+#define KG_TSDF_LOCAL_2D 16
+#define KG_TSDF_BLOCK_SIDE 8
+#define KG_TSDF_BLOCK_VOXELS 512u
+#define KG_TSDF_NO_BLOCK 0xffffffffu
+#define KG_TSDF_BLOCK_LIMIT 1048576  // 2^20 blocks each way from the origin
+
+// The status counters the passes fill and the host reads.
+#define KG_TSDF_STATUS_BLOCKS 0u         // blocks given a pool index (may pass the capacity)
+#define KG_TSDF_STATUS_ACTIVE 1u         // blocks the frame touched
+#define KG_TSDF_STATUS_TABLE_FULL 2u     // keys the table had no slot for
+#define KG_TSDF_STATUS_OUT_OF_BLOCKS 3u  // blocks the pool had no room for
+#define KG_TSDF_STATUS_OUT_OF_RANGE 4u   // points beyond 2^20 blocks (or not finite)
+#define KG_TSDF_STATUS_VALUES 5u
+
+KG_RULES_BEGIN
+
+// One parameter block for every pass: the camera, its pose (camera to world: p_w = R p_c + t,
+// R row-major) and the field's layout.
+KG_PARAMS_BEGIN(TsdfParams)
+KG_PARAM(uint, width)
+KG_PARAM(uint, height)
+KG_PARAM(uint, min_units)  // valid depth values are min_units..max_units (never 0)
+KG_PARAM(uint, max_units)
+KG_PARAM(float, metres_per_unit)
+KG_PARAM(float, fx)
+KG_PARAM(float, fy)
+KG_PARAM(float, cx)
+KG_PARAM(float, cy)
+KG_PARAM(float, voxel_size)
+KG_PARAM(float, truncation)
+KG_PARAM(float, max_weight)
+KG_PARAM(float, r00)
+KG_PARAM(float, r01)
+KG_PARAM(float, r02)
+KG_PARAM(float, r10)
+KG_PARAM(float, r11)
+KG_PARAM(float, r12)
+KG_PARAM(float, r20)
+KG_PARAM(float, r21)
+KG_PARAM(float, r22)
+KG_PARAM(float, tx)
+KG_PARAM(float, ty)
+KG_PARAM(float, tz)
+KG_PARAM(uint, capacity_log2)   // the table has 2^capacity_log2 slots
+KG_PARAM(uint, block_capacity)  // the pool's blocks
+KG_PARAM(uint, stamp)           // this frame's stamp (never 0)
+KG_PARAM(uint, count)           // items of the pass: slots, active voxels
+KG_PARAM(uint, step)            // touch: every step-th pixel each way; ray cast: the most steps
+KG_PARAM(uint, has_color)
+KG_PARAMS_END(TsdfParams)
+
+KG_INLINE bool tsdf_depth_valid(uint d, TsdfParams p) {
+  return d != 0u && d >= p.min_units && d <= p.max_units;
+}
+
+KG_INLINE float3 tsdf_to_world(float3 c, TsdfParams p) {
+  return KG_FLOAT3(p.r00 * c.x + p.r01 * c.y + p.r02 * c.z + p.tx,
+                   p.r10 * c.x + p.r11 * c.y + p.r12 * c.z + p.ty,
+                   p.r20 * c.x + p.r21 * c.y + p.r22 * c.z + p.tz);
+}
+
+// A direction (no translation) from the camera's frame to the world's.
+KG_INLINE float3 tsdf_rotate_to_world(float3 c, TsdfParams p) {
+  return KG_FLOAT3(p.r00 * c.x + p.r01 * c.y + p.r02 * c.z, p.r10 * c.x + p.r11 * c.y + p.r12 * c.z,
+                   p.r20 * c.x + p.r21 * c.y + p.r22 * c.z);
+}
+
+KG_INLINE float3 tsdf_to_camera(float3 w, TsdfParams p) {
+  const float3 d = w - KG_FLOAT3(p.tx, p.ty, p.tz);
+  return KG_FLOAT3(p.r00 * d.x + p.r10 * d.y + p.r20 * d.z, p.r01 * d.x + p.r11 * d.y + p.r21 * d.z,
+                   p.r02 * d.x + p.r12 * d.y + p.r22 * d.z);
+}
+
+// Whether floor(x) is a block coordinate with a key (false for NaN and infinities).
+KG_INLINE bool tsdf_axis_in_range(float x) {
+  return x >= -KG_FLOAT(KG_TSDF_BLOCK_LIMIT) && x < KG_FLOAT(KG_TSDF_BLOCK_LIMIT);
+}
+
+KG_INLINE uint64_t tsdf_block_key(int bx, int by, int bz) {
+  return 1UL + (KG_UINT64(bx + KG_TSDF_BLOCK_LIMIT) | (KG_UINT64(by + KG_TSDF_BLOCK_LIMIT) << 21) |
+                (KG_UINT64(bz + KG_TSDF_BLOCK_LIMIT) << 42));
+}
+
+KG_INLINE int tsdf_key_axis(uint64_t key, uint shift) {
+  return KG_INT(KG_INT64(((key - 1UL) >> shift) & 0x1fffffUL) - KG_INT64(KG_TSDF_BLOCK_LIMIT));
+}
+
+// The voxel's index in its block: x fastest.
+KG_INLINE uint tsdf_local_index(int vx, int vy, int vz) {
+  return KG_UINT(vx & 7) + 8u * KG_UINT(vy & 7) + 64u * KG_UINT(vz & 7);
+}
+
+// ---- Pass 1 (touch): the shader declares keys, stamps and status.
+#if !defined(VULKAN) || defined(KG_TSDF_TOUCH_PASS)
+
+// Inserts the block (bx, by, bz) and stamps its slot.
+KG_INLINE void tsdf_touch_block(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(uint, stamps)
+                                    KG_BUFFER_PARAM(uint, status) int bx,
+                                int by, int bz, TsdfParams p) {
+  const int slot =
+      voxel_insert_key(KG_BUFFER_ARG(keys) tsdf_block_key(bx, by, bz), p.capacity_log2);
+  if (slot < 0) {
+    kg_atomic_add_u32(status, KG_TSDF_STATUS_TABLE_FULL, 1u);
+  } else if (stamps[slot] != p.stamp) {
+    stamps[slot] = p.stamp;  // every writer writes the same value
+  }
+}
+
+// Pixel (x, y) with depth value d: the blocks within +-truncation of its surface point. The host
+// keeps truncation <= a block's side, so that is at most 2 blocks along each axis.
+KG_FORCE_INLINE void tsdf_touch_pixel(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(uint, stamps)
+                                          KG_BUFFER_PARAM(uint, status) uint x,
+                                      uint y, uint d, TsdfParams p) {
+  if (!tsdf_depth_valid(d, p)) return;
+  const float z = KG_FLOAT(d) * p.metres_per_unit;
+  const float3 c = KG_FLOAT3((KG_FLOAT(x) - p.cx) / p.fx * z, (KG_FLOAT(y) - p.cy) / p.fy * z, z);
+  const float3 w = tsdf_to_world(c, p);
+  const float inverse_block = 1.0f / (p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE));
+  const float3 lo = (w - KG_FLOAT3(p.truncation, p.truncation, p.truncation)) * inverse_block;
+  const float3 hi = (w + KG_FLOAT3(p.truncation, p.truncation, p.truncation)) * inverse_block;
+  if (!tsdf_axis_in_range(lo.x) || !tsdf_axis_in_range(lo.y) || !tsdf_axis_in_range(lo.z) ||
+      !tsdf_axis_in_range(hi.x) || !tsdf_axis_in_range(hi.y) || !tsdf_axis_in_range(hi.z)) {
+    kg_atomic_add_u32(status, KG_TSDF_STATUS_OUT_OF_RANGE, 1u);
+    return;
+  }
+  const int x0 = KG_INT(floor(lo.x)), y0 = KG_INT(floor(lo.y)), z0 = KG_INT(floor(lo.z));
+  const int x1 = KG_INT(floor(hi.x)), y1 = KG_INT(floor(hi.y)), z1 = KG_INT(floor(hi.z));
+  for (int bz = z0; bz <= z1; ++bz) {
+    for (int by = y0; by <= y1; ++by) {
+      for (int bx = x0; bx <= x1; ++bx) {
+        tsdf_touch_block(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(stamps) KG_BUFFER_ARG(status) bx, by, bz,
+                         p);
+      }
+    }
+  }
+}
+
+#endif
+
+// ---- Pass 2 (assign): the shader declares keys, slot_blocks, block_keys, stamps, active and
+// status.
+#if !defined(VULKAN) || defined(KG_TSDF_ASSIGN_PASS)
+
+KG_FORCE_INLINE void tsdf_assign_slot(KG_BUFFER_PARAM(const uint64_t, keys)
+                                          KG_BUFFER_PARAM(uint, slot_blocks)
+                                              KG_BUFFER_PARAM(uint64_t, block_keys)
+                                                  KG_BUFFER_PARAM(const uint, stamps)
+                                                      KG_BUFFER_PARAM(uint, active_blocks)
+                                                          KG_BUFFER_PARAM(uint, status) uint slot,
+                                      TsdfParams p) {
+  const uint64_t key = keys[slot];
+  if (key == KG_EMPTY_VOXEL_KEY) return;
+  uint block = slot_blocks[slot];
+  if (block == KG_TSDF_NO_BLOCK) {
+    block = kg_atomic_add_u32(status, KG_TSDF_STATUS_BLOCKS, 1u);
+    if (block >= p.block_capacity) {
+      kg_atomic_add_u32(status, KG_TSDF_STATUS_OUT_OF_BLOCKS, 1u);
+      return;
+    }
+    slot_blocks[slot] = block;
+    block_keys[block] = key;
+  }
+  if (stamps[slot] == p.stamp)
+    active_blocks[kg_atomic_add_u32(status, KG_TSDF_STATUS_ACTIVE, 1u)] = block;
+}
+
+#endif
+
+// ---- Pass 3 (integrate): per voxel, the wrapper reads the pixel the rule names.
+
+// Voxel `cell` of the block with `key`: its centre in the camera's frame.
+KG_INLINE float3 tsdf_voxel_in_camera(uint64_t key, uint cell, TsdfParams p) {
+  const int vx = tsdf_key_axis(key, 0u) * KG_TSDF_BLOCK_SIDE + KG_INT(cell & 7u);
+  const int vy = tsdf_key_axis(key, 21u) * KG_TSDF_BLOCK_SIDE + KG_INT((cell >> 3u) & 7u);
+  const int vz = tsdf_key_axis(key, 42u) * KG_TSDF_BLOCK_SIDE + KG_INT(cell >> 6u);
+  const float3 w =
+      KG_FLOAT3(KG_FLOAT(vx) + 0.5f, KG_FLOAT(vy) + 0.5f, KG_FLOAT(vz) + 0.5f) * p.voxel_size;
+  return tsdf_to_camera(w, p);
+}
+
+// The pixel (y * width + x) a voxel centre at c (camera frame) projects to, or -1.
+KG_INLINE int tsdf_pixel_of(float3 c, TsdfParams p) {
+  if (!(c.z > 0.0f)) return -1;
+  const float u = floor(p.fx * c.x / c.z + p.cx + 0.5f);
+  const float v = floor(p.fy * c.y / c.z + p.cy + 0.5f);
+  if (!(u >= 0.0f && v >= 0.0f && u < KG_FLOAT(p.width) && v < KG_FLOAT(p.height))) return -1;
+  return KG_INT(v) * KG_INT(p.width) + KG_INT(u);
+}
+
+// One channel's weighted mean, rounded to the nearest level.
+KG_INLINE uint tsdf_mean_channel(uint old_color, uint new_color, uint shift, float old_weight) {
+  const float a = KG_FLOAT((old_color >> shift) & 0xffu);
+  const float b = KG_FLOAT((new_color >> shift) & 0xffu);
+  const float mean = (a * old_weight + b) / (old_weight + 1.0f);
+  return min(KG_UINT(mean + 0.5f), 255u) << shift;
+}
+
+// The voxel after fusing depth value d (and colour) seen at depth z of the voxel's centre.
+KG_INLINE TsdfVoxel tsdf_fuse(TsdfVoxel voxel, uint d, float z, uint color, TsdfParams p) {
+  if (!tsdf_depth_valid(d, p)) return voxel;
+  const float distance = KG_FLOAT(d) * p.metres_per_unit - z;
+  if (distance < -p.truncation) return voxel;  // hidden behind the surface
+  const float value = min(1.0f, distance / p.truncation);
+  TsdfVoxel fused;
+  fused.tsdf = (voxel.tsdf * voxel.weight + value) / (voxel.weight + 1.0f);
+  fused.weight = min(voxel.weight + 1.0f, p.max_weight);
+  fused.color = voxel.color;
+  if (p.has_color != 0u) {
+    fused.color = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight) |
+                  tsdf_mean_channel(voxel.color, color, 8u, voxel.weight) |
+                  tsdf_mean_channel(voxel.color, color, 16u, voxel.weight);
+  }
+  return fused;
+}
+
+// ---- Ray casting: the shader declares keys, slot_blocks and voxels.
+#if !defined(VULKAN) || defined(KG_TSDF_READ_PASS)
+
+// The voxel (vx, vy, vz) (integral voxel coordinates); weight 0 where no block holds it.
+KG_INLINE TsdfVoxel tsdf_voxel_at(KG_BUFFER_PARAM(const uint64_t, keys)
+                                      KG_BUFFER_PARAM(const uint, slot_blocks)
+                                          KG_BUFFER_PARAM(const TsdfVoxel, voxels) int vx,
+                                  int vy, int vz, TsdfParams p) {
+  const uint64_t key = tsdf_block_key(vx >> 3, vy >> 3, vz >> 3);
+  const int slot = voxel_find_key(KG_BUFFER_ARG(keys) key, p.capacity_log2);
+  const uint block = slot < 0 ? KG_TSDF_NO_BLOCK : slot_blocks[slot];
+  if (block == KG_TSDF_NO_BLOCK) {
+    TsdfVoxel none;
+    none.tsdf = 1.0f;
+    none.weight = 0.0f;
+    none.color = 0u;
+    return none;
+  }
+  return voxels[block * KG_TSDF_BLOCK_VOXELS + tsdf_local_index(vx, vy, vz)];
+}
+
+// Whether world point w lies in the range of keys.
+KG_INLINE bool tsdf_point_in_range(float3 w, TsdfParams p) {
+  const float inverse_block = 1.0f / (p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE));
+  return tsdf_axis_in_range(w.x * inverse_block - 1.0f) &&
+         tsdf_axis_in_range(w.y * inverse_block - 1.0f) &&
+         tsdf_axis_in_range(w.z * inverse_block - 1.0f) &&
+         tsdf_axis_in_range(w.x * inverse_block + 1.0f) &&
+         tsdf_axis_in_range(w.y * inverse_block + 1.0f) &&
+         tsdf_axis_in_range(w.z * inverse_block + 1.0f);
+}
+
+// The voxel whose cell contains world point w.
+KG_INLINE TsdfVoxel tsdf_nearest(KG_BUFFER_PARAM(const uint64_t, keys)
+                                     KG_BUFFER_PARAM(const uint, slot_blocks)
+                                         KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 w,
+                                 TsdfParams p) {
+  const float3 g = w * (1.0f / p.voxel_size);
+  return tsdf_voxel_at(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels)
+                           KG_INT(floor(g.x)),
+                       KG_INT(floor(g.y)), KG_INT(floor(g.z)), p);
+}
+
+// The field at world point w, trilinear between the 8 voxel centres around it; NaN where one of
+// them was never observed.
+KG_FORCE_INLINE float tsdf_trilinear(KG_BUFFER_PARAM(const uint64_t, keys)
+                                         KG_BUFFER_PARAM(const uint, slot_blocks)
+                                             KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 w,
+                                     TsdfParams p) {
+  const float3 g = w * (1.0f / p.voxel_size) - KG_FLOAT3(0.5f, 0.5f, 0.5f);
+  const float fx = floor(g.x), fy = floor(g.y), fz = floor(g.z);
+  const float ax = g.x - fx, ay = g.y - fy, az = g.z - fz;
+  const int x0 = KG_INT(fx), y0 = KG_INT(fy), z0 = KG_INT(fz);
+  float sum = 0.0f;
+  for (uint corner = 0u; corner < 8u; ++corner) {
+    const int dx = KG_INT(corner & 1u), dy = KG_INT((corner >> 1u) & 1u), dz = KG_INT(corner >> 2u);
+    const TsdfVoxel v =
+        tsdf_voxel_at(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) x0 + dx,
+                      y0 + dy, z0 + dz, p);
+    if (v.weight <= 0.0f) return KG_NAN;
+    const float weight =
+        (dx == 1 ? ax : 1.0f - ax) * (dy == 1 ? ay : 1.0f - ay) * (dz == 1 ? az : 1.0f - az);
+    sum += weight * v.tsdf;
+  }
+  return sum;
+}
+
+// Where the ray crosses zero between depths t0 (field f0 > 0) and t1 (f1 <= 0): linear in the
+// trilinear field where both ends have one, else in the voxels' values.
+KG_INLINE float tsdf_crossing(KG_BUFFER_PARAM(const uint64_t, keys)
+                                  KG_BUFFER_PARAM(const uint, slot_blocks)
+                                      KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 origin,
+                              float3 direction, float t0, float f0, float t1, float f1,
+                              TsdfParams p) {
+  const float s0 = tsdf_trilinear(
+      KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin + direction * t0,
+      p);
+  const float s1 = tsdf_trilinear(
+      KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin + direction * t1,
+      p);
+  const bool interpolated = !kg_isnan(s0) && !kg_isnan(s1) && s0 > 0.0f && s1 <= 0.0f;
+  const float a = interpolated ? s0 : f0;
+  const float b = interpolated ? s1 : f1;
+  return t0 + (t1 - t0) * a / (a - b);
+}
+
+// Pixel (x, y)'s ray from depth min to max (metres along the optical axis): the first surface
+// (a change from + to -) as a point in the camera's frame (w = 1); the invalid point where the
+// ray meets none, or meets the back of one first.
+KG_FORCE_INLINE float4 tsdf_cast_ray(KG_BUFFER_PARAM(const uint64_t, keys)
+                                         KG_BUFFER_PARAM(const uint, slot_blocks)
+                                             KG_BUFFER_PARAM(const TsdfVoxel, voxels) uint x,
+                                     uint y, float min_depth, float max_depth, TsdfParams p) {
+  // Along the optical axis: depth t is the ray's parameter.
+  const float3 ray_c = KG_FLOAT3((KG_FLOAT(x) - p.cx) / p.fx, (KG_FLOAT(y) - p.cy) / p.fy, 1.0f);
+  const float3 direction = tsdf_rotate_to_world(ray_c, p);
+  const float3 origin = KG_FLOAT3(p.tx, p.ty, p.tz);
+  const float per_depth = sqrt(dot(ray_c, ray_c));  // metres along the ray per unit of depth
+  float t = min_depth;
+  float previous_t = t;
+  float previous = KG_NAN;
+  for (uint i = 0u; i < p.step && t <= max_depth; ++i) {
+    const float3 w = origin + direction * t;
+    if (!tsdf_point_in_range(w, p)) break;
+    const TsdfVoxel v =
+        tsdf_nearest(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) w, p);
+    const bool known = v.weight > 0.0f;
+    if (known && v.tsdf <= 0.0f) {
+      if (kg_isnan(previous)) break;  // the back of a surface, or inside it from the start
+      const float hit =
+          tsdf_crossing(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin,
+                        direction, previous_t, previous, t, v.tsdf, p);
+      return KG_FLOAT4(ray_c.x * hit, ray_c.y * hit, hit, 1.0f);
+    }
+    previous = known ? v.tsdf : KG_NAN;
+    previous_t = t;
+    // Never past the surface the value promises is at least this far; a voxel at a time near it.
+    const float ahead =
+        known ? max(0.8f * v.tsdf * p.truncation, p.voxel_size) : 0.5f * p.truncation;
+    t += ahead / per_depth;
+  }
+  return KG_INVALID_POINT;
+}
+
+// The colour of the voxel at a ray cast's point c (camera frame).
+KG_INLINE uint tsdf_color_at(KG_BUFFER_PARAM(const uint64_t, keys)
+                                 KG_BUFFER_PARAM(const uint, slot_blocks)
+                                     KG_BUFFER_PARAM(const TsdfVoxel, voxels) float4 c,
+                             TsdfParams p) {
+  if (kg_isnan(c.x)) return 0u;
+  return tsdf_nearest(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels)
+                          tsdf_to_world(kg_xyz(c), p),
+                      p)
+      .color;
+}
+
+#endif
+
+KG_RULES_END
+
+#endif

@@ -1,0 +1,87 @@
+// CPU wrapper of kernels/tsdf/tsdf.h (the atomics of the rule are std::atomic_ref on the host).
+#include "compute/cpu/cpu_kernel.hpp"
+#include "kernels/tsdf/tsdf.h"
+
+namespace kartograf::kernels {
+
+namespace {
+
+using compute::detail::CpuDispatch;
+using compute::detail::for_each_item;
+using compute::detail::for_each_item_2d;
+
+void touch(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfParams>();
+  const auto* depth = call.buffer<const std::uint16_t>(0);
+  auto* keys = call.buffer<uint64_t>(1);
+  auto* stamps = call.buffer<uint>(2);
+  auto* status = call.buffer<uint>(3);
+  for_each_item_2d(call, [&](uint gx, uint gy) {
+    const uint x = gx * params.step, y = gy * params.step;
+    if (x >= params.width || y >= params.height) return;
+    tsdf_touch_pixel(keys, stamps, status, x, y, depth[y * params.width + x], params);
+  });
+}
+
+// One ordered loop: the blocks are numbered in slot order.
+void assign(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfParams>();
+  const auto* keys = call.buffer<const uint64_t>(0);
+  auto* slot_blocks = call.buffer<uint>(1);
+  auto* block_keys = call.buffer<uint64_t>(2);
+  const auto* stamps = call.buffer<const uint>(3);
+  auto* active_blocks = call.buffer<uint>(4);
+  auto* status = call.buffer<uint>(5);
+  for (uint slot = 0; slot < params.count; ++slot) {
+    tsdf_assign_slot(keys, slot_blocks, block_keys, stamps, active_blocks, status, slot, params);
+  }
+}
+
+void integrate(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfParams>();
+  const auto* depth = call.buffer<const std::uint16_t>(0);
+  const auto* colors = call.buffer<const uint>(1);
+  const auto* active_blocks = call.buffer<const uint>(2);
+  const auto* block_keys = call.buffer<const uint64_t>(3);
+  auto* voxels = call.buffer<TsdfVoxel>(4);
+  for_each_item(call, [&](uint i) {
+    if (i >= params.count) return;
+    const uint block = active_blocks[i / KG_TSDF_BLOCK_VOXELS];
+    const uint cell = i % KG_TSDF_BLOCK_VOXELS;
+    const float3 c = tsdf_voxel_in_camera(block_keys[block], cell, params);
+    const int pixel = tsdf_pixel_of(c, params);
+    if (pixel < 0) return;
+    const uint color = params.has_color != 0u ? colors[pixel] : 0u;
+    const uint v = block * KG_TSDF_BLOCK_VOXELS + cell;
+    voxels[v] = tsdf_fuse(voxels[v], depth[pixel], c.z, color, params);
+  });
+}
+
+void raycast(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfParams>();
+  const auto* keys = call.buffer<const uint64_t>(0);
+  const auto* slot_blocks = call.buffer<const uint>(1);
+  const auto* voxels = call.buffer<const TsdfVoxel>(2);
+  auto* points = call.buffer<float4>(3);
+  auto* colors = call.buffer<uint>(4);
+  const float min_depth = static_cast<float>(params.min_units) * params.metres_per_unit;
+  const float max_depth = static_cast<float>(params.max_units) * params.metres_per_unit;
+  for_each_item_2d(call, [&](uint x, uint y) {
+    if (x >= params.width || y >= params.height) return;
+    const uint index = y * params.width + x;
+    const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, min_depth, max_depth, params);
+    points[index] = p;
+    if (params.has_color != 0u) colors[index] = tsdf_color_at(keys, slot_blocks, voxels, p, params);
+  });
+}
+
+}  // namespace
+
+void register_tsdf_cpu(compute::detail::CpuKernelRegistry& registry) {
+  registry.add("tsdf_touch", touch);
+  registry.add("tsdf_assign", assign);
+  registry.add("tsdf_integrate", integrate);
+  registry.add("tsdf_raycast", raycast);
+}
+
+}  // namespace kartograf::kernels

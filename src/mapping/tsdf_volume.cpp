@@ -1,0 +1,257 @@
+#include "kartograf/mapping/tsdf_volume.hpp"
+
+#include <algorithm>
+#include <array>
+#include <bit>
+#include <cmath>
+#include <numeric>
+#include <string>
+#include <tuple>
+
+#include "kartograf/compute/kernel.hpp"
+#include "kartograf/core/memory_budget.hpp"
+#include "kernels/tsdf/tsdf.h"
+
+namespace kartograf::mapping {
+
+namespace {
+
+static_assert(sizeof(TsdfVoxel) == sizeof(kernels::TsdfVoxel) && sizeof(TsdfVoxel) == 12);
+static_assert(kTsdfBlockSide == KG_TSDF_BLOCK_SIDE && kTsdfBlockVoxels == KG_TSDF_BLOCK_VOXELS);
+
+constexpr compute::KernelSpec kTouchKernel{"tsdf_touch", KG_TSDF_LOCAL_2D, KG_TSDF_LOCAL_2D};
+constexpr compute::KernelSpec kAssignKernel{"tsdf_assign", KG_TSDF_LOCAL_X};
+constexpr compute::KernelSpec kIntegrateKernel{"tsdf_integrate", KG_TSDF_LOCAL_X};
+constexpr compute::KernelSpec kRaycastKernel{"tsdf_raycast", KG_TSDF_LOCAL_2D, KG_TSDF_LOCAL_2D};
+// 2^23 blocks of 512 voxels keep every voxel index below 2^32.
+constexpr std::size_t kMaxBlocks = std::size_t{1} << 23;
+
+// The parameter block for a camera at a pose; the passes fill in count, step and has_color.
+kernels::TsdfParams frame_params(const TsdfVolumeParams& volume, const PinholeIntrinsics& camera,
+                                 const geometry::DepthRange& range,
+                                 const Eigen::Isometry3d& camera_to_world) {
+  const geometry::DepthUnits units = geometry::valid_depth_units(range);
+  kernels::TsdfParams p{};
+  p.width = static_cast<std::uint32_t>(camera.width);
+  p.height = static_cast<std::uint32_t>(camera.height);
+  p.min_units = units.min;
+  p.max_units = units.max;
+  p.metres_per_unit = static_cast<float>(1.0 / range.units_per_metre);
+  p.fx = static_cast<float>(camera.fx);
+  p.fy = static_cast<float>(camera.fy);
+  p.cx = static_cast<float>(camera.cx);
+  p.cy = static_cast<float>(camera.cy);
+  p.voxel_size = static_cast<float>(volume.voxel_size);
+  p.truncation = static_cast<float>(volume.truncation);
+  p.max_weight = static_cast<float>(volume.max_weight);
+  const Eigen::Matrix3f r = camera_to_world.linear().cast<float>();
+  const Eigen::Vector3f t = camera_to_world.translation().cast<float>();
+  p.r00 = r(0, 0), p.r01 = r(0, 1), p.r02 = r(0, 2);
+  p.r10 = r(1, 0), p.r11 = r(1, 1), p.r12 = r(1, 2);
+  p.r20 = r(2, 0), p.r21 = r(2, 1), p.r22 = r(2, 2);
+  p.tx = t.x(), p.ty = t.y(), p.tz = t.z();
+  return p;
+}
+
+void require_rigid(const Eigen::Isometry3d& pose, const char* what) {
+  const Eigen::Matrix3d r = pose.linear();
+  require(pose.matrix().allFinite() &&
+              (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-4 &&
+              r.determinant() > 0,
+          std::string("TSDF volume: the ") + what + " pose is not a finite rigid motion");
+}
+
+std::string blocks_text(std::size_t blocks) {
+  return std::to_string(blocks) + " blocks (" +
+         memory_size_text(static_cast<double>(blocks) * kTsdfBlockVoxels * sizeof(TsdfVoxel)) + ")";
+}
+
+}  // namespace
+
+void TsdfVolumeParams::validate() const {
+  require(std::isfinite(voxel_size) && voxel_size >= 1e-4 && voxel_size <= 10,
+          "TSDF volume: voxel_size must be in [0.0001, 10] m, got " + std::to_string(voxel_size));
+  require(std::isfinite(truncation) && truncation >= voxel_size &&
+              truncation <= voxel_size * kTsdfBlockSide,
+          "TSDF volume: truncation must be between one voxel and one block (8 voxels), got " +
+              std::to_string(truncation) + " m for voxels of " + std::to_string(voxel_size) + " m");
+  require(std::isfinite(max_weight) && max_weight >= 1,
+          "TSDF volume: max_weight must be >= 1, got " + std::to_string(max_weight));
+  require(max_blocks >= 1 && max_blocks <= kMaxBlocks,
+          "TSDF volume: max_blocks must be in [1, 2^23], got " + std::to_string(max_blocks));
+  require(touch_step >= 1, "TSDF volume: touch_step must be >= 1");
+}
+
+std::ptrdiff_t TsdfBlocks::find(const Eigen::Vector3i& block) const {
+  // Sorted by key: z, then y, then x.
+  const auto before = [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+    return std::tie(a.z(), a.y(), a.x()) < std::tie(b.z(), b.y(), b.x());
+  };
+  const auto it = std::lower_bound(coords.begin(), coords.end(), block, before);
+  return it != coords.end() && *it == block ? it - coords.begin() : -1;
+}
+
+const TsdfVoxel* TsdfBlocks::voxel(const Eigen::Vector3i& v) const {
+  const Eigen::Vector3i block(v.x() >> 3, v.y() >> 3, v.z() >> 3);
+  const std::ptrdiff_t b = find(block);
+  if (b < 0) return nullptr;
+  const Eigen::Vector3i local = v - block * kTsdfBlockSide;
+  return &voxels[static_cast<std::size_t>(b) * kTsdfBlockVoxels + local.x() + 8 * local.y() +
+                 64 * local.z()];
+}
+
+TsdfVolume::TsdfVolume(const compute::Context& context, const TsdfVolumeParams& params)
+    : context_(&context), params_(params) {
+  params_.validate();
+  capacity_log2_ = static_cast<unsigned>(std::bit_width(params_.max_blocks * 2 - 1));
+  const std::size_t slots = std::size_t{1} << capacity_log2_;
+  const double bytes =
+      static_cast<double>(params_.max_blocks) * (kTsdfBlockVoxels * sizeof(TsdfVoxel) + 12) +
+      static_cast<double>(slots) * 16;
+  require_fits_in_memory(bytes, "TSDF volume of " + blocks_text(params_.max_blocks));
+  const std::uint64_t largest = context.device_info().limits.max_buffer_bytes;
+  const double pool_bytes =
+      static_cast<double>(params_.max_blocks) * kTsdfBlockVoxels * sizeof(TsdfVoxel);
+  require(largest == 0 || pool_bytes <= static_cast<double>(largest),
+          "TSDF volume: a pool of " + blocks_text(params_.max_blocks) +
+              " is larger than the device's largest buffer (" +
+              memory_size_text(static_cast<double>(largest)) + "); lower max_blocks");
+  keys_ = compute::Buffer<std::uint64_t>(context, slots);
+  keys_.fill_zero();
+  slot_blocks_ = compute::Buffer<std::uint32_t>::from_host(
+      context, std::vector<std::uint32_t>(slots, KG_TSDF_NO_BLOCK));
+  stamps_ = compute::Buffer<std::uint32_t>(context, slots);
+  stamps_.fill_zero();
+  block_keys_ = compute::Buffer<std::uint64_t>(context, params_.max_blocks);
+  active_ = compute::Buffer<std::uint32_t>(context, params_.max_blocks);
+  status_ = compute::Buffer<std::uint32_t>(context, KG_TSDF_STATUS_VALUES);
+  status_.fill_zero();
+  voxels_ = compute::Buffer<TsdfVoxel>(context, params_.max_blocks * kTsdfBlockVoxels);
+  voxels_.fill_zero();
+}
+
+TsdfIntegration TsdfVolume::integrate(const compute::DeviceImage<std::uint16_t>& depth,
+                                      const compute::Buffer<std::uint32_t>* colors,
+                                      const PinholeIntrinsics& camera,
+                                      const geometry::DepthRange& range,
+                                      const Eigen::Isometry3d& camera_to_world) {
+  camera.validate("TSDF integration");
+  require(depth.width() == camera.width && depth.height() == camera.height,
+          "TSDF integration: the depth image is " + std::to_string(depth.width()) + "x" +
+              std::to_string(depth.height()) + " but the camera is " +
+              std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  require(!colors || colors->size() == depth.size(),
+          "TSDF integration: the colour image's size differs from the depth image's");
+  require_rigid(camera_to_world, "camera");
+  kernels::TsdfParams p = frame_params(params_, camera, range, camera_to_world);
+  stamp_ = stamp_ == 0xffffffffu ? 1 : stamp_ + 1;
+  p.stamp = stamp_;
+  p.capacity_log2 = capacity_log2_;
+  p.block_capacity = static_cast<std::uint32_t>(params_.max_blocks);
+  p.step = static_cast<std::uint32_t>(params_.touch_step);
+  p.has_color = colors ? 1u : 0u;
+  const std::uint32_t step = p.step;
+  compute::dispatch(*context_, kTouchKernel, {depth.buffer(), keys_, stamps_, status_}, p,
+                    {compute::groups_for((camera.width + step - 1) / step, KG_TSDF_LOCAL_2D),
+                     compute::groups_for((camera.height + step - 1) / step, KG_TSDF_LOCAL_2D)});
+  p.count = static_cast<std::uint32_t>(keys_.size());
+  compute::dispatch(*context_, kAssignKernel,
+                    {keys_, slot_blocks_, block_keys_, stamps_, active_, status_}, p,
+                    {compute::groups_for(keys_.size(), KG_TSDF_LOCAL_X), 1});
+  std::array<std::uint32_t, KG_TSDF_STATUS_VALUES> status{};
+  status_.download(status);
+  require(status[KG_TSDF_STATUS_OUT_OF_RANGE] == 0,
+          "TSDF integration: " + std::to_string(status[KG_TSDF_STATUS_OUT_OF_RANGE]) +
+              " surface points lie beyond 2^20 blocks from the origin");
+  require(status[KG_TSDF_STATUS_OUT_OF_BLOCKS] == 0 && status[KG_TSDF_STATUS_TABLE_FULL] == 0,
+          "TSDF integration: the volume is full: the frame needs more than its " +
+              blocks_text(params_.max_blocks) + "; raise max_blocks or the voxel size");
+  block_count_ = status[KG_TSDF_STATUS_BLOCKS];
+  const std::size_t active = status[KG_TSDF_STATUS_ACTIVE];
+  status[KG_TSDF_STATUS_ACTIVE] = 0;  // the next frame counts its own
+  status_.upload(status);
+  if (active > 0) {
+    p.count = static_cast<std::uint32_t>(active * kTsdfBlockVoxels);
+    compute::dispatch(*context_, kIntegrateKernel,
+                      {depth.buffer(), colors ? compute::BufferArg(*colors) : compute::BufferArg(),
+                       active_, block_keys_, voxels_},
+                      p, {compute::groups_for(p.count, KG_TSDF_LOCAL_X), 1});
+  }
+  return {active, block_count_};
+}
+
+TsdfIntegration TsdfVolume::integrate(const DepthImage& depth, const RgbImage& color,
+                                      const PinholeIntrinsics& camera,
+                                      const geometry::DepthRange& range,
+                                      const Eigen::Isometry3d& camera_to_world) {
+  const auto device_depth = compute::DeviceImage<std::uint16_t>::from_host(*context_, depth);
+  if (color.empty()) return integrate(device_depth, nullptr, camera, range, camera_to_world);
+  require(color.width() == depth.width() && color.height() == depth.height(),
+          "TSDF integration: the colour image's size differs from the depth image's");
+  std::vector<std::uint32_t> packed(color.pixels().size());
+  std::transform(color.pixels().begin(), color.pixels().end(), packed.begin(), pack_rgb);
+  const auto device_colors = compute::Buffer<std::uint32_t>::from_host(*context_, packed);
+  return integrate(device_depth, &device_colors, camera, range, camera_to_world);
+}
+
+void TsdfVolume::raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,
+                         const Eigen::Isometry3d& camera_to_world,
+                         compute::DeviceImage<Point4f>& points,
+                         compute::Buffer<std::uint32_t>* colors) const {
+  camera.validate("TSDF ray casting");
+  require_rigid(camera_to_world, "ray casting");
+  if (points.width() != camera.width || points.height() != camera.height) {
+    points = compute::DeviceImage<Point4f>(*context_, camera.width, camera.height);
+  }
+  if (colors && colors->size() != points.size()) {
+    *colors = compute::Buffer<std::uint32_t>(*context_, points.size());
+  }
+  kernels::TsdfParams p = frame_params(params_, camera, range, camera_to_world);
+  p.capacity_log2 = capacity_log2_;
+  p.block_capacity = static_cast<std::uint32_t>(params_.max_blocks);
+  p.has_color = colors ? 1u : 0u;
+  // Enough steps of one voxel each to cross the whole range.
+  const double span = range.max_metres - range.min_metres;
+  p.step = static_cast<std::uint32_t>(std::min(1e6, std::ceil(span / params_.voxel_size) + 2));
+  compute::dispatch(*context_, kRaycastKernel,
+                    {keys_, slot_blocks_, voxels_, points.buffer(),
+                     colors ? compute::BufferArg(*colors) : compute::BufferArg()},
+                    p,
+                    {compute::groups_for(camera.width, KG_TSDF_LOCAL_2D),
+                     compute::groups_for(camera.height, KG_TSDF_LOCAL_2D)});
+}
+
+PointImage TsdfVolume::raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,
+                               const Eigen::Isometry3d& camera_to_world) const {
+  compute::DeviceImage<Point4f> points;
+  raycast(camera, range, camera_to_world, points);
+  return points.to_image();
+}
+
+TsdfBlocks TsdfVolume::download() const {
+  TsdfBlocks out;
+  out.voxel_size = params_.voxel_size;
+  out.truncation = params_.truncation;
+  const std::size_t n = std::min(block_count_, params_.max_blocks);
+  std::vector<std::uint64_t> keys(n);
+  std::vector<TsdfVoxel> voxels(n * kTsdfBlockVoxels);
+  if (n > 0) {
+    block_keys_.download(keys);
+    voxels_.download(voxels);
+  }
+  std::vector<std::size_t> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+  out.coords.reserve(n);
+  out.voxels.reserve(n * kTsdfBlockVoxels);
+  for (const std::size_t b : order) {
+    out.coords.emplace_back(kernels::tsdf_key_axis(keys[b], 0), kernels::tsdf_key_axis(keys[b], 21),
+                            kernels::tsdf_key_axis(keys[b], 42));
+    const auto first = voxels.begin() + static_cast<std::ptrdiff_t>(b * kTsdfBlockVoxels);
+    out.voxels.insert(out.voxels.end(), first, first + kTsdfBlockVoxels);
+  }
+  return out;
+}
+
+}  // namespace kartograf::mapping

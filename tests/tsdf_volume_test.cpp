@@ -1,0 +1,321 @@
+// The TSDF volume (kernels/tsdf) on every backend: the block set and each voxel against a plain
+// host reference of the rules, the backends against the CPU backend on real 7-Scenes frames, and
+// ray casting against analytic surfaces.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <map>
+#include <set>
+#include <tuple>
+
+#include "kartograf/mapping/tsdf_volume.hpp"
+#include "real_data.hpp"
+#include "test_support.hpp"
+
+namespace kartograf {
+namespace {
+
+using mapping::TsdfBlocks;
+using mapping::TsdfVolume;
+using mapping::TsdfVolumeParams;
+using mapping::TsdfVoxel;
+
+const PinholeIntrinsics kCamera{160, 120, 140.0, 140.0, 79.5, 59.5};
+constexpr double kUnits = 1000.0;  // millimetres
+
+// A scene as the distance along a unit ray to its first surface (or infinity).
+struct Scene {
+  Eigen::Vector3d sphere_centre{0.1, -0.05, 1.6};
+  double sphere_radius = 0.35;
+  double wall_z = 2.4;  // a plane z = wall_z, facing the camera at the origin
+
+  double hit(const Eigen::Vector3d& origin, const Eigen::Vector3d& ray) const {
+    double best = std::numeric_limits<double>::infinity();
+    const Eigen::Vector3d oc = origin - sphere_centre;
+    const double b = oc.dot(ray);
+    const double disc = b * b - (oc.squaredNorm() - sphere_radius * sphere_radius);
+    if (disc >= 0 && -b - std::sqrt(disc) > 0) best = -b - std::sqrt(disc);
+    if (ray.z() > 1e-9) {
+      const double t = (wall_z - origin.z()) / ray.z();
+      if (t > 0) best = std::min(best, t);
+    }
+    return best;
+  }
+  // Distance from p to the nearest surface.
+  double distance(const Eigen::Vector3d& p) const {
+    return std::min(std::abs((p - sphere_centre).norm() - sphere_radius), std::abs(p.z() - wall_z));
+  }
+};
+
+// The depth image (millimetres) of the scene from a camera at pose.
+DepthImage render(const Scene& scene, const Eigen::Isometry3d& pose) {
+  DepthImage depth(kCamera.width, kCamera.height);
+  for (int v = 0; v < kCamera.height; ++v) {
+    for (int u = 0; u < kCamera.width; ++u) {
+      const Eigen::Vector3d ray_c((u - kCamera.cx) / kCamera.fx, (v - kCamera.cy) / kCamera.fy, 1);
+      const Eigen::Vector3d ray = pose.linear() * ray_c.normalized();
+      const double t = scene.hit(pose.translation(), ray);
+      const double z = t / ray_c.norm();
+      depth(u, v) =
+          std::isfinite(t) && z < 60 ? static_cast<std::uint16_t>(std::lround(z * kUnits)) : 0;
+    }
+  }
+  return depth;
+}
+
+Eigen::Isometry3d pose_at(double x, double y, double yaw_deg) {
+  Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  pose.linear() =
+      Eigen::AngleAxisd(yaw_deg * M_PI / 180, Eigen::Vector3d::UnitY()).toRotationMatrix();
+  pose.translation() = Eigen::Vector3d(x, y, 0);
+  return pose;
+}
+
+geometry::DepthRange depth_range() {
+  return {kUnits, 0.2, 5.0};
+}
+
+// The plain reference of one frame fused into an empty volume: the blocks within +-truncation of
+// every surface point, and each of their voxels fused once (in double precision).
+std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> reference_frame(
+    const DepthImage& depth, const Eigen::Isometry3d& pose, const TsdfVolumeParams& p) {
+  std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> blocks;
+  const double block = p.voxel_size * mapping::kTsdfBlockSide;
+  for (int v = 0; v < depth.height(); ++v) {
+    for (int u = 0; u < depth.width(); ++u) {
+      if (depth(u, v) == 0) continue;
+      const double z = depth(u, v) / kUnits;
+      const Eigen::Vector3d w = pose * Eigen::Vector3d((u - kCamera.cx) / kCamera.fx * z,
+                                                       (v - kCamera.cy) / kCamera.fy * z, z);
+      const Eigen::Vector3i lo = ((w.array() - p.truncation) / block).floor().cast<int>();
+      const Eigen::Vector3i hi = ((w.array() + p.truncation) / block).floor().cast<int>();
+      for (int bz = lo.z(); bz <= hi.z(); ++bz)
+        for (int by = lo.y(); by <= hi.y(); ++by)
+          for (int bx = lo.x(); bx <= hi.x(); ++bx) blocks[{bx, by, bz}];
+    }
+  }
+  for (auto& [coords, voxels] : blocks) {
+    voxels.resize(mapping::kTsdfBlockVoxels);
+    const Eigen::Vector3i b(std::get<0>(coords), std::get<1>(coords), std::get<2>(coords));
+    for (std::size_t i = 0; i < voxels.size(); ++i) {
+      const Eigen::Vector3i local(static_cast<int>(i % 8), static_cast<int>(i / 8 % 8),
+                                  static_cast<int>(i / 64));
+      const Eigen::Vector3d centre = ((b * 8 + local).cast<double>().array() + 0.5) * p.voxel_size;
+      const Eigen::Vector3d c = pose.inverse() * centre;
+      if (c.z() <= 0) continue;
+      const double u = std::floor(kCamera.fx * c.x() / c.z() + kCamera.cx + 0.5);
+      const double v = std::floor(kCamera.fy * c.y() / c.z() + kCamera.cy + 0.5);
+      if (u < 0 || v < 0 || u >= kCamera.width || v >= kCamera.height) continue;
+      const std::uint16_t d = depth(static_cast<int>(u), static_cast<int>(v));
+      if (d == 0) continue;
+      const double distance = d / kUnits - c.z();
+      if (distance < -p.truncation) continue;
+      voxels[i] = {static_cast<float>(std::min(1.0, distance / p.truncation)), 1.0f, 0};
+    }
+  }
+  return blocks;
+}
+
+class TsdfVolumeTest : public testing::BackendTest {};
+
+TEST_P(TsdfVolumeTest, OneFrameMatchesThePlainReference) {
+  const Scene scene;
+  const Eigen::Isometry3d pose = pose_at(0.05, 0.02, 8);
+  const DepthImage depth = render(scene, pose);
+  TsdfVolumeParams params;
+  params.voxel_size = 0.02;
+  params.truncation = 0.06;
+  TsdfVolume volume(context(), params);
+  const mapping::TsdfIntegration done = volume.integrate(depth, {}, kCamera, depth_range(), pose);
+  const TsdfBlocks blocks = volume.download();
+  const auto expected = reference_frame(depth, pose, params);
+  EXPECT_EQ(done.active_blocks, expected.size());
+  ASSERT_EQ(blocks.size(), expected.size());
+  // Rounding may move a voxel centre across a pixel's edge: a few voxels may differ.
+  std::size_t compared = 0, differing = 0;
+  double worst = 0;
+  for (std::size_t b = 0; b < blocks.size(); ++b) {
+    const Eigen::Vector3i& c = blocks.coords[b];
+    const auto it = expected.find({c.x(), c.y(), c.z()});
+    ASSERT_NE(it, expected.end()) << c.transpose();
+    for (std::size_t i = 0; i < mapping::kTsdfBlockVoxels; ++i) {
+      const TsdfVoxel& got = blocks.voxels[b * mapping::kTsdfBlockVoxels + i];
+      const TsdfVoxel& want = it->second[i];
+      ++compared;
+      if (want.weight == 0 && got.weight == 0) continue;  // never observed: no value
+      if (got.weight != want.weight || std::abs(got.tsdf - want.tsdf) > 1e-4f) {
+        ++differing;
+        continue;
+      }
+      if (want.weight > 0) worst = std::max(worst, double(std::abs(got.tsdf - want.tsdf)));
+    }
+  }
+  EXPECT_LE(differing, compared / 2000) << differing << " of " << compared;
+  RecordProperty("voxels_compared", std::to_string(compared));
+  RecordProperty("voxels_differing", std::to_string(differing));
+  RecordProperty("max_tsdf_error", testing::scientific(worst));
+}
+
+TEST_P(TsdfVolumeTest, RayCastSurfaceLiesOnTheScene) {
+  const Scene scene;
+  TsdfVolumeParams params;
+  params.voxel_size = 0.01;
+  params.truncation = 0.04;
+  TsdfVolume volume(context(), params);
+  for (const Eigen::Isometry3d& pose :
+       {pose_at(0, 0, 0), pose_at(0.1, 0, 6), pose_at(-0.1, 0.05, -6), pose_at(0.05, -0.05, 3)}) {
+    volume.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  }
+  const Eigen::Isometry3d view = pose_at(0.02, 0.01, 2);
+  const PointImage points = volume.raycast(kCamera, depth_range(), view);
+  const DepthImage truth = render(scene, view);
+  std::size_t hits = 0, surface = 0;
+  double sum = 0, worst = 0;
+  for (int v = 0; v < kCamera.height; ++v) {
+    for (int u = 0; u < kCamera.width; ++u) {
+      if (truth(u, v) == 0) continue;
+      ++surface;
+      const Point4f& p = points(u, v);
+      if (!is_valid(p)) continue;
+      ++hits;
+      const double error = scene.distance(view * p.head<3>().cast<double>());
+      sum += error;
+      worst = std::max(worst, error);
+    }
+  }
+  // Depth quantised to 1 mm, voxels of 1 cm: the surface within a few millimetres.
+  EXPECT_GE(hits, surface * 97 / 100) << hits << " of " << surface;
+  EXPECT_LT(sum / hits, 0.002);
+  EXPECT_LT(worst, 0.01);
+  RecordProperty("mean_distance_m", testing::scientific(sum / hits));
+  RecordProperty("max_distance_m", testing::scientific(worst));
+}
+
+// Blocks and voxels by block coordinates, for comparing volumes whose pools are numbered apart.
+void expect_same_volume(const TsdfBlocks& a, const TsdfBlocks& b, const std::string& what) {
+  std::size_t only_one = 0, differing = 0, compared = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    const std::ptrdiff_t j = b.find(a.coords[i]);
+    if (j < 0) {
+      ++only_one;
+      continue;
+    }
+    for (std::size_t k = 0; k < mapping::kTsdfBlockVoxels; ++k) {
+      const TsdfVoxel& x = a.voxels[i * mapping::kTsdfBlockVoxels + k];
+      const TsdfVoxel& y = b.voxels[static_cast<std::size_t>(j) * mapping::kTsdfBlockVoxels + k];
+      ++compared;
+      const auto channel = [](std::uint32_t c, int s) { return static_cast<int>((c >> s) & 0xff); };
+      bool same = x.weight == y.weight && std::abs(x.tsdf - y.tsdf) <= 1e-4f;
+      for (int s : {0, 8, 16})
+        same = same && std::abs(channel(x.color, s) - channel(y.color, s)) <= 1;
+      if (!same) ++differing;
+    }
+  }
+  only_one += b.size() - (a.size() - only_one);
+  // Float rounding (fused multiply-adds on devices) may move a point across a block's edge or a
+  // voxel centre across a pixel's: allowed in 1 block or voxel in 2000.
+  EXPECT_LE(only_one, a.size() / 2000) << what << ": blocks in one volume only";
+  EXPECT_LE(differing, compared / 2000) << what << ": " << differing << " of " << compared;
+}
+
+TEST_P(TsdfVolumeTest, EqualsTheCpuBackendOnSevenScenesFrames) {
+  const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
+  const PinholeIntrinsics camera = PinholeIntrinsics::kinect_7scenes();
+  const geometry::DepthRange range{1000.0, 0.3, 4.0};
+  const RgbImage color = testing::read_color(frames / "frame-000100.color.jpg");
+  TsdfVolumeParams params;
+  params.voxel_size = 0.02;
+  params.truncation = 0.08;
+  const compute::Context cpu = compute::Context::cpu();
+  TsdfVolume on_backend(context(), params), on_cpu(cpu, params);
+  for (const char* name : {"frame-000000", "frame-000010"}) {
+    const DepthImage depth = testing::read_depth(frames / (std::string(name) + ".depth.png"));
+    const Eigen::Isometry3d pose = testing::read_pose(frames / (std::string(name) + ".pose.txt"));
+    const auto a = on_backend.integrate(depth, color, camera, range, pose);
+    const auto b = on_cpu.integrate(depth, color, camera, range, pose);
+    EXPECT_NEAR(double(a.active_blocks), double(b.active_blocks), b.active_blocks / 2000.0 + 1);
+  }
+  expect_same_volume(on_backend.download(), on_cpu.download(), "7-Scenes frames 0 and 10");
+  const Eigen::Isometry3d view = testing::read_pose(frames / "frame-000010.pose.txt");
+  const PointImage a = on_backend.raycast(camera, range, view);
+  const PointImage b = on_cpu.raycast(camera, range, view);
+  std::size_t valid = 0, disagree = 0;
+  for (std::size_t i = 0; i < a.pixels().size(); ++i) {
+    const Point4f& p = a.pixels()[i];
+    const Point4f& q = b.pixels()[i];
+    valid += is_valid(q) ? 1 : 0;
+    if (is_valid(p) != is_valid(q) || (is_valid(p) && (p - q).norm() > 1e-3f)) ++disagree;
+  }
+  EXPECT_GT(valid, a.pixels().size() / 2);
+  EXPECT_LE(disagree, a.pixels().size() / 1000);
+  RecordProperty("raycast_pixels_disagreeing", std::to_string(disagree));
+}
+
+TEST_P(TsdfVolumeTest, FullVolumeAndBadInputsAreErrors) {
+  const Scene scene;
+  const DepthImage depth = render(scene, Eigen::Isometry3d::Identity());
+  TsdfVolumeParams small;
+  small.voxel_size = 0.01;
+  small.max_blocks = 16;
+  TsdfVolume volume(context(), small);
+  EXPECT_ERROR_MENTIONS(
+      volume.integrate(depth, {}, kCamera, depth_range(), Eigen::Isometry3d::Identity()), "full",
+      "16 blocks", "max_blocks");
+  TsdfVolume roomy(context(), TsdfVolumeParams{});
+  Eigen::Isometry3d bad = Eigen::Isometry3d::Identity();
+  bad(0, 3) = std::nan("");
+  EXPECT_ERROR_MENTIONS(roomy.integrate(depth, {}, kCamera, depth_range(), bad), "pose");
+  bad = Eigen::Isometry3d::Identity();
+  bad.linear() *= 2;
+  EXPECT_ERROR_MENTIONS(roomy.integrate(depth, {}, kCamera, depth_range(), bad), "rigid");
+  const DepthImage wrong(kCamera.width + 1, kCamera.height);
+  EXPECT_ERROR_MENTIONS(
+      roomy.integrate(wrong, {}, kCamera, depth_range(), Eigen::Isometry3d::Identity()), "161x120");
+  const RgbImage wrong_color(4, 4);
+  EXPECT_ERROR_MENTIONS(
+      roomy.integrate(depth, wrong_color, kCamera, depth_range(), Eigen::Isometry3d::Identity()),
+      "colour");
+  EXPECT_EQ(roomy.block_count(), 0u);
+  for (auto change : std::initializer_list<void (*)(TsdfVolumeParams&)>{
+           [](TsdfVolumeParams& p) { p.voxel_size = 0; },
+           [](TsdfVolumeParams& p) { p.voxel_size = std::nan(""); },
+           [](TsdfVolumeParams& p) { p.truncation = 0.5; },
+           [](TsdfVolumeParams& p) { p.truncation = 0.001; },
+           [](TsdfVolumeParams& p) { p.max_weight = 0.5; },
+           [](TsdfVolumeParams& p) { p.max_blocks = 0; },
+           [](TsdfVolumeParams& p) { p.touch_step = 0; }}) {
+    TsdfVolumeParams p;
+    change(p);
+    EXPECT_THROW(TsdfVolume(context(), p), Error);
+  }
+}
+
+TEST_P(TsdfVolumeTest, WeightsStopAtTheMaximumAndTheFieldFollowsChange) {
+  Scene scene;
+  TsdfVolumeParams params;
+  params.voxel_size = 0.02;
+  params.truncation = 0.06;
+  params.max_weight = 4;
+  TsdfVolume volume(context(), params);
+  const Eigen::Isometry3d pose = Eigen::Isometry3d::Identity();
+  for (int i = 0; i < 6; ++i)
+    volume.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  // The wall moves 2 cm nearer: with weights capped at 4 the surface follows within frames.
+  scene.wall_z -= 0.02;
+  for (int i = 0; i < 12; ++i)
+    volume.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  const TsdfBlocks blocks = volume.download();
+  float max_weight = 0;
+  for (const TsdfVoxel& v : blocks.voxels) max_weight = std::max(max_weight, v.weight);
+  EXPECT_EQ(max_weight, 4.0f);
+  const PointImage points = volume.raycast(kCamera, depth_range(), pose);
+  // A corner pixel sees the wall past the sphere.
+  ASSERT_TRUE(is_valid(points(2, 2)));
+  EXPECT_NEAR(points(2, 2).z(), scene.wall_z, 0.005);
+}
+
+KARTOGRAF_INSTANTIATE_BACKEND_TESTS(TsdfVolumeTest);
+
+}  // namespace
+}  // namespace kartograf
