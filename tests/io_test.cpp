@@ -1432,3 +1432,51 @@ TEST_F(IoRealData, RedKitchenColorFrameIsAPicture) {
 
 }  // namespace
 }  // namespace kartograf
+
+namespace kartograf {
+namespace {
+
+class IoPlyMesh : public testing::TempDirTest {};
+
+TEST_F(IoPlyMesh, TrianglesAndColoursAreWrittenAsBinaryLittleEndian) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0.5f}};
+  mesh.colors = {0x0000ffu, 0x00ff00u, 0xff0000u};
+  mesh.triangles = {{0, 1, 2}};
+  const auto file = dir() / "mesh.ply";
+  io::write_mesh_ply(file, mesh);
+  const std::string text = testing::read_text(file);
+  const std::string header =
+      "ply\nformat binary_little_endian 1.0\ncomment written by Kartograf\nelement vertex 3\n"
+      "property float x\nproperty float y\nproperty float z\nproperty uchar red\n"
+      "property uchar green\nproperty uchar blue\nelement face 1\n"
+      "property list uchar int vertex_indices\nend_header\n";
+  ASSERT_EQ(text.substr(0, header.size()), header);
+  ASSERT_EQ(text.size(), header.size() + 3 * 15 + 13);
+  float z = 0;
+  std::memcpy(&z, text.data() + header.size() + 2 * 15 + 8, 4);
+  EXPECT_EQ(z, 0.5f);
+  EXPECT_EQ(static_cast<unsigned char>(text[header.size() + 2 * 15 + 12 + 2]), 0xffu);  // blue
+  const std::string face = text.substr(header.size() + 45);
+  EXPECT_EQ(face[0], 3);
+  std::int32_t last = 0;
+  std::memcpy(&last, face.data() + 9, 4);
+  EXPECT_EQ(last, 2);
+  // The cloud reader skips the faces and reads the vertices back.
+  EXPECT_EQ(io::read_ply(file).size(), 3u);
+}
+
+TEST_F(IoPlyMesh, BadIndicesAndColourCountsAreErrorsAndWriteNothing) {
+  TriangleMesh mesh;
+  mesh.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
+  mesh.triangles = {{0, 1, 3}};
+  EXPECT_ERROR_MENTIONS(io::write_mesh_ply(dir() / "bad.ply", mesh), "bad.ply",
+                        "beyond the 3 vertices");
+  mesh.triangles = {{0, 1, 2}};
+  mesh.colors = {1, 2};
+  EXPECT_ERROR_MENTIONS(io::write_mesh_ply(dir() / "bad.ply", mesh), "2 colours for 3 vertices");
+  EXPECT_FALSE(std::filesystem::exists(dir() / "bad.ply"));
+}
+
+}  // namespace
+}  // namespace kartograf

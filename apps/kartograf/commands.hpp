@@ -195,4 +195,19 @@ struct MapOptions {
 CLI::App* add_map_command(CLI::App& app, MapOptions& options);
 int run_map_command(const MapOptions& options, std::ostream& out, std::ostream& err);
 
+// `fuse SEQUENCE --poses FILE|groundtruth --out DIR`: the frames fused at known poses into a TSDF
+// (mapping/tsdf_volume.hpp), its surface as DIR/mesh.ply (coloured) and a summary DIR/fuse.json.
+struct FuseOptions {
+  SequenceRunOptions run;  // the sequence, input options, backend, progress
+  std::string poses;       // "groundtruth" or a TUM trajectory file
+  std::filesystem::path out_dir;
+  double voxel = 0.01;     // metres
+  double truncation = 0;   // metres; 0: 4 voxels
+  double max_depth = 4.0;  // metres: farther depth is not fused
+  std::size_t max_blocks = 1 << 18;
+  bool force = false;
+};
+CLI::App* add_fuse_command(CLI::App& app, FuseOptions& options);
+int run_fuse_command(const FuseOptions& options, std::ostream& out, std::ostream& err);
+
 }  // namespace kartograf::cli

@@ -73,6 +73,8 @@ int main(int argc, char** argv) {
   CLI::App* semantic = kartograf::cli::add_semantic_command(app, semantic_options);
   kartograf::cli::MapOptions map_options;
   CLI::App* map = kartograf::cli::add_map_command(app, map_options);
+  kartograf::cli::FuseOptions fuse_options;
+  CLI::App* fuse = kartograf::cli::add_fuse_command(app, fuse_options);
 
   try {
     app.parse(argc, argv);
@@ -99,6 +101,7 @@ int main(int argc, char** argv) {
       return kartograf::cli::run_rooms_eval_command(rooms_eval_options, std::cout, std::cerr);
     }
     if (*map) return kartograf::cli::run_map_command(map_options, std::cout, std::cerr);
+    if (*fuse) return kartograf::cli::run_fuse_command(fuse_options, std::cout, std::cerr);
     if (*semantic)
       return kartograf::cli::run_semantic_command(semantic_options, std::cout, std::cerr);
   } catch (const std::bad_alloc&) {

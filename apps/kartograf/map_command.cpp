@@ -69,44 +69,6 @@ void print_summary(std::ostream& out, const pipeline::MapPipelineResult& r,
   }
 }
 
-// --poses: each frame's pose from the sequence's ground truth or from a TUM file, matched by
-// timestamp, or by frame number where the layout has no timestamps (as the trajectories Kartograf
-// writes for it are stamped); a frame without one stops the run with an Error naming it.
-mapping::KnownPoseLookup known_pose_lookup(const std::string& poses, bool by_frame_number) {
-  if (poses.empty()) return {};
-  if (poses == "groundtruth") {
-    return [](std::size_t i, const registration::RgbdImages& images) {
-      require(images.ground_truth.has_value(), "map --poses groundtruth: frame " +
-                                                   std::to_string(i) +
-                                                   " has no ground-truth pose in the sequence");
-      return *images.ground_truth;
-    };
-  }
-  auto trajectory = std::make_shared<Trajectory>(io::read_tum_trajectory(poses));
-  require(!trajectory->empty(), "map --poses: '" + poses + "' holds no pose");
-  std::sort(trajectory->begin(), trajectory->end(),
-            [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
-  return
-      [trajectory, poses, by_frame_number](std::size_t i, const registration::RgbdImages& images) {
-        constexpr double kMaxDifference = 0.02;  // seconds
-        const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp;
-        const auto after =
-            std::lower_bound(trajectory->begin(), trajectory->end(), stamp,
-                             [](const StampedPose& p, double t) { return p.timestamp < t; });
-        const StampedPose* best = nullptr;
-        for (auto it : {after, after == trajectory->begin() ? after : std::prev(after)}) {
-          if (it == trajectory->end()) continue;
-          if (!best || std::fabs(it->timestamp - stamp) < std::fabs(best->timestamp - stamp))
-            best = &*it;
-        }
-        require(best && std::fabs(best->timestamp - stamp) <= kMaxDifference,
-                "map --poses: '" + poses + "' has no pose within 20 ms of frame " +
-                    std::to_string(i) + " (" + (by_frame_number ? "frame number " : "timestamp ") +
-                    std::to_string(stamp) + ")");
-        return best->pose;
-      };
-}
-
 }  // namespace
 
 CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
@@ -149,7 +111,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   params.slam.odometry = odometry_params(o.run);
   params.label_step = o.label_step;
   params.features = !o.no_features && o.poses.empty();
-  params.known_poses = known_pose_lookup(o.poses, !run.opened.detected.has_timestamps);
+  params.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps);
   params.label_width = o.label_width;
   params.grid.resolution = o.resolution;
   params.room_method = rooms::parse_room_method(o.room_method);

@@ -2,12 +2,17 @@
 
 #include <unistd.h>
 
+#include <algorithm>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <iostream>
+#include <iterator>
+#include <memory>
 
 #include "backend_option.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/formats/tum.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "option_checks.hpp"
 
@@ -223,6 +228,45 @@ std::optional<eval::AteResult> absolute_trajectory_error(
   const eval::MatchedPoses matched = eval::match_frames(source.ground_truth(), poses);
   if (matched.size() < 3) return std::nullopt;
   return eval::compute_ate(matched, eval::Alignment::se3);
+}
+
+// --poses: each frame's pose from the sequence's ground truth or from a TUM file, matched by
+// timestamp, or by frame number where the layout has no timestamps (as the trajectories Kartograf
+// writes for it are stamped); a frame without one stops the run with an Error naming it.
+mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
+                                           bool by_frame_number) {
+  if (poses.empty()) return {};
+  if (poses == "groundtruth") {
+    return [command](std::size_t i, const registration::RgbdImages& images) {
+      require(images.ground_truth.has_value(), command + " --poses groundtruth: frame " +
+                                                   std::to_string(i) +
+                                                   " has no ground-truth pose in the sequence");
+      return *images.ground_truth;
+    };
+  }
+  auto trajectory = std::make_shared<Trajectory>(io::read_tum_trajectory(poses));
+  require(!trajectory->empty(), command + " --poses: '" + poses + "' holds no pose");
+  std::sort(trajectory->begin(), trajectory->end(),
+            [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  return [command, trajectory, poses, by_frame_number](std::size_t i,
+                                                       const registration::RgbdImages& images) {
+    constexpr double kMaxDifference = 0.02;  // seconds
+    const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp;
+    const auto after =
+        std::lower_bound(trajectory->begin(), trajectory->end(), stamp,
+                         [](const StampedPose& p, double t) { return p.timestamp < t; });
+    const StampedPose* best = nullptr;
+    for (auto it : {after, after == trajectory->begin() ? after : std::prev(after)}) {
+      if (it == trajectory->end()) continue;
+      if (!best || std::fabs(it->timestamp - stamp) < std::fabs(best->timestamp - stamp))
+        best = &*it;
+    }
+    require(best && std::fabs(best->timestamp - stamp) <= kMaxDifference,
+            command + " --poses: '" + poses + "' has no pose within 20 ms of frame " +
+                std::to_string(i) + " (" + (by_frame_number ? "frame number " : "timestamp ") +
+                std::to_string(stamp) + ")");
+    return best->pose;
+  };
 }
 
 }  // namespace kartograf::cli

@@ -90,4 +90,10 @@ Trajectory ground_truth_trajectory(const pipeline::SequenceFrameSource& source,
 std::optional<eval::AteResult> absolute_trajectory_error(
     const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
 
+// --poses of `map` and `fuse`: each frame's pose from the sequence's ground truth ("groundtruth")
+// or from a TUM file, matched by timestamp, or by frame number where the layout has no
+// timestamps; a frame without one stops the run with an Error naming `command` and the frame.
+mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
+                                           bool by_frame_number);
+
 }  // namespace kartograf::cli

@@ -657,6 +657,18 @@ World make_building(std::uint64_t seed, const BuildingParams& options) {
   return LayoutBuilder(seed, options).build();
 }
 
+double distance_to_surfaces(const World& world, const Eigen::Vector3d& p) {
+  double best = std::min(std::abs(p.z()), std::abs(p.z() - world.height));
+  for (const Solid& solid : world.solids) {
+    const Eigen::Vector3d& lo = solid.box.min;
+    const Eigen::Vector3d& hi = solid.box.max;
+    const double outside = (lo - p).cwiseMax(p - hi).cwiseMax(0.0).norm();
+    const double depth_inside = std::min((p - lo).minCoeff(), (hi - p).minCoeff());
+    best = std::min(best, outside > 0 ? outside : std::max(0.0, depth_inside));
+  }
+  return best;
+}
+
 RoutePath route_path(const World& world) {
   return RoutePath(world.route, kMaxTurnRadius);
 }

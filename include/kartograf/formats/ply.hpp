@@ -13,6 +13,7 @@
 #include "kartograf/core/color.hpp"
 #include "kartograf/core/point_cloud.hpp"
 #include "kartograf/core/point_image.hpp"
+#include "kartograf/core/triangle_mesh.hpp"
 
 namespace kartograf::io {
 
@@ -29,6 +30,10 @@ void write_ply(const std::filesystem::path& path, const PointImage& points,
 // Same rules; cloud.normals and cloud.colors must be empty or one per point.
 void write_ply(const std::filesystem::path& path, const PointCloud& cloud,
                PlyEncoding encoding = PlyEncoding::binary_little_endian);
+
+// A triangle mesh: vertices x y z (float) with red green blue (uchar) when it has colours, faces
+// as lists of three vertex indices (uchar count, int indices), binary little-endian. Atomic.
+void write_mesh_ply(const std::filesystem::path& path, const TriangleMesh& mesh);
 
 PointCloud read_ply(const std::filesystem::path& path);
 // The parser behind read_ply, on bytes in memory; `name` stands for the file in messages.

@@ -159,6 +159,10 @@ struct World {
 // plane to any sensor; plane-segmentation scores count them as one.
 std::vector<Label> continuous_surface_ids(const World& world);
 
+// Metres from p to the nearest surface of the world: the floor, the ceiling and every solid's box
+// (hidden contact faces included). Linear in the solids; for scoring reconstructions.
+double distance_to_surfaces(const World& world, const Eigen::Vector3d& p);
+
 // The building for `seed`. Throws Error when the options are inconsistent.
 World make_building(std::uint64_t seed, const BuildingParams& options = {});
 

@@ -1,0 +1,30 @@
+#pragma once
+// The zero surface of a TSDF (tsdf_volume.hpp) as a triangle mesh, on the host from a downloaded
+// copy of the field.
+//
+// Cells are the cubes between 8 neighbouring voxel centres; a cell with an unobserved corner is
+// skipped. Each cell is cut into 6 tetrahedra around its main diagonal (marching tetrahedra: no
+// ambiguous cases, and neighbouring cells cut their shared faces the same way, so the surface
+// has no cracks). A vertex lies on every edge whose ends differ in sign, placed by linear
+// interpolation, and is shared by the triangles that use that edge; its colour is interpolated
+// alike. An edge whose two values are both at the truncation (|value| >= max_jump) is a jump in
+// the field, not a surface (the boundary between what a view saw in front of a surface and what
+// it saw behind another), and makes no vertex. Triangles face the + side (the viewer).
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/core/triangle_mesh.hpp"
+#include "kartograf/mapping/tsdf_volume.hpp"
+
+namespace kartograf::mapping {
+
+struct MeshParams {
+  float min_weight = 1;     // corners observed at least this much
+  float max_jump = 0.999f;  // see above
+};
+
+TriangleMesh extract_mesh(const TsdfBlocks& blocks, const MeshParams& params = {});
+
+}  // namespace kartograf::mapping

@@ -1,0 +1,94 @@
+// Mesh extraction from a TSDF (mapping/tsdf_mesh.hpp) on fields written directly: a sphere's
+// signed distance, and fields with holes and jumps.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <utility>
+
+#include "kartograf/mapping/tsdf_mesh.hpp"
+
+namespace kartograf {
+namespace {
+
+using mapping::kTsdfBlockSide;
+using mapping::kTsdfBlockVoxels;
+using mapping::TsdfBlocks;
+using mapping::TsdfVoxel;
+
+// The truncated signed distance of a sphere, in every block of a cube of blocks around it.
+TsdfBlocks sphere_field(const Eigen::Vector3d& centre, double radius, double voxel,
+                        double truncation, int blocks_each_way) {
+  TsdfBlocks field;
+  field.voxel_size = voxel;
+  field.truncation = truncation;
+  for (int z = -blocks_each_way; z < blocks_each_way; ++z)
+    for (int y = -blocks_each_way; y < blocks_each_way; ++y)
+      for (int x = -blocks_each_way; x < blocks_each_way; ++x) {
+        field.coords.emplace_back(x, y, z);
+        for (std::size_t i = 0; i < kTsdfBlockVoxels; ++i) {
+          const Eigen::Vector3i v = Eigen::Vector3i(x, y, z) * kTsdfBlockSide +
+                                    Eigen::Vector3i(int(i % 8), int(i / 8 % 8), int(i / 64));
+          const Eigen::Vector3d p = (v.cast<double>().array() + 0.5) * voxel;
+          const double d = ((p - centre).norm() - radius) / truncation;
+          field.voxels.push_back({float(std::clamp(d, -1.0, 1.0)), 1.0f, 0x204080u});
+        }
+      }
+  return field;
+}
+
+TEST(TsdfMesh, SphereIsClosedOnTheSurfaceAndFacesOut) {
+  const Eigen::Vector3d centre(0.013, -0.021, 0.007);
+  const double radius = 0.3;
+  const TsdfBlocks field = sphere_field(centre, radius, 0.01, 0.04, 5);
+  const TriangleMesh mesh = mapping::extract_mesh(field);
+  ASSERT_GT(mesh.triangles.size(), 1000u);
+  double worst = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    worst = std::max(worst, std::abs((v.cast<double>() - centre).norm() - radius));
+  }
+  // Linear interpolation of a distance field that is linear along rays: well under a millimetre.
+  EXPECT_LT(worst, 5e-4);
+  std::map<std::pair<int, int>, int> edge_uses;
+  std::size_t facing_out = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    for (int k = 0; k < 3; ++k) {
+      const int a = t[k], b = t[(k + 1) % 3];
+      ++edge_uses[{std::min(a, b), std::max(a, b)}];
+    }
+    const Eigen::Vector3f& p = mesh.vertices[t[0]];
+    const Eigen::Vector3f n = (mesh.vertices[t[1]] - p).cross(mesh.vertices[t[2]] - p);
+    if (n.dot(p - centre.cast<float>()) > 0) ++facing_out;
+  }
+  for (const auto& [edge, uses] : edge_uses) ASSERT_EQ(uses, 2) << edge.first << "-" << edge.second;
+  EXPECT_EQ(facing_out, mesh.triangles.size());
+  EXPECT_EQ(mesh.colors.size(), mesh.vertices.size());
+  EXPECT_EQ(mesh.colors.front(), 0x204080u);
+}
+
+TEST(TsdfMesh, UnobservedCornersAndJumpsMakeNoSurface) {
+  TsdfBlocks field = sphere_field({0, 0, 0}, 0.3, 0.01, 0.04, 5);
+  const std::size_t full = mapping::extract_mesh(field).triangles.size();
+  // Forget every voxel with x < 0: half of the sphere goes.
+  for (std::size_t b = 0; b < field.size(); ++b) {
+    if (field.coords[b].x() >= 0) continue;
+    for (std::size_t i = 0; i < kTsdfBlockVoxels; ++i)
+      field.voxels[b * kTsdfBlockVoxels + i].weight = 0;
+  }
+  const std::size_t half = mapping::extract_mesh(field).triangles.size();
+  EXPECT_NEAR(double(half), full / 2.0, full * 0.05);
+  // A field that jumps from +1 to -1 (one view's free space against another's back side).
+  TsdfBlocks jump;
+  jump.voxel_size = 0.01;
+  jump.truncation = 0.04;
+  jump.coords.emplace_back(0, 0, 0);
+  for (std::size_t i = 0; i < kTsdfBlockVoxels; ++i) {
+    jump.voxels.push_back({i % 8 < 4 ? 1.0f : -1.0f, 1.0f, 0});
+  }
+  EXPECT_TRUE(mapping::extract_mesh(jump).triangles.empty());
+  jump.voxels.pop_back();
+  EXPECT_THROW(mapping::extract_mesh(jump), Error);
+}
+
+}  // namespace
+}  // namespace kartograf
