@@ -87,6 +87,8 @@ struct SequenceRunOptions {
   int reestimate_interval = 5;
   // The re-estimates' anchor bounds: metres, degrees, frames (registration::AnchorPolicy).
   std::vector<double> anchor_bounds{0.4, 25, 100};
+  std::string tracking = "frame";  // frame | model (mapping/model_tracking.hpp)
+  double model_voxel = 0.02;       // metres: the model's voxels with --tracking model
   bool progress = true;
 };
 

@@ -40,7 +40,8 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
 
   ProgressBar bar(err, o.run.progress);
   const mapping::SlamObserver observer = slam_progress_observer(err, bar);
-  const mapping::OdometryRun result = mapping::run_odometry(context, *run.source, params, observer);
+  const mapping::OdometryRun result =
+      mapping::run_odometry(context, *run.source, params, observer, model_tracking_params(o.run));
   bar.finish();
 
   const InterruptsDeferred writing;  // a signal waits for the files, then drops them
@@ -65,6 +66,13 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
                 1000.0 * result.timing.load_seconds / std::max(frames, 1.0));
   out << line;
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.frames)) << "\n";
+  if (result.model_tracking) {
+    std::snprintf(line, sizeof(line),
+                  "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame\n",
+                  result.model_kept, result.poses.size(),
+                  1000.0 * result.model_seconds / std::max(frames, 1.0));
+    out << line;
+  }
   if (ate) {
     std::snprintf(line, sizeof(line), "  ate_rmse_m %.6f (max %.6f, %zu poses with ground truth)\n",
                   ate->translation_m.rmse, ate->translation_m.max, ate->translation_m.count);

@@ -55,6 +55,15 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
       ->capture_default_str();
   add_backend_option(command, o.backend, o.backend_source);
   command
+      .add_option("--tracking", o.tracking,
+                  "frame: frame-to-frame odometry; model: each frame then registered against the "
+                  "TSDF of the frames before it (KinectFusion's frame-to-model tracking)")
+      ->check(CLI::IsMember({"frame", "model"}))
+      ->capture_default_str();
+  command.add_option("--model-voxel", o.model_voxel, "Voxel size of the model [m]")
+      ->check(CLI::Range(0.005, 0.2))
+      ->capture_default_str();
+  command
       .add_option("--reestimate-every", o.reestimate_interval,
                   "Re-register every k-th frame against the anchor (the M3 paper's drift "
                   "reduction; 0: off)")
@@ -105,6 +114,14 @@ registration::OdometryParams odometry_params(const SequenceRunOptions& options) 
   params.reestimate_interval = options.reestimate_interval;
   params.anchor = {options.anchor_bounds.at(0), options.anchor_bounds.at(1),
                    static_cast<int>(options.anchor_bounds.at(2))};
+  return params;
+}
+
+mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& options) {
+  mapping::ModelTrackingParams params;
+  params.enabled = options.tracking == "model";
+  params.volume.voxel_size = options.model_voxel;
+  params.volume.truncation = 4 * options.model_voxel;
   return params;
 }
 

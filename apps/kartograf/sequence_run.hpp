@@ -45,6 +45,8 @@ io::OpenedSequence open_input(const std::filesystem::path& folder,
                               const SequenceInputOptions& options, std::ostream& err);
 registration::OdometryParams odometry_params(const SequenceRunOptions& options);
 compute::Context make_run_context(const SequenceRunOptions& options);
+// --tracking and --model-voxel.
+mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& options);
 // The options and the context as the stats documents record them.
 io::SequenceRunRecord run_record(const SequenceRunOptions& options,
                                  const compute::Context& context);

@@ -6,6 +6,7 @@
 #include "kartograf/geometry/segment_moments.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
+#include "kartograf/mapping/tsdf_volume.hpp"
 #include "kartograf/registration/color_gate.hpp"
 #include "kartograf/registration/frame_pyramid.hpp"
 #include "kartograf/registration/icp.hpp"
@@ -34,7 +35,16 @@ struct Workspace {
         downsampler(context),
         gate(context),
         hash(context),
-        grower(context) {}
+        grower(context),
+        tsdf_fine(context, tsdf_params(0.01)),
+        tsdf_coarse(context, tsdf_params(0.05)) {}
+
+  static mapping::TsdfVolumeParams tsdf_params(double voxel) {
+    mapping::TsdfVolumeParams params;
+    params.voxel_size = voxel;
+    params.truncation = 4 * voxel;
+    return params;
+  }
 
   const RgbdFrame& next_frame() { return frames.frames[next++ % frames.frames.size()]; }
   registration::FramePyramid& reference() { return pyramids[reference_index]; }
@@ -67,6 +77,9 @@ struct Workspace {
   segmentation::RegionGrower grower;
   segmentation::LabCodeImage lab;          // of frame 1
   compute::Buffer<Point4f> frame1_points;  // frame 1 back-projected, for the region growing
+  // TSDFs of 1 and 5 cm voxels: every frame fused at the identity (the poses are unknown here).
+  mapping::TsdfVolume tsdf_fine, tsdf_coarse;
+  compute::DeviceImage<Point4f> cast;
 };
 
 namespace {
@@ -114,6 +127,15 @@ void voxel_hash_nearest(Workspace& w) {
   w.hash.find(unorganized(w.current().level(0).view()), target, kSmallMotion, params, w.hash_out);
 }
 
+void integrate(Workspace& w, mapping::TsdfVolume& volume) {
+  volume.integrate(w.depth, &w.current_colors, w.frames.camera, geometry::DepthRange{},
+                   Eigen::Isometry3d::Identity());
+}
+
+void ray_cast(Workspace& w, const mapping::TsdfVolume& volume) {
+  volume.raycast(w.frames.camera, geometry::DepthRange{}, Eigen::Isometry3d::Identity(), w.cast);
+}
+
 void build_current(Workspace& w) {
   w.depth.upload(w.next_frame().depth);
   w.current().build(w.projector, w.depth);
@@ -154,6 +176,8 @@ std::shared_ptr<Workspace> make_workspace(const compute::Context& context, const
   w->lab = segmentation::to_lab_codes(frames.frames[1 % frames.frames.size()].color);
   w->frame1_points = compute::Buffer<Point4f>(context, w->points.size());
   w->frame1_points.raw().copy_from(w->points.buffer().raw(), w->points.buffer().raw().size_bytes());
+  integrate(*w, w->tsdf_fine);
+  integrate(*w, w->tsdf_coarse);
   context.finish();
   return w;
 }
@@ -192,6 +216,10 @@ const std::vector<Operation>& frame_operations() {
        [](Workspace& w) { w.downsampler.run(w.cloud, geometry::VoxelDownsampleParams{}); }},
       {"colour gate (HSI)", 0, gate_colours},
       {"voxel-hash build + nearest", 0, voxel_hash_nearest},
+      {"TSDF integrate 1 cm", 0, [](Workspace& w) { integrate(w, w.tsdf_fine); }},
+      {"TSDF ray cast 1 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_fine); }},
+      {"TSDF integrate 5 cm", 0, [](Workspace& w) { integrate(w, w.tsdf_coarse); }},
+      {"TSDF ray cast 5 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_coarse); }},
       {"region growing (Lab)", 0,
        [](Workspace& w) {
          w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});

@@ -206,6 +206,29 @@ KG_INLINE int tsdf_pixel_of(float3 c, TsdfParams p) {
   return KG_INT(v) * KG_INT(p.width) + KG_INT(u);
 }
 
+KG_STRUCT_BEGIN(TsdfVoxelView)
+uint voxel;  // index in the pool's voxels
+int pixel;   // the pixel it projects to (y * width + x), or -1
+float z;     // its centre's depth in the camera
+KG_STRUCT_END(TsdfVoxelView)
+
+// Item i of the integration: voxel i % 512 of active block i / 512, and where the camera sees it.
+// The shader declares active_blocks and block_keys.
+#if !defined(VULKAN) || defined(KG_TSDF_INTEGRATE_PASS)
+KG_INLINE TsdfVoxelView tsdf_voxel_view(KG_BUFFER_PARAM(const uint, active_blocks)
+                                            KG_BUFFER_PARAM(const uint64_t, block_keys) uint i,
+                                        TsdfParams p) {
+  const uint block = active_blocks[i / KG_TSDF_BLOCK_VOXELS];
+  const uint cell = i % KG_TSDF_BLOCK_VOXELS;
+  const float3 c = tsdf_voxel_in_camera(block_keys[block], cell, p);
+  TsdfVoxelView view;
+  view.voxel = block * KG_TSDF_BLOCK_VOXELS + cell;
+  view.pixel = tsdf_pixel_of(c, p);
+  view.z = c.z;
+  return view;
+}
+#endif
+
 // One channel's weighted mean, rounded to the nearest level.
 KG_INLINE uint tsdf_mean_channel(uint old_color, uint new_color, uint shift, float old_weight) {
   const float a = KG_FLOAT((old_color >> shift) & 0xffu);

@@ -46,14 +46,10 @@ void integrate(const CpuDispatch& call) {
   auto* voxels = call.buffer<TsdfVoxel>(4);
   for_each_item(call, [&](uint i) {
     if (i >= params.count) return;
-    const uint block = active_blocks[i / KG_TSDF_BLOCK_VOXELS];
-    const uint cell = i % KG_TSDF_BLOCK_VOXELS;
-    const float3 c = tsdf_voxel_in_camera(block_keys[block], cell, params);
-    const int pixel = tsdf_pixel_of(c, params);
-    if (pixel < 0) return;
-    const uint color = params.has_color != 0u ? colors[pixel] : 0u;
-    const uint v = block * KG_TSDF_BLOCK_VOXELS + cell;
-    voxels[v] = tsdf_fuse(voxels[v], depth[pixel], c.z, color, params);
+    const TsdfVoxelView view = tsdf_voxel_view(active_blocks, block_keys, i, params);
+    if (view.pixel < 0) return;
+    const uint color = params.has_color != 0u ? colors[view.pixel] : 0u;
+    voxels[view.voxel] = tsdf_fuse(voxels[view.voxel], depth[view.pixel], view.z, color, params);
   });
 }
 

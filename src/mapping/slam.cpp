@@ -40,13 +40,19 @@ void report_progress(const SlamObserver& observer, std::string_view stage, std::
 class Tracker {
  public:
   Tracker(const compute::Context& context, const FrameSource& source,
-          const registration::OdometryParams& params)
-      : odometry_(context, source.camera(), with_source_units(params, source)) {}
+          const registration::OdometryParams& params, const ModelTrackingParams& model = {})
+      : odometry_(context, source.camera(), with_source_units(params, source)) {
+    if (model.enabled) {
+      model_.emplace(context, source.camera(), odometry_.params().depth_range, model);
+      run_.model_tracking = true;
+    }
+  }
 
   const registration::OdometryFrame& track(const registration::RgbdImages& images) {
     run_.timestamps.push_back(images.timestamp);
     const registration::OdometryFrame& frame = odometry_.track(images.depth, color_of(images));
     run_.compute_seconds += frame.seconds;
+    if (model_) track_model(images);
     const auto& poses = odometry_.poses();
     const std::size_t n = poses.size() - 1;
     path_.push_back(
@@ -58,7 +64,7 @@ class Tracker {
   double path_length(std::size_t frame) const { return path_[frame]; }
 
   OdometryRun finish(const FrameLoopTiming& timing) {
-    run_.poses = odometry_.poses();
+    run_.poses = model_ ? model_poses_ : odometry_.poses();
     run_.frames = odometry_.frames();
     run_.constraints = odometry_.constraints();
     run_.keyframes = odometry_.keyframes();
@@ -67,7 +73,22 @@ class Tracker {
   }
 
  private:
+  // The odometry's motion since the last frame, applied to the model's pose of that frame.
+  void track_model(const registration::RgbdImages& images) {
+    const auto start = Clock::now();
+    const auto& odometry = odometry_.poses();
+    const std::size_t n = odometry.size() - 1;
+    const Eigen::Isometry3d predicted =
+        n == 0 ? odometry[0] : model_poses_.back() * (odometry[n - 1].inverse() * odometry[n]);
+    const ModelTrackingStep step = model_->track(images.depth, color_of(images), predicted);
+    model_poses_.push_back(step.pose);
+    run_.model_kept += step.from_model ? 1 : 0;
+    run_.model_seconds += seconds_since(start);
+  }
+
   registration::RgbdOdometry odometry_;
+  std::optional<ModelTracker> model_;
+  std::vector<Eigen::Isometry3d> model_poses_;
   OdometryRun run_;
   std::vector<double> path_;
 };
@@ -283,8 +304,9 @@ PoseGraphParams slam_graph_options() {
 }
 
 OdometryRun run_odometry(const compute::Context& context, const FrameSource& source,
-                         const registration::OdometryParams& params, const SlamObserver& observer) {
-  Tracker tracker(context, source, params);
+                         const registration::OdometryParams& params, const SlamObserver& observer,
+                         const ModelTrackingParams& model) {
+  Tracker tracker(context, source, params, model);
   const std::size_t total = source.size();
   const FrameLoopTiming timing =
       for_each_frame(source, 0, total, [&](std::size_t i, registration::RgbdImages& images) {

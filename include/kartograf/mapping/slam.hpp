@@ -29,6 +29,7 @@
 #include "kartograf/mapping/frame_source.hpp"
 #include "kartograf/mapping/loop_closure.hpp"
 #include "kartograf/mapping/map_fusion.hpp"
+#include "kartograf/mapping/model_tracking.hpp"
 #include "kartograf/mapping/pose_graph.hpp"
 #include "kartograf/registration/odometry.hpp"
 
@@ -81,12 +82,18 @@ struct OdometryRun {
   std::vector<std::size_t> keyframes;
   FrameLoopTiming timing;      // wall time with frame loading, load time, waits
   double compute_seconds = 0;  // sum of OdometryFrame::seconds: the run without file I/O
+  // With model tracking: poses are the model's (frame-to-frame odometry predicts them), and
+  // how many frames kept the model's registration.
+  bool model_tracking = false;
+  std::size_t model_kept = 0;
+  double model_seconds = 0;  // ray casting, registration and fusion
 };
 
 // Odometry alone over the whole source.
+// With model.enabled, each frame is then tracked against the model (model_tracking.hpp).
 OdometryRun run_odometry(const compute::Context& context, const FrameSource& source,
                          const registration::OdometryParams& params,
-                         const SlamObserver& observer = {});
+                         const SlamObserver& observer = {}, const ModelTrackingParams& model = {});
 
 struct LoopClosureRecord {
   LoopClosure closure;
