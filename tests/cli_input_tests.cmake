@@ -66,18 +66,20 @@ test ! -e "$1/short/report.json" || { echo "FAIL: partial output"; exit 1; }
 "$0" map "$2/sun3d_studyroom_fragment1" --poses "$1/none.txt" --out "$1/none" > "$1/none.log" 2>&1 && { echo "FAIL: a missing file was accepted"; exit 1; }
 grep -q "none.txt" "$1/none.log" || { cat "$1/none.log"; echo "FAIL: message"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-map-known-poses ${KARTOGRAF_DATA_DIR})
-# fuse: the SUN3D fragment fused at its ground-truth poses into a coloured mesh with a summary;
+# fuse: the SUN3D fragment fused at its ground-truth poses into a coloured mesh with a summary
+# (and, with --floor-z, the height band's occupancy and ESDF);
 # a volume too small for the frames is an error naming max_blocks that leaves no output, and a
 # trajectory without the frames an error naming the frame.
 add_test(NAME Cli.fuse_with_known_poses
   COMMAND sh -c [=[
 rm -rf "$1" && mkdir -p "$1" || exit 1
-"$0" fuse "$2/sun3d_studyroom_fragment1" --poses groundtruth --voxel 0.02 --out "$1/mesh" > "$1/mesh.log" 2> "$1/mesh.err" || { cat "$1/mesh.log" "$1/mesh.err"; exit 1; }
+"$0" fuse "$2/sun3d_studyroom_fragment1" --poses groundtruth --voxel 0.02 --floor-z -1.2 --out "$1/mesh" > "$1/mesh.log" 2> "$1/mesh.err" || { cat "$1/mesh.log" "$1/mesh.err"; exit 1; }
 cat "$1/mesh.log"
 grep -q "^fuse: 50 frames, [1-9][0-9]* blocks of 0.020 m voxels, mesh [1-9][0-9]* vertices [1-9][0-9]* triangles" "$1/mesh.log" || { echo "FAIL: summary line"; exit 1; }
 head -c 400 "$1/mesh/mesh.ply" | grep -a -q "^element face [1-9]" || { echo "FAIL: no faces in mesh.ply"; exit 1; }
 head -c 400 "$1/mesh/mesh.ply" | grep -a -q "^property uchar red" || { echo "FAIL: no colours in mesh.ply"; exit 1; }
 grep -q '"frames": 50' "$1/mesh/fuse.json" || { cat "$1/mesh/fuse.json"; echo "FAIL: fuse.json"; exit 1; }
+grep -q "^image: occupancy.pgm" "$1/mesh/occupancy.yaml" && test -s "$1/mesh/occupancy.pgm" && test -s "$1/mesh/esdf.png" || { ls "$1/mesh"; echo "FAIL: --floor-z maps"; exit 1; }
 "$0" fuse "$2/sun3d_studyroom_fragment1" --poses groundtruth --max-blocks 10 --out "$1/small" > "$1/small.log" 2>&1 && { echo "FAIL: a full volume was accepted"; exit 1; }
 grep -q "volume is full.*max_blocks" "$1/small.log" || { cat "$1/small.log"; echo "FAIL: message"; exit 1; }
 test ! -e "$1/small/mesh.ply" || { echo "FAIL: partial output"; exit 1; }

@@ -92,3 +92,61 @@ TEST(TsdfMesh, UnobservedCornersAndJumpsMakeNoSurface) {
 
 }  // namespace
 }  // namespace kartograf
+
+#include "kartograf/mapping/tsdf_slice.hpp"
+
+namespace kartograf {
+namespace {
+
+// A floor (z = 0) over 2 m x 2 m with a box 0.4 x 0.4 x 0.8 m standing at (1, 1): the truncated
+// signed distance of their union, every voxel observed.
+TsdfBlocks floor_and_box() {
+  TsdfBlocks field;
+  field.voxel_size = 0.02;
+  field.truncation = 0.08;
+  const auto box_distance = [](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d lo(0.8, 0.8, 0), hi(1.2, 1.2, 0.8);
+    const Eigen::Vector3d out = (lo - p).cwiseMax(p - hi).cwiseMax(0.0);
+    return out.squaredNorm() > 0 ? out.norm() : -std::min((p - lo).minCoeff(), (hi - p).minCoeff());
+  };
+  for (int z = -1; z < 6; ++z)
+    for (int y = 0; y < 13; ++y)
+      for (int x = 0; x < 13; ++x) {
+        field.coords.emplace_back(x, y, z);
+        for (std::size_t i = 0; i < kTsdfBlockVoxels; ++i) {
+          const Eigen::Vector3i v = Eigen::Vector3i(x, y, z) * kTsdfBlockSide +
+                                    Eigen::Vector3i(int(i % 8), int(i / 8 % 8), int(i / 64));
+          const Eigen::Vector3d p = (v.cast<double>().array() + 0.5) * field.voxel_size;
+          const double d = std::min(p.z(), box_distance(p)) / field.truncation;
+          field.voxels.push_back({float(std::clamp(d, -1.0, 1.0)), 4.0f, 0});  // seen 4 times
+        }
+      }
+  return field;
+}
+
+TEST(TsdfSlice, TheBoxIsOccupiedTheFloorFreeAndTheEsdfMeasuresTheGap) {
+  mapping::TsdfSliceParams params;
+  params.resolution = 0.05;
+  const OccupancyGrid grid = mapping::tsdf_occupancy(floor_and_box(), params);
+  ASSERT_GT(grid.width(), 30);
+  const auto state_at = [&](double x, double y) {
+    const Eigen::Vector2i c = grid.cell_of({x, y});
+    return grid.cells(c.x(), c.y());
+  };
+  EXPECT_EQ(state_at(1.0, 1.0), CellState::occupied);  // the box's middle (its top and sides)
+  EXPECT_EQ(state_at(1.19, 0.81), CellState::occupied);
+  EXPECT_EQ(state_at(0.3, 0.3), CellState::free);
+  EXPECT_EQ(state_at(1.7, 1.0), CellState::free);
+  const Image<float> esdf = mapping::occupancy_esdf(grid);
+  const Eigen::Vector2i far = grid.cell_of({1.7, 1.0});
+  // 0.5 m from the box's face, to within a cell.
+  EXPECT_NEAR(esdf(far.x(), far.y()), 0.5, 0.05);
+  const Eigen::Vector2i middle = grid.cell_of({1.0, 1.0});
+  EXPECT_LT(esdf(middle.x(), middle.y()), -0.1);  // inside: negative
+  mapping::TsdfSliceParams bad;
+  bad.band_min = 2;
+  EXPECT_THROW(mapping::tsdf_occupancy(floor_and_box(), bad), Error);
+}
+
+}  // namespace
+}  // namespace kartograf

@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -207,6 +208,9 @@ struct FuseOptions {
   double truncation = 0;   // metres; 0: 4 voxels
   double max_depth = 4.0;  // metres: farther depth is not fused
   std::size_t max_blocks = 1 << 18;
+  // With a floor height (metres, world z up): occupancy.pgm/.yaml of the robot's height band and
+  // esdf.png (mapping/tsdf_slice.hpp).
+  double floor_z = std::numeric_limits<double>::quiet_NaN();  // NaN: no 2-D maps
   bool force = false;
 };
 CLI::App* add_fuse_command(CLI::App& app, FuseOptions& options);

@@ -1,6 +1,8 @@
 // `kartograf fuse SEQUENCE --poses FILE|groundtruth --out DIR`: every frame fused at its known
 // pose into a TSDF on the chosen backend, the surface meshed on the host. Wiring only.
+#include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <ostream>
@@ -9,10 +11,13 @@
 #include "backend_option.hpp"
 #include "commands.hpp"
 #include "interrupts.hpp"
+#include "kartograf/formats/image_io.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/formats/ply.hpp"
 #include "kartograf/formats/text_file.hpp"
 #include "kartograf/mapping/frame_source.hpp"
 #include "kartograf/mapping/tsdf_mesh.hpp"
+#include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "kartograf/outputs/fuse_summary.hpp"
 #include "output_transaction.hpp"
@@ -44,14 +49,42 @@ CLI::App* add_fuse_command(CLI::App& app, FuseOptions& o) {
   command->add_option("--max-blocks", o.max_blocks, "Blocks of 8^3 voxels the volume holds")
       ->check(CLI::Range(1, 1 << 23))
       ->capture_default_str();
+  command
+      ->add_option("--floor-z", o.floor_z,
+                   "Also write the 2-D maps of the robot's height band (0.05-1.5 m above this "
+                   "floor height, world z up): occupancy.pgm/.yaml and esdf.png")
+      ->check(CLI::Range(-1000.0, 1000.0));
   command->add_flag(
       "--no-progress", [&o](std::int64_t) { o.run.progress = false; }, "No progress bar on stderr");
   command->add_flag("--force", o.force, "Replace the files of an earlier run");
   return command;
 }
 
+namespace {
+
+// The height band's occupancy (ROS map_server files) and its ESDF as grey levels: 0 at obstacles
+// and inside them, 255 at 2 m or more.
+void write_band_maps(const std::filesystem::path& dir, const mapping::TsdfBlocks& blocks,
+                     double floor_z) {
+  mapping::TsdfSliceParams params;
+  params.floor_z = floor_z;
+  const OccupancyGrid grid = mapping::tsdf_occupancy(blocks, params);
+  require(grid.width() > 0, "fuse --floor-z: the volume holds no surface to map");
+  io::write_ros_map(dir / "occupancy.yaml", grid);
+  const Image<float> esdf = mapping::occupancy_esdf(grid);
+  GrayImage grey(esdf.width(), esdf.height());
+  for (std::size_t i = 0; i < esdf.pixels().size(); ++i) {
+    const float metres = std::clamp(esdf.pixels()[i], 0.0f, 2.0f);
+    grey.pixels()[i] = static_cast<std::uint8_t>(std::lround(metres / 2.0f * 255.0f));
+  }
+  io::write_png(dir / "esdf.png", grey);
+}
+
+}  // namespace
+
 int run_fuse_command(const FuseOptions& o, std::ostream& out, std::ostream& err) {
-  OutputFolder folder("fuse", o.out_dir, o.force, {"mesh.ply", "fuse.json"});
+  OutputFolder folder("fuse", o.out_dir, o.force,
+                      {"mesh.ply", "fuse.json", "occupancy.pgm", "occupancy.yaml", "esdf.png"});
   const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   mapping::TsdfVolumeParams params;
@@ -78,10 +111,12 @@ int run_fuse_command(const FuseOptions& o, std::ostream& out, std::ostream& err)
         bar.update("fusing", i + 1, frames);
       });
   bar.finish();
-  const TriangleMesh mesh = mapping::extract_mesh(volume.download());
+  const mapping::TsdfBlocks blocks = volume.download();
+  const TriangleMesh mesh = mapping::extract_mesh(blocks);
 
   const InterruptsDeferred writing;  // a signal waits for the files, then drops them
   io::write_mesh_ply(folder.dir() / "mesh.ply", mesh);
+  if (!std::isnan(o.floor_z)) write_band_maps(folder.dir(), blocks, o.floor_z);
   const io::FuseRun record{
       o.run.sequence.string(),    o.poses, std::string(compute::to_string(context.backend())),
       context.device_info().name, frames,  fuse_seconds};
