@@ -87,9 +87,22 @@ printf '0 0 0 0 0 0 0 1\n' > "$1/one.txt"
 "$0" fuse "$2/sun3d_studyroom_fragment1" --poses "$1/one.txt" --out "$1/one" > "$1/one.log" 2>&1 && { echo "FAIL: a short trajectory was accepted"; exit 1; }
 grep -q "fuse --poses: '.*one.txt' has no pose within 20 ms of frame 1" "$1/one.log" || { cat "$1/one.log"; echo "FAIL: message"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-fuse ${KARTOGRAF_DATA_DIR})
+# odometry --tracking model: the frame-to-model line and an ATE; slam refuses the option (it has
+# no model tracking yet) before reading anything.
+add_test(NAME Cli.odometry_tracking_model
+  COMMAND sh -c [=[
+rm -rf "$1" && mkdir -p "$1" || exit 1
+"$0" odometry "$2/sun3d_studyroom_fragment1" --tracking model --out "$1/model.txt" > "$1/model.log" 2> "$1/model.err" || { cat "$1/model.log" "$1/model.err"; exit 1; }
+cat "$1/model.log"
+grep -q "^  model tracking: the model's pose kept on [0-9]* of 50 frames" "$1/model.log" || { echo "FAIL: model line"; exit 1; }
+grep -q "^  ate_rmse_m [0-9]" "$1/model.log" || { echo "FAIL: no ATE"; exit 1; }
+"$0" slam "$2/sun3d_studyroom_fragment1" --tracking model --out "$1/slam" > "$1/slam.log" 2>&1 && { echo "FAIL: slam accepted --tracking model"; exit 1; }
+grep -q "slam: --tracking model is only in .kartograf odometry." "$1/slam.log" || { cat "$1/slam.log"; echo "FAIL: message"; exit 1; }
+test ! -e "$1/slam" || { echo "FAIL: output"; exit 1; }
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-odometry-model ${KARTOGRAF_DATA_DIR})
 set_tests_properties(Cli.input_slam_on_7scenes_frames_300_to_599 Cli.input_map_on_7scenes_frames_300_to_599
   Cli.input_slam_and_map_on_sun3d Cli.input_slam_with_features_on_7scenes Cli.input_map_with_known_poses
-  Cli.fuse_with_known_poses PROPERTIES TIMEOUT 600 ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+  Cli.fuse_with_known_poses Cli.odometry_tracking_model PROPERTIES TIMEOUT 600 ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
 
 # A TUM folder (kartograf synth output without world.json and camera_intrinsics.json): the
 # default camera with a warning naming --camera; --camera tum-fr3 (fx 535.4, fy 539.2) printed and

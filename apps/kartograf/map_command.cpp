@@ -105,6 +105,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<std::string> known_files = io::map_output_files();
   known_files.push_back("evaluation.png");
   OutputFolder folder("map", o.out_dir, o.force, known_files);
+  require_frame_tracking("map", o.run);
   const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   pipeline::MapPipelineParams params;

@@ -125,6 +125,13 @@ mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& opt
   return params;
 }
 
+void require_frame_tracking(std::string_view command, const SequenceRunOptions& options) {
+  require(options.tracking == "frame",
+          std::string(command) +
+              ": --tracking model is only in `kartograf odometry` for now "
+              "(docs/volumetric.md)");
+}
+
 compute::Context make_run_context(const SequenceRunOptions& options) {
   return backend_context(options.backend, options.backend_source);
 }

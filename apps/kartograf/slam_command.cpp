@@ -117,6 +117,7 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   OutputFolder folder("slam", o.out_dir, o.force,
                       {"trajectory.txt", "odometry.txt", "groundtruth.txt", "map.ply",
                        "top_view.png", "stats.json"});
+  require_frame_tracking("slam", o.run);
   const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   mapping::SlamParams params;
