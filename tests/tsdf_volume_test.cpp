@@ -3,11 +3,13 @@
 // ray casting against analytic surfaces.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <map>
 #include <set>
 #include <tuple>
+#include <vector>
 
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "real_data.hpp"
@@ -170,24 +172,28 @@ TEST_P(TsdfVolumeTest, RayCastSurfaceLiesOnTheScene) {
   const Eigen::Isometry3d view = pose_at(0.02, 0.01, 2);
   const PointImage points = volume.raycast(kCamera, depth_range(), view);
   const DepthImage truth = render(scene, view);
-  std::size_t hits = 0, surface = 0;
-  double sum = 0, worst = 0;
+  std::size_t surface = 0;
+  std::vector<double> errors;
   for (int v = 0; v < kCamera.height; ++v) {
     for (int u = 0; u < kCamera.width; ++u) {
       if (truth(u, v) == 0) continue;
       ++surface;
       const Point4f& p = points(u, v);
-      if (!is_valid(p)) continue;
-      ++hits;
-      const double error = scene.distance(view * p.head<3>().cast<double>());
-      sum += error;
-      worst = std::max(worst, error);
+      if (is_valid(p)) errors.push_back(scene.distance(view * p.head<3>().cast<double>()));
     }
   }
-  // Depth quantised to 1 mm, voxels of 1 cm: the surface within a few millimetres.
-  EXPECT_GE(hits, surface * 97 / 100) << hits << " of " << surface;
-  EXPECT_LT(sum / hits, 0.002);
-  EXPECT_LT(worst, 0.01);
+  const std::size_t hits = errors.size();
+  ASSERT_GE(hits, surface * 97 / 100) << hits << " of " << surface;
+  double sum = 0;
+  for (double e : errors) sum += e;
+  std::sort(errors.begin(), errors.end());
+  const double p99 = errors[hits * 99 / 100], worst = errors.back();
+  // Depth quantised to 1 mm, voxels of 1 cm: the surface within a millimetre on the whole. Rays
+  // that graze the sphere's outline meet the band behind its edge, up to about a voxel off.
+  EXPECT_LT(sum / hits, 0.001);
+  EXPECT_LT(p99, 0.005);
+  EXPECT_LT(worst, 0.015);
+  RecordProperty("p99_distance_m", testing::scientific(p99));
   RecordProperty("mean_distance_m", testing::scientific(sum / hits));
   RecordProperty("max_distance_m", testing::scientific(worst));
 }

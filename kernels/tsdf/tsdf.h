@@ -48,6 +48,8 @@ KG_PARAM(float, cy)
 KG_PARAM(float, voxel_size)
 KG_PARAM(float, truncation)
 KG_PARAM(float, max_weight)
+KG_PARAM(float, inverse_voxel)  // 1 / voxel_size and 1 / (8 voxel_size), rounded once on the host:
+KG_PARAM(float, inverse_block)  // a device's division may round otherwise
 KG_PARAM(float, r00)
 KG_PARAM(float, r01)
 KG_PARAM(float, r02)
@@ -134,7 +136,7 @@ KG_FORCE_INLINE void tsdf_touch_pixel(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_
   const float z = KG_FLOAT(d) * p.metres_per_unit;
   const float3 c = KG_FLOAT3((KG_FLOAT(x) - p.cx) / p.fx * z, (KG_FLOAT(y) - p.cy) / p.fy * z, z);
   const float3 w = tsdf_to_world(c, p);
-  const float inverse_block = 1.0f / (p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE));
+  const float inverse_block = p.inverse_block;
   const float3 lo = (w - KG_FLOAT3(p.truncation, p.truncation, p.truncation)) * inverse_block;
   const float3 hi = (w + KG_FLOAT3(p.truncation, p.truncation, p.truncation)) * inverse_block;
   if (!tsdf_axis_in_range(lo.x) || !tsdf_axis_in_range(lo.y) || !tsdf_axis_in_range(lo.z) ||
@@ -258,17 +260,25 @@ KG_INLINE TsdfVoxel tsdf_fuse(TsdfVoxel voxel, uint d, float z, uint color, Tsdf
 // ---- Ray casting: the shader declares keys, slot_blocks and voxels.
 #if !defined(VULKAN) || defined(KG_TSDF_READ_PASS)
 
-// The voxel (vx, vy, vz) (integral voxel coordinates); weight 0 where no block holds it.
-KG_INLINE TsdfVoxel tsdf_voxel_at(KG_BUFFER_PARAM(const uint64_t, keys)
-                                      KG_BUFFER_PARAM(const uint, slot_blocks)
-                                          KG_BUFFER_PARAM(const TsdfVoxel, voxels) int vx,
-                                  int vy, int vz, TsdfParams p) {
-  const uint64_t key = tsdf_block_key(vx >> 3, vy >> 3, vz >> 3);
+// A voxel's tsdf where no block holds it (weight 0 too): beyond any stored value.
+#define KG_TSDF_NO_BLOCK_VALUE 2.0f
+
+// The voxel (vx, vy, vz) (integral voxel coordinates); weight 0 and tsdf KG_TSDF_NO_BLOCK_VALUE
+// where no block holds it.
+// The pool index of the block with `key`, or KG_TSDF_NO_BLOCK.
+KG_INLINE uint tsdf_find_block(KG_BUFFER_PARAM(const uint64_t, keys)
+                                   KG_BUFFER_PARAM(const uint, slot_blocks) uint64_t key,
+                               TsdfParams p) {
   const int slot = voxel_find_key(KG_BUFFER_ARG(keys) key, p.capacity_log2);
-  const uint block = slot < 0 ? KG_TSDF_NO_BLOCK : slot_blocks[slot];
+  return slot < 0 ? KG_TSDF_NO_BLOCK : slot_blocks[slot];
+}
+
+// Voxel (vx, vy, vz) of pool block `block` (KG_TSDF_NO_BLOCK: the missing voxel).
+KG_INLINE TsdfVoxel tsdf_voxel_in(KG_BUFFER_PARAM(const TsdfVoxel, voxels) uint block, int vx,
+                                  int vy, int vz) {
   if (block == KG_TSDF_NO_BLOCK) {
     TsdfVoxel none;
-    none.tsdf = 1.0f;
+    none.tsdf = KG_TSDF_NO_BLOCK_VALUE;
     none.weight = 0.0f;
     none.color = 0u;
     return none;
@@ -276,9 +286,36 @@ KG_INLINE TsdfVoxel tsdf_voxel_at(KG_BUFFER_PARAM(const uint64_t, keys)
   return voxels[block * KG_TSDF_BLOCK_VOXELS + tsdf_local_index(vx, vy, vz)];
 }
 
+KG_INLINE TsdfVoxel tsdf_voxel_at(KG_BUFFER_PARAM(const uint64_t, keys)
+                                      KG_BUFFER_PARAM(const uint, slot_blocks)
+                                          KG_BUFFER_PARAM(const TsdfVoxel, voxels) int vx,
+                                  int vy, int vz, TsdfParams p) {
+  const uint block = tsdf_find_block(
+      KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) tsdf_block_key(vx >> 3, vy >> 3, vz >> 3), p);
+  return tsdf_voxel_in(KG_BUFFER_ARG(voxels) block, vx, vy, vz);
+}
+
+// The ray parameter (depth) where the ray origin + direction x t leaves the block holding w,
+// reached at parameter t; a hair beyond, so that the next sample lies in the next block.
+KG_INLINE float tsdf_block_exit(float3 w, float3 direction, float t, TsdfParams p) {
+  const float side = p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE);
+  float exit = 1e30f;
+  const float bx = floor(w.x * p.inverse_block), by = floor(w.y * p.inverse_block),
+              bz = floor(w.z * p.inverse_block);
+  if (direction.x != 0.0f)
+    exit = min(exit, ((direction.x > 0.0f ? bx + 1.0f : bx) * side - w.x) / direction.x);
+  if (direction.y != 0.0f)
+    exit = min(exit, ((direction.y > 0.0f ? by + 1.0f : by) * side - w.y) / direction.y);
+  if (direction.z != 0.0f)
+    exit = min(exit, ((direction.z > 0.0f ? bz + 1.0f : bz) * side - w.z) / direction.z);
+  // A step of at least a tenth of a voxel along the ray: never stuck on a block's face.
+  const float length = sqrt(dot(direction, direction));
+  return t + max(exit, 0.0f) + 0.1f * p.voxel_size / length;
+}
+
 // Whether world point w lies in the range of keys.
 KG_INLINE bool tsdf_point_in_range(float3 w, TsdfParams p) {
-  const float inverse_block = 1.0f / (p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE));
+  const float inverse_block = p.inverse_block;
   return tsdf_axis_in_range(w.x * inverse_block - 1.0f) &&
          tsdf_axis_in_range(w.y * inverse_block - 1.0f) &&
          tsdf_axis_in_range(w.z * inverse_block - 1.0f) &&
@@ -292,7 +329,7 @@ KG_INLINE TsdfVoxel tsdf_nearest(KG_BUFFER_PARAM(const uint64_t, keys)
                                      KG_BUFFER_PARAM(const uint, slot_blocks)
                                          KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 w,
                                  TsdfParams p) {
-  const float3 g = w * (1.0f / p.voxel_size);
+  const float3 g = w * p.inverse_voxel;
   return tsdf_voxel_at(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels)
                            KG_INT(floor(g.x)),
                        KG_INT(floor(g.y)), KG_INT(floor(g.z)), p);
@@ -304,7 +341,7 @@ KG_FORCE_INLINE float tsdf_trilinear(KG_BUFFER_PARAM(const uint64_t, keys)
                                          KG_BUFFER_PARAM(const uint, slot_blocks)
                                              KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 w,
                                      TsdfParams p) {
-  const float3 g = w * (1.0f / p.voxel_size) - KG_FLOAT3(0.5f, 0.5f, 0.5f);
+  const float3 g = w * p.inverse_voxel - KG_FLOAT3(0.5f, 0.5f, 0.5f);
   const float fx = floor(g.x), fy = floor(g.y), fz = floor(g.z);
   const float ax = g.x - fx, ay = g.y - fy, az = g.z - fz;
   const int x0 = KG_INT(fx), y0 = KG_INT(fy), z0 = KG_INT(fz);
@@ -356,11 +393,20 @@ KG_FORCE_INLINE float4 tsdf_cast_ray(KG_BUFFER_PARAM(const uint64_t, keys)
   float t = min_depth;
   float previous_t = t;
   float previous = KG_NAN;
+  // Consecutive samples mostly fall in one block: its lookup is kept.
+  uint64_t cached_key = KG_EMPTY_VOXEL_KEY;
+  uint cached_block = KG_TSDF_NO_BLOCK;
   for (uint i = 0u; i < p.step && t <= max_depth; ++i) {
     const float3 w = origin + direction * t;
     if (!tsdf_point_in_range(w, p)) break;
-    const TsdfVoxel v =
-        tsdf_nearest(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) w, p);
+    const float3 g = w * p.inverse_voxel;
+    const int vx = KG_INT(floor(g.x)), vy = KG_INT(floor(g.y)), vz = KG_INT(floor(g.z));
+    const uint64_t key = tsdf_block_key(vx >> 3, vy >> 3, vz >> 3);
+    if (key != cached_key) {
+      cached_block = tsdf_find_block(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) key, p);
+      cached_key = key;
+    }
+    const TsdfVoxel v = tsdf_voxel_in(KG_BUFFER_ARG(voxels) cached_block, vx, vy, vz);
     const bool known = v.weight > 0.0f;
     if (known && v.tsdf <= 0.0f) {
       if (kg_isnan(previous)) break;  // the back of a surface, or inside it from the start
@@ -371,10 +417,15 @@ KG_FORCE_INLINE float4 tsdf_cast_ray(KG_BUFFER_PARAM(const uint64_t, keys)
     }
     previous = known ? v.tsdf : KG_NAN;
     previous_t = t;
-    // Never past the surface the value promises is at least this far; a voxel at a time near it.
-    const float ahead =
-        known ? max(0.8f * v.tsdf * p.truncation, p.voxel_size) : 0.5f * p.truncation;
-    t += ahead / per_depth;
+    // Never past the surface the value promises is at least this far; a voxel at a time near it;
+    // out of a missing block at once (no surface lies in it).
+    if (v.tsdf == KG_TSDF_NO_BLOCK_VALUE) {
+      t = tsdf_block_exit(w, direction, t, p);
+    } else {
+      const float ahead =
+          known ? max(0.8f * v.tsdf * p.truncation, p.voxel_size) : 0.5f * p.truncation;
+      t += ahead / per_depth;
+    }
   }
   return KG_INVALID_POINT;
 }

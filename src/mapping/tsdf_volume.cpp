@@ -44,6 +44,8 @@ kernels::TsdfParams frame_params(const TsdfVolumeParams& volume, const PinholeIn
   p.voxel_size = static_cast<float>(volume.voxel_size);
   p.truncation = static_cast<float>(volume.truncation);
   p.max_weight = static_cast<float>(volume.max_weight);
+  p.inverse_voxel = static_cast<float>(1.0 / volume.voxel_size);
+  p.inverse_block = static_cast<float>(1.0 / (volume.voxel_size * kTsdfBlockSide));
   const Eigen::Matrix3f r = camera_to_world.linear().cast<float>();
   const Eigen::Vector3f t = camera_to_world.translation().cast<float>();
   p.r00 = r(0, 0), p.r01 = r(0, 1), p.r02 = r(0, 2);
