@@ -232,27 +232,34 @@ KG_INLINE TsdfVoxelView tsdf_voxel_view(KG_BUFFER_PARAM(const uint, active_block
 #endif
 
 // One channel's weighted mean, rounded to the nearest level.
-KG_INLINE uint tsdf_mean_channel(uint old_color, uint new_color, uint shift, float old_weight) {
+KG_INLINE uint tsdf_mean_channel(uint old_color, uint new_color, uint shift, float old_weight,
+                                 float share) {
   const float a = KG_FLOAT((old_color >> shift) & 0xffu);
   const float b = KG_FLOAT((new_color >> shift) & 0xffu);
-  const float mean = (a * old_weight + b) / (old_weight + 1.0f);
+  const float mean = (a * old_weight + b) * share;
   return min(KG_UINT(mean + 0.5f), 255u) << shift;
+}
+
+// Whether depth value d, seen at depth z of a voxel's centre, changes the voxel: a valid depth,
+// and the voxel not hidden behind the surface. The wrappers write only those voxels.
+KG_INLINE bool tsdf_fuses(uint d, float z, TsdfParams p) {
+  return tsdf_depth_valid(d, p) && KG_FLOAT(d) * p.metres_per_unit - z >= -p.truncation;
 }
 
 // The voxel after fusing depth value d (and colour) seen at depth z of the voxel's centre.
 KG_INLINE TsdfVoxel tsdf_fuse(TsdfVoxel voxel, uint d, float z, uint color, TsdfParams p) {
-  if (!tsdf_depth_valid(d, p)) return voxel;
+  if (!tsdf_fuses(d, z, p)) return voxel;
   const float distance = KG_FLOAT(d) * p.metres_per_unit - z;
-  if (distance < -p.truncation) return voxel;  // hidden behind the surface
   const float value = min(1.0f, distance / p.truncation);
+  const float share = 1.0f / (voxel.weight + 1.0f);  // the new measurement's share of the mean
   TsdfVoxel fused;
-  fused.tsdf = (voxel.tsdf * voxel.weight + value) / (voxel.weight + 1.0f);
+  fused.tsdf = (voxel.tsdf * voxel.weight + value) * share;
   fused.weight = min(voxel.weight + 1.0f, p.max_weight);
   fused.color = voxel.color;
   if (p.has_color != 0u) {
-    fused.color = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight) |
-                  tsdf_mean_channel(voxel.color, color, 8u, voxel.weight) |
-                  tsdf_mean_channel(voxel.color, color, 16u, voxel.weight);
+    fused.color = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight, share) |
+                  tsdf_mean_channel(voxel.color, color, 8u, voxel.weight, share) |
+                  tsdf_mean_channel(voxel.color, color, 16u, voxel.weight, share);
   }
   return fused;
 }

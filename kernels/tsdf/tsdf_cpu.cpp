@@ -47,7 +47,7 @@ void integrate(const CpuDispatch& call) {
   for_each_item(call, [&](uint i) {
     if (i >= params.count) return;
     const TsdfVoxelView view = tsdf_voxel_view(active_blocks, block_keys, i, params);
-    if (view.pixel < 0) return;
+    if (view.pixel < 0 || !tsdf_fuses(depth[view.pixel], view.z, params)) return;
     const uint color = params.has_color != 0u ? colors[view.pixel] : 0u;
     voxels[view.voxel] = tsdf_fuse(voxels[view.voxel], depth[view.pixel], view.z, color, params);
   });

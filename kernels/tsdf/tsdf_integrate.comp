@@ -22,6 +22,7 @@ void main() {
   if (view.pixel < 0) return;
   const uint index = uint(view.pixel);
   const uint d = (depth_pairs[index >> 1] >> ((index & 1u) * 16u)) & 0xffffu;
+  if (!tsdf_fuses(d, view.z, params)) return;
   const uint color = params.has_color != 0u ? colors[index] : 0u;
   voxels[view.voxel] = tsdf_fuse(voxels[view.voxel], d, view.z, color, params);
 }
