@@ -89,10 +89,10 @@ int run(const Options& o) {
   const PinholeIntrinsics camera{640, 480, 525.0, 525.0, 319.5, 239.5};
   const geometry::DepthRange range{5000.0, 0.3, 4.0};
   synth::NoiseModel noisy;
-  synth::NoiseModel exact_model;
-  exact_model.axial = exact_model.lateral = exact_model.quantization = false;
-  exact_model.grazing_dropout = exact_model.dark_dropout = exact_model.flying_pixels = false;
-  exact_model.color_noise = false;
+  // Exact depth over the sensor's range: the noise model's range without its noise.
+  synth::NoiseModel exact_model = synth::NoiseModel::none();
+  exact_model.min_range = noisy.min_range;
+  exact_model.max_range = noisy.max_range;
   compute::ContextParams context_params;
   context_params.backend = compute::parse_backend_choice(o.backend, "--backend");
   const compute::Context context(context_params);

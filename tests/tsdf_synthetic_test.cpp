@@ -24,10 +24,11 @@ struct Reconstruction {
   double completeness = 0;
 };
 
+// Exact depth over the sensor's range: the noise model's range without its noise.
 synth::NoiseModel exact_sensor() {
-  synth::NoiseModel n;
-  n.axial = n.lateral = n.quantization = false;
-  n.grazing_dropout = n.dark_dropout = n.flying_pixels = n.color_noise = false;
+  synth::NoiseModel n = synth::NoiseModel::none();
+  n.min_range = synth::NoiseModel{}.min_range;
+  n.max_range = synth::NoiseModel{}.max_range;
   return n;
 }
 

@@ -65,7 +65,8 @@ ModelTracker::ModelTracker(const compute::Context& context, const PinholeIntrins
       engine_(context, params.icp,
               std::make_unique<registration::DepthWeightedFinder>(
                   context, std::make_unique<registration::ProjectiveAssociation>(context),
-                  params.depth_weights)) {}
+                  params.depth_weights)),
+      frame_(context) {}
 
 std::string ModelTracker::rejection(const registration::IcpResult& result) const {
   // Not `converged`: on a ray-cast surface the finest level's updates often stay just above the
@@ -83,22 +84,14 @@ std::string ModelTracker::rejection(const registration::IcpResult& result) const
 
 ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* color,
                                       const Eigen::Isometry3d& predicted) {
-  if (depth_.width() != depth.width() || depth_.height() != depth.height()) {
-    depth_ = compute::DeviceImage<std::uint16_t>(*context_, depth.width(), depth.height());
-  }
-  depth_.upload(depth);
-  const bool with_color = color && !color->empty();
-  if (with_color) {
-    packed_.resize(color->pixels().size());
-    std::transform(color->pixels().begin(), color->pixels().end(), packed_.begin(), pack_rgb);
-    colors_.refer_or_upload(*context_, packed_);
-  }
+  static const RgbImage kNoColor;
+  frame_.upload(depth, color ? *color : kNoColor);
   ModelTrackingStep step;
   step.pose = predicted;
   if (empty_) {
     step.reason = "first frame";
   } else {
-    source_.build(projector_, depth_);
+    source_.build(projector_, frame_.depth());
     // Cast at ICP's first level only: the finer level would cost 4x and never be read.
     volume_.raycast(target_camera_, range_, predicted, target_.base_points());
     target_.build();
@@ -124,7 +117,7 @@ ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* c
     step.from_model = step.reason.empty();
     if (step.from_model) step.pose = predicted * result.source_to_target;
   }
-  volume_.integrate(depth_, with_color ? &colors_ : nullptr, camera_, range_, step.pose);
+  volume_.integrate(frame_.depth(), frame_.colors(), camera_, range_, step.pose);
   empty_ = false;
   return step;
 }

@@ -103,7 +103,7 @@ const TsdfVoxel* TsdfBlocks::voxel(const Eigen::Vector3i& v) const {
 }
 
 TsdfVolume::TsdfVolume(const compute::Context& context, const TsdfVolumeParams& params)
-    : context_(&context), params_(params) {
+    : context_(&context), params_(params), upload_(context) {
   params_.validate();
   capacity_log2_ = static_cast<unsigned>(std::bit_width(params_.max_blocks * 2 - 1));
   const std::size_t slots = std::size_t{1} << capacity_log2_;
@@ -182,18 +182,26 @@ TsdfIntegration TsdfVolume::integrate(const compute::DeviceImage<std::uint16_t>&
   return {active, block_count_};
 }
 
+void FrameUpload::upload(const DepthImage& depth, const RgbImage& color) {
+  require(color.empty() || (color.width() == depth.width() && color.height() == depth.height()),
+          "TSDF integration: the colour image's size differs from the depth image's");
+  if (depth_.width() != depth.width() || depth_.height() != depth.height()) {
+    depth_ = compute::DeviceImage<std::uint16_t>(*context_, depth.width(), depth.height());
+  }
+  depth_.upload(depth);
+  has_colors_ = !color.empty();
+  if (!has_colors_) return;
+  packed_.resize(color.pixels().size());
+  std::transform(color.pixels().begin(), color.pixels().end(), packed_.begin(), pack_rgb);
+  colors_.refer_or_upload(*context_, packed_);
+}
+
 TsdfIntegration TsdfVolume::integrate(const DepthImage& depth, const RgbImage& color,
                                       const PinholeIntrinsics& camera,
                                       const geometry::DepthRange& range,
                                       const Eigen::Isometry3d& camera_to_world) {
-  const auto device_depth = compute::DeviceImage<std::uint16_t>::from_host(*context_, depth);
-  if (color.empty()) return integrate(device_depth, nullptr, camera, range, camera_to_world);
-  require(color.width() == depth.width() && color.height() == depth.height(),
-          "TSDF integration: the colour image's size differs from the depth image's");
-  std::vector<std::uint32_t> packed(color.pixels().size());
-  std::transform(color.pixels().begin(), color.pixels().end(), packed.begin(), pack_rgb);
-  const auto device_colors = compute::Buffer<std::uint32_t>::from_host(*context_, packed);
-  return integrate(device_depth, &device_colors, camera, range, camera_to_world);
+  upload_.upload(depth, color);
+  return integrate(upload_.depth(), upload_.colors(), camera, range, camera_to_world);
 }
 
 void TsdfVolume::raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,

@@ -85,9 +85,7 @@ class ModelTracker {
   PinholeIntrinsics target_camera_;  // ICP's first level: where the model is ray cast
   registration::FramePyramid source_, target_;
   registration::IcpEngine engine_;
-  compute::DeviceImage<std::uint16_t> depth_;
-  compute::Buffer<std::uint32_t> colors_;
-  std::vector<std::uint32_t> packed_;
+  FrameUpload frame_;
   bool empty_ = true;
 };
 

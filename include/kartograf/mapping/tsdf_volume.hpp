@@ -80,6 +80,26 @@ struct TsdfIntegration {
   std::size_t total_blocks = 0;   // blocks in the volume after it
 };
 
+// A depth frame and its colours (packed 0xBBGGRR) on a context's device, in images and buffers
+// kept from frame to frame: uploading the next frame of the same size allocates nothing.
+class FrameUpload {
+ public:
+  explicit FrameUpload(const compute::Context& context) : context_(&context) {}
+
+  // color may be empty (no colour); else it must have the depth's size (Error otherwise).
+  void upload(const DepthImage& depth, const RgbImage& color);
+
+  const compute::DeviceImage<std::uint16_t>& depth() const { return depth_; }
+  const compute::Buffer<std::uint32_t>* colors() const { return has_colors_ ? &colors_ : nullptr; }
+
+ private:
+  const compute::Context* context_;
+  compute::DeviceImage<std::uint16_t> depth_;
+  compute::Buffer<std::uint32_t> colors_;
+  std::vector<std::uint32_t> packed_;  // host staging of the colours
+  bool has_colors_ = false;
+};
+
 class TsdfVolume {
  public:
   TsdfVolume(const compute::Context& context, const TsdfVolumeParams& params);
@@ -121,6 +141,7 @@ class TsdfVolume {
   compute::Buffer<std::uint32_t> active_;       // this frame's blocks
   compute::Buffer<std::uint32_t> status_;
   compute::Buffer<TsdfVoxel> voxels_;  // the pool: 512 per block
+  FrameUpload upload_;  // the host overload's frames
 };
 
 }  // namespace kartograf::mapping
