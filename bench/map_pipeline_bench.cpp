@@ -1,4 +1,4 @@
-// The whole `kartograf map` pipeline (pipeline/map_pipeline.hpp) on 300 frames of 640x480, on
+// The whole `kartograf map` pipeline (pipeline/mapper.hpp) on 300 frames of 640x480, on
 // every available backend (Google Benchmark, one iteration each: a run takes seconds).
 //   map_pipeline/<backend>/7scenes: ../shared/data/7scenes_redkitchen (300 frames, read from disk
 //       as the CLI reads them, prefetched on a second thread), stages as counters (seconds).
@@ -11,8 +11,8 @@
 
 #include "bench_support.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/pipeline/mapper.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
-#include "kartograf/pipeline/map_pipeline.hpp"
 
 namespace kartograf {
 namespace {

@@ -71,4 +71,15 @@ DepthImage depth_of(const PointImage& points, double units_per_metre) {
   return depth;
 }
 
+const RenderedSequence& out_and_back() {
+  static const RenderedSequence sequence = [] {
+    const Trajectory tour = synth::robot_tour(test_world(), 500);
+    std::vector<Eigen::Isometry3d> poses;
+    for (int i = 400; i < 430; ++i) poses.push_back(tour[static_cast<std::size_t>(i)].pose);
+    for (int i = 429; i >= 400; --i) poses.push_back(tour[static_cast<std::size_t>(i)].pose);
+    return render_sequence(poses, qvga_kinect());
+  }();
+  return sequence;
+}
+
 }  // namespace kartograf::testing

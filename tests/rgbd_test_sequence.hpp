@@ -39,6 +39,11 @@ RenderedSequence render_sequence(const synth::World& world,
                                  const std::vector<Eigen::Isometry3d>& poses,
                                  const PinholeIntrinsics& camera, bool noise = true);
 
+// 30 frames (1.3 m) of the 500-frame robot tour along a furnished room, then back the same way
+// (as a robot reversing): the return trip sees again what the way out saw, so SLAM closes loops.
+// Rendered once.
+const RenderedSequence& out_and_back();
+
 // The pipeline's view of a rendered sequence.
 class MemoryFrameSource final : public mapping::FrameSource {
  public:

@@ -17,19 +17,6 @@ namespace {
 
 constexpr int kFrames = 60;
 
-// 30 frames (1.3 m) of the 500-frame robot tour along a furnished room, then back the same way
-// (as a robot reversing): the return trip sees again what the way out saw.
-const testing::RenderedSequence& out_and_back() {
-  static const testing::RenderedSequence sequence = [] {
-    const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
-    std::vector<Eigen::Isometry3d> poses;
-    for (int i = 400; i < 430; ++i) poses.push_back(tour[static_cast<std::size_t>(i)].pose);
-    for (int i = 429; i >= 400; --i) poses.push_back(tour[static_cast<std::size_t>(i)].pose);
-    return testing::render_sequence(poses, testing::qvga_kinect());
-  }();
-  return sequence;
-}
-
 mapping::SlamParams loop_params() {
   mapping::SlamParams params;
   params.loops.min_frame_gap = 20;
@@ -38,7 +25,7 @@ mapping::SlamParams loop_params() {
 }
 
 TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
-  const testing::MemoryFrameSource source(out_and_back());
+  const testing::MemoryFrameSource source(testing::out_and_back());
   const compute::Context context = compute::Context::cpu();
   std::size_t tracked = 0, verified = 0, odometry_progress = 0, map_progress = 0;
   mapping::SlamObserver observer;
@@ -71,8 +58,9 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
   EXPECT_GE(result.graph_edges, static_cast<std::size_t>(kFrames - 1) + kept);
   EXPECT_TRUE(result.final_graph.converged);
 
-  const double odometry_ate = testing::ate_rmse(result.odometry.poses, out_and_back().truth);
-  const double slam_ate = testing::ate_rmse(result.poses, out_and_back().truth);
+  const double odometry_ate =
+      testing::ate_rmse(result.odometry.poses, testing::out_and_back().truth);
+  const double slam_ate = testing::ate_rmse(result.poses, testing::out_and_back().truth);
   RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
   RecordProperty("slam_ate_m", testing::scientific(slam_ate));
   EXPECT_LT(slam_ate, 0.01);
@@ -93,13 +81,14 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
 // With the paper's re-estimation (against frame n-5) the odometry drifts more, and the loops
 // closing the way back onto the way out take at least 40 % of it out (measured: 4.1 -> 2.0 mm).
 TEST(Slam, LoopClosuresTakeOutTheOdometrysDrift) {
-  const testing::MemoryFrameSource source(out_and_back());
+  const testing::MemoryFrameSource source(testing::out_and_back());
   const compute::Context context = compute::Context::cpu();
   mapping::SlamParams params = loop_params();
   params.odometry.anchor = {0, 0, 0};
   const mapping::SlamResult result = mapping::run_slam(context, source, params);
-  const double odometry_ate = testing::ate_rmse(result.odometry.poses, out_and_back().truth);
-  const double slam_ate = testing::ate_rmse(result.poses, out_and_back().truth);
+  const double odometry_ate =
+      testing::ate_rmse(result.odometry.poses, testing::out_and_back().truth);
+  const double slam_ate = testing::ate_rmse(result.poses, testing::out_and_back().truth);
   RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
   RecordProperty("slam_ate_m", testing::scientific(slam_ate));
   EXPECT_LT(slam_ate, 0.6 * odometry_ate);
@@ -108,7 +97,7 @@ TEST(Slam, LoopClosuresTakeOutTheOdometrysDrift) {
 // Known poses (the frames' ground truth): nothing estimated, the poses are the truth relative to
 // the first frame, the map is fused; a pose that is not a rotation is an error naming its frame.
 TEST(Slam, KnownPosesFuseTheMapWithoutEstimating) {
-  const testing::MemoryFrameSource source(out_and_back());
+  const testing::MemoryFrameSource source(testing::out_and_back());
   const compute::Context context = compute::Context::cpu();
   const auto truth = [](std::size_t, const registration::RgbdImages& images) {
     require(images.ground_truth.has_value(), "no ground truth");
@@ -118,7 +107,7 @@ TEST(Slam, KnownPosesFuseTheMapWithoutEstimating) {
       mapping::run_with_known_poses(context, source, truth, loop_params());
   EXPECT_TRUE(result.poses_given);
   ASSERT_EQ(result.poses.size(), static_cast<std::size_t>(kFrames));
-  const std::vector<Eigen::Isometry3d>& expected = out_and_back().truth;
+  const std::vector<Eigen::Isometry3d>& expected = testing::out_and_back().truth;
   for (std::size_t i = 0; i < result.poses.size(); ++i) {
     const Eigen::Isometry3d relative = expected[0].inverse() * expected[i];
     EXPECT_LT((result.poses[i].matrix() - relative.matrix()).cwiseAbs().maxCoeff(), 1e-9) << i;
@@ -155,7 +144,7 @@ class BrokenSource final : public mapping::FrameSource {
 };
 
 TEST(Slam, PassesFrameErrorsToTheCaller) {
-  const BrokenSource source(out_and_back());
+  const BrokenSource source(testing::out_and_back());
   const compute::Context context = compute::Context::cpu();
   try {
     mapping::run_slam(context, source, loop_params());
@@ -167,7 +156,7 @@ TEST(Slam, PassesFrameErrorsToTheCaller) {
 }
 
 TEST(Slam, OdometryRunReportsTimingAndEveryFrame) {
-  testing::RenderedSequence sequence = out_and_back();
+  testing::RenderedSequence sequence = testing::out_and_back();
   sequence.frames.resize(12);
   const testing::MemoryFrameSource source(sequence);
   const compute::Context context = compute::Context::cpu();

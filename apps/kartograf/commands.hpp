@@ -192,7 +192,9 @@ struct MapOptions {
   double resolution = 0.05;
   std::string room_method = "distance";
   bool no_features = false;
-  std::string poses;  // "groundtruth", a TUM trajectory file, or empty: estimate them
+  std::string poses;    // "groundtruth", a TUM trajectory file, or empty: estimate them
+  double voxel = 0.04;  // the TSDF's (pipeline/mapper.hpp)
+  std::size_t max_blocks = 1u << 14;  // the TSDF's budget
   bool force = false;
 };
 CLI::App* add_map_command(CLI::App& app, MapOptions& options);

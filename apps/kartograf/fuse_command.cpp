@@ -20,6 +20,7 @@
 #include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "kartograf/outputs/fuse_summary.hpp"
+#include "kartograf/outputs/map_outputs.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
 
@@ -62,8 +63,7 @@ CLI::App* add_fuse_command(CLI::App& app, FuseOptions& o) {
 
 namespace {
 
-// The height band's occupancy (ROS map_server files) and its ESDF as grey levels: 0 at obstacles
-// and inside them, 255 at 2 m or more.
+// The height band's occupancy (ROS map_server files) and its ESDF as grey levels.
 void write_band_maps(const std::filesystem::path& dir, const mapping::TsdfBlocks& blocks,
                      double floor_z) {
   mapping::TsdfSliceParams params;
@@ -71,13 +71,7 @@ void write_band_maps(const std::filesystem::path& dir, const mapping::TsdfBlocks
   const OccupancyGrid grid = mapping::tsdf_occupancy(blocks, params);
   require(grid.width() > 0, "fuse --floor-z: the volume holds no surface to map");
   io::write_ros_map(dir / "occupancy.yaml", grid);
-  const Image<float> esdf = mapping::occupancy_esdf(grid);
-  GrayImage grey(esdf.width(), esdf.height());
-  for (std::size_t i = 0; i < esdf.pixels().size(); ++i) {
-    const float metres = std::clamp(esdf.pixels()[i], 0.0f, 2.0f);
-    grey.pixels()[i] = static_cast<std::uint8_t>(std::lround(metres / 2.0f * 255.0f));
-  }
-  io::write_png(dir / "esdf.png", grey);
+  io::write_png(dir / "esdf.png", io::esdf_picture(mapping::occupancy_esdf(grid)));
 }
 
 }  // namespace

@@ -20,7 +20,7 @@
 #include "kartograf/outputs/map_run_info.hpp"
 #include "kartograf/outputs/synthetic_dataset.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
-#include "kartograf/pipeline/map_pipeline.hpp"
+#include "kartograf/pipeline/mapper.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
@@ -97,6 +97,15 @@ CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
   command->add_option("--poses", o.poses,
                       "Known camera poses instead of SLAM: 'groundtruth' (the sequence's own) or "
                       "a TUM trajectory file (matched by timestamp within 20 ms)");
+  command->add_option("--voxel", o.voxel, "TSDF voxel size [m] (truncation: 3 voxels)")
+      ->check(finite_in(0.005, 0.2))
+      ->capture_default_str();
+  command
+      ->add_option("--max-blocks", o.max_blocks,
+                   "TSDF budget in blocks of 8^3 voxels (6 KiB each); past 85 %, blocks far from "
+                   "the camera are evicted")
+      ->check(CLI::Range(std::size_t{64}, std::size_t{1} << 23))
+      ->capture_default_str();
   command->add_flag("--force", o.force, "Overwrite the files of an earlier run");
   return command;
 }
@@ -108,14 +117,18 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   require_frame_tracking("map", o.run);
   const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
-  pipeline::MapPipelineParams params;
-  params.slam.odometry = odometry_params(o.run);
-  params.label_step = o.label_step;
-  params.features = !o.no_features && o.poses.empty();
-  params.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps);
-  params.label_width = o.label_width;
-  params.grid.resolution = o.resolution;
-  params.room_method = rooms::parse_room_method(o.room_method);
+  pipeline::MapperParams params;
+  pipeline::MapPipelineParams& stages = params.pipeline;
+  stages.slam.odometry = odometry_params(o.run);
+  stages.label_step = o.label_step;
+  stages.features = !o.no_features && o.poses.empty();
+  stages.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps);
+  stages.label_width = o.label_width;
+  stages.grid.resolution = o.resolution;
+  stages.room_method = rooms::parse_room_method(o.room_method);
+  params.volume.voxel_size = o.voxel;
+  params.volume.truncation = 3 * o.voxel;
+  params.volume.max_blocks = o.max_blocks;
 
   ProgressBar bar(err, o.run.progress);
   pipeline::MapPipelineObserver observer;
@@ -123,7 +136,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   int stage_number = 0;
   observer.on_stage = [&](std::string_view stage) {
     bar.finish();
-    if (o.run.progress) err << "map: stage " << ++stage_number << "/5: " << stage << "\n";
+    if (o.run.progress) err << "map: stage " << ++stage_number << "/6: " << stage << "\n";
   };
   const pipeline::MapPipelineResult result =
       pipeline::run_map_pipeline(context, *run.source, params, observer);

@@ -17,4 +17,11 @@ Eigen::Isometry3d orthonormalized_pose(const Eigen::Matrix4d& matrix) {
   return pose;
 }
 
+bool is_rigid(const Eigen::Isometry3d& pose, double tolerance) {
+  const Eigen::Matrix3d r = pose.linear();
+  return pose.matrix().allFinite() &&
+         (r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff() < tolerance &&
+         r.determinant() > 0;
+}
+
 }  // namespace kartograf

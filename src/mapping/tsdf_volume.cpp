@@ -10,6 +10,7 @@
 
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/memory_budget.hpp"
+#include "kartograf/core/pose.hpp"
 #include "kernels/tsdf/tsdf.h"
 
 namespace kartograf::mapping {
@@ -56,10 +57,7 @@ kernels::TsdfParams frame_params(const TsdfVolumeParams& volume, const PinholeIn
 }
 
 void require_rigid(const Eigen::Isometry3d& pose, const char* what) {
-  const Eigen::Matrix3d r = pose.linear();
-  require(pose.matrix().allFinite() &&
-              (r.transpose() * r - Eigen::Matrix3d::Identity()).norm() < 1e-4 &&
-              r.determinant() > 0,
+  require(is_rigid(pose, 1e-4),
           std::string("TSDF volume: the ") + what + " pose is not a finite rigid motion");
 }
 

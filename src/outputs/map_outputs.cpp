@@ -1,5 +1,6 @@
 #include "kartograf/outputs/map_outputs.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <map>
@@ -154,6 +155,19 @@ Json report_json(const pipeline::MapPipelineResult& r,
                   {"loop_closures_pruned", pruned},
                   {"pose_graph_converged", r.slam.final_graph.converged},
                   {"map_points", r.map.size()}};
+  const pipeline::VolumeStats& v = r.volume;
+  json["volume"] = {{"blocks", v.blocks},
+                    {"peak_blocks", v.peak_blocks},
+                    {"budget_blocks", v.budget_blocks},
+                    {"evictions", v.evictions},
+                    {"refusions", v.refusions},
+                    {"fused_frames", v.fused_frames},
+                    {"fusion_s", v.fusion_seconds},
+                    {"covers_all_frames", v.covers_all_frames},
+                    {"frame_store_memory_bytes", v.store_memory_bytes},
+                    {"frame_store_disk_bytes", v.store_disk_bytes},
+                    {"mesh_vertices", r.mesh.vertices.size()},
+                    {"mesh_triangles", r.mesh.triangles.size()}};
   json["views"] = {{"labelled", r.labelled_views},
                    {"unlabelled", r.unlabelled_views},
                    {"first_unlabelled_reason", r.first_unlabelled_reason}};
@@ -205,11 +219,22 @@ std::vector<Eigen::Vector3d> true_path(const std::optional<pipeline::MapEvaluati
 
 }  // namespace
 
+GrayImage esdf_picture(const Image<float>& esdf) {
+  GrayImage grey(esdf.width(), esdf.height());
+  for (std::size_t i = 0; i < esdf.pixels().size(); ++i) {
+    const float metres = std::clamp(esdf.pixels()[i], 0.0f, 2.0f);
+    grey.pixels()[i] = static_cast<std::uint8_t>(std::lround(metres / 2.0f * 255.0f));
+  }
+  return grey;
+}
+
 const std::vector<std::string>& map_output_files() {
   static const std::vector<std::string> files = {
-      "trajectory.txt", "map.ply",      "planes.json",      "occupancy.yaml", "occupancy.pgm",
-      "occupancy.png",  "rooms.png",    "rooms_labels.png", "rooms.json",     "semantic.png",
-      "semantic.json",  "top_view.png", "report.json",      "report.html"};
+      "trajectory.txt",     "map.ply",       "mesh.ply",      "planes.json",
+      "occupancy.yaml",     "occupancy.pgm", "occupancy.png", "band_occupancy.yaml",
+      "band_occupancy.pgm", "esdf.png",      "rooms.png",     "rooms_labels.png",
+      "rooms.json",         "semantic.png",  "semantic.json", "top_view.png",
+      "report.json",        "report.html"};
   return files;
 }
 
@@ -233,10 +258,16 @@ void write_map_outputs(const fs::path& dir, const pipeline::MapPipelineResult& r
   const bool scored = evaluation && !evaluation->true_classes.empty();
   const std::string html = detail::map_report_html({report, result, evaluation, scored});
   const RgbImage scored_picture = scored ? evaluation_picture(*evaluation) : RgbImage();
+  const GrayImage esdf = esdf_picture(result.esdf);
 
   fs::create_directories(dir);
   write_tum_trajectory(dir / "trajectory.txt", trajectory);
   write_ply(dir / "map.ply", result.map);
+  write_mesh_ply(dir / "mesh.ply", result.mesh);
+  if (result.band_occupancy.width() > 0) {
+    write_ros_map(dir / "band_occupancy.yaml", result.band_occupancy);
+    write_png(dir / "esdf.png", esdf);
+  }
   write_text(dir / "planes.json", planes);
   write_ros_map(dir / "occupancy.yaml", result.occupancy);
   write_png(dir / "occupancy.png", occupancy);

@@ -9,13 +9,16 @@ namespace kartograf::io {
 namespace {
 
 // The parameters a run can change (options of `kartograf map`), a JSON object.
-detail::RunJson parameters_json(const std::string& method, const pipeline::MapPipelineParams& p) {
+detail::RunJson parameters_json(const std::string& method, const pipeline::MapperParams& mapper) {
+  const pipeline::MapPipelineParams& p = mapper.pipeline;
   return {{"method", method},
           {"reestimate_interval", p.slam.odometry.reestimate_interval},
           {"label_step", p.label_step},
           {"label_width", p.label_width},
           {"grid_resolution_m", p.grid.resolution},
-          {"map_voxel_m", p.slam.map.voxel_size},
+          {"tsdf_voxel_m", mapper.volume.voxel_size},
+          {"tsdf_truncation_m", mapper.volume.truncation},
+          {"tsdf_budget_blocks", mapper.volume.max_blocks},
           {"room_method", rooms::to_string(p.room_method)},
           {"rooms_end_at_doorways", p.rooms_end_at_doorways},
           {"rooms_take_enclosed", p.rooms_take_enclosed},
@@ -25,7 +28,7 @@ detail::RunJson parameters_json(const std::string& method, const pipeline::MapPi
 }  // namespace
 
 MapRunInfo map_run_info(const SequenceRunRecord& record, const OpenedSequence& opened,
-                        const pipeline::MapPipelineParams& params) {
+                        const pipeline::MapperParams& params) {
   MapRunInfo info;
   info.sequence = record.sequence;
   info.layout = std::string(to_string(opened.detected.layout));

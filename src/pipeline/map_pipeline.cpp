@@ -8,6 +8,7 @@
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/backproject.hpp"
+#include "kartograf/mapping/frame_store.hpp"
 #include "kartograf/pipeline/labelled_view_pool.hpp"
 #include "kartograf/semantic/labelled_views.hpp"
 
@@ -19,21 +20,6 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_since(Clock::time_point start) {
   return std::chrono::duration<double>(Clock::now() - start).count();
-}
-
-// Every factor-th pixel of every factor-th row: a smaller camera with the same rays.
-template <typename Pixel>
-Image<Pixel> decimate(const Image<Pixel>& image, int factor) {
-  if (factor == 1 || image.empty()) return image;
-  Image<Pixel> out(image.width() / factor, image.height() / factor);
-  for (int y = 0; y < out.height(); ++y)
-    for (int x = 0; x < out.width(); ++x) out(x, y) = image(x * factor, y * factor);
-  return out;
-}
-
-PinholeIntrinsics decimate(const PinholeIntrinsics& k, int factor) {
-  return {k.width / factor, k.height / factor, k.fx / factor,
-          k.fy / factor,    k.cx / factor,     k.cy / factor};
 }
 
 // A grey image where the source has no colour: region growing then splits by geometry alone.
@@ -52,14 +38,6 @@ std::optional<double> median_height(const semantic::LabelledViews& views, Semant
   const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
   std::nth_element(heights.begin(), middle, heights.end());
   return *middle;
-}
-
-PointCloud transformed(const PointCloud& cloud, const Eigen::Isometry3d& transform) {
-  PointCloud out = cloud;
-  const Eigen::Isometry3f t = transform.cast<float>();
-  for (Eigen::Vector3f& p : out.points) p = t * p;
-  for (Eigen::Vector3f& n : out.normals) n = t.linear() * n;
-  return out;
 }
 
 // Stage bookkeeping: announces a stage, and records its time when the next one starts.
@@ -178,14 +156,15 @@ struct ViewLabeller {
              semantic::LabelledViews& views, mapping::PlaneMap& plane_map, std::string* failure) {
     const registration::RgbdImages frame = source.frame(i);
     const PointImage points =
-        geometry::backproject(context, decimate(frame.depth, factor), camera, range);
+        geometry::backproject(context, mapping::decimate(frame.depth, factor), camera, range);
     const std::string frame_name = "frame " + std::to_string(i) + ": ";
     const std::optional<semantic::SemanticLabelling> labelling =
         label_and_pool_view(context, points, pose, params, views, frame_name, failure);
     if (!labelling) return false;
     try {
-      plane_map.add_view(extractor.extract(points, decimate(colour_or_grey(frame), factor)), points,
-                         labelling->semantic, pose);
+      plane_map.add_view(
+          extractor.extract(points, mapping::decimate(colour_or_grey(frame), factor)), points,
+          labelling->semantic, pose);
     } catch (const Error& e) {
       views.skip(frame_name + e.what());  // a pooled view whose planes failed: skipped as well
     }
@@ -201,10 +180,10 @@ void label_views(const compute::Context& context, const mapping::FrameSource& so
                  semantic::LabelledViews& views, mapping::PlaneMap& plane_map,
                  const MapPipelineObserver& observer) {
   const PinholeIntrinsics camera = source.camera();
-  const int factor = std::max(1, (camera.width + params.label_width - 1) / params.label_width);
+  const int factor = mapping::decimation_for_width(camera, params.label_width);
   geometry::DepthRange range;
   range.units_per_metre = source.depth_units_per_metre();
-  const PinholeIntrinsics view_camera = decimate(camera, factor);
+  const PinholeIntrinsics view_camera = mapping::decimate(camera, factor);
   ViewLabeller labeller{context, source,
                         factor,  view_camera,
                         range,   segmentation::PlaneExtractor(context, view_camera, params.planes)};
@@ -262,32 +241,14 @@ double MapPipelineResult::total_seconds() const {
                          [](double sum, const StageTiming& t) { return sum + t.seconds; });
 }
 
-MapPipelineResult run_map_pipeline(const compute::Context& context,
-                                   const mapping::FrameSource& source,
-                                   const MapPipelineParams& params,
-                                   const MapPipelineObserver& observer) {
-  params.validate();
-  require(source.size() > 0, "map: the sequence holds no frame");
-  MapPipelineResult result;
+void complete_map(const compute::Context& context, const mapping::FrameSource& views_source,
+                  const MapPipelineParams& params, const MapPipelineObserver& observer,
+                  MapPipelineResult& result) {
   StageClock clock(observer, result.timings);
-
-  clock.start("slam");
-  mapping::SlamParams slam_params = params.slam;
-  slam_params.build_map = true;
-  if (params.features) {
-    const auto features = std::make_shared<const features::OrbFrontEnd>(params.orb);
-    slam_params.features = features;
-    slam_params.odometry.features = features;
-  }
-  result.slam = params.known_poses
-                    ? mapping::run_with_known_poses(context, source, params.known_poses,
-                                                    slam_params, observer.slam)
-                    : mapping::run_slam(context, source, slam_params, observer.slam);
-
   clock.start("views");
   semantic::LabelledViews views;
   mapping::PlaneMap plane_map(params.plane_map);
-  label_views(context, source, params, result.slam.poses, views, plane_map, observer);
+  label_views(context, views_source, params, result.slam.poses, views, plane_map, observer);
   result.labelled_views = views.views();
   result.unlabelled_views = views.skipped();
   result.first_unlabelled_reason = views.first_skip_reason();
@@ -305,7 +266,6 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   views.transform(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -*floor_height)));
   for (const Eigen::Isometry3d& pose : result.slam.poses)
     result.poses.push_back(map_from_slam * pose);
-  result.map = transformed(result.slam.map, map_from_slam);
   result.planes = plane_map.planes(map_from_slam);
 
   clock.start("grid");
@@ -316,7 +276,6 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
   clock.start("rooms");
   segment_rooms(context, params, result);
   clock.stop();
-  return result;
 }
 
 }  // namespace kartograf::pipeline

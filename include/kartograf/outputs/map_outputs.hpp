@@ -2,8 +2,11 @@
 // The files of a map pipeline run (pipeline/map_pipeline.hpp), all in one folder and one map
 // frame (z up, floor at z = 0):
 //   trajectory.txt          camera-to-map poses (TUM)
-//   map.ply                 the fused coloured map
-//   planes.json             the map's planes with their classes
+//   map.ply                 the map's points: the mesh's vertices with colours and normals
+//   mesh.ply                The TSDF's surface, coloured (pipeline/mapper.hpp)
+//   band_occupancy.yaml/.pgm  the TSDF's height band as a ROS occupancy grid
+//   (mapping/tsdf_slice.hpp) esdf.png                its distance field as grey levels
+//   (esdf_picture), same cells planes.json             the map's planes with their classes
 //   occupancy.yaml/.pgm     ROS map_server occupancy grid; occupancy.png the same for browsers
 //   rooms.png, rooms.json   the rooms in colour over the grid, and their records (rooms_labels.png:
 //                           16-bit room ids)
@@ -19,6 +22,7 @@
 #include <string>
 #include <vector>
 
+#include "kartograf/core/image.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
 
@@ -34,6 +38,9 @@ struct MapRunInfo {
   // (preset, file, option, default), the depth scale and the frames left out; or empty.
   std::string input_json;
 };
+
+// A distance field (metres) as grey levels: 0 at obstacles and inside them, 255 at 2 m or more.
+GrayImage esdf_picture(const Image<float>& esdf);
 
 // The names written by write_map_outputs, in order.
 const std::vector<std::string>& map_output_files();

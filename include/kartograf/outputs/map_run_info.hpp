@@ -4,11 +4,11 @@
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/outputs/map_outputs.hpp"
 #include "kartograf/outputs/odometry_stats.hpp"
-#include "kartograf/pipeline/map_pipeline.hpp"
+#include "kartograf/pipeline/mapper.hpp"
 
 namespace kartograf::io {
 
 MapRunInfo map_run_info(const SequenceRunRecord& record, const OpenedSequence& opened,
-                        const pipeline::MapPipelineParams& params);
+                        const pipeline::MapperParams& params);
 
 }  // namespace kartograf::io

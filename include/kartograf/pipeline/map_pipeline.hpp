@@ -29,6 +29,7 @@
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/occupancy_grid.hpp"
 #include "kartograf/core/point_cloud.hpp"
+#include "kartograf/core/triangle_mesh.hpp"
 #include "kartograf/features/orb_front_end.hpp"
 #include "kartograf/mapping/frame_source.hpp"
 #include "kartograf/mapping/plane_map.hpp"
@@ -84,11 +85,29 @@ struct StageTiming {
   double seconds = 0;
 };
 
+// What the TSDF of the online mapper (mapper.hpp) did.
+struct VolumeStats {
+  std::size_t blocks = 0;       // in the live volume now
+  std::size_t peak_blocks = 0;  // the most it held
+  std::size_t budget_blocks = 0;
+  std::size_t evictions = 0;  // rebuilds around the camera (the budget was reached)
+  std::size_t refusions = 0;  // rebuilds at moved poses
+  std::size_t fused_frames = 0;
+  double fusion_seconds = 0;           // integration and rebuilds
+  bool covers_all_frames = true;       // false after an eviction: the volume holds the nearby part
+  std::size_t store_memory_bytes = 0;  // the kept frames in memory (up to 64 MiB)
+  std::size_t store_disk_bytes = 0;    // and in a temporary file
+};
+
 struct MapPipelineResult {
   mapping::SlamResult slam;  // in the SLAM frame (the first camera's)
   Eigen::Isometry3d map_from_slam = Eigen::Isometry3d::Identity();
-  std::vector<Eigen::Isometry3d> poses;   // camera-to-map, one per frame
-  PointCloud map;                         // the fused map in the map frame
+  std::vector<Eigen::Isometry3d> poses;  // camera-to-map, one per frame
+  PointCloud map;                        // the map in the map frame: the mesh's vertices
+  TriangleMesh mesh;                     // the TSDF's surface, map frame
+  OccupancyGrid band_occupancy;          // the TSDF's height band (mapping/tsdf_slice.hpp)
+  Image<float> esdf;                     // metres, of band_occupancy (mapping::occupancy_esdf)
+  VolumeStats volume;
   std::vector<mapping::MapPlane> planes;  // map frame
   semantic::SemanticGrid semantic;
   OccupancyGrid occupancy;               // the grid's free / occupied / unknown cells
@@ -105,11 +124,11 @@ struct MapPipelineObserver {
   std::function<void(std::string_view stage)> on_stage;  // when a stage starts
 };
 
-// Throws Error when a stage cannot go on (no frame, bad parameters, no view could be labelled,
-// no floor seen, ...), naming the stage.
-MapPipelineResult run_map_pipeline(const compute::Context& context,
-                                   const mapping::FrameSource& source,
-                                   const MapPipelineParams& params = {},
-                                   const MapPipelineObserver& observer = {});
+// Stages 2-5 on result.slam's poses (filled by the caller, with result.timings' "slam"), the views
+// read from `views` (frame(i) for every label_step-th i, any width: decimated to label_width).
+// Fills the rest of the result but map, mesh, band_occupancy, esdf and volume.
+void complete_map(const compute::Context& context, const mapping::FrameSource& views,
+                  const MapPipelineParams& params, const MapPipelineObserver& observer,
+                  MapPipelineResult& result);
 
 }  // namespace kartograf::pipeline

@@ -1,4 +1,4 @@
-// report.html's 3-D view: the map's points and the camera paths (three.js), turned with the
+// report.html's 3-D view: the map's mesh (or points) and the camera paths (three.js), turned with the
 // mouse (three.js' OrbitControls). The data come from <script id="map-3d-data"> (map z up, metres);
 // when the view is drawn, <html data-scene> says "ok ..." (a test reads it).
 "use strict";
@@ -51,6 +51,19 @@
     return new THREE.Points(geometry, material);
   }
 
+  // The TSDF's surface: vertex colours, lit from above so that its shape shows.
+  function surface(ceiling) {
+    const geometry = new THREE.BufferGeometry();
+    const xyz = positions();
+    geometry.setAttribute("position", new THREE.BufferAttribute(xyz, 3));
+    geometry.setAttribute("color", colours(xyz));
+    geometry.setIndex(new THREE.BufferAttribute(new Uint32Array(bytes(data.triangles).buffer), 1));
+    geometry.computeVertexNormals();
+    const material = new THREE.MeshLambertMaterial({
+      vertexColors: THREE.VertexColors, side: THREE.DoubleSide, clippingPlanes: [ceiling]});
+    return new THREE.Mesh(geometry, material);
+  }
+
   // Looks at the map's middle from `direction` (map frame), far enough to see all of it.
   function viewFrom(camera, controls, direction) {
     const low = new THREE.Vector3().fromArray(data.min);
@@ -72,7 +85,15 @@
     renderer.localClippingEnabled = true;
     const scene = new THREE.Scene();
     const ceiling = new THREE.Plane(new THREE.Vector3(0, 0, -1), data.ceiling_z);  // keeps z below
-    scene.add(pointCloud(ceiling));
+    if (data.triangles) {
+      scene.add(surface(ceiling));
+      scene.add(new THREE.AmbientLight(0xffffff, 0.55));
+      const light = new THREE.DirectionalLight(0xffffff, 0.6);
+      light.position.set(0.3, -0.5, 1);
+      scene.add(light);
+    } else {
+      scene.add(pointCloud(ceiling));
+    }
     if (data.truth.length > 0) scene.add(path(data.truth, 0xffc800));
     scene.add(path(data.estimated, 0xff3b30));
     const reach = Math.ceil(Math.max(Math.abs(data.min[0]), Math.abs(data.max[0]),
@@ -104,8 +125,8 @@
     });
     viewFrom(camera, controls, views.oblique);
     resize();
-    root.setAttribute("data-scene", "ok " + data.count + " points, " +
-                      data.estimated.length / 3 + " poses");
+    const drawn = data.triangles ? data.triangle_count + " triangles, " : data.count + " points, ";
+    root.setAttribute("data-scene", "ok " + drawn + data.estimated.length / 3 + " poses");
   }
 
   try {

@@ -1,0 +1,183 @@
+// The online mapper (pipeline/mapper.hpp) on rendered sequences: frame by frame it gives the batch
+// SLAM's poses, its TSDF stays inside its block budget by evicting what is far from the camera,
+// its mesh lies on the true surfaces, and misuse is an Error. Plus the frame store it keeps frames
+// in (mapping/frame_store.hpp).
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "kartograf/core/error.hpp"
+#include "kartograf/mapping/frame_store.hpp"
+#include "kartograf/mapping/slam.hpp"
+#include "kartograf/pipeline/mapper.hpp"
+#include "kartograf/synth/trajectory.hpp"
+#include "rgbd_test_sequence.hpp"
+#include "test_support_core.hpp"
+
+namespace kartograf {
+namespace {
+
+// Every 4th frame of the first 400 of the survey, without noise: it crosses several rooms.
+const testing::RenderedSequence& survey_walk() {
+  static const testing::RenderedSequence sequence = testing::render_sequence(
+      testing::survey_poses(testing::test_world(), 0, 100, 4), testing::qvga_kinect(), false);
+  return sequence;
+}
+
+pipeline::MapperParams loop_params() {
+  pipeline::MapperParams params;
+  params.pipeline.features = false;
+  params.pipeline.slam.loops.min_frame_gap = 20;
+  return params;
+}
+
+std::vector<pipeline::MapperStep> feed(pipeline::Mapper& mapper,
+                                       const testing::RenderedSequence& sequence, bool with_truth) {
+  std::vector<pipeline::MapperStep> steps;
+  for (std::size_t i = 0; i < sequence.frames.size(); ++i) {
+    steps.push_back(mapper.add_frame(sequence.frames[i],
+                                     with_truth ? std::optional(sequence.truth[i]) : std::nullopt));
+  }
+  return steps;
+}
+
+TEST(Mapper, GivesTheBatchSlamPosesFrameByFrame) {
+  const compute::Context cpu = compute::Context::cpu();
+  const pipeline::MapperParams params = loop_params();
+  const testing::MemoryFrameSource source(testing::out_and_back());
+  mapping::SlamParams batch_params = params.pipeline.slam;
+  batch_params.build_map = false;
+  const mapping::SlamResult batch = mapping::run_slam(cpu, source, batch_params);
+
+  pipeline::Mapper mapper(cpu, source.camera(), source.depth_units_per_metre(), params);
+  const std::vector<pipeline::MapperStep> steps = feed(mapper, testing::out_and_back(), false);
+  bool moved = false;
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    EXPECT_EQ(steps[i].frame, i);
+    EXPECT_NE(steps[i].status, pipeline::FrameStatus::given);
+    EXPECT_TRUE(steps[i].pose.matrix().isApprox(batch.odometry.poses[i].matrix(), 0.05) ||
+                steps[i].poses_moved || moved)
+        << "frame " << i << ": the step's pose is not the tracking's";
+    moved = moved || steps[i].poses_moved;
+  }
+  EXPECT_TRUE(moved) << "no loop closure moved the poses: the sequence tests less than it should";
+  ASSERT_EQ(mapper.poses().size(), batch.poses.size());
+  const pipeline::MapPipelineResult result = mapper.finish();
+  ASSERT_EQ(result.slam.poses.size(), batch.poses.size());
+  for (std::size_t i = 0; i < batch.poses.size(); ++i)
+    EXPECT_TRUE(result.slam.poses[i].isApprox(batch.poses[i], 1e-12)) << "frame " << i;
+  EXPECT_EQ(result.slam.loop_closures.size(), batch.loop_closures.size());
+  EXPECT_GE(result.volume.refusions, 1u);  // the final poses were fused again
+  EXPECT_FALSE(result.mesh.triangles.empty());
+  EXPECT_EQ(result.mesh.vertices.size(), result.map.size());
+}
+
+// A budget of 1000 blocks (4 cm voxels: about 100 m^2 of surface) on a walk through several rooms:
+// the volume evicts, never holds more than its budget, and keeps what is around the camera.
+TEST(Mapper, EvictsFarBlocksWithinItsBudget) {
+  const compute::Context cpu = compute::Context::cpu();
+  pipeline::MapperParams params;
+  params.volume.max_blocks = 1000;
+  params.keep_radius_m = 3;
+  const testing::RenderedSequence& walk = survey_walk();
+  pipeline::Mapper mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre, params);
+  const std::vector<pipeline::MapperStep> steps = feed(mapper, walk, true);
+  std::size_t evictions = 0;
+  for (const pipeline::MapperStep& step : steps) {
+    EXPECT_EQ(step.status, pipeline::FrameStatus::given);
+    evictions += step.evicted;
+  }
+  const pipeline::VolumeStats stats = mapper.volume_stats();
+  EXPECT_GE(evictions, 1u);
+  EXPECT_EQ(stats.evictions, evictions);
+  EXPECT_LE(stats.peak_blocks, params.volume.max_blocks);
+  EXPECT_FALSE(stats.covers_all_frames);
+  EXPECT_GT(stats.store_memory_bytes, 0u);
+  // The mesh is the camera's surroundings: every vertex within reach of the last frames' cameras.
+  const TriangleMesh mesh = mapper.mesh();
+  ASSERT_FALSE(mesh.vertices.empty());
+  const Eigen::Vector3f last_camera = mapper.poses().back().translation().cast<float>();
+  double farthest = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices)
+    farthest = std::max(farthest, static_cast<double>((v - last_camera).norm()));
+  EXPECT_LT(farthest, params.keep_radius_m + params.max_fusion_depth_m + 0.5);
+}
+
+// Known poses, exact depth: the mesh lies on the world's surfaces (4 cm voxels).
+TEST(Mapper, MeshFromGivenPosesLiesOnTheTrueSurfaces) {
+  const compute::Context cpu = compute::Context::cpu();
+  const testing::RenderedSequence& walk = survey_walk();
+  pipeline::Mapper mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre, {});
+  feed(mapper, walk, true);
+  const TriangleMesh mesh = mapper.mesh();
+  ASSERT_GT(mesh.vertices.size(), 10000u);
+  // Poses are relative to the first frame's: back to the world's.
+  const Eigen::Isometry3f world_from_first = walk.truth.front().cast<float>();
+  double sum = 0;
+  std::size_t far = 0;
+  for (const Eigen::Vector3f& v : mesh.vertices) {
+    const double d =
+        synth::distance_to_surfaces(testing::test_world(), (world_from_first * v).cast<double>());
+    sum += d;
+    far += d > 0.04;
+  }
+  EXPECT_LT(sum / mesh.vertices.size(), 0.01);
+  EXPECT_LT(static_cast<double>(far) / mesh.vertices.size(), 0.02);
+  EXPECT_EQ(mapper.volume_stats().evictions, 0u);
+  EXPECT_TRUE(mapper.volume_stats().covers_all_frames);
+}
+
+TEST(Mapper, RejectsMixedPosesUseAfterFinishAndBadParameters) {
+  const compute::Context cpu = compute::Context::cpu();
+  const testing::RenderedSequence& walk = survey_walk();
+  {
+    pipeline::Mapper mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre);
+    mapper.add_frame(walk.frames[0], walk.truth[0]);
+    EXPECT_ERROR_MENTIONS(mapper.add_frame(walk.frames[1]), "has no pose");
+    Eigen::Isometry3d sheared = walk.truth[1];
+    sheared.linear()(0, 1) += 0.2;
+    EXPECT_ERROR_MENTIONS(mapper.add_frame(walk.frames[1], sheared), "not a rotation");
+  }
+  {
+    pipeline::Mapper mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre);
+    EXPECT_ERROR_MENTIONS(mapper.finish(), "no frame");
+  }
+  {
+    pipeline::Mapper mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre);
+    registration::RgbdImages small = walk.frames[0];
+    small.depth = DepthImage(100, 100);
+    EXPECT_ERROR_MENTIONS(mapper.add_frame(small), "100x100");
+  }
+  pipeline::MapperParams bad;
+  bad.high_water = 1.5;
+  EXPECT_ERROR_MENTIONS(pipeline::Mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre, bad),
+                        "high_water");
+}
+
+// Room in memory for one frame and a half: the first stays there, the others go to the file.
+TEST(FrameStore, GivesBackTheDecimatedFramesFromMemoryAndDisk) {
+  const testing::RenderedSequence& walk = survey_walk();
+  const std::size_t frame_bytes = 160 * 120 * 5;
+  mapping::FrameStore store(walk.camera, testing::kSynthUnitsPerMetre, 2, frame_bytes * 3 / 2);
+  for (std::size_t i = 0; i < 3; ++i) store.add(walk.frames[i]);
+  ASSERT_EQ(store.size(), 3u);
+  EXPECT_EQ(store.camera().width, walk.camera.width / 2);
+  EXPECT_DOUBLE_EQ(store.camera().fx, walk.camera.fx / 2);
+  for (std::size_t i : {2u, 0u, 1u}) {
+    const registration::RgbdImages back = store.frame(i);
+    const registration::RgbdImages& original = walk.frames[i];
+    EXPECT_DOUBLE_EQ(back.timestamp, original.timestamp);
+    for (int y = 0; y < back.depth.height(); y += 7) {
+      for (int x = 0; x < back.depth.width(); x += 5) {
+        ASSERT_EQ(back.depth(x, y), original.depth(2 * x, 2 * y)) << i << " " << x << " " << y;
+        ASSERT_EQ(back.color(x, y), original.color(2 * x, 2 * y));
+      }
+    }
+  }
+  EXPECT_ERROR_MENTIONS(store.frame(3), "no frame 3");
+  EXPECT_EQ(store.bytes_in_memory(), frame_bytes);
+  EXPECT_EQ(store.bytes_on_disk(), 2 * frame_bytes);
+}
+
+}  // namespace
+}  // namespace kartograf
