@@ -311,7 +311,12 @@ MapperStep Mapper::add_frame(const registration::RgbdImages& frame,
   s.store.check(frame);
   step.pose = s.locate(frame, pose, step);
   s.stale = s.stale || step.poses_moved;
-  step.evicted = s.volume.fuse(s.store.add(frame), step.pose, s.poses());
+  const registration::RgbdImages kept = s.store.add(frame);
+  if (s.params.live_fusion) {
+    step.evicted = s.volume.fuse(kept, step.pose, s.poses());
+  } else {
+    s.stale = true;  // fused when first asked for
+  }
   s.snapshot.reset();
   step.seconds = seconds_since(start);
   s.adding_seconds += step.seconds;
@@ -372,7 +377,9 @@ MapPipelineResult run_map_pipeline(const compute::Context& context,
                                    const mapping::FrameSource& source, const MapperParams& params,
                                    const MapPipelineObserver& observer) {
   require(source.size() > 0, "map: the sequence holds no frame");
-  Mapper mapper(context, source.camera(), source.depth_units_per_metre(), params, observer);
+  MapperParams batch = params;
+  batch.live_fusion = false;  // the volume is fused once, at the final poses
+  Mapper mapper(context, source.camera(), source.depth_units_per_metre(), batch, observer);
   if (observer.on_stage) observer.on_stage("slam");
   const mapping::KnownPoseLookup& known = params.pipeline.known_poses;
   const std::size_t total = source.size();

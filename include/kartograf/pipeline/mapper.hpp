@@ -47,6 +47,9 @@ struct MapperParams {
   double max_fusion_depth_m = 4.0;  // depth beyond this is not fused (noise grows as depth^2)
   double high_water = 0.85;         // of volume.max_blocks
   double keep_radius_m = 8.0;
+  // Fuse each frame as it comes (a robot asking for the map while it runs). Off: the volume is
+  // fused once, when the map is first asked for (a batch run: run_map_pipeline).
+  bool live_fusion = true;
   mapping::MeshParams mesh;
   mapping::TsdfSliceParams slice;  // world_to_level and floor_z come from the snapshot's gravity
 
@@ -112,8 +115,10 @@ class Mapper {
 };
 
 // The mapper fed with every frame of the source (read one ahead on a second thread; with
-// params.pipeline.known_poses, at those poses), then finished. Throws Error when a stage cannot go
-// on (no frame, bad parameters, no view could be labelled, no floor seen, ...), naming the stage.
+// params.pipeline.known_poses, at those poses), then finished; without live fusion (the volume is
+// fused once, at the final poses: the same field, half the work). Throws Error when a stage cannot
+// go on (no frame, bad parameters, no view could be labelled, no floor seen, ...), naming the
+// stage.
 MapPipelineResult run_map_pipeline(const compute::Context& context,
                                    const mapping::FrameSource& source,
                                    const MapperParams& params = {},
