@@ -78,8 +78,18 @@ geometry::DepthRange depth_range() {
   return {kUnits, 0.2, 5.0};
 }
 
-// The plain reference of one frame fused into an empty volume: the blocks within +-truncation of
-// every surface point, and each of their voxels fused once (in double precision).
+// The blocks (grid units) the segment from a to b crosses, by sampling it 1000 times: a plain
+// reference of the touch pass's walk.
+void blocks_on_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
+                       std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>>& blocks) {
+  for (int k = 0; k <= 1000; ++k) {
+    const Eigen::Vector3i c = (a + (b - a) * (k / 1000.0)).array().floor().cast<int>();
+    blocks[{c.x(), c.y(), c.z()}];
+  }
+}
+
+// The plain reference of one frame fused into an empty volume: the blocks each pixel's ray crosses
+// within +-truncation of its depth, and each of their voxels fused once (in double precision).
 std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> reference_frame(
     const DepthImage& depth, const Eigen::Isometry3d& pose, const TsdfVolumeParams& p) {
   std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> blocks;
@@ -88,13 +98,9 @@ std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> reference_frame(
     for (int u = 0; u < depth.width(); ++u) {
       if (depth(u, v) == 0) continue;
       const double z = depth(u, v) / kUnits;
-      const Eigen::Vector3d w = pose * Eigen::Vector3d((u - kCamera.cx) / kCamera.fx * z,
-                                                       (v - kCamera.cy) / kCamera.fy * z, z);
-      const Eigen::Vector3i lo = ((w.array() - p.truncation) / block).floor().cast<int>();
-      const Eigen::Vector3i hi = ((w.array() + p.truncation) / block).floor().cast<int>();
-      for (int bz = lo.z(); bz <= hi.z(); ++bz)
-        for (int by = lo.y(); by <= hi.y(); ++by)
-          for (int bx = lo.x(); bx <= hi.x(); ++bx) blocks[{bx, by, bz}];
+      const Eigen::Vector3d ray((u - kCamera.cx) / kCamera.fx, (v - kCamera.cy) / kCamera.fy, 1);
+      blocks_on_segment(pose * (ray * (z - p.truncation)) / block,
+                        pose * (ray * (z + p.truncation)) / block, blocks);
     }
   }
   for (auto& [coords, voxels] : blocks) {

@@ -6,7 +6,7 @@
 // Space is cut into blocks of 8^3 voxels of voxel_size; only blocks near an observed surface
 // exist (a hash table from block coordinates to a pool of max_blocks blocks). Integrating a depth
 // frame at a pose (camera to world):
-//   - every valid pixel's surface point allocates the blocks within +-truncation of it;
+//   - every valid pixel's ray allocates the blocks it crosses within +-truncation of its depth;
 //   - every voxel of those blocks in front of the camera is projected into the depth image, and
 //     where the measured depth d is at most `truncation` in front of it (d - z >= -truncation,
 //     z the voxel centre's depth) the value min(1, (d - z) / truncation) joins the voxel's running
