@@ -5,6 +5,7 @@
 //   completeness  the fraction of the surface the views saw (noise-free, within the fusion's depth
 //                 range, one sample per 1 cm voxel) that has a mesh vertex within 2 cm.
 // Usage: kartograf_tsdf_accuracy [--seed N] [--noise] [--step K] [--voxel M] [--frames N]
+//                                [--touch-step P (0: automatic)]
 //                                [--backend cpu|vulkan|opencl]
 #include <algorithm>
 #include <chrono>
@@ -34,6 +35,7 @@ struct Options {
   int step = 1;
   int frames = 0;  // 0: the whole tour
   double voxel = 0.01;
+  int touch_step = 0;
   std::string backend = "cpu";
 };
 
@@ -55,6 +57,8 @@ Options parse(int argc, char** argv) {
       o.frames = std::stoi(value());
     else if (a == "--voxel")
       o.voxel = std::stod(value());
+    else if (a == "--touch-step")
+      o.touch_step = std::stoi(value());
     else if (a == "--backend")
       o.backend = value();
     else
@@ -99,6 +103,7 @@ int run(const Options& o) {
   mapping::TsdfVolumeParams params;
   params.voxel_size = o.voxel;
   params.truncation = 4 * o.voxel;
+  params.touch_step = o.touch_step;
   params.max_blocks = std::size_t{1} << 18;
   mapping::TsdfVolume volume(context, params);
   std::unordered_map<std::uint64_t, Eigen::Vector3d> seen;

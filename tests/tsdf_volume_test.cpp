@@ -296,7 +296,7 @@ TEST_P(TsdfVolumeTest, FullVolumeAndBadInputsAreErrors) {
            [](TsdfVolumeParams& p) { p.truncation = 0.001; },
            [](TsdfVolumeParams& p) { p.max_weight = 0.5; },
            [](TsdfVolumeParams& p) { p.max_blocks = 0; },
-           [](TsdfVolumeParams& p) { p.touch_step = 0; }}) {
+           [](TsdfVolumeParams& p) { p.touch_step = -1; }}) {
     TsdfVolumeParams p;
     change(p);
     EXPECT_THROW(TsdfVolume(context(), p), Error);

@@ -191,7 +191,7 @@ KG_INLINE void tsdf_touch_block(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(
 // Pixel (x, y) with depth value d: the blocks its ray crosses between depths d - truncation and
 // d + truncation, where the field it writes is not saturated (a 3-D DDA over the block grid,
 // Amanatides and Woo 1987). Voxels off this ray are on other pixels' rays: allocating the box of
-// +-truncation around the point instead took 1.7x the blocks (7-Scenes, 1 cm voxels).
+// +-truncation around the point instead took 1.47x the blocks (7-Scenes, 1 cm voxels).
 KG_FORCE_INLINE void tsdf_touch_pixel(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(uint, stamps)
                                           KG_BUFFER_PARAM(uint, status) uint x,
                                       uint y, uint d, TsdfParams p) {

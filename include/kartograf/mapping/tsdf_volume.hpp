@@ -47,7 +47,10 @@ struct TsdfVolumeParams {
   // The pool: 12 bytes a voxel, 6 KiB a block; 16384 blocks (96 MiB) fit every device's largest
   // buffer (Vulkan guarantees 128 MiB) and hold about 170 m^2 of surface at 1 cm voxels.
   std::size_t max_blocks = 1 << 14;
-  int touch_step = 1;  // pixels between the depth samples that allocate blocks
+  // Pixels between the rays that allocate blocks; 0: automatic, the most that keeps the rays at
+  // most two voxels apart at the depth range's far end (at most 4; 640x480 at 4 m: 2 at 1 cm
+  // voxels, 4 from 2 cm).
+  int touch_step = 0;
 
   // Throws Error naming the field that is out of range.
   void validate() const;
@@ -141,7 +144,7 @@ class TsdfVolume {
   compute::Buffer<std::uint32_t> active_;       // this frame's blocks
   compute::Buffer<std::uint32_t> status_;
   compute::Buffer<TsdfVoxel> voxels_;  // the pool: 512 per block
-  FrameUpload upload_;  // the host overload's frames
+  FrameUpload upload_;                 // the host overload's frames
 };
 
 }  // namespace kartograf::mapping
