@@ -11,6 +11,7 @@
 #include <tuple>
 #include <vector>
 
+#include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "real_data.hpp"
 #include "test_support.hpp"
@@ -262,6 +263,63 @@ TEST_P(TsdfVolumeTest, EqualsTheCpuBackendOnSevenScenesFrames) {
   EXPECT_GT(valid, a.pixels().size() / 2);
   EXPECT_LE(disagree, a.pixels().size() / 1000);
   RecordProperty("raycast_pixels_disagreeing", std::to_string(disagree));
+}
+
+// The band's occupancy on the device against the host's on a downloaded copy, in a level frame
+// turned by `roll` degrees about x; both cell states must occur.
+void expect_same_band(const TsdfVolume& volume, double roll, double floor_z, const char* what) {
+  mapping::TsdfSliceParams params;
+  params.world_to_level.linear() =
+      Eigen::AngleAxisd(roll * M_PI / 180, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  params.floor_z = floor_z;
+  params.floor_tolerance = 0.1;
+  params.band_min = 0.15;
+  params.band_max = 1.0;
+  params.min_weight = 1;
+  const OccupancyGrid device = mapping::tsdf_occupancy(volume, params);
+  const OccupancyGrid host = mapping::tsdf_occupancy(volume.download(), params);
+  ASSERT_EQ(device.width(), host.width()) << what;
+  ASSERT_EQ(device.height(), host.height()) << what;
+  EXPECT_TRUE(device.origin.isApprox(host.origin)) << what;
+  std::size_t marked = 0, differing = 0, occupied = 0, free = 0;
+  for (std::size_t i = 0; i < host.cells.pixels().size(); ++i) {
+    const CellState h = host.cells.pixels()[i];
+    marked += h != CellState::unknown;
+    occupied += h == CellState::occupied;
+    free += h == CellState::free;
+    differing += h != device.cells.pixels()[i];
+  }
+  EXPECT_GT(occupied, 20u) << what;
+  EXPECT_GT(free, 20u) << what;
+  // A voxel centre within rounding of a cell's edge may fall on either side (float against double).
+  EXPECT_LE(differing, marked / 200 + 2) << what << ": " << differing << " of " << marked;
+}
+
+TEST_P(TsdfVolumeTest, BandOccupancyEqualsTheHostsOnSyntheticAndRealFields) {
+  const Scene scene;
+  TsdfVolumeParams params;
+  params.voxel_size = 0.02;
+  params.truncation = 0.06;
+  TsdfVolume synthetic(context(), params);
+  for (const double yaw : {-10.0, 0.0, 12.0}) {
+    const Eigen::Isometry3d pose = pose_at(0.05 * yaw / 10, 0.02, yaw);
+    synthetic.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  }
+  // Looking along z at a wall at z = 2.4: with the level frame's z along the world's, the wall is
+  // the floor and the sphere in front stands above it... upside down (roll 180).
+  expect_same_band(synthetic, 180.0, -2.4, "sphere and wall");
+  expect_same_band(synthetic, 150.0, -2.2, "sphere and wall, tilted");
+
+  const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
+  const geometry::DepthRange range{1000.0, 0.3, 4.0};
+  TsdfVolume kitchen(context(), params);
+  for (const char* name : {"frame-000000", "frame-000010"}) {
+    kitchen.integrate(testing::read_depth(frames / (std::string(name) + ".depth.png")), {},
+                      PinholeIntrinsics::kinect_7scenes(), range,
+                      testing::read_pose(frames / (std::string(name) + ".pose.txt")));
+  }
+  // 7-Scenes' world has y down: roll 90 turns it up.
+  expect_same_band(kitchen, 90.0, -0.8, "7-Scenes frames 0 and 10");
 }
 
 TEST_P(TsdfVolumeTest, FullVolumeAndBadInputsAreErrors) {

@@ -6,6 +6,7 @@
 #include "kartograf/geometry/segment_moments.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
+#include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "kartograf/registration/color_gate.hpp"
 #include "kartograf/registration/frame_pyramid.hpp"
@@ -153,6 +154,15 @@ void ray_cast(Workspace& w, const mapping::TsdfVolume& volume) {
   volume.raycast(w.frames.camera, geometry::DepthRange{}, Eigen::Isometry3d::Identity(), w.cast);
 }
 
+// The height band's occupancy on the device (the camera's frame turned so that -y is up).
+void band_occupancy(Workspace& w, const mapping::TsdfVolume& volume) {
+  ensure_tsdf(w);
+  mapping::TsdfSliceParams params;
+  params.world_to_level.linear() =
+      Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
+  mapping::tsdf_occupancy(volume, params);
+}
+
 void build_current(Workspace& w) {
   w.depth.upload(w.next_frame().depth);
   w.current().build(w.projector, w.depth);
@@ -235,6 +245,7 @@ const std::vector<Operation>& frame_operations() {
       {"TSDF ray cast 1 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_fine); }},
       {"TSDF integrate 5 cm", 0, [](Workspace& w) { integrate(w, w.tsdf_coarse); }},
       {"TSDF ray cast 5 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_coarse); }},
+      {"TSDF band occupancy 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine); }},
       {"region growing (Lab)", 0,
        [](Workspace& w) {
          w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});

@@ -1,5 +1,6 @@
 // OpenCL wrapper of kernels/tsdf/tsdf.h.
 #include "kernels/tsdf/tsdf.h"
+#include "kernels/tsdf/tsdf_band.h"
 
 __kernel void tsdf_touch(__global const ushort* depth, __global ulong* keys, __global uint* stamps,
                          __global uint* status, const TsdfParams params) {
@@ -41,4 +42,13 @@ __kernel void tsdf_raycast(__global const ulong* keys, __global const uint* slot
   const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, min_depth, max_depth, params);
   points[index] = p;
   if (params.has_color != 0u) colors[index] = tsdf_color_at(keys, slot_blocks, voxels, p, params);
+}
+
+__kernel void tsdf_band(__global const ulong* block_keys, __global const TsdfVoxel* voxels,
+                        __global uint* cells, const TsdfBandParams params) {
+  const uint i = get_global_id(0);
+  if (i >= params.count) return;
+  const TsdfBandMark mark = tsdf_band_mark(voxels[i], block_keys[i / KG_TSDF_BLOCK_VOXELS],
+                                           i % KG_TSDF_BLOCK_VOXELS, params);
+  if (mark.cell >= 0) kg_atomic_max_u32(cells, (uint)mark.cell, mark.state);
 }

@@ -31,6 +31,21 @@
 #define KG_TSDF_STATUS_OUT_OF_RANGE 4u   // points beyond 2^20 blocks (or not finite)
 #define KG_TSDF_STATUS_VALUES 5u
 
+// A rigid motion p' = R p + t in a parameter block (R row-major): the TSDF's passes and the band's.
+#define KG_TSDF_RIGID_PARAMS                                                                       \
+  KG_PARAM(float, r00)                                                                             \
+  KG_PARAM(float, r01)                                                                             \
+  KG_PARAM(float, r02)                                                                             \
+  KG_PARAM(float, r10)                                                                             \
+  KG_PARAM(float, r11)                                                                             \
+  KG_PARAM(float, r12)                                                                             \
+  KG_PARAM(float, r20)                                                                             \
+  KG_PARAM(float, r21)                                                                             \
+  KG_PARAM(float, r22)                                                                             \
+  KG_PARAM(float, tx)                                                                              \
+  KG_PARAM(float, ty)                                                                              \
+  KG_PARAM(float, tz)
+
 KG_RULES_BEGIN
 
 // One parameter block for every pass: the camera, its pose (camera to world: p_w = R p_c + t,
@@ -50,18 +65,7 @@ KG_PARAM(float, truncation)
 KG_PARAM(float, max_weight)
 KG_PARAM(float, inverse_voxel)  // 1 / voxel_size and 1 / (8 voxel_size), rounded once on the host:
 KG_PARAM(float, inverse_block)  // a device's division may round otherwise
-KG_PARAM(float, r00)
-KG_PARAM(float, r01)
-KG_PARAM(float, r02)
-KG_PARAM(float, r10)
-KG_PARAM(float, r11)
-KG_PARAM(float, r12)
-KG_PARAM(float, r20)
-KG_PARAM(float, r21)
-KG_PARAM(float, r22)
-KG_PARAM(float, tx)
-KG_PARAM(float, ty)
-KG_PARAM(float, tz)
+KG_TSDF_RIGID_PARAMS
 KG_PARAM(uint, capacity_log2)   // the table has 2^capacity_log2 slots
 KG_PARAM(uint, block_capacity)  // the pool's blocks
 KG_PARAM(uint, stamp)           // this frame's stamp (never 0)

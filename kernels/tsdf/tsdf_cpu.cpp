@@ -1,6 +1,7 @@
 // CPU wrapper of kernels/tsdf/tsdf.h (the atomics of the rule are std::atomic_ref on the host).
 #include "compute/cpu/cpu_kernel.hpp"
 #include "kernels/tsdf/tsdf.h"
+#include "kernels/tsdf/tsdf_band.h"
 
 namespace kartograf::kernels {
 
@@ -71,6 +72,19 @@ void raycast(const CpuDispatch& call) {
   });
 }
 
+void band(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfBandParams>();
+  const auto* block_keys = call.buffer<const uint64_t>(0);
+  const auto* voxels = call.buffer<const TsdfVoxel>(1);
+  auto* cells = call.buffer<uint>(2);
+  for_each_item(call, [&](uint i) {
+    if (i >= params.count) return;
+    const TsdfBandMark mark = tsdf_band_mark(voxels[i], block_keys[i / KG_TSDF_BLOCK_VOXELS],
+                                             i % KG_TSDF_BLOCK_VOXELS, params);
+    if (mark.cell >= 0) kg_atomic_max_u32(cells, static_cast<uint>(mark.cell), mark.state);
+  });
+}
+
 }  // namespace
 
 void register_tsdf_cpu(compute::detail::CpuKernelRegistry& registry) {
@@ -78,6 +92,7 @@ void register_tsdf_cpu(compute::detail::CpuKernelRegistry& registry) {
   registry.add("tsdf_assign", assign);
   registry.add("tsdf_integrate", integrate);
   registry.add("tsdf_raycast", raycast);
+  registry.add("tsdf_band", band);
 }
 
 }  // namespace kartograf::kernels

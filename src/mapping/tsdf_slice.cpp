@@ -6,12 +6,16 @@
 #include <string>
 #include <vector>
 
+#include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/distance_transform.hpp"
+#include "kernels/tsdf/tsdf_band.h"
 
 namespace kartograf::mapping {
 
 namespace {
+
+constexpr compute::KernelSpec kBandKernel{"tsdf_band", KG_TSDF_LOCAL_X, 1};
 
 // The centres of the surface voxels, in the level frame.
 std::vector<Eigen::Vector3d> surface_points(const TsdfBlocks& blocks,
@@ -33,6 +37,60 @@ std::vector<Eigen::Vector3d> surface_points(const TsdfBlocks& blocks,
   return out;
 }
 
+// An empty grid (all unknown) over the footprint of the blocks' voxel centres in the level frame.
+OccupancyGrid band_grid(const std::vector<Eigen::Vector3i>& coords, double voxel_size,
+                        const TsdfSliceParams& params) {
+  OccupancyGrid grid;
+  grid.resolution = params.resolution;
+  if (coords.empty()) return grid;
+  Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector2d hi = -lo;
+  for (const Eigen::Vector3i& b : coords) {
+    for (int corner = 0; corner < 8; ++corner) {
+      const Eigen::Vector3i offset((corner & 1) * 7, ((corner >> 1) & 1) * 7, (corner >> 2) * 7);
+      const Eigen::Vector3d centre =
+          ((b * kTsdfBlockSide + offset).cast<double>().array() + 0.5) * voxel_size;
+      const Eigen::Vector2d p = (params.world_to_level * centre).head<2>();
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  // Half a cell of margin: cell edges then fall between voxel centres for the usual sizes (1, 2,
+  // 4, 5 cm voxels, 5 cm cells) instead of on every few of them.
+  lo -= Eigen::Vector2d::Constant(params.resolution / 2);
+  const auto cols = static_cast<int>(std::floor((hi.x() - lo.x()) / params.resolution)) + 1;
+  const auto rows = static_cast<int>(std::floor((hi.y() - lo.y()) / params.resolution)) + 1;
+  require(static_cast<double>(cols) * rows <= 1e8, "TSDF slice: the grid would exceed 1e8 cells");
+  grid.origin = Eigen::Vector3d(lo.x(), lo.y(), 0);
+  grid.cells = Image<CellState>(cols, rows, CellState::unknown);
+  return grid;
+}
+
+kernels::TsdfBandParams band_params(const TsdfVolumeParams& volume, const OccupancyGrid& grid,
+                                    const TsdfSliceParams& params, std::size_t blocks) {
+  kernels::TsdfBandParams p{};
+  const Eigen::Matrix3d r = params.world_to_level.linear();
+  const Eigen::Vector3d t = params.world_to_level.translation();
+  float* rotation[] = {&p.r00, &p.r01, &p.r02, &p.r10, &p.r11, &p.r12, &p.r20, &p.r21, &p.r22};
+  for (int k = 0; k < 9; ++k) *rotation[k] = static_cast<float>(r(k / 3, k % 3));
+  p.tx = static_cast<float>(t.x()), p.ty = static_cast<float>(t.y()),
+  p.tz = static_cast<float>(t.z());
+  p.voxel_size = static_cast<float>(volume.voxel_size);
+  p.near = static_cast<float>(volume.voxel_size / volume.truncation);
+  p.min_weight = params.min_weight;
+  p.floor_z = static_cast<float>(params.floor_z);
+  p.floor_tolerance = static_cast<float>(params.floor_tolerance);
+  p.band_min = static_cast<float>(params.band_min);
+  p.band_max = static_cast<float>(params.band_max);
+  p.origin_x = static_cast<float>(grid.origin.x());
+  p.origin_y = static_cast<float>(grid.origin.y());
+  p.inverse_resolution = static_cast<float>(1.0 / params.resolution);
+  p.cols = static_cast<std::uint32_t>(grid.width());
+  p.rows = static_cast<std::uint32_t>(grid.height());
+  p.count = static_cast<std::uint32_t>(blocks * kTsdfBlockVoxels);
+  return p;
+}
+
 }  // namespace
 
 void TsdfSliceParams::validate() const {
@@ -44,22 +102,9 @@ void TsdfSliceParams::validate() const {
 
 OccupancyGrid tsdf_occupancy(const TsdfBlocks& blocks, const TsdfSliceParams& params) {
   params.validate();
-  OccupancyGrid grid;
-  grid.resolution = params.resolution;
-  const std::vector<Eigen::Vector3d> points = surface_points(blocks, params);
-  if (points.empty()) return grid;
-  Eigen::Vector2d lo = points.front().head<2>(), hi = lo;
-  for (const Eigen::Vector3d& p : points) {
-    lo = lo.cwiseMin(p.head<2>());
-    hi = hi.cwiseMax(p.head<2>());
-  }
-  const auto cols = static_cast<int>(std::floor((hi.x() - lo.x()) / params.resolution)) + 1;
-  const auto rows = static_cast<int>(std::floor((hi.y() - lo.y()) / params.resolution)) + 1;
-  require(static_cast<double>(cols) * rows <= 1e8, "TSDF slice: the grid would exceed 1e8 cells");
-  grid.origin = Eigen::Vector3d(lo.x(), lo.y(), 0);
-  grid.cells = Image<CellState>(cols, rows);
-  std::fill(grid.cells.pixels().begin(), grid.cells.pixels().end(), CellState::unknown);
-  for (const Eigen::Vector3d& p : points) {
+  OccupancyGrid grid = band_grid(blocks.coords, blocks.voxel_size, params);
+  if (grid.width() == 0) return grid;
+  for (const Eigen::Vector3d& p : surface_points(blocks, params)) {
     const double h = p.z() - params.floor_z;
     const bool in_band = h >= params.band_min && h <= params.band_max;
     const bool floor = std::abs(h) <= params.floor_tolerance;
@@ -71,6 +116,33 @@ OccupancyGrid tsdf_occupancy(const TsdfBlocks& blocks, const TsdfSliceParams& pa
       state = CellState::occupied;
     else if (state == CellState::unknown)
       state = CellState::free;
+  }
+  return grid;
+}
+
+OccupancyGrid tsdf_occupancy(const TsdfVolume& volume, const TsdfSliceParams& params) {
+  params.validate();
+  const std::size_t n = std::min(volume.block_count(), volume.params().max_blocks);
+  std::vector<std::uint64_t> keys(n);
+  if (n > 0) volume.device_block_keys().download(keys);
+  std::vector<Eigen::Vector3i> coords;
+  for (const std::uint64_t key : keys)
+    coords.emplace_back(kernels::tsdf_key_axis(key, 0), kernels::tsdf_key_axis(key, 21),
+                        kernels::tsdf_key_axis(key, 42));
+  OccupancyGrid grid = band_grid(coords, volume.params().voxel_size, params);
+  if (grid.width() == 0) return grid;
+  const compute::Context& context = volume.context();
+  compute::Buffer<std::uint32_t> cells(context, grid.cells.pixels().size());
+  cells.fill_zero();
+  const kernels::TsdfBandParams p = band_params(volume.params(), grid, params, n);
+  compute::dispatch(context, kBandKernel,
+                    {volume.device_block_keys(), volume.device_voxels(), cells}, p,
+                    {compute::groups_for(p.count, KG_TSDF_LOCAL_X), 1});
+  const std::vector<std::uint32_t> marks = cells.to_vector();
+  for (std::size_t i = 0; i < marks.size(); ++i) {
+    grid.cells.pixels()[i] = marks[i] == KG_TSDF_BAND_OCCUPIED ? CellState::occupied
+                             : marks[i] == KG_TSDF_BAND_FREE   ? CellState::free
+                                                               : CellState::unknown;
   }
   return grid;
 }

@@ -284,7 +284,7 @@ MapPipelineResult Mapper::State::complete(mapping::SlamResult slam_result) {
   mapping::TsdfSliceParams slice = params.slice;
   slice.world_to_level = result.map_from_slam;
   slice.floor_z = 0;
-  result.band_occupancy = mapping::tsdf_occupancy(blocks, slice);
+  result.band_occupancy = mapping::tsdf_occupancy(volume.volume(), slice);  // on the device
   result.esdf = mapping::occupancy_esdf(result.band_occupancy);
   result.volume = volume.stats();
   result.slam.timing.map_seconds = result.volume.fusion_seconds;

@@ -10,7 +10,8 @@
 //             floor_tolerance of floor_z);
 //   unknown   otherwise (the field keeps only a band around surfaces, so open space with no
 //             floor in view is not known to be free).
-// The grid covers the observed voxels' footprint, origin at its lower-left corner.
+// The grid covers the footprint of the field's blocks (the centres of their voxels), origin at its
+// lower-left corner.
 #include <Eigen/Geometry>
 
 #include "kartograf/core/image.hpp"
@@ -34,6 +35,10 @@ struct TsdfSliceParams {
 };
 
 OccupancyGrid tsdf_occupancy(const TsdfBlocks& blocks, const TsdfSliceParams& params);
+// The same on the field's device (kernels/tsdf/tsdf_band.h: each voxel marks its cell): only the
+// block keys and the grid cross to the host. Equal to the host's on a downloaded copy but where a
+// voxel centre lies within rounding of a cell's edge (float here, double there).
+OccupancyGrid tsdf_occupancy(const TsdfVolume& volume, const TsdfSliceParams& params);
 
 // Metres from each cell centre to the nearest occupied cell's centre for free and unknown cells,
 // minus the distance to the nearest non-occupied cell inside occupied ones; +infinity everywhere

@@ -129,6 +129,11 @@ class TsdfVolume {
 
   std::size_t block_count() const { return block_count_; }
   const TsdfVolumeParams& params() const { return params_; }
+  // The pool on the device, for other passes over the field (the first block_count() blocks are
+  // in use; block_keys holds each one's key).
+  const compute::Context& context() const { return *context_; }
+  const compute::Buffer<std::uint64_t>& device_block_keys() const { return block_keys_; }
+  const compute::Buffer<TsdfVoxel>& device_voxels() const { return voxels_; }
   TsdfBlocks download() const;
 
  private:
