@@ -148,6 +148,9 @@ TEST(Mapper, RejectsMixedPosesUseAfterFinishAndBadParameters) {
     small.depth = DepthImage(100, 100);
     EXPECT_ERROR_MENTIONS(mapper.add_frame(small), "100x100");
   }
+  PinholeIntrinsics no_camera = walk.camera;
+  no_camera.fx = 0;
+  EXPECT_ERROR_MENTIONS(pipeline::Mapper(cpu, no_camera, testing::kSynthUnitsPerMetre), "mapper");
   pipeline::MapperParams bad;
   bad.high_water = 1.5;
   EXPECT_ERROR_MENTIONS(pipeline::Mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre, bad),

@@ -194,10 +194,13 @@ struct Mapper::State {
       : context(&context),
         params(prepared(params)),
         observer(observer),
-        camera(camera),
+        camera(checked(camera)),
         store(camera, units, mapping::decimation_for_width(camera, params.fusion_width)),
-        volume(context, params, store, units) {
+        volume(context, params, store, units) {}
+
+  static const PinholeIntrinsics& checked(const PinholeIntrinsics& camera) {
     camera.validate("mapper");
+    return camera;
   }
 
   // Validated, with the local features (ORB) the SLAM uses when params.pipeline.features.
