@@ -9,6 +9,7 @@
 #include <sstream>
 #include <unordered_map>
 
+#include "kartograf/core/color.hpp"
 #include "kartograf/formats/top_view.hpp"
 #include "outputs/html_text.hpp"
 #include "outputs/map_report_html.hpp"
@@ -132,10 +133,7 @@ Json mesh_json(const TriangleMesh& full, std::size_t max_triangles) {
   const TriangleMesh mesh = mesh_for_view(full, max_triangles);
   PointCloud cloud;
   cloud.points = mesh.vertices;
-  for (const std::uint32_t c : mesh.colors)
-    cloud.colors.push_back({static_cast<std::uint8_t>(c & 0xff),
-                            static_cast<std::uint8_t>((c >> 8) & 0xff),
-                            static_cast<std::uint8_t>((c >> 16) & 0xff)});
+  for (const std::uint32_t c : mesh.colors) cloud.colors.push_back(unpack_rgb(c));
   std::vector<std::size_t> all(cloud.size());
   for (std::size_t i = 0; i < all.size(); ++i) all[i] = i;
   Json scene = points_json(cloud, all);

@@ -7,6 +7,7 @@
 #include <optional>
 #include <string>
 
+#include "kartograf/core/color.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/pose.hpp"
 #include "kartograf/features/orb_front_end.hpp"
@@ -42,10 +43,7 @@ PointCloud mesh_points(const TriangleMesh& mesh) {
   for (Eigen::Vector3f& n : cloud.normals) n.normalize();
   if (!mesh.colors.empty()) {
     cloud.colors.reserve(mesh.colors.size());
-    for (const std::uint32_t c : mesh.colors)
-      cloud.colors.push_back({static_cast<std::uint8_t>(c & 0xff),
-                              static_cast<std::uint8_t>((c >> 8) & 0xff),
-                              static_cast<std::uint8_t>((c >> 16) & 0xff)});
+    for (const std::uint32_t c : mesh.colors) cloud.colors.push_back(unpack_rgb(c));
   }
   return cloud;
 }
