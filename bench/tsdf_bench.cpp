@@ -89,11 +89,13 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
   const bool integrating = operation == Operation::integrate;
   const std::unique_ptr<mapping::TsdfVolume> volume =
       fused(context, voxel, integrating ? kWarmUp : kFrames);
-  std::size_t k = kWarmUp;
+  std::size_t k = kWarmUp, active = 0;
   for (auto _ : state) {
     const std::size_t i = k++ % kFrames;
     if (operation == Operation::integrate) {
-      volume->integrate(f.images[i].depth, f.images[i].color, f.camera, f.range, f.poses[i]);
+      active +=
+          volume->integrate(f.images[i].depth, f.images[i].color, f.camera, f.range, f.poses[i])
+              .active_blocks;
     } else if (operation == Operation::raycast) {
       benchmark::DoNotOptimize(volume->raycast(f.camera, f.range, f.poses[i]));
     } else if (operation == Operation::mesh) {
@@ -104,6 +106,8 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
     }
   }
   state.counters["blocks"] = static_cast<double>(volume->block_count());
+  if (integrating)  // blocks a frame touches, mean
+    state.counters["active"] = static_cast<double>(active) / static_cast<double>(k - kWarmUp);
 }
 
 void register_cases() {

@@ -127,6 +127,8 @@ inline uint64_t kg_atomic_cas_u64(uint64_t* buffer, uint index, uint64_t compare
   }                         \
   ;
 #define KG_NAN std::numeric_limits<float>::quiet_NaN()
+// Both conditions, evaluated without a branch: loops over such rules become vector code.
+#define KG_BOTH(a, b) (static_cast<bool>(a) & static_cast<bool>(b))
 
 // GLSL's `precise`: C++ never contracts (-std=c++20 implies -ffp-contract=off).
 #define KG_PRECISE

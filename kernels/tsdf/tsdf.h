@@ -32,18 +32,18 @@
 #define KG_TSDF_STATUS_VALUES 5u
 
 // A rigid motion p' = R p + t in a parameter block (R row-major): the TSDF's passes and the band's.
-#define KG_TSDF_RIGID_PARAMS                                                                       \
-  KG_PARAM(float, r00)                                                                             \
-  KG_PARAM(float, r01)                                                                             \
-  KG_PARAM(float, r02)                                                                             \
-  KG_PARAM(float, r10)                                                                             \
-  KG_PARAM(float, r11)                                                                             \
-  KG_PARAM(float, r12)                                                                             \
-  KG_PARAM(float, r20)                                                                             \
-  KG_PARAM(float, r21)                                                                             \
-  KG_PARAM(float, r22)                                                                             \
-  KG_PARAM(float, tx)                                                                              \
-  KG_PARAM(float, ty)                                                                              \
+#define KG_TSDF_RIGID_PARAMS \
+  KG_PARAM(float, r00)       \
+  KG_PARAM(float, r01)       \
+  KG_PARAM(float, r02)       \
+  KG_PARAM(float, r10)       \
+  KG_PARAM(float, r11)       \
+  KG_PARAM(float, r12)       \
+  KG_PARAM(float, r20)       \
+  KG_PARAM(float, r21)       \
+  KG_PARAM(float, r22)       \
+  KG_PARAM(float, tx)        \
+  KG_PARAM(float, ty)        \
   KG_PARAM(float, tz)
 
 KG_RULES_BEGIN
@@ -75,7 +75,12 @@ KG_PARAM(uint, has_color)
 KG_PARAMS_END(TsdfParams)
 
 KG_INLINE bool tsdf_depth_valid(uint d, TsdfParams p) {
-  return d != 0u && d >= p.min_units && d <= p.max_units;
+  return KG_BOTH(d != 0u, KG_BOTH(d >= p.min_units, d <= p.max_units));
+}
+
+// Depth value d (16 bits) in metres; through int, which converts as vector code on every CPU.
+KG_INLINE float tsdf_metres(uint d, TsdfParams p) {
+  return KG_FLOAT(KG_INT(d)) * p.metres_per_unit;
 }
 
 KG_INLINE float3 tsdf_to_world(float3 c, TsdfParams p) {
@@ -192,26 +197,37 @@ KG_INLINE void tsdf_touch_block(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(
   }
 }
 
-// Pixel (x, y) with depth value d: the blocks its ray crosses between depths d - truncation and
-// d + truncation, where the field it writes is not saturated (a 3-D DDA over the block grid,
-// Amanatides and Woo 1987). Voxels off this ray are on other pixels' rays: allocating the box of
-// +-truncation around the point instead took 1.47x the blocks (7-Scenes, 1 cm voxels).
-KG_FORCE_INLINE void tsdf_touch_pixel(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(uint, stamps)
-                                          KG_BUFFER_PARAM(uint, status) uint x,
-                                      uint y, uint d, TsdfParams p) {
-  if (!tsdf_depth_valid(d, p)) return;
-  const float z = KG_FLOAT(d) * p.metres_per_unit;
+// Pixel (x, y) with depth value d: the walk over the blocks its ray crosses between depths
+// d - truncation and d + truncation, where the field it writes is not saturated (a 3-D DDA over
+// the block grid, Amanatides and Woo 1987); an empty walk (more = 0) for an invalid depth or a
+// point out of range (counted). Voxels off this ray are on other pixels' rays: allocating the box
+// of +-truncation around the point instead took 1.47x the blocks (7-Scenes, 1 cm voxels).
+KG_FORCE_INLINE TsdfSegmentWalk tsdf_touch_walk(KG_BUFFER_PARAM(uint, status) uint x, uint y,
+                                                uint d, TsdfParams p) {
+  const float z = tsdf_metres(d, p);
   const float3 ray = KG_FLOAT3((KG_FLOAT(x) - p.cx) / p.fx, (KG_FLOAT(y) - p.cy) / p.fy, 1.0f);
   const float3 a = tsdf_to_world(ray * (z - p.truncation), p) * p.inverse_block;
   const float3 b = tsdf_to_world(ray * (z + p.truncation), p) * p.inverse_block;
-  if (!tsdf_axis_in_range(a.x) || !tsdf_axis_in_range(a.y) || !tsdf_axis_in_range(a.z) ||
-      !tsdf_axis_in_range(b.x) || !tsdf_axis_in_range(b.y) || !tsdf_axis_in_range(b.z)) {
-    kg_atomic_add_u32(status, KG_TSDF_STATUS_OUT_OF_RANGE, 1u);
-    return;
-  }
-  TsdfSegmentWalk walk = tsdf_segment_walk(a, b);
-  // The segment is at most two blocks long (truncation <= a block's side): at most 7 blocks.
-  for (int i = 0; i < 8 && walk.more != 0; ++i) {
+  const bool in_range = tsdf_axis_in_range(a.x) && tsdf_axis_in_range(a.y) &&
+                        tsdf_axis_in_range(a.z) && tsdf_axis_in_range(b.x) &&
+                        tsdf_axis_in_range(b.y) && tsdf_axis_in_range(b.z);
+  const bool valid = tsdf_depth_valid(d, p);
+  if (valid && !in_range) kg_atomic_add_u32(status, KG_TSDF_STATUS_OUT_OF_RANGE, 1u);
+  TsdfSegmentWalk walk = tsdf_segment_walk(in_range ? a : KG_FLOAT3(0.0f, 0.0f, 0.0f),
+                                           in_range ? b : KG_FLOAT3(0.0f, 0.0f, 0.0f));
+  walk.more = valid && in_range ? 1 : 0;
+  return walk;
+}
+
+// The segment is at most two blocks long (truncation <= a block's side): at most 7 blocks.
+#define KG_TSDF_WALK_BLOCKS 8
+
+// Pixel (x, y) with depth value d: every block of its walk inserted and stamped.
+KG_FORCE_INLINE void tsdf_touch_pixel(KG_BUFFER_PARAM(uint64_t, keys) KG_BUFFER_PARAM(uint, stamps)
+                                          KG_BUFFER_PARAM(uint, status) uint x,
+                                      uint y, uint d, TsdfParams p) {
+  TsdfSegmentWalk walk = tsdf_touch_walk(KG_BUFFER_ARG(status) x, y, d, p);
+  for (int i = 0; i < KG_TSDF_WALK_BLOCKS && walk.more != 0; ++i) {
     tsdf_touch_block(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(stamps) KG_BUFFER_ARG(status) walk.x, walk.y,
                      walk.z, p);
     walk = tsdf_segment_step(walk);
@@ -299,30 +315,29 @@ KG_INLINE uint tsdf_mean_channel(uint old_color, uint new_color, uint shift, flo
   const float a = KG_FLOAT((old_color >> shift) & 0xffu);
   const float b = KG_FLOAT((new_color >> shift) & 0xffu);
   const float mean = (a * old_weight + b) * share;
-  return min(KG_UINT(mean + 0.5f), 255u) << shift;
+  return KG_UINT(min(KG_INT(mean + 0.5f), 255)) << shift;  // int: a vector conversion
 }
 
 // Whether depth value d, seen at depth z of a voxel's centre, changes the voxel: a valid depth,
 // and the voxel not hidden behind the surface. The wrappers write only those voxels.
 KG_INLINE bool tsdf_fuses(uint d, float z, TsdfParams p) {
-  return tsdf_depth_valid(d, p) && KG_FLOAT(d) * p.metres_per_unit - z >= -p.truncation;
+  return KG_BOTH(tsdf_depth_valid(d, p), tsdf_metres(d, p) - z >= -p.truncation);
 }
 
 // The voxel after fusing depth value d (and colour) seen at depth z of the voxel's centre.
+// Selections instead of branches: the CPU wrapper runs it over a block as vector code.
 KG_INLINE TsdfVoxel tsdf_fuse(TsdfVoxel voxel, uint d, float z, uint color, TsdfParams p) {
-  if (!tsdf_fuses(d, z, p)) return voxel;
-  const float distance = KG_FLOAT(d) * p.metres_per_unit - z;
+  const bool fuses = tsdf_fuses(d, z, p);
+  const float distance = tsdf_metres(d, p) - z;
   const float value = min(1.0f, distance / p.truncation);
   const float share = 1.0f / (voxel.weight + 1.0f);  // the new measurement's share of the mean
+  const uint mean = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight, share) |
+                    tsdf_mean_channel(voxel.color, color, 8u, voxel.weight, share) |
+                    tsdf_mean_channel(voxel.color, color, 16u, voxel.weight, share);
   TsdfVoxel fused;
-  fused.tsdf = (voxel.tsdf * voxel.weight + value) * share;
-  fused.weight = min(voxel.weight + 1.0f, p.max_weight);
-  fused.color = voxel.color;
-  if (p.has_color != 0u) {
-    fused.color = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight, share) |
-                  tsdf_mean_channel(voxel.color, color, 8u, voxel.weight, share) |
-                  tsdf_mean_channel(voxel.color, color, 16u, voxel.weight, share);
-  }
+  fused.tsdf = fuses ? (voxel.tsdf * voxel.weight + value) * share : voxel.tsdf;
+  fused.weight = fuses ? min(voxel.weight + 1.0f, p.max_weight) : voxel.weight;
+  fused.color = KG_BOTH(fuses, p.has_color != 0u) ? mean : voxel.color;
   return fused;
 }
 

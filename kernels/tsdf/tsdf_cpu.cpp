@@ -1,9 +1,19 @@
 // CPU wrapper of kernels/tsdf/tsdf.h (the atomics of the rule are std::atomic_ref on the host).
+#include <array>
+
 #include "compute/cpu/cpu_kernel.hpp"
 #include "kernels/tsdf/tsdf.h"
 #include "kernels/tsdf/tsdf_band.h"
 
 namespace kartograf::kernels {
+
+// The loops below as vector code twice: for AVX2 (8 lanes, picked at load time where the CPU has
+// it) and for the baseline. Without FMA, so that both give the rule's results bit for bit.
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#define KG_CPU_VECTOR_CLONES __attribute__((target_clones("avx2", "default")))
+#else
+#define KG_CPU_VECTOR_CLONES
+#endif
 
 namespace {
 
@@ -11,17 +21,47 @@ using compute::detail::CpuDispatch;
 using compute::detail::for_each_item;
 using compute::detail::for_each_item_2d;
 
+// Blocks a thread touched recently (a direct-mapped cache: one compare): neighbouring rays cross
+// mostly the same blocks, and a block already inserted and stamped in this pass needs neither
+// again.
+class RecentBlocks {
+ public:
+  // Whether key was seen; remembers it either way.
+  bool seen(std::uint64_t key) {
+    std::uint64_t& entry = keys_[(key ^ (key >> 21) ^ (key >> 42)) % keys_.size()];
+    const bool hit = entry == key;
+    entry = key;
+    return hit;
+  }
+
+ private:
+  std::array<std::uint64_t, 64> keys_{};  // 0 is no key (KG_EMPTY_VOXEL_KEY)
+};
+
 void touch(const CpuDispatch& call) {
   const auto params = call.params_as<TsdfParams>();
   const auto* depth = call.buffer<const std::uint16_t>(0);
   auto* keys = call.buffer<uint64_t>(1);
   auto* stamps = call.buffer<uint>(2);
   auto* status = call.buffer<uint>(3);
-  for_each_item_2d(call, [&](uint gx, uint gy) {
-    const uint x = gx * params.step, y = gy * params.step;
-    if (x >= params.width || y >= params.height) return;
-    tsdf_touch_pixel(keys, stamps, status, x, y, depth[y * params.width + x], params);
-  });
+  const uint columns = (params.width + params.step - 1) / params.step;
+  const uint rows = (params.height + params.step - 1) / params.step;
+  compute::detail::for_each_chunk(
+      rows, std::size_t{rows} * columns, [&](std::size_t first, std::size_t last, std::size_t) {
+        RecentBlocks recent;
+        for (std::size_t row = first; row < last; ++row) {
+          const uint y = static_cast<uint>(row) * params.step;
+          for (uint x = 0; x < params.width; x += params.step) {
+            TsdfSegmentWalk walk =
+                tsdf_touch_walk(status, x, y, depth[y * params.width + x], params);
+            for (int i = 0; i < KG_TSDF_WALK_BLOCKS && walk.more != 0; ++i) {
+              if (!recent.seen(tsdf_block_key(walk.x, walk.y, walk.z)))
+                tsdf_touch_block(keys, stamps, status, walk.x, walk.y, walk.z, params);
+              walk = tsdf_segment_step(walk);
+            }
+          }
+        }
+      });
 }
 
 // One ordered loop: the blocks are numbered in slot order.
@@ -38,6 +78,66 @@ void assign(const CpuDispatch& call) {
   }
 }
 
+// Where the camera sees each voxel of the block with `key`: the rule's tsdf_voxel_in_camera and
+// tsdf_pixel_of, operation for operation (so bit for bit), as one branch-free loop over the block
+// that the compiler turns into vector code. floor() is a truncation there: the check before it
+// keeps only u, v >= 0.
+KG_CPU_VECTOR_CLONES void project_block(std::uint64_t key, const TsdfParams& p,
+                                        int* __restrict pixels, float* __restrict depths) {
+  const int bx = tsdf_key_axis(key, 0u) * KG_TSDF_BLOCK_SIDE;
+  const int by = tsdf_key_axis(key, 21u) * KG_TSDF_BLOCK_SIDE;
+  const int bz = tsdf_key_axis(key, 42u) * KG_TSDF_BLOCK_SIDE;
+  // Locals, so that the compiler knows the stores below leave them alone.
+  const float size = p.voxel_size, tx = p.tx, ty = p.ty, tz = p.tz;
+  const float r00 = p.r00, r01 = p.r01, r02 = p.r02, r10 = p.r10, r11 = p.r11, r12 = p.r12;
+  const float r20 = p.r20, r21 = p.r21, r22 = p.r22;
+  const float fx = p.fx, fy = p.fy, cx = p.cx, cy = p.cy;
+  const float width = static_cast<float>(p.width), height = static_cast<float>(p.height);
+  const int stride = static_cast<int>(p.width);
+  for (int cell = 0; cell < static_cast<int>(KG_TSDF_BLOCK_VOXELS); ++cell) {
+    const float wx = (static_cast<float>(bx + (cell & 7)) + 0.5f) * size - tx;
+    const float wy = (static_cast<float>(by + ((cell >> 3) & 7)) + 0.5f) * size - ty;
+    const float wz = (static_cast<float>(bz + (cell >> 6)) + 0.5f) * size - tz;
+    const float x = r00 * wx + r10 * wy + r20 * wz;
+    const float y = r01 * wx + r11 * wy + r21 * wz;
+    const float z = r02 * wx + r12 * wy + r22 * wz;
+    const float u = fx * x / z + cx + 0.5f;
+    const float v = fy * y / z + cy + 0.5f;
+    const bool seen = (z > 0.0f) & (u >= 0.0f) & (v >= 0.0f) & (u < width) & (v < height);
+    // Unseen voxels convert 0 instead: a float out of int's range would be undefined behaviour.
+    const int column = static_cast<int>(seen ? u : 0.0f), row = static_cast<int>(seen ? v : 0.0f);
+    pixels[cell] = seen ? row * stride + column : -1;
+    depths[cell] = z;
+  }
+}
+
+// The block's voxels after the frame: the rule's tsdf_fuse on each, as a loop without branches on
+// the data (vector code). A voxel the camera does not see reads depth 0, which the rule ignores.
+KG_CPU_VECTOR_CLONES void fuse_block(TsdfVoxel* __restrict voxels, const int* __restrict pixels,
+                                     const float* __restrict depths,
+                                     const std::uint16_t* __restrict depth,
+                                     const uint* __restrict colors, const TsdfParams& params) {
+  alignas(64) uint seen_depth[KG_TSDF_BLOCK_VOXELS];
+  alignas(64) uint seen_color[KG_TSDF_BLOCK_VOXELS];
+  for (uint cell = 0; cell < KG_TSDF_BLOCK_VOXELS; ++cell) {
+    const int pixel = pixels[cell];
+    seen_depth[cell] = pixel >= 0 ? depth[pixel] : 0u;
+    seen_color[cell] = pixel >= 0 && colors ? colors[pixel] : 0u;
+  }
+  const TsdfParams p = params;
+  for (uint cell = 0; cell < KG_TSDF_BLOCK_VOXELS; ++cell) {
+    TsdfVoxel voxel;  // field by field: the vectoriser takes no whole 12-byte structs
+    voxel.tsdf = voxels[cell].tsdf;
+    voxel.weight = voxels[cell].weight;
+    voxel.color = voxels[cell].color;
+    const TsdfVoxel fused = tsdf_fuse(voxel, seen_depth[cell], depths[cell], seen_color[cell], p);
+    voxels[cell].tsdf = fused.tsdf;
+    voxels[cell].weight = fused.weight;
+    voxels[cell].color = fused.color;
+  }
+}
+
+// Block by block: the projections first (vector code), then the voxels that change.
 void integrate(const CpuDispatch& call) {
   const auto params = call.params_as<TsdfParams>();
   const auto* depth = call.buffer<const std::uint16_t>(0);
@@ -45,13 +145,18 @@ void integrate(const CpuDispatch& call) {
   const auto* active_blocks = call.buffer<const uint>(2);
   const auto* block_keys = call.buffer<const uint64_t>(3);
   auto* voxels = call.buffer<TsdfVoxel>(4);
-  for_each_item(call, [&](uint i) {
-    if (i >= params.count) return;
-    const TsdfVoxelView view = tsdf_voxel_view(active_blocks, block_keys, i, params);
-    if (view.pixel < 0 || !tsdf_fuses(depth[view.pixel], view.z, params)) return;
-    const uint color = params.has_color != 0u ? colors[view.pixel] : 0u;
-    voxels[view.voxel] = tsdf_fuse(voxels[view.voxel], depth[view.pixel], view.z, color, params);
-  });
+  const std::size_t blocks = params.count / KG_TSDF_BLOCK_VOXELS;
+  compute::detail::for_each_chunk(
+      blocks, params.count, [&](std::size_t first, std::size_t last, std::size_t) {
+        alignas(64) int pixels[KG_TSDF_BLOCK_VOXELS];
+        alignas(64) float depths[KG_TSDF_BLOCK_VOXELS];
+        for (std::size_t b = first; b < last; ++b) {
+          const uint block = active_blocks[b];
+          project_block(block_keys[block], params, pixels, depths);
+          fuse_block(voxels + std::size_t{block} * KG_TSDF_BLOCK_VOXELS, pixels, depths, depth,
+                     params.has_color != 0u ? colors : nullptr, params);
+        }
+      });
 }
 
 void raycast(const CpuDispatch& call) {
