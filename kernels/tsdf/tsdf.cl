@@ -32,16 +32,25 @@ __kernel void tsdf_integrate(__global const ushort* depth, __global const uint* 
 
 __kernel void tsdf_raycast(__global const ulong* keys, __global const uint* slot_blocks,
                            __global const TsdfVoxel* voxels, __global float4* points,
-                           __global uint* colors, const TsdfParams params) {
+                           __global uint* colors, __global const uint* ranges,
+                           const TsdfParams params) {
   const uint x = get_global_id(0);
   const uint y = get_global_id(1);
   if (x >= params.width || y >= params.height) return;
   const uint index = y * params.width + x;
   const float min_depth = (float)params.min_units * params.metres_per_unit;
   const float max_depth = (float)params.max_units * params.metres_per_unit;
-  const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, min_depth, max_depth, params);
+  const TsdfDepthSpan span = tsdf_ray_span(ranges, x, y, min_depth, max_depth, params);
+  const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, span.near, span.far, params);
   points[index] = p;
   if (params.has_color != 0u) colors[index] = tsdf_color_at(keys, slot_blocks, voxels, p, params);
+}
+
+__kernel void tsdf_range(__global const ulong* block_keys, __global uint* ranges,
+                         const TsdfParams params) {
+  const uint i = get_global_id(0);
+  if (i >= params.count) return;
+  tsdf_range_block(ranges, block_keys[i], params);
 }
 
 __kernel void tsdf_band(__global const ulong* block_keys, __global const TsdfVoxel* voxels,

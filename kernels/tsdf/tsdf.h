@@ -341,6 +341,81 @@ KG_INLINE TsdfVoxel tsdf_fuse(TsdfVoxel voxel, uint d, float z, uint color, Tsdf
   return fused;
 }
 
+// ---- Ranges (before a ray cast): the image in tiles of KG_TSDF_TILE x KG_TSDF_TILE pixels, each
+// with the depths (in depth units) between which blocks can lie on its rays, so that a ray starts
+// at the first block instead of crossing empty space a block at a time. ranges[2 t] holds
+// 0xffffffff - nearest, ranges[2 t + 1] the farthest: all 0 is a tile without blocks.
+#define KG_TSDF_TILE 8u
+
+KG_INLINE uint tsdf_tile_columns(TsdfParams p) {
+  return (p.width + KG_TSDF_TILE - 1u) / KG_TSDF_TILE;
+}
+
+KG_INLINE uint tsdf_tile_count(TsdfParams p) {
+  return tsdf_tile_columns(p) * ((p.height + KG_TSDF_TILE - 1u) / KG_TSDF_TILE);
+}
+
+KG_STRUCT_BEGIN(TsdfTileBox)
+uint x0;  // tiles x0..x1, y0..y1; x0 > x1 where the block is out of view
+uint x1;
+uint y0;
+uint y1;
+uint near_units;  // its depths, widened to whole depth units
+uint far_units;
+KG_STRUCT_END(TsdfTileBox)
+
+// The tiles and depths the block with `key` can cover: its 8 corners' projections where all lie
+// in front of the camera (a box's image is inside its corners'), else the whole image.
+KG_INLINE TsdfTileBox tsdf_block_tiles(uint64_t key, TsdfParams p) {
+  const float side = p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE);
+  const float3 origin =
+      KG_FLOAT3(KG_FLOAT(tsdf_key_axis(key, 0u)), KG_FLOAT(tsdf_key_axis(key, 21u)),
+                KG_FLOAT(tsdf_key_axis(key, 42u))) *
+      side;
+  float near = 1e30f, far = -1e30f, u0 = 1e30f, u1 = -1e30f, v0 = 1e30f, v1 = -1e30f;
+  for (uint corner = 0u; corner < 8u; ++corner) {
+    const float3 offset =
+        KG_FLOAT3(KG_FLOAT(corner & 1u), KG_FLOAT((corner >> 1u) & 1u), KG_FLOAT(corner >> 2u));
+    const float3 c = tsdf_to_camera(origin + offset * side, p);
+    near = min(near, c.z);
+    far = max(far, c.z);
+    const float z = max(c.z, 1e-6f);
+    u0 = min(u0, p.fx * c.x / z + p.cx);
+    u1 = max(u1, p.fx * c.x / z + p.cx);
+    v0 = min(v0, p.fy * c.y / z + p.cy);
+    v1 = max(v1, p.fy * c.y / z + p.cy);
+  }
+  const float right = KG_FLOAT(p.width - 1u), bottom = KG_FLOAT(p.height - 1u);
+  const bool whole = !(near > 1e-4f);  // a corner at or behind the camera
+  const bool seen =
+      far > 0.0f && (whole || (u1 >= 0.0f && u0 <= right && v1 >= 0.0f && v0 <= bottom));
+  TsdfTileBox box;
+  box.x0 = whole ? 0u : KG_UINT(max(u0, 0.0f)) / KG_TSDF_TILE;
+  box.x1 = whole ? (p.width - 1u) / KG_TSDF_TILE : KG_UINT(min(u1, right)) / KG_TSDF_TILE;
+  box.y0 = whole ? 0u : KG_UINT(max(v0, 0.0f)) / KG_TSDF_TILE;
+  box.y1 = whole ? (p.height - 1u) / KG_TSDF_TILE : KG_UINT(min(v1, bottom)) / KG_TSDF_TILE;
+  box.x0 = seen ? box.x0 : 1u;
+  box.x1 = seen ? box.x1 : 0u;
+  box.near_units = KG_UINT(floor(max(near, 0.0f) / p.metres_per_unit));
+  box.far_units = KG_UINT(min(floor(max(far, 0.0f) / p.metres_per_unit) + 2.0f, 4.0e9f));
+  return box;
+}
+
+#if !defined(VULKAN) || defined(KG_TSDF_RANGE_PASS)
+// The shader declares ranges.
+KG_INLINE void tsdf_range_block(KG_BUFFER_PARAM(uint, ranges) uint64_t key, TsdfParams p) {
+  const TsdfTileBox box = tsdf_block_tiles(key, p);
+  const uint columns = tsdf_tile_columns(p);
+  for (uint ty = box.y0; ty <= box.y1 && box.x0 <= box.x1; ++ty) {
+    for (uint tx = box.x0; tx <= box.x1; ++tx) {
+      const uint tile = ty * columns + tx;
+      kg_atomic_max_u32(ranges, 2u * tile, 0xffffffffu - box.near_units);
+      kg_atomic_max_u32(ranges, 2u * tile + 1u, box.far_units);
+    }
+  }
+}
+#endif
+
 // ---- Ray casting: the shader declares keys, slot_blocks and voxels.
 #if !defined(VULKAN) || defined(KG_TSDF_READ_PASS)
 
@@ -430,11 +505,18 @@ KG_FORCE_INLINE float tsdf_trilinear(KG_BUFFER_PARAM(const uint64_t, keys)
   const float ax = g.x - fx, ay = g.y - fy, az = g.z - fz;
   const int x0 = KG_INT(fx), y0 = KG_INT(fy), z0 = KG_INT(fz);
   float sum = 0.0f;
+  // The corners mostly share a block: its lookup is kept.
+  uint64_t cached_key = KG_EMPTY_VOXEL_KEY;
+  uint cached_block = KG_TSDF_NO_BLOCK;
   for (uint corner = 0u; corner < 8u; ++corner) {
     const int dx = KG_INT(corner & 1u), dy = KG_INT((corner >> 1u) & 1u), dz = KG_INT(corner >> 2u);
-    const TsdfVoxel v =
-        tsdf_voxel_at(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) x0 + dx,
-                      y0 + dy, z0 + dz, p);
+    const int vx = x0 + dx, vy = y0 + dy, vz = z0 + dz;
+    const uint64_t key = tsdf_block_key(vx >> 3, vy >> 3, vz >> 3);
+    if (key != cached_key) {
+      cached_block = tsdf_find_block(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) key, p);
+      cached_key = key;
+    }
+    const TsdfVoxel v = tsdf_voxel_in(KG_BUFFER_ARG(voxels) cached_block, vx, vy, vz);
     if (v.weight <= 0.0f) return KG_NAN;
     const float weight =
         (dx == 1 ? ax : 1.0f - ax) * (dy == 1 ? ay : 1.0f - ay) * (dz == 1 ? az : 1.0f - az);
@@ -512,6 +594,23 @@ KG_FORCE_INLINE float4 tsdf_cast_ray(KG_BUFFER_PARAM(const uint64_t, keys)
     }
   }
   return KG_INVALID_POINT;
+}
+
+KG_STRUCT_BEGIN(TsdfDepthSpan)
+float near;  // metres along the optical axis; near > far: nothing to search
+float far;
+KG_STRUCT_END(TsdfDepthSpan)
+
+// The depths pixel (x, y)'s ray searches: its tile's range (the ray cast's shader declares
+// ranges too) within min_depth..max_depth.
+KG_INLINE TsdfDepthSpan tsdf_ray_span(KG_BUFFER_PARAM(const uint, ranges) uint x, uint y,
+                                      float min_depth, float max_depth, TsdfParams p) {
+  const uint tile = (y / KG_TSDF_TILE) * tsdf_tile_columns(p) + x / KG_TSDF_TILE;
+  const uint far_units = ranges[2u * tile + 1u];
+  TsdfDepthSpan span;
+  span.near = max(min_depth, KG_FLOAT(0xffffffffu - ranges[2u * tile]) * p.metres_per_unit);
+  span.far = far_units == 0u ? -1.0f : min(max_depth, KG_FLOAT(far_units) * p.metres_per_unit);
+  return span;
 }
 
 // The colour of the voxel at a ray cast's point c (camera frame).

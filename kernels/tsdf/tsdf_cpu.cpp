@@ -166,14 +166,25 @@ void raycast(const CpuDispatch& call) {
   const auto* voxels = call.buffer<const TsdfVoxel>(2);
   auto* points = call.buffer<float4>(3);
   auto* colors = call.buffer<uint>(4);
+  const auto* ranges = call.buffer<const uint>(5);
   const float min_depth = static_cast<float>(params.min_units) * params.metres_per_unit;
   const float max_depth = static_cast<float>(params.max_units) * params.metres_per_unit;
   for_each_item_2d(call, [&](uint x, uint y) {
     if (x >= params.width || y >= params.height) return;
     const uint index = y * params.width + x;
-    const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, min_depth, max_depth, params);
+    const TsdfDepthSpan span = tsdf_ray_span(ranges, x, y, min_depth, max_depth, params);
+    const float4 p = tsdf_cast_ray(keys, slot_blocks, voxels, x, y, span.near, span.far, params);
     points[index] = p;
     if (params.has_color != 0u) colors[index] = tsdf_color_at(keys, slot_blocks, voxels, p, params);
+  });
+}
+
+void range(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfParams>();
+  const auto* block_keys = call.buffer<const uint64_t>(0);
+  auto* ranges = call.buffer<uint>(1);
+  for_each_item(call, [&](uint i) {
+    if (i < params.count) tsdf_range_block(ranges, block_keys[i], params);
   });
 }
 
@@ -197,6 +208,7 @@ void register_tsdf_cpu(compute::detail::CpuKernelRegistry& registry) {
   registry.add("tsdf_assign", assign);
   registry.add("tsdf_integrate", integrate);
   registry.add("tsdf_raycast", raycast);
+  registry.add("tsdf_range", range);
   registry.add("tsdf_band", band);
 }
 

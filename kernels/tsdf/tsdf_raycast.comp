@@ -8,6 +8,7 @@ layout(std430, binding = 1) readonly buffer SlotBlocks { uint slot_blocks[]; };
 layout(std430, binding = 2) readonly buffer Voxels { TsdfVoxel voxels[]; };
 layout(std430, binding = 3) writeonly buffer Points { vec4 points[]; };
 layout(std430, binding = 4) writeonly buffer Colors { uint colors[]; };  // optional
+layout(std430, binding = 5) readonly buffer Ranges { uint ranges[]; };    // the tiles' depths
 
 #define KG_VOXEL_HASH_FIND
 #define KG_TSDF_READ_PASS
@@ -22,7 +23,8 @@ void main() {
   const uint index = pixel.y * params.width + pixel.x;
   const float min_depth = float(params.min_units) * params.metres_per_unit;
   const float max_depth = float(params.max_units) * params.metres_per_unit;
-  const vec4 p = tsdf_cast_ray(pixel.x, pixel.y, min_depth, max_depth, params);
+  const TsdfDepthSpan span = tsdf_ray_span(pixel.x, pixel.y, min_depth, max_depth, params);
+  const vec4 p = tsdf_cast_ray(pixel.x, pixel.y, span.near, span.far, params);
   points[index] = p;
   if (params.has_color != 0u) colors[index] = tsdf_color_at(p, params);
 }

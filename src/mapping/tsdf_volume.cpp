@@ -24,6 +24,7 @@ constexpr compute::KernelSpec kTouchKernel{"tsdf_touch", KG_TSDF_LOCAL_2D, KG_TS
 constexpr compute::KernelSpec kAssignKernel{"tsdf_assign", KG_TSDF_LOCAL_X};
 constexpr compute::KernelSpec kIntegrateKernel{"tsdf_integrate", KG_TSDF_LOCAL_X};
 constexpr compute::KernelSpec kRaycastKernel{"tsdf_raycast", KG_TSDF_LOCAL_2D, KG_TSDF_LOCAL_2D};
+constexpr compute::KernelSpec kRangeKernel{"tsdf_range", KG_TSDF_LOCAL_X};
 // 2^23 blocks of 512 voxels keep every voxel index below 2^32.
 constexpr std::size_t kMaxBlocks = std::size_t{1} << 23;
 
@@ -71,6 +72,20 @@ int touch_step_for(const TsdfVolumeParams& params, const PinholeIntrinsics& came
   if (params.touch_step > 0) return params.touch_step;
   const double pixels = 2 * params.voxel_size * std::min(camera.fx, camera.fy) / range.max_metres;
   return std::clamp(static_cast<int>(std::floor(pixels)), 1, 4);
+}
+
+// Fills `ranges` with the tiles' depth ranges for a ray cast with parameters p over the first
+// `blocks` blocks of the pool (kernels/tsdf/tsdf.h).
+void cast_ranges(const compute::Context& context, const compute::Buffer<std::uint64_t>& block_keys,
+                 std::size_t blocks, kernels::TsdfParams p,
+                 compute::Buffer<std::uint32_t>& ranges) {
+  const std::size_t values = 2 * std::size_t{kernels::tsdf_tile_count(p)};
+  if (ranges.size() != values) ranges = compute::Buffer<std::uint32_t>(context, values);
+  ranges.fill_zero();
+  if (blocks == 0) return;
+  p.count = static_cast<std::uint32_t>(blocks);
+  compute::dispatch(context, kRangeKernel, {block_keys, ranges}, p,
+                    {compute::groups_for(blocks, KG_TSDF_LOCAL_X), 1});
 }
 
 std::string blocks_text(std::size_t blocks) {
@@ -233,9 +248,10 @@ void TsdfVolume::raycast(const PinholeIntrinsics& camera, const geometry::DepthR
   // Enough steps of one voxel each to cross the whole range.
   const double span = range.max_metres - range.min_metres;
   p.step = static_cast<std::uint32_t>(std::min(1e6, std::ceil(span / params_.voxel_size) + 2));
+  cast_ranges(*context_, block_keys_, std::min(block_count_, params_.max_blocks), p, ranges_);
   compute::dispatch(*context_, kRaycastKernel,
                     {keys_, slot_blocks_, voxels_, points.buffer(),
-                     colors ? compute::BufferArg(*colors) : compute::BufferArg()},
+                     colors ? compute::BufferArg(*colors) : compute::BufferArg(), ranges_},
                     p,
                     {compute::groups_for(camera.width, KG_TSDF_LOCAL_2D),
                      compute::groups_for(camera.height, KG_TSDF_LOCAL_2D)});

@@ -150,6 +150,8 @@ class TsdfVolume {
   compute::Buffer<std::uint32_t> status_;
   compute::Buffer<TsdfVoxel> voxels_;  // the pool: 512 per block
   FrameUpload upload_;                 // the host overload's frames
+  // The ray cast's tiles: where blocks can lie on their rays (refilled by each ray cast).
+  mutable compute::Buffer<std::uint32_t> ranges_;
 };
 
 }  // namespace kartograf::mapping
