@@ -38,6 +38,23 @@ class RecentBlocks {
   std::array<std::uint64_t, 64> keys_{};  // 0 is no key (KG_EMPTY_VOXEL_KEY)
 };
 
+// Row y's touching pixels. A pixel without a valid depth has no walk: skipped before the ray's
+// set-up.
+KG_CPU_VECTOR_CLONES void touch_row(const std::uint16_t* depth, uint64_t* keys, uint* stamps,
+                                    uint* status, uint y, const TsdfParams& params,
+                                    RecentBlocks& recent) {
+  for (uint x = 0; x < params.width; x += params.step) {
+    const uint d = depth[y * params.width + x];
+    if (!tsdf_depth_valid(d, params)) continue;
+    TsdfSegmentWalk walk = tsdf_touch_walk(status, x, y, d, params);
+    for (int i = 0; i < KG_TSDF_WALK_BLOCKS && walk.more != 0; ++i) {
+      if (!recent.seen(tsdf_block_key(walk.x, walk.y, walk.z)))
+        tsdf_touch_block(keys, stamps, status, walk.x, walk.y, walk.z, params);
+      walk = tsdf_segment_step(walk);
+    }
+  }
+}
+
 void touch(const CpuDispatch& call) {
   const auto params = call.params_as<TsdfParams>();
   const auto* depth = call.buffer<const std::uint16_t>(0);
@@ -49,18 +66,9 @@ void touch(const CpuDispatch& call) {
   compute::detail::for_each_chunk(
       rows, std::size_t{rows} * columns, [&](std::size_t first, std::size_t last, std::size_t) {
         RecentBlocks recent;
-        for (std::size_t row = first; row < last; ++row) {
-          const uint y = static_cast<uint>(row) * params.step;
-          for (uint x = 0; x < params.width; x += params.step) {
-            TsdfSegmentWalk walk =
-                tsdf_touch_walk(status, x, y, depth[y * params.width + x], params);
-            for (int i = 0; i < KG_TSDF_WALK_BLOCKS && walk.more != 0; ++i) {
-              if (!recent.seen(tsdf_block_key(walk.x, walk.y, walk.z)))
-                tsdf_touch_block(keys, stamps, status, walk.x, walk.y, walk.z, params);
-              walk = tsdf_segment_step(walk);
-            }
-          }
-        }
+        for (std::size_t row = first; row < last; ++row)
+          touch_row(depth, keys, stamps, status, static_cast<uint>(row) * params.step, params,
+                    recent);
       });
 }
 
