@@ -1,10 +1,11 @@
 #include "kartograf/mapping/tsdf_mesh.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cmath>
 #include <cstdlib>
 #include <string>
-#include <unordered_map>
+#include <vector>
 
 #include "kartograf/core/error.hpp"
 
@@ -39,20 +40,80 @@ std::uint32_t mix_colors(std::uint32_t a, std::uint32_t b, float t) {
   return out;
 }
 
+// Vertex indices by edge key: open addressing with linear probing (a key is never 0). Against
+// std::unordered_map: no allocation per entry, and a probe stays in one cache line.
+class EdgeIndex {
+ public:
+  // The index stored for key; where key is new, `next` is stored and inserted set.
+  int find_or_add(std::uint64_t key, int next, bool& inserted) {
+    if ((count_ + 1) * 2 > keys_.size()) grow();
+    const std::size_t mask = keys_.size() - 1;
+    for (std::size_t slot = spread(key) & mask;; slot = (slot + 1) & mask) {
+      if (keys_[slot] == key) {
+        inserted = false;
+        return values_[slot];
+      }
+      if (keys_[slot] == 0) {
+        keys_[slot] = key;
+        values_[slot] = next;
+        ++count_;
+        inserted = true;
+        return next;
+      }
+    }
+  }
+
+ private:
+  static std::size_t spread(std::uint64_t key) {
+    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 17);
+  }
+  void grow() {
+    std::vector<std::uint64_t> keys(std::max<std::size_t>(keys_.size() * 2, 1 << 16), 0);
+    std::vector<int> values(keys.size());
+    const std::size_t mask = keys.size() - 1;
+    for (std::size_t i = 0; i < keys_.size(); ++i) {
+      if (keys_[i] == 0) continue;
+      std::size_t slot = spread(keys_[i]) & mask;
+      while (keys[slot] != 0) slot = (slot + 1) & mask;
+      keys[slot] = keys_[i];
+      values[slot] = values_[i];
+    }
+    keys_ = std::move(keys);
+    values_ = std::move(values);
+  }
+  std::vector<std::uint64_t> keys_;
+  std::vector<int> values_;
+  std::size_t count_ = 0;
+};
+
 class MeshBuilder {
  public:
   MeshBuilder(const TsdfBlocks& blocks, const MeshParams& params)
       : blocks_(blocks), params_(params) {}
 
-  // The cell whose lowest corner is voxel `low` of block `block` (local coordinates).
+  // The blocks a cell of `block` can reach: the block itself and those one step up on each
+  // combination of axes (index dx + 2 dy + 4 dz), -1 where none.
+  void enter_block(std::size_t block) {
+    for (int c = 0; c < 8; ++c)
+      neighbours_[c] = blocks_.find(blocks_.coords[block] + corner_offset(c));
+  }
+
+  // The cell whose lowest corner is voxel `low` of the block last entered (local coordinates).
   void cell(std::size_t block, const Eigen::Vector3i& local) {
+    std::array<const TsdfVoxel*, 8> voxels{};
+    bool any_inside = false, any_outside = false;
+    for (int c = 0; c < 8; ++c) {
+      voxels[c] = corner_voxel(local + corner_offset(c));
+      if (!voxels[c]) return;
+      (voxels[c]->tsdf < 0 ? any_inside : any_outside) = true;
+    }
+    if (!any_inside || !any_outside) return;  // no corner on the other side: no surface
     std::array<Corner, 8> corners;
     for (int c = 0; c < 8; ++c) {
+      if (voxels[c]->weight < params_.min_weight) return;
       const Eigen::Vector3i voxel =
           blocks_.coords[block] * kTsdfBlockSide + local + corner_offset(c);
-      const TsdfVoxel* v = corner_voxel(block, local + corner_offset(c), voxel);
-      if (!v || v->weight < params_.min_weight) return;
-      corners[c] = {voxel, v->tsdf, v->color};
+      corners[c] = {voxel, voxels[c]->tsdf, voxels[c]->color};
     }
     for (const auto& t : kTetrahedra) {
       tetrahedron({corners[t[0]], corners[t[1]], corners[t[2]], corners[t[3]]});
@@ -62,12 +123,15 @@ class MeshBuilder {
   TriangleMesh take() { return std::move(mesh_); }
 
  private:
-  const TsdfVoxel* corner_voxel(std::size_t block, const Eigen::Vector3i& local,
-                                const Eigen::Vector3i& voxel) const {
-    if ((local.array() < kTsdfBlockSide).all()) {
-      return &blocks_.voxels[block * kTsdfBlockVoxels + local.x() + 8 * local.y() + 64 * local.z()];
-    }
-    return blocks_.voxel(voxel);
+  // Voxel `local` (0..8 on each axis) of the entered block, past its upper faces in the
+  // neighbours; null where no block holds it.
+  const TsdfVoxel* corner_voxel(const Eigen::Vector3i& local) const {
+    const int x = local.x() >> 3, y = local.y() >> 3, z = local.z() >> 3;
+    const std::ptrdiff_t block = neighbours_[x + 2 * y + 4 * z];
+    if (block < 0) return nullptr;
+    const Eigen::Vector3i inner = local.array() - kTsdfBlockSide * Eigen::Array3i(x, y, z);
+    return &blocks_.voxels[static_cast<std::size_t>(block) * kTsdfBlockVoxels + inner.x() +
+                           8 * inner.y() + 64 * inner.z()];
   }
 
   // The vertex on the edge between two corners, made once (keyed by its lower end: the other is
@@ -83,14 +147,15 @@ class MeshBuilder {
           static_cast<std::uint64_t>(biased.z()) << 40)
          << 3) |
         static_cast<std::uint64_t>(step.x() | step.y() << 1 | step.z() << 2);
-    const auto [it, inserted] = edges_.try_emplace(key, static_cast<int>(mesh_.vertices.size()));
+    bool inserted = false;
+    const int index = edges_.find_or_add(key, static_cast<int>(mesh_.vertices.size()), inserted);
     if (inserted) {
       const float t = a.value / (a.value - b.value);
       const Eigen::Vector3f p = a.voxel.cast<float>() + t * step.cast<float>();
       mesh_.vertices.push_back((p.array() + 0.5f) * static_cast<float>(blocks_.voxel_size));
       mesh_.colors.push_back(mix_colors(a.color, b.color, t));
     }
-    return it->second;
+    return index;
   }
 
   bool is_jump(const Corner& a, const Corner& b) const {
@@ -138,7 +203,8 @@ class MeshBuilder {
   const TsdfBlocks& blocks_;
   MeshParams params_;
   TriangleMesh mesh_;
-  std::unordered_map<std::uint64_t, int> edges_;
+  EdgeIndex edges_;
+  std::array<std::ptrdiff_t, 8> neighbours_{};
 };
 
 }  // namespace
@@ -156,6 +222,7 @@ TriangleMesh extract_mesh(const TsdfBlocks& blocks, const MeshParams& params) {
   }
   MeshBuilder builder(blocks, params);
   for (std::size_t b = 0; b < blocks.size(); ++b) {
+    builder.enter_block(b);
     for (int z = 0; z < kTsdfBlockSide; ++z) {
       for (int y = 0; y < kTsdfBlockSide; ++y) {
         for (int x = 0; x < kTsdfBlockSide; ++x) builder.cell(b, {x, y, z});
