@@ -6,8 +6,8 @@
 //                                      (frames 5-39, after 5 that build the volume)
 //   tsdf_raycast/<backend>/<voxel>     depth and colour of the 40-frame volume from a frame's pose
 //   tsdf_mesh/<backend>/<voxel>        download and marching tetrahedra of that volume (host)
-//   tsdf_esdf/<backend>/<voxel>        its height-band occupancy on the device (the 7-Scenes
-//                                      world's z as up) and the grid's ESDF (host)
+//   tsdf_esdf/<backend>/<voxel>        its height-band occupancy and the grid's ESDF, both on the
+//                                      device (the 7-Scenes world's z as up)
 // KARTOGRAF_DATA_DIR overrides the data folder; KARTOGRAF_BENCH_BACKENDS=cpu,... the backends.
 // bench/peer/tsdf_side_by_side.sh runs this and Open3D in one go and prints the ratios.
 #include <benchmark/benchmark.h>
@@ -101,8 +101,7 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
     } else if (operation == Operation::mesh) {
       benchmark::DoNotOptimize(mapping::extract_mesh(volume->download()));
     } else {
-      const OccupancyGrid grid = mapping::tsdf_occupancy(*volume, {});
-      benchmark::DoNotOptimize(mapping::occupancy_esdf(grid));
+      benchmark::DoNotOptimize(mapping::tsdf_band_maps(*volume, {}));
     }
   }
   state.counters["blocks"] = static_cast<double>(volume->block_count());

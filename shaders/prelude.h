@@ -17,7 +17,7 @@
 //   atomics   kg_atomic_add_u32, kg_atomic_add_i64, kg_atomic_max_u32 (buffer, index, value),
 //             kg_atomic_cas_u64(buffer, index, compare, value) -> old value; on KG_BUFFER_PARAMs
 //   logic     KG_BOTH(a, b): a and b without a branch (C++: &, so that CPU loops vectorise)
-//   constants KG_NAN, KG_INVALID_POINT (all-NaN float4)
+//   constants KG_NAN, KG_INFINITY, KG_INVALID_POINT (all-NaN float4)
 //   functions KG_INLINE before each function (KG_FORCE_INLINE: a large per-item one); arguments
 //             by value (GLSL has no pointers), except
 //             KG_ACCUMULATOR(type, name, size): a leading parameter, the array the function adds to

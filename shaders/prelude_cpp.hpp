@@ -127,6 +127,7 @@ inline uint64_t kg_atomic_cas_u64(uint64_t* buffer, uint index, uint64_t compare
   }                         \
   ;
 #define KG_NAN std::numeric_limits<float>::quiet_NaN()
+#define KG_INFINITY std::numeric_limits<float>::infinity()
 // Both conditions, evaluated without a branch: loops over such rules become vector code.
 #define KG_BOTH(a, b) (static_cast<bool>(a) & static_cast<bool>(b))
 

@@ -45,6 +45,7 @@
 #define kg_xyz(v) (v).xyz
 
 #define KG_NAN uintBitsToFloat(0x7fc00000u)
+#define KG_INFINITY uintBitsToFloat(0x7f800000u)
 #define KG_BOTH(a, b) ((a) && (b))
 
 // Atomics on a buffer's element (the 64-bit ones need GL_EXT_shader_atomic_int64 in the shader).

@@ -39,6 +39,7 @@ typedef ulong uint64_t;
 #define kg_xyz(v) (v).xyz
 
 #define KG_NAN NAN
+#define KG_INFINITY INFINITY
 #define KG_BOTH(a, b) ((a) && (b))
 
 // Atomics on a buffer's element (the 64-bit ones need cl_khr_int64_base_atomics, see common.cl).

@@ -8,7 +8,9 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <random>
 #include <set>
+#include <string>
 #include <tuple>
 #include <vector>
 
@@ -304,6 +306,21 @@ TEST_P(TsdfVolumeTest, EqualsTheCpuBackendOnSevenScenesFrames) {
 
 // The band's occupancy on the device against the host's on a downloaded copy, in a level frame
 // turned by `roll` degrees about x; both cell states must occur.
+// Device and host ESDFs: equal squared distances, so equal values but for the device's square root
+// (Vulkan allows a few units in the last place).
+void expect_same_esdf(const Image<float>& device, const Image<float>& host,
+                      const std::string& what) {
+  ASSERT_EQ(device.width(), host.width()) << what;
+  ASSERT_EQ(device.height(), host.height()) << what;
+  std::size_t differing = 0;
+  for (std::size_t i = 0; i < host.pixels().size(); ++i) {
+    const float a = device.pixels()[i], b = host.pixels()[i];
+    const bool same = std::isinf(b) ? a == b : std::abs(a - b) <= 1e-6f * std::abs(b);
+    differing += same ? 0 : 1;
+  }
+  EXPECT_EQ(differing, 0u) << what << ": " << differing << " of " << host.pixels().size();
+}
+
 void expect_same_band(const TsdfVolume& volume, double roll, double floor_z, const char* what) {
   mapping::TsdfSliceParams params;
   params.world_to_level.linear() =
@@ -330,6 +347,35 @@ void expect_same_band(const TsdfVolume& volume, double roll, double floor_z, con
   EXPECT_GT(free, 20u) << what;
   // A voxel centre within rounding of a cell's edge may fall on either side (float against double).
   EXPECT_LE(differing, marked / 200 + 2) << what << ": " << differing << " of " << marked;
+  // The grid and its ESDF both on the device: the same grid, and the host's ESDF of it.
+  const mapping::TsdfBandMaps maps = mapping::tsdf_band_maps(volume, params);
+  ASSERT_TRUE(std::ranges::equal(maps.occupancy.cells.pixels(), device.cells.pixels())) << what;
+  expect_same_esdf(maps.esdf, mapping::occupancy_esdf(device), what);
+}
+
+// The device ESDF (kernels/esdf) against the host's on random grids of every shape, with and
+// without occupied cells, and all occupied.
+TEST_P(TsdfVolumeTest, EsdfOnTheDeviceEqualsTheHostsOnRandomGrids) {
+  std::mt19937 random(24);
+  const std::pair<int, int> sizes[] = {{1, 1}, {1, 37}, {53, 1}, {64, 48}, {97, 131}, {200, 150}};
+  for (const auto& [cols, rows] : sizes) {
+    for (const double occupied_share : {0.0, 0.002, 0.05, 0.3, 1.0}) {
+      OccupancyGrid grid;
+      grid.resolution = 0.05;
+      grid.cells = Image<CellState>(cols, rows, CellState::unknown);
+      std::uniform_real_distribution<double> uniform(0, 1);
+      for (CellState& c : grid.cells.pixels()) {
+        const double u = uniform(random);
+        c = u < occupied_share ? CellState::occupied
+            : u < 0.6          ? CellState::free
+                               : CellState::unknown;
+      }
+      const std::string what =
+          std::to_string(cols) + "x" + std::to_string(rows) + ", " + std::to_string(occupied_share);
+      expect_same_esdf(mapping::occupancy_esdf(context(), grid), mapping::occupancy_esdf(grid),
+                       what);
+    }
+  }
 }
 
 TEST_P(TsdfVolumeTest, BandOccupancyEqualsTheHostsOnSyntheticAndRealFields) {

@@ -154,13 +154,17 @@ void ray_cast(Workspace& w, const mapping::TsdfVolume& volume) {
   volume.raycast(w.frames.camera, geometry::DepthRange{}, Eigen::Isometry3d::Identity(), w.cast);
 }
 
-// The height band's occupancy on the device (the camera's frame turned so that -y is up).
-void band_occupancy(Workspace& w, const mapping::TsdfVolume& volume) {
+// The height band's occupancy on the device (the camera's frame turned so that -y is up), and
+// with `esdf` its ESDF there too.
+void band_occupancy(Workspace& w, const mapping::TsdfVolume& volume, bool esdf) {
   ensure_tsdf(w);
   mapping::TsdfSliceParams params;
   params.world_to_level.linear() =
       Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitX()).toRotationMatrix();
-  mapping::tsdf_occupancy(volume, params);
+  if (esdf)
+    mapping::tsdf_band_maps(volume, params);
+  else
+    mapping::tsdf_occupancy(volume, params);
 }
 
 void build_current(Workspace& w) {
@@ -245,7 +249,8 @@ const std::vector<Operation>& frame_operations() {
       {"TSDF ray cast 1 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_fine); }},
       {"TSDF integrate 5 cm", 0, [](Workspace& w) { integrate(w, w.tsdf_coarse); }},
       {"TSDF ray cast 5 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_coarse); }},
-      {"TSDF band occupancy 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine); }},
+      {"TSDF band occupancy 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine, false); }},
+      {"TSDF band + ESDF 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine, true); }},
       {"region growing (Lab)", 0,
        [](Workspace& w) {
          w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});

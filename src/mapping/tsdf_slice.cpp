@@ -9,6 +9,7 @@
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/geometry/distance_transform.hpp"
+#include "kernels/esdf/esdf.h"
 #include "kernels/tsdf/tsdf_band.h"
 
 namespace kartograf::mapping {
@@ -16,6 +17,10 @@ namespace kartograf::mapping {
 namespace {
 
 constexpr compute::KernelSpec kBandKernel{"tsdf_band", KG_TSDF_LOCAL_X, 1};
+constexpr compute::KernelSpec kEsdfSeedKernel{"esdf_seed", KG_ESDF_LOCAL_X, 1};
+constexpr compute::KernelSpec kEsdfEnvelopeKernel{"esdf_envelope", KG_ESDF_LOCAL_X, 1};
+constexpr compute::KernelSpec kEsdfWriteKernel{"esdf_write", KG_ESDF_LOCAL_X, 1};
+static_assert(KG_ESDF_OCCUPIED == KG_TSDF_BAND_OCCUPIED);
 
 // The centres of the surface voxels, in the level frame.
 std::vector<Eigen::Vector3d> surface_points(const TsdfBlocks& blocks,
@@ -120,7 +125,11 @@ OccupancyGrid tsdf_occupancy(const TsdfBlocks& blocks, const TsdfSliceParams& pa
   return grid;
 }
 
-OccupancyGrid tsdf_occupancy(const TsdfVolume& volume, const TsdfSliceParams& params) {
+namespace {
+
+// The band's grid over the volume's blocks (cells still unknown) and its marks on the device.
+compute::Buffer<std::uint32_t> band_cells(const TsdfVolume& volume, const TsdfSliceParams& params,
+                                          OccupancyGrid& grid) {
   params.validate();
   const std::size_t n = std::min(volume.block_count(), volume.params().max_blocks);
   std::vector<std::uint64_t> keys(n);
@@ -129,22 +138,101 @@ OccupancyGrid tsdf_occupancy(const TsdfVolume& volume, const TsdfSliceParams& pa
   for (const std::uint64_t key : keys)
     coords.emplace_back(kernels::tsdf_key_axis(key, 0), kernels::tsdf_key_axis(key, 21),
                         kernels::tsdf_key_axis(key, 42));
-  OccupancyGrid grid = band_grid(coords, volume.params().voxel_size, params);
-  if (grid.width() == 0) return grid;
+  grid = band_grid(coords, volume.params().voxel_size, params);
   const compute::Context& context = volume.context();
-  compute::Buffer<std::uint32_t> cells(context, grid.cells.pixels().size());
+  compute::Buffer<std::uint32_t> cells(context, std::max<std::size_t>(grid.cells.size(), 1));
   cells.fill_zero();
+  if (grid.width() == 0) return cells;
   const kernels::TsdfBandParams p = band_params(volume.params(), grid, params, n);
   compute::dispatch(context, kBandKernel,
                     {volume.device_block_keys(), volume.device_voxels(), cells}, p,
                     {compute::groups_for(p.count, KG_TSDF_LOCAL_X), 1});
-  const std::vector<std::uint32_t> marks = cells.to_vector();
-  for (std::size_t i = 0; i < marks.size(); ++i) {
+  return cells;
+}
+
+void set_states(const std::vector<std::uint32_t>& marks, OccupancyGrid& grid) {
+  for (std::size_t i = 0; i < grid.cells.size(); ++i) {
     grid.cells.pixels()[i] = marks[i] == KG_TSDF_BAND_OCCUPIED ? CellState::occupied
                              : marks[i] == KG_TSDF_BAND_FREE   ? CellState::free
                                                                : CellState::unknown;
   }
+}
+
+// One transform of kernels/esdf/esdf.h (to the occupied cells or to the others) into `esdf`.
+void esdf_transform(const compute::Context& context, const compute::Buffer<std::uint32_t>& cells,
+                    int cols, int rows, kernels::EsdfParams p, compute::Buffer<float>& esdf) {
+  const std::size_t n = std::size_t(cols) * rows;
+  compute::Buffer<std::int64_t> a(context, n), b(context, n), start_num(context, n),
+      start_den(context, n);
+  compute::Buffer<std::uint32_t> apex(context, n);
+  p.count = static_cast<std::uint32_t>(n);
+  compute::dispatch(context, kEsdfSeedKernel, {cells, a}, p,
+                    {compute::groups_for(n, KG_ESDF_LOCAL_X), 1});
+  const auto lines = [&](int count, int length, int line_stride, int cell_stride,
+                         const compute::Buffer<std::int64_t>& in,
+                         compute::Buffer<std::int64_t>& out) {
+    kernels::EsdfParams q = p;
+    q.count = static_cast<std::uint32_t>(count);
+    q.line_cells = static_cast<std::uint32_t>(length);
+    q.line_stride = static_cast<std::uint32_t>(line_stride);
+    q.cell_stride = static_cast<std::uint32_t>(cell_stride);
+    compute::dispatch(context, kEsdfEnvelopeKernel, {in, out, apex, start_num, start_den}, q,
+                      {compute::groups_for(std::size_t(count), KG_ESDF_LOCAL_X), 1});
+  };
+  lines(cols, rows, 1, cols, a, b);  // columns
+  lines(rows, cols, cols, 1, b, a);  // rows
+  compute::dispatch(context, kEsdfWriteKernel, {a, cells, esdf}, p,
+                    {compute::groups_for(n, KG_ESDF_LOCAL_X), 1});
+}
+
+// The ESDF of a grid of band marks (row-major, cols x rows) on their device.
+Image<float> device_esdf(const compute::Context& context,
+                         const compute::Buffer<std::uint32_t>& cells, int cols, int rows,
+                         double resolution) {
+  Image<float> out(cols, rows);
+  if (out.empty()) return out;
+  compute::Buffer<float> esdf(context, out.pixels().size());
+  esdf.fill_zero();
+  kernels::EsdfParams p{};
+  p.resolution = static_cast<float>(resolution);
+  for (const std::uint32_t to_occupied : {1u, 0u}) {
+    p.to_occupied = to_occupied;
+    esdf_transform(context, cells, cols, rows, p, esdf);
+  }
+  esdf.download(out.pixels());
+  return out;
+}
+
+}  // namespace
+
+OccupancyGrid tsdf_occupancy(const TsdfVolume& volume, const TsdfSliceParams& params) {
+  OccupancyGrid grid;
+  const compute::Buffer<std::uint32_t> cells = band_cells(volume, params, grid);
+  if (grid.width() > 0) set_states(cells.to_vector(), grid);
   return grid;
+}
+
+TsdfBandMaps tsdf_band_maps(const TsdfVolume& volume, const TsdfSliceParams& params) {
+  TsdfBandMaps maps;
+  const compute::Buffer<std::uint32_t> cells = band_cells(volume, params, maps.occupancy);
+  if (maps.occupancy.width() == 0) return maps;
+  set_states(cells.to_vector(), maps.occupancy);
+  maps.esdf = device_esdf(volume.context(), cells, maps.occupancy.width(), maps.occupancy.height(),
+                          maps.occupancy.resolution);
+  return maps;
+}
+
+Image<float> occupancy_esdf(const compute::Context& context, const OccupancyGrid& grid) {
+  std::vector<std::uint32_t> marks(grid.cells.size());
+  for (std::size_t i = 0; i < marks.size(); ++i) {
+    const CellState state = grid.cells.pixels()[i];
+    marks[i] = state == CellState::occupied ? KG_TSDF_BAND_OCCUPIED
+               : state == CellState::free   ? KG_TSDF_BAND_FREE
+                                            : 0u;
+  }
+  if (marks.empty()) return Image<float>(grid.width(), grid.height());
+  const auto cells = compute::Buffer<std::uint32_t>::from_host(context, marks);
+  return device_esdf(context, cells, grid.width(), grid.height(), grid.resolution);
 }
 
 Image<float> occupancy_esdf(const OccupancyGrid& grid) {

@@ -285,8 +285,9 @@ MapPipelineResult Mapper::State::complete(mapping::SlamResult slam_result) {
   mapping::TsdfSliceParams slice = params.slice;
   slice.world_to_level = result.map_from_slam;
   slice.floor_z = 0;
-  result.band_occupancy = mapping::tsdf_occupancy(volume.volume(), slice);  // on the device
-  result.esdf = mapping::occupancy_esdf(result.band_occupancy);
+  mapping::TsdfBandMaps band = mapping::tsdf_band_maps(volume.volume(), slice);  // on the device
+  result.band_occupancy = std::move(band.occupancy);
+  result.esdf = std::move(band.esdf);
   result.volume = volume.stats();
   result.slam.timing.map_seconds = result.volume.fusion_seconds;
   result.timings.push_back({"volume", seconds_since(start)});

@@ -44,5 +44,16 @@ OccupancyGrid tsdf_occupancy(const TsdfVolume& volume, const TsdfSliceParams& pa
 // minus the distance to the nearest non-occupied cell inside occupied ones; +infinity everywhere
 // when nothing is occupied.
 Image<float> occupancy_esdf(const OccupancyGrid& grid);
+// The same on a context's device (kernels/esdf: the exact transform in integers, so equal to the
+// host's but for the device's square root).
+Image<float> occupancy_esdf(const compute::Context& context, const OccupancyGrid& grid);
+
+// The band's grid and its ESDF, both made on the field's device: only the block keys and the two
+// results cross to the host.
+struct TsdfBandMaps {
+  OccupancyGrid occupancy;
+  Image<float> esdf;
+};
+TsdfBandMaps tsdf_band_maps(const TsdfVolume& volume, const TsdfSliceParams& params);
 
 }  // namespace kartograf::mapping
