@@ -6,6 +6,7 @@
 //                                      (frames 5-39, after 5 that build the volume)
 //   tsdf_raycast/<backend>/<voxel>     depth and colour of the 40-frame volume from a frame's pose
 //   tsdf_mesh/<backend>/<voxel>        download and marching tetrahedra of that volume (host)
+//   tsdf_mesh_device/<backend>/<voxel> the same mesh made on the device, joined on the host
 //   tsdf_esdf/<backend>/<voxel>        its height-band occupancy and the grid's ESDF, both on the
 //                                      device (the 7-Scenes world's z as up)
 // KARTOGRAF_DATA_DIR overrides the data folder; KARTOGRAF_BENCH_BACKENDS=cpu,... the backends.
@@ -76,7 +77,7 @@ std::unique_ptr<mapping::TsdfVolume> fused(const compute::Context& context, doub
   return volume;
 }
 
-enum class Operation { integrate, raycast, mesh, esdf };
+enum class Operation { integrate, raycast, mesh, device_mesh, esdf };
 
 void run_case(benchmark::State& state, compute::BackendKind backend, Operation operation,
               double voxel) {
@@ -100,6 +101,8 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
       benchmark::DoNotOptimize(volume->raycast(f.camera, f.range, f.poses[i]));
     } else if (operation == Operation::mesh) {
       benchmark::DoNotOptimize(mapping::extract_mesh(volume->download()));
+    } else if (operation == Operation::device_mesh) {
+      benchmark::DoNotOptimize(mapping::extract_mesh(*volume));
     } else {
       benchmark::DoNotOptimize(mapping::tsdf_band_maps(*volume, {}));
     }
@@ -110,10 +113,12 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
 }
 
 void register_cases() {
-  const std::pair<Operation, const char*> operations[] = {{Operation::integrate, "tsdf_integrate"},
-                                                          {Operation::raycast, "tsdf_raycast"},
-                                                          {Operation::mesh, "tsdf_mesh"},
-                                                          {Operation::esdf, "tsdf_esdf"}};
+  const std::pair<Operation, const char*> operations[] = {
+      {Operation::integrate, "tsdf_integrate"},
+      {Operation::raycast, "tsdf_raycast"},
+      {Operation::mesh, "tsdf_mesh"},
+      {Operation::device_mesh, "tsdf_mesh_device"},
+      {Operation::esdf, "tsdf_esdf"}};
   for (const compute::BackendKind backend : bench::backends_to_run()) {
     for (const double voxel : {0.01, 0.05}) {
       for (const auto& [operation, name] : operations) {

@@ -25,6 +25,8 @@ inline constexpr std::array kDeviceDataFiles{
     DeviceDataFile{"7scenes_redkitchen/frames/frame-000150.depth.png", DeviceDataKind::depth},
     DeviceDataFile{"7scenes_redkitchen/frames/frame-000299.depth.png", DeviceDataKind::depth},
     DeviceDataFile{"7scenes_redkitchen/frames/frame-000100.color.jpg", DeviceDataKind::color},
+    DeviceDataFile{"7scenes_redkitchen/frames/frame-000000.color.jpg", DeviceDataKind::color},
+    DeviceDataFile{"7scenes_redkitchen/frames/frame-000010.color.jpg", DeviceDataKind::color},
     DeviceDataFile{"7scenes_redkitchen/frames/frame-000000.pose.txt", DeviceDataKind::text},
     DeviceDataFile{"7scenes_redkitchen/frames/frame-000010.pose.txt", DeviceDataKind::text},
     DeviceDataFile{"ipa_room_maps/test_maps/office_e.png", DeviceDataKind::occupancy_map},

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 #include <map>
+#include <memory>
 #include <numeric>
 #include <random>
 #include <set>
@@ -14,6 +15,7 @@
 #include <tuple>
 #include <vector>
 
+#include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "real_data.hpp"
@@ -244,6 +246,68 @@ TEST_P(TsdfVolumeTest, RayCastFromInsideAndBesideTheVolumeMissesNoSurface) {
   }
 }
 
+// A 2 cm field of the sphere and the wall seen from three yaws.
+std::unique_ptr<TsdfVolume> sphere_and_wall(const compute::Context& context) {
+  const Scene scene;
+  TsdfVolumeParams params;
+  params.voxel_size = 0.02;
+  params.truncation = 0.06;
+  auto volume = std::make_unique<TsdfVolume>(context, params);
+  for (const double yaw : {-10.0, 0.0, 12.0}) {
+    const Eigen::Isometry3d pose = pose_at(0.05 * yaw / 10, 0.02, yaw);
+    volume->integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  }
+  return volume;
+}
+
+// A 2 cm field of 7-Scenes frames 0 and 10 at their poses, with colour or without.
+std::unique_ptr<TsdfVolume> kitchen_frames(const compute::Context& context, bool color) {
+  TsdfVolumeParams params;
+  params.voxel_size = 0.02;
+  params.truncation = 0.06;
+  auto volume = std::make_unique<TsdfVolume>(context, params);
+  const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
+  for (const std::string name : {"frame-000000", "frame-000010"}) {
+    volume->integrate(testing::read_depth(frames / (name + ".depth.png")),
+                      color ? testing::read_color(frames / (name + ".color.jpg")) : RgbImage(),
+                      PinholeIntrinsics::kinect_7scenes(), geometry::DepthRange{1000.0, 0.3, 4.0},
+                      testing::read_pose(frames / (name + ".pose.txt")));
+  }
+  return volume;
+}
+
+// The device's mesh against the host's of a downloaded copy: the same triangles in the same
+// order; vertices equal on the CPU backend and within float rounding elsewhere (fused
+// multiply-adds), colours within a level.
+void expect_same_mesh(const TsdfVolume& volume, const std::string& what) {
+  const TriangleMesh host = mapping::extract_mesh(volume.download());
+  const TriangleMesh device = mapping::extract_mesh(volume);
+  ASSERT_GT(host.triangles.size(), 1000u) << what;
+  ASSERT_EQ(device.triangles.size(), host.triangles.size()) << what;
+  ASSERT_EQ(device.vertices.size(), host.vertices.size()) << what;
+  std::size_t differing = 0;
+  for (std::size_t t = 0; t < host.triangles.size(); ++t)
+    differing += device.triangles[t] == host.triangles[t] ? 0 : 1;
+  float worst = 0;
+  int worst_color = 0;
+  for (std::size_t v = 0; v < host.vertices.size(); ++v) {
+    worst = std::max(worst, (device.vertices[v] - host.vertices[v]).norm());
+    for (const int s : {0, 8, 16})
+      worst_color =
+          std::max(worst_color, std::abs(static_cast<int>((device.colors[v] >> s) & 0xff) -
+                                         static_cast<int>((host.colors[v] >> s) & 0xff)));
+  }
+  EXPECT_EQ(differing, 0u) << what;
+  EXPECT_LE(worst, 1e-6f) << what;
+  EXPECT_LE(worst_color, 1) << what;
+}
+
+// Marching tetrahedra on the device (kernels/tsdf/tsdf_mesh.h) on a synthetic and a real field.
+TEST_P(TsdfVolumeTest, MeshOnTheDeviceEqualsTheHostsOnSyntheticAndRealFields) {
+  expect_same_mesh(*sphere_and_wall(context()), "sphere and wall");
+  expect_same_mesh(*kitchen_frames(context(), true), "7-Scenes frames 0 and 10");
+}
+
 // Blocks and voxels by block coordinates, for comparing volumes whose pools are numbered apart.
 void expect_same_volume(const TsdfBlocks& a, const TsdfBlocks& b, const std::string& what) {
   std::size_t only_one = 0, differing = 0, compared = 0;
@@ -379,30 +443,13 @@ TEST_P(TsdfVolumeTest, EsdfOnTheDeviceEqualsTheHostsOnRandomGrids) {
 }
 
 TEST_P(TsdfVolumeTest, BandOccupancyEqualsTheHostsOnSyntheticAndRealFields) {
-  const Scene scene;
-  TsdfVolumeParams params;
-  params.voxel_size = 0.02;
-  params.truncation = 0.06;
-  TsdfVolume synthetic(context(), params);
-  for (const double yaw : {-10.0, 0.0, 12.0}) {
-    const Eigen::Isometry3d pose = pose_at(0.05 * yaw / 10, 0.02, yaw);
-    synthetic.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
-  }
+  const std::unique_ptr<TsdfVolume> synthetic = sphere_and_wall(context());
   // Looking along z at a wall at z = 2.4: with the level frame's z along the world's, the wall is
   // the floor and the sphere in front stands above it... upside down (roll 180).
-  expect_same_band(synthetic, 180.0, -2.4, "sphere and wall");
-  expect_same_band(synthetic, 150.0, -2.2, "sphere and wall, tilted");
-
-  const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
-  const geometry::DepthRange range{1000.0, 0.3, 4.0};
-  TsdfVolume kitchen(context(), params);
-  for (const char* name : {"frame-000000", "frame-000010"}) {
-    kitchen.integrate(testing::read_depth(frames / (std::string(name) + ".depth.png")), {},
-                      PinholeIntrinsics::kinect_7scenes(), range,
-                      testing::read_pose(frames / (std::string(name) + ".pose.txt")));
-  }
+  expect_same_band(*synthetic, 180.0, -2.4, "sphere and wall");
+  expect_same_band(*synthetic, 150.0, -2.2, "sphere and wall, tilted");
   // 7-Scenes' world has y down: roll 90 turns it up.
-  expect_same_band(kitchen, 90.0, -0.8, "7-Scenes frames 0 and 10");
+  expect_same_band(*kitchen_frames(context(), false), 90.0, -0.8, "7-Scenes frames 0 and 10");
 }
 
 TEST_P(TsdfVolumeTest, FullVolumeAndBadInputsAreErrors) {

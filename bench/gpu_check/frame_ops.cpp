@@ -6,6 +6,7 @@
 #include "kartograf/geometry/segment_moments.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
+#include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
 #include "kartograf/registration/color_gate.hpp"
@@ -167,6 +168,12 @@ void band_occupancy(Workspace& w, const mapping::TsdfVolume& volume, bool esdf) 
     mapping::tsdf_occupancy(volume, params);
 }
 
+// The volume's mesh made on the device and joined on the host.
+void mesh(Workspace& w, const mapping::TsdfVolume& volume) {
+  ensure_tsdf(w);
+  mapping::extract_mesh(volume);
+}
+
 void build_current(Workspace& w) {
   w.depth.upload(w.next_frame().depth);
   w.current().build(w.projector, w.depth);
@@ -251,6 +258,7 @@ const std::vector<Operation>& frame_operations() {
       {"TSDF ray cast 5 cm", 0, [](Workspace& w) { ray_cast(w, w.tsdf_coarse); }},
       {"TSDF band occupancy 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine, false); }},
       {"TSDF band + ESDF 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine, true); }},
+      {"TSDF mesh 1 cm", 0, [](Workspace& w) { mesh(w, w.tsdf_fine); }},
       {"region growing (Lab)", 0,
        [](Workspace& w) {
          w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});

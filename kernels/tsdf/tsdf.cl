@@ -1,6 +1,7 @@
 // OpenCL wrapper of kernels/tsdf/tsdf.h.
 #include "kernels/tsdf/tsdf.h"
 #include "kernels/tsdf/tsdf_band.h"
+#include "kernels/tsdf/tsdf_mesh.h"
 
 __kernel void tsdf_touch(__global const ushort* depth, __global ulong* keys, __global uint* stamps,
                          __global uint* status, const TsdfParams params) {
@@ -60,4 +61,15 @@ __kernel void tsdf_band(__global const ulong* block_keys, __global const TsdfVox
   const TsdfBandMark mark = tsdf_band_mark(voxels[i], block_keys[i / KG_TSDF_BLOCK_VOXELS],
                                            i % KG_TSDF_BLOCK_VOXELS, params);
   if (mark.cell >= 0) kg_atomic_max_u32(cells, (uint)mark.cell, mark.state);
+}
+
+__kernel void tsdf_mesh(__global const ulong* keys, __global const uint* slot_blocks,
+                        __global const ulong* block_keys, __global const TsdfVoxel* voxels,
+                        __global uint* status, __global uint* order, __global ulong* edge_keys,
+                        __global float* points, __global uint* colors,
+                        const TsdfMeshParams params) {
+  const uint cell = get_global_id(0);
+  if (cell >= params.count) return;
+  tsdf_mesh_cell(keys, slot_blocks, block_keys, voxels, status, order, edge_keys, points, colors,
+                 cell, params);
 }

@@ -4,6 +4,7 @@
 #include "compute/cpu/cpu_kernel.hpp"
 #include "kernels/tsdf/tsdf.h"
 #include "kernels/tsdf/tsdf_band.h"
+#include "kernels/tsdf/tsdf_mesh.h"
 
 namespace kartograf::kernels {
 
@@ -213,6 +214,24 @@ void range(const CpuDispatch& call) {
   });
 }
 
+void mesh(const CpuDispatch& call) {
+  const auto params = call.params_as<TsdfMeshParams>();
+  const auto* keys = call.buffer<const uint64_t>(0);
+  const auto* slot_blocks = call.buffer<const uint>(1);
+  const auto* block_keys = call.buffer<const uint64_t>(2);
+  const auto* voxels = call.buffer<const TsdfVoxel>(3);
+  auto* status = call.buffer<uint>(4);
+  auto* order = call.buffer<uint>(5);
+  auto* edge_keys = call.buffer<uint64_t>(6);
+  auto* points = call.buffer<float>(7);
+  auto* colors = call.buffer<uint>(8);
+  for_each_item(call, [&](uint cell) {
+    if (cell < params.count)
+      tsdf_mesh_cell(keys, slot_blocks, block_keys, voxels, status, order, edge_keys, points,
+                     colors, cell, params);
+  });
+}
+
 void band(const CpuDispatch& call) {
   const auto params = call.params_as<TsdfBandParams>();
   const auto* block_keys = call.buffer<const uint64_t>(0);
@@ -234,6 +253,7 @@ void register_tsdf_cpu(compute::detail::CpuKernelRegistry& registry) {
   registry.add("tsdf_integrate", integrate);
   registry.add("tsdf_raycast", raycast);
   registry.add("tsdf_range", range);
+  registry.add("tsdf_mesh", mesh);
   registry.add("tsdf_band", band);
 }
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
+#include "mapping/edge_index.hpp"
 
 namespace kartograf::mapping {
 
@@ -35,56 +36,11 @@ std::uint32_t mix_colors(std::uint32_t a, std::uint32_t b, float t) {
   for (int shift : {0, 8, 16}) {
     const float x = static_cast<float>((a >> shift) & 0xff),
                 y = static_cast<float>((b >> shift) & 0xff);
-    out |= static_cast<std::uint32_t>(std::lround(x + (y - x) * t)) << shift;
+    // floor(v + 0.5), as the device's rule (kernels/tsdf/tsdf_mesh.h) rounds.
+    out |= static_cast<std::uint32_t>(std::floor(x + (y - x) * t + 0.5f)) << shift;
   }
   return out;
 }
-
-// Vertex indices by edge key: open addressing with linear probing (a key is never 0). Against
-// std::unordered_map: no allocation per entry, and a probe stays in one cache line.
-class EdgeIndex {
- public:
-  // The index stored for key; where key is new, `next` is stored and inserted set.
-  int find_or_add(std::uint64_t key, int next, bool& inserted) {
-    if ((count_ + 1) * 2 > keys_.size()) grow();
-    const std::size_t mask = keys_.size() - 1;
-    for (std::size_t slot = spread(key) & mask;; slot = (slot + 1) & mask) {
-      if (keys_[slot] == key) {
-        inserted = false;
-        return values_[slot];
-      }
-      if (keys_[slot] == 0) {
-        keys_[slot] = key;
-        values_[slot] = next;
-        ++count_;
-        inserted = true;
-        return next;
-      }
-    }
-  }
-
- private:
-  static std::size_t spread(std::uint64_t key) {
-    return static_cast<std::size_t>((key * 0x9e3779b97f4a7c15ull) >> 17);
-  }
-  void grow() {
-    std::vector<std::uint64_t> keys(std::max<std::size_t>(keys_.size() * 2, 1 << 16), 0);
-    std::vector<int> values(keys.size());
-    const std::size_t mask = keys.size() - 1;
-    for (std::size_t i = 0; i < keys_.size(); ++i) {
-      if (keys_[i] == 0) continue;
-      std::size_t slot = spread(keys_[i]) & mask;
-      while (keys[slot] != 0) slot = (slot + 1) & mask;
-      keys[slot] = keys_[i];
-      values[slot] = values_[i];
-    }
-    keys_ = std::move(keys);
-    values_ = std::move(values);
-  }
-  std::vector<std::uint64_t> keys_;
-  std::vector<int> values_;
-  std::size_t count_ = 0;
-};
 
 class MeshBuilder {
  public:
@@ -203,7 +159,7 @@ class MeshBuilder {
   const TsdfBlocks& blocks_;
   MeshParams params_;
   TriangleMesh mesh_;
-  EdgeIndex edges_;
+  detail::EdgeIndex edges_;
   std::array<std::ptrdiff_t, 8> neighbours_{};
 };
 

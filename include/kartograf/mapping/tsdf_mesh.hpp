@@ -26,5 +26,10 @@ struct MeshParams {
 };
 
 TriangleMesh extract_mesh(const TsdfBlocks& blocks, const MeshParams& params = {});
+// The same on the field's device (kernels/tsdf/tsdf_mesh.h: each cell appends its triangles with
+// their vertices' edges); the host joins the shared vertices and puts the triangles in the order
+// above. Equal to the host's on a downloaded copy: bit for bit on the CPU backend, within float
+// rounding on devices that fuse multiply-adds.
+TriangleMesh extract_mesh(const TsdfVolume& volume, const MeshParams& params = {});
 
 }  // namespace kartograf::mapping

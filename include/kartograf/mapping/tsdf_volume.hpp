@@ -134,6 +134,10 @@ class TsdfVolume {
   const compute::Context& context() const { return *context_; }
   const compute::Buffer<std::uint64_t>& device_block_keys() const { return block_keys_; }
   const compute::Buffer<TsdfVoxel>& device_voxels() const { return voxels_; }
+  // The block table (kernels/voxel_hash: 2^table_log2() slots of keys, each slot's pool index).
+  const compute::Buffer<std::uint64_t>& device_table_keys() const { return keys_; }
+  const compute::Buffer<std::uint32_t>& device_table_blocks() const { return slot_blocks_; }
+  unsigned table_log2() const { return capacity_log2_; }
   TsdfBlocks download() const;
 
  private:
