@@ -132,6 +132,29 @@ TEST_F(LoopClosureTest, VerificationRecoversATrueLoopFromADriftedEstimate) {
       0.0);
 }
 
+// With no memory for keyframe depth every keyframe's depth is read back from the temporary file:
+// the same overlaps and the same verified loop.
+TEST_F(LoopClosureTest, KeyframeDepthFromDiskGivesTheSameLoops) {
+  mapping::LoopClosureParams on_disk = params();
+  on_disk.keyframe_depth_memory = 0;
+  LoopClosureDetector spilled(context_, testing::qvga_kinect(), range(), on_disk);
+  const double path[] = {0.0, 10.0, 10.5, 11.0, 11.1};
+  for (std::size_t k = 0; k < scenario().frames.size(); ++k)
+    spilled.add_keyframe(scenario().frames[k], scenario().rendered.frames[k].depth, path[k]);
+  std::vector<Eigen::Isometry3d> estimate = scenario().truth;
+  estimate[1] = estimate[1] * Eigen::Translation3d(0.06, -0.02, 0.04);
+  const auto poses = scenario().poses_by_frame(estimate);
+  const std::vector<LoopCandidate> mine = detector_.find_candidates(1, poses);
+  const std::vector<LoopCandidate> theirs = spilled.find_candidates(1, poses);
+  ASSERT_EQ(mine.size(), 1u);
+  ASSERT_EQ(theirs.size(), 1u);
+  EXPECT_EQ(theirs[0].overlap, mine[0].overlap);
+  const mapping::LoopClosure a = detector_.verify(mine[0], poses);
+  const mapping::LoopClosure b = spilled.verify(theirs[0], poses);
+  EXPECT_TRUE(b.report.accepted());
+  EXPECT_TRUE(b.constraint.motion.isApprox(a.constraint.motion, 0.0));
+}
+
 TEST_F(LoopClosureTest, RejectsAWrongCandidate) {
   // The estimate claims D (another room) is where A is: a false loop.
   std::vector<Eigen::Isometry3d> estimate = scenario().truth;

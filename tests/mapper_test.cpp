@@ -127,6 +127,20 @@ TEST(Mapper, MeshFromGivenPosesLiesOnTheTrueSurfaces) {
   EXPECT_TRUE(mapper.volume_stats().covers_all_frames);
 }
 
+// max_views bounds the views stage: 100 frames, every 5th would be 20 views; 7 are allowed, so
+// every 15th frame is labelled.
+TEST(Mapper, LabelsAtMostMaxViews) {
+  const compute::Context cpu = compute::Context::cpu();
+  const testing::RenderedSequence& walk = survey_walk();
+  pipeline::MapperParams params;
+  params.pipeline.max_views = 7;
+  pipeline::Mapper mapper(cpu, walk.camera, testing::kSynthUnitsPerMetre, params);
+  feed(mapper, walk, true);
+  const pipeline::MapPipelineResult result = mapper.finish();
+  EXPECT_EQ(result.labelled_views + result.unlabelled_views, 7);
+  EXPECT_GT(result.labelled_views, 3);
+}
+
 TEST(Mapper, RejectsMixedPosesUseAfterFinishAndBadParameters) {
   const compute::Context cpu = compute::Context::cpu();
   const testing::RenderedSequence& walk = survey_walk();

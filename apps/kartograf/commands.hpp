@@ -188,6 +188,7 @@ struct MapOptions {
   SequenceRunOptions run;
   std::filesystem::path out_dir;
   std::size_t label_step = 5;
+  std::size_t max_views = 300;
   int label_width = 320;
   double resolution = 0.05;
   std::string room_method = "distance";

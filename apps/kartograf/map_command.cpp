@@ -82,6 +82,11 @@ CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
       ->check(CLI::Range(1, 1000))
       ->capture_default_str();
   command
+      ->add_option("--max-views", o.max_views,
+                   "Label at most this many frames, spread evenly (bounds the views' memory)")
+      ->check(CLI::Range(1, 1000000))
+      ->capture_default_str();
+  command
       ->add_option("--label-width", o.label_width, "Labelled views: at most this many pixels wide")
       ->check(CLI::Range(64, 4096))
       ->capture_default_str();
@@ -121,6 +126,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   pipeline::MapPipelineParams& stages = params.pipeline;
   stages.slam.odometry = odometry_params(o.run);
   stages.label_step = o.label_step;
+  stages.max_views = o.max_views;
   stages.features = !o.no_features && o.poses.empty();
   stages.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps);
   stages.label_width = o.label_width;

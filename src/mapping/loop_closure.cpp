@@ -85,6 +85,8 @@ LoopClosureDetector::LoopClosureDetector(
       source_(context, camera, pyramid_params(params_, finest_level_, information_level_)),
       target_(context, camera, pyramid_params(params_, finest_level_, information_level_)) {
   validate(params_);
+  depths_ =
+      std::make_unique<FrameStore>(camera, range.units_per_metre, 1, params_.keyframe_depth_memory);
 }
 
 void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& depth,
@@ -95,7 +97,7 @@ void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& dept
   require(
       depth.width() == camera_.width && depth.height() == camera_.height,
       "loop closure: keyframe " + std::to_string(frame) + " depth size differs from the camera");
-  Keyframe keyframe{frame, path_length, depth, {}, nullptr};
+  Keyframe keyframe{frame, path_length, {}, nullptr};
   if (features_ && color && !color->empty()) {
     keyframe.features = features_->describe(depth, *color, camera_, range_.units_per_metre);
     places_->add(frame, keyframe.features);
@@ -111,6 +113,7 @@ void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& dept
                                     static_cast<float>(z));
     }
   }
+  depths_->add({depth, RgbImage(), 0.0, std::nullopt});
   keyframes_.push_back(std::move(keyframe));
 }
 
@@ -124,8 +127,8 @@ double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
                                          const Eigen::Isometry3d& from_to_to,
                                          double tolerance) const {
   const Keyframe& source = keyframes_.at(from);
-  const Keyframe& target = keyframes_.at(to);
   if (source.samples.empty()) return 0;
+  const DepthImage target = depth_of(to);
   const double metres_per_unit = 1.0 / range_.units_per_metre;
   std::size_t seen = 0;
   for (const Eigen::Vector3f& sample : source.samples) {
@@ -134,7 +137,7 @@ double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
     const double u = std::floor(camera_.fx * p.x() / p.z() + camera_.cx + 0.5);
     const double v = std::floor(camera_.fy * p.y() / p.z() + camera_.cy + 0.5);
     if (u < 0 || v < 0 || u >= camera_.width || v >= camera_.height) continue;
-    const std::uint16_t d = target.depth(static_cast<int>(u), static_cast<int>(v));
+    const std::uint16_t d = target(static_cast<int>(u), static_cast<int>(v));
     if (d != 0 && std::abs(d * metres_per_unit - p.z()) <= tolerance) ++seen;
   }
   return static_cast<double>(seen) / static_cast<double>(source.samples.size());
@@ -222,8 +225,8 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   const Keyframe& match = keyframes_.at(candidate.match);
   require_pose(poses, query.frame);
   require_pose(poses, match.frame);
-  builder_.build(query.depth, nullptr, source_);
-  builder_.build(match.depth, nullptr, target_);
+  builder_.build(depth_of(candidate.query), nullptr, source_);
+  builder_.build(depth_of(candidate.match), nullptr, target_);
   const Eigen::Isometry3d expected = candidate.by_appearance
                                          ? candidate.feature_motion
                                          : poses[match.frame].inverse() * poses[query.frame];

@@ -14,6 +14,7 @@ detail::RunJson parameters_json(const std::string& method, const pipeline::Mappe
   return {{"method", method},
           {"reestimate_interval", p.slam.odometry.reestimate_interval},
           {"label_step", p.label_step},
+          {"max_views", p.max_views},
           {"label_width", p.label_width},
           {"grid_resolution_m", p.grid.resolution},
           {"tsdf_voxel_m", mapper.volume.voxel_size},

@@ -172,7 +172,12 @@ struct ViewLabeller {
   }
 };
 
-// Every label_step-th frame labelled with its own gravity estimate and pooled. Frames that cannot
+// Every label_step-th frame, or fewer so that at most max_views are labelled.
+std::size_t view_step(const MapPipelineParams& params, std::size_t frames) {
+  return std::max(params.label_step, (frames + params.max_views - 1) / params.max_views);
+}
+
+// Every view_step-th frame labelled with its own gravity estimate and pooled. Frames that cannot
 // find up alone (no floor or ceiling in sight: close to a wall, a kitchen counter) are labelled
 // again with the map's up and floor from the other views, through their SLAM pose.
 void label_views(const compute::Context& context, const mapping::FrameSource& source,
@@ -190,7 +195,8 @@ void label_views(const compute::Context& context, const mapping::FrameSource& so
   semantic::LabellingParams own = params.labelling;
   if (!own.gravity.prior_up) own.gravity.prior_up = Eigen::Vector3d(0, -1, 0);  // image up
   std::vector<std::pair<std::size_t, std::string>> retry;
-  for (std::size_t i = 0; i < poses.size(); i += params.label_step) {
+  const std::size_t step = view_step(params, poses.size());
+  for (std::size_t i = 0; i < poses.size(); i += step) {
     std::string failure;
     if (!labeller.label(i, poses[i], own, views, plane_map, &failure))
       retry.push_back({i, failure});
@@ -226,6 +232,7 @@ segmentation::PlaneExtractionParams view_plane_params() {
 
 void MapPipelineParams::validate() const {
   require(label_step >= 1, "MapPipelineParams: label_step must be >= 1");
+  require(max_views >= 1, "MapPipelineParams: max_views must be >= 1");
   require(label_width >= 64, "MapPipelineParams: label_width must be >= 64 pixels");
   require(room_fragment_area_m2 >= 0 && std::isfinite(room_fragment_area_m2),
           "MapPipelineParams: room_fragment_area_m2 must be finite and >= 0");

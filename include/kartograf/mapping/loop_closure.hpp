@@ -44,6 +44,7 @@
 #include "kartograf/core/intrinsics.hpp"
 #include "kartograf/core/point_image.hpp"
 #include "kartograf/geometry/backproject.hpp"
+#include "kartograf/mapping/frame_store.hpp"
 #include "kartograf/registration/feature_front_end.hpp"
 #include "kartograf/registration/geometric_information.hpp"
 #include "kartograf/registration/icp.hpp"
@@ -87,6 +88,9 @@ struct LoopClosureParams {
   // the drift allowance (5 % of a 40 m path is 2 m): with a feature front end, the features of
   // the two keyframes must then find the same motion within this (else: unconfirmed).
   double feature_agreement_m = 0.1;
+  // Keyframe depth kept in memory, in bytes; beyond it the depth goes to a temporary file, so
+  // that a long run's keyframes grow by their samples and features only (about 0.1 MB each).
+  std::size_t keyframe_depth_memory = std::size_t{32} << 20;
 };
 
 struct LoopCandidate {
@@ -123,8 +127,9 @@ class LoopClosureDetector {
                       const geometry::DepthRange& range, LoopClosureParams params = {},
                       std::shared_ptr<const registration::FeatureFrontEnd> features = nullptr);
 
-  // Keeps the keyframe's depth (for verification) and its overlap samples, and with a feature
-  // front end and a colour image its features. path_length: metres travelled from the first
+  // Keeps the keyframe's depth (for verification; the first keyframe_depth_memory bytes of
+  // keyframes in memory, the rest in a temporary file) and its overlap samples, and with a
+  // feature front end and a colour image its features. path_length: metres travelled from the first
   // frame to this one. Frames must come in increasing order.
   void add_keyframe(std::size_t frame, const DepthImage& depth, double path_length,
                     const RgbImage* color = nullptr);
@@ -154,7 +159,6 @@ class LoopClosureDetector {
   struct Keyframe {
     std::size_t frame = 0;
     double path_length = 0;
-    DepthImage depth;
     std::vector<Eigen::Vector3f> samples;                              // camera frame
     std::shared_ptr<const registration::FeatureDescription> features;  // or null
   };
@@ -174,6 +178,8 @@ class LoopClosureDetector {
   int finest_level_;
   int information_level_;
   std::vector<Keyframe> keyframes_;
+  std::unique_ptr<FrameStore> depths_;  // keyframe k's depth is frame k
+  DepthImage depth_of(std::size_t keyframe) const { return depths_->frame(keyframe).depth; }
   std::shared_ptr<const registration::FeatureFrontEnd> features_;
   std::unique_ptr<registration::PlaceIndex> places_;
   registration::RgbdPyramidBuilder builder_;

@@ -4,10 +4,11 @@
 // first camera's heading).
 //
 //   1. slam       odometry, loop closure, pose graph, fused coloured map (mapping/slam.hpp, M3)
-//   2. views      every label_step-th frame at its optimised pose, at most label_width pixels
-//                 wide: per-pixel semantic classes (semantic/classify.hpp, M2) and planes
-//                 (segmentation/plane_extraction.hpp, M1), pooled in the map
-//                 (semantic/labelled_views.hpp, mapping/plane_map.hpp); the views vote for up
+//   2. views      every label_step-th frame at its optimised pose (at most max_views of them),
+//                 at most label_width pixels wide: per-pixel semantic classes
+//                 (semantic/classify.hpp, M2) and planes (segmentation/plane_extraction.hpp, M1),
+//                 pooled in the map (semantic/labelled_views.hpp, mapping/plane_map.hpp); the views
+//                 vote for up
 //   3. gravity    the voted up becomes +z; the floor's median height becomes z = 0
 //   4. grid       the metric-semantic grid (semantic/semantic_grid.hpp): floor evidence free,
 //                 obstacles in the robot's height band, doors, traversability; the occupancy grid
@@ -57,7 +58,11 @@ struct MapPipelineParams {
   // A trajectory known beforehand (e.g. ground truth): stage 1 only fuses the map at these poses
   // (mapping::run_with_known_poses). Empty: SLAM estimates them.
   mapping::KnownPoseLookup known_poses;
-  std::size_t label_step = 5;           // views: every k-th frame
+  std::size_t label_step = 5;  // views: every k-th frame
+  // views: at most this many, spread evenly (every max(label_step, ceil(frames / max_views))-th
+  // frame), so that the pooled views' memory is bounded on long runs (about 2.7 MB a 320x240 view
+  // on the survey: 0.8 GB for 300).
+  std::size_t max_views = 300;
   int label_width = 320;                // views: decimated to at most this many pixels per row
   semantic::LabellingParams labelling;  // gravity.prior_up defaults to the camera's -y
   segmentation::PlaneExtractionParams planes = view_plane_params();
