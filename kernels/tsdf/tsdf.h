@@ -277,13 +277,17 @@ KG_INLINE float3 tsdf_voxel_in_camera(uint64_t key, uint cell, TsdfParams p) {
   return tsdf_to_camera(w, p);
 }
 
-// The pixel (y * width + x) a voxel centre at c (camera frame) projects to, or -1.
+// The pixel (y * width + x) a voxel centre at c (camera frame) projects to (the nearest pixel
+// centre), or -1. Without branches, so that the CPU's loop over a block is vector code: the
+// conversion truncates, which is floor() for the u, v >= 0 it keeps (and 0 stands in elsewhere:
+// converting a float out of int's range is undefined).
 KG_INLINE int tsdf_pixel_of(float3 c, TsdfParams p) {
-  if (!(c.z > 0.0f)) return -1;
-  const float u = floor(p.fx * c.x / c.z + p.cx + 0.5f);
-  const float v = floor(p.fy * c.y / c.z + p.cy + 0.5f);
-  if (!(u >= 0.0f && v >= 0.0f && u < KG_FLOAT(p.width) && v < KG_FLOAT(p.height))) return -1;
-  return KG_INT(v) * KG_INT(p.width) + KG_INT(u);
+  const float u = p.fx * c.x / c.z + p.cx + 0.5f;
+  const float v = p.fy * c.y / c.z + p.cy + 0.5f;
+  const bool seen = KG_BOTH(KG_BOTH(c.z > 0.0f, KG_BOTH(u >= 0.0f, v >= 0.0f)),
+                            KG_BOTH(u < KG_FLOAT(p.width), v < KG_FLOAT(p.height)));
+  const int column = KG_INT(seen ? u : 0.0f), row = KG_INT(seen ? v : 0.0f);
+  return seen ? row * KG_INT(p.width) + column : -1;
 }
 
 KG_STRUCT_BEGIN(TsdfVoxelView)

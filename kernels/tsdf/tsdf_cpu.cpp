@@ -87,36 +87,15 @@ void assign(const CpuDispatch& call) {
   }
 }
 
-// Where the camera sees each voxel of the block with `key`: the rule's tsdf_voxel_in_camera and
-// tsdf_pixel_of, operation for operation (so bit for bit), as one branch-free loop over the block
-// that the compiler turns into vector code. floor() is a truncation there: the check before it
-// keeps only u, v >= 0.
-KG_CPU_VECTOR_CLONES void project_block(std::uint64_t key, const TsdfParams& p,
+// Where the camera sees each voxel of the block with `key` (the rule's tsdf_voxel_in_camera and
+// tsdf_pixel_of), as one loop over the block that the compiler turns into vector code.
+KG_CPU_VECTOR_CLONES void project_block(std::uint64_t key, const TsdfParams& params,
                                         int* __restrict pixels, float* __restrict depths) {
-  const int bx = tsdf_key_axis(key, 0u) * KG_TSDF_BLOCK_SIDE;
-  const int by = tsdf_key_axis(key, 21u) * KG_TSDF_BLOCK_SIDE;
-  const int bz = tsdf_key_axis(key, 42u) * KG_TSDF_BLOCK_SIDE;
-  // Locals, so that the compiler knows the stores below leave them alone.
-  const float size = p.voxel_size, tx = p.tx, ty = p.ty, tz = p.tz;
-  const float r00 = p.r00, r01 = p.r01, r02 = p.r02, r10 = p.r10, r11 = p.r11, r12 = p.r12;
-  const float r20 = p.r20, r21 = p.r21, r22 = p.r22;
-  const float fx = p.fx, fy = p.fy, cx = p.cx, cy = p.cy;
-  const float width = static_cast<float>(p.width), height = static_cast<float>(p.height);
-  const int stride = static_cast<int>(p.width);
-  for (int cell = 0; cell < static_cast<int>(KG_TSDF_BLOCK_VOXELS); ++cell) {
-    const float wx = (static_cast<float>(bx + (cell & 7)) + 0.5f) * size - tx;
-    const float wy = (static_cast<float>(by + ((cell >> 3) & 7)) + 0.5f) * size - ty;
-    const float wz = (static_cast<float>(bz + (cell >> 6)) + 0.5f) * size - tz;
-    const float x = r00 * wx + r10 * wy + r20 * wz;
-    const float y = r01 * wx + r11 * wy + r21 * wz;
-    const float z = r02 * wx + r12 * wy + r22 * wz;
-    const float u = fx * x / z + cx + 0.5f;
-    const float v = fy * y / z + cy + 0.5f;
-    const bool seen = (z > 0.0f) & (u >= 0.0f) & (v >= 0.0f) & (u < width) & (v < height);
-    // Unseen voxels convert 0 instead: a float out of int's range would be undefined behaviour.
-    const int column = static_cast<int>(seen ? u : 0.0f), row = static_cast<int>(seen ? v : 0.0f);
-    pixels[cell] = seen ? row * stride + column : -1;
-    depths[cell] = z;
+  const TsdfParams p = params;  // a local: the compiler then knows the stores leave it alone
+  for (uint cell = 0; cell < KG_TSDF_BLOCK_VOXELS; ++cell) {
+    const float3 c = tsdf_voxel_in_camera(key, cell, p);
+    pixels[cell] = tsdf_pixel_of(c, p);
+    depths[cell] = c.z;
   }
 }
 
