@@ -8,6 +8,7 @@
 
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/memory_budget.hpp"
 #include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kernels/tsdf/tsdf_mesh.h"
 #include "mapping/edge_index.hpp"
@@ -31,6 +32,10 @@ struct DeviceTriangles {
 std::size_t run_cells(const TsdfVolume& volume, kernels::TsdfMeshParams p, std::size_t capacity,
                       DeviceTriangles& out) {
   const compute::Context& context = volume.context();
+  // Per triangle: its order key, 3 edge keys, 9 coordinates and 3 colours, on the device and
+  // again on the host.
+  require_fits_in_memory(2.0 * static_cast<double>(capacity) * (4 + 24 + 36 + 12),
+                         "the device mesh's " + std::to_string(capacity) + " triangles");
   auto status = compute::Buffer<std::uint32_t>::from_host(context, std::vector<std::uint32_t>{0});
   compute::Buffer<std::uint32_t> order(context, capacity), colors(context, 3 * capacity);
   compute::Buffer<std::uint64_t> edge_keys(context, 3 * capacity);

@@ -8,6 +8,7 @@
 
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/memory_budget.hpp"
 #include "kartograf/geometry/distance_transform.hpp"
 #include "kernels/esdf/esdf.h"
 #include "kernels/tsdf/tsdf_band.h"
@@ -189,6 +190,12 @@ void esdf_transform(const compute::Context& context, const compute::Buffer<std::
 Image<float> device_esdf(const compute::Context& context,
                          const compute::Buffer<std::uint32_t>& cells, int cols, int rows,
                          double resolution) {
+  const double cells_count = static_cast<double>(cols) * rows;
+  require(cells_count < 4294967296.0, "ESDF: a grid of 2^32 cells or more");
+  // Per cell: the result, two squared distances and the envelope's apex and crossing.
+  require_fits_in_memory(
+      cells_count * (4 + 8 + 8 + 4 + 8 + 8),
+      "ESDF of a " + std::to_string(cols) + "x" + std::to_string(rows) + " grid");
   Image<float> out(cols, rows);
   if (out.empty()) return out;
   compute::Buffer<float> esdf(context, out.pixels().size());
