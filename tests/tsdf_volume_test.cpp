@@ -84,6 +84,13 @@ geometry::DepthRange depth_range() {
   return {kUnits, 0.2, 5.0};
 }
 
+TsdfVolumeParams volume_params(double voxel_size, double truncation) {
+  TsdfVolumeParams params;
+  params.voxel_size = voxel_size;
+  params.truncation = truncation;
+  return params;
+}
+
 // The blocks (grid units) the segment from a to b crosses, by sampling it 1000 times: a plain
 // reference of the touch pass's walk.
 void blocks_on_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
@@ -137,9 +144,7 @@ TEST_P(TsdfVolumeTest, OneFrameMatchesThePlainReference) {
   const Scene scene;
   const Eigen::Isometry3d pose = pose_at(0.05, 0.02, 8);
   const DepthImage depth = render(scene, pose);
-  TsdfVolumeParams params;
-  params.voxel_size = 0.02;
-  params.truncation = 0.06;
+  const TsdfVolumeParams params = volume_params(0.02, 0.06);
   TsdfVolume volume(context(), params);
   const mapping::TsdfIntegration done = volume.integrate(depth, {}, kCamera, depth_range(), pose);
   const TsdfBlocks blocks = volume.download();
@@ -193,9 +198,7 @@ std::vector<double> cast_errors(const TsdfVolume& volume, const Scene& scene,
 
 TEST_P(TsdfVolumeTest, RayCastSurfaceLiesOnTheScene) {
   const Scene scene;
-  TsdfVolumeParams params;
-  params.voxel_size = 0.01;
-  params.truncation = 0.04;
+  const TsdfVolumeParams params = volume_params(0.01, 0.04);
   TsdfVolume volume(context(), params);
   for (const Eigen::Isometry3d& pose :
        {pose_at(0, 0, 0), pose_at(0.1, 0, 6), pose_at(-0.1, 0.05, -6), pose_at(0.05, -0.05, 3)}) {
@@ -224,9 +227,7 @@ TEST_P(TsdfVolumeTest, RayCastSurfaceLiesOnTheScene) {
 // behind the camera, close to it, and at the image's edge still find every surface they see.
 TEST_P(TsdfVolumeTest, RayCastFromInsideAndBesideTheVolumeMissesNoSurface) {
   const Scene scene;
-  TsdfVolumeParams params;
-  params.voxel_size = 0.01;
-  params.truncation = 0.04;
+  const TsdfVolumeParams params = volume_params(0.01, 0.04);
   TsdfVolume volume(context(), params);
   // 5 cm from the sphere: its blocks lie around the camera and cross the image plane.
   Eigen::Isometry3d beside_sphere = pose_at(0.5, 0, 0);
@@ -249,9 +250,7 @@ TEST_P(TsdfVolumeTest, RayCastFromInsideAndBesideTheVolumeMissesNoSurface) {
 // A 2 cm field of the sphere and the wall seen from three yaws.
 std::unique_ptr<TsdfVolume> sphere_and_wall(const compute::Context& context) {
   const Scene scene;
-  TsdfVolumeParams params;
-  params.voxel_size = 0.02;
-  params.truncation = 0.06;
+  const TsdfVolumeParams params = volume_params(0.02, 0.06);
   auto volume = std::make_unique<TsdfVolume>(context, params);
   for (const double yaw : {-10.0, 0.0, 12.0}) {
     const Eigen::Isometry3d pose = pose_at(0.05 * yaw / 10, 0.02, yaw);
@@ -262,9 +261,7 @@ std::unique_ptr<TsdfVolume> sphere_and_wall(const compute::Context& context) {
 
 // A 2 cm field of 7-Scenes frames 0 and 10 at their poses, with colour or without.
 std::unique_ptr<TsdfVolume> kitchen_frames(const compute::Context& context, bool color) {
-  TsdfVolumeParams params;
-  params.voxel_size = 0.02;
-  params.truncation = 0.06;
+  const TsdfVolumeParams params = volume_params(0.02, 0.06);
   auto volume = std::make_unique<TsdfVolume>(context, params);
   const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
   for (const std::string name : {"frame-000000", "frame-000010"}) {
@@ -340,9 +337,7 @@ TEST_P(TsdfVolumeTest, EqualsTheCpuBackendOnSevenScenesFrames) {
   const PinholeIntrinsics camera = PinholeIntrinsics::kinect_7scenes();
   const geometry::DepthRange range{1000.0, 0.3, 4.0};
   const RgbImage color = testing::read_color(frames / "frame-000100.color.jpg");
-  TsdfVolumeParams params;
-  params.voxel_size = 0.02;
-  params.truncation = 0.08;
+  const TsdfVolumeParams params = volume_params(0.02, 0.08);
   const compute::Context cpu = compute::Context::cpu();
   TsdfVolume on_backend(context(), params), on_cpu(cpu, params);
   for (const char* name : {"frame-000000", "frame-000010"}) {

@@ -48,10 +48,11 @@ std::size_t run_cells(const TsdfVolume& volume, kernels::TsdfMeshParams p, std::
       p, {compute::groups_for(p.count, KG_TSDF_LOCAL_X), 1});
   const std::size_t made = status.to_vector()[0];
   if (made > capacity) return made;
+  // Only what the cells wrote crosses to the host.
   const auto first = [made](const auto& buffer, std::size_t per) {
-    auto all = buffer.to_vector();
-    all.resize(made * per);
-    return all;
+    decltype(buffer.to_vector()) values(made * per);
+    buffer.download(values);
+    return values;
   };
   out = {first(order, 1), first(edge_keys, 3), first(points, 9), first(colors, 3)};
   return made;

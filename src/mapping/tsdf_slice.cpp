@@ -159,13 +159,24 @@ void set_states(const std::vector<std::uint32_t>& marks, OccupancyGrid& grid) {
   }
 }
 
+// The transforms' working buffers, one element per cell, made once for both transforms.
+struct EsdfScratch {
+  EsdfScratch(const compute::Context& context, std::size_t n)
+      : a(context, n),
+        b(context, n),
+        start_num(context, n),
+        start_den(context, n),
+        apex(context, n) {}
+  compute::Buffer<std::int64_t> a, b, start_num, start_den;
+  compute::Buffer<std::uint32_t> apex;
+};
+
 // One transform of kernels/esdf/esdf.h (to the occupied cells or to the others) into `esdf`.
 void esdf_transform(const compute::Context& context, const compute::Buffer<std::uint32_t>& cells,
-                    int cols, int rows, kernels::EsdfParams p, compute::Buffer<float>& esdf) {
+                    int cols, int rows, kernels::EsdfParams p, EsdfScratch& scratch,
+                    compute::Buffer<float>& esdf) {
   const std::size_t n = std::size_t(cols) * rows;
-  compute::Buffer<std::int64_t> a(context, n), b(context, n), start_num(context, n),
-      start_den(context, n);
-  compute::Buffer<std::uint32_t> apex(context, n);
+  auto& [a, b, start_num, start_den, apex] = scratch;
   p.count = static_cast<std::uint32_t>(n);
   compute::dispatch(context, kEsdfSeedKernel, {cells, a}, p,
                     {compute::groups_for(n, KG_ESDF_LOCAL_X), 1});
@@ -202,9 +213,10 @@ Image<float> device_esdf(const compute::Context& context,
   esdf.fill_zero();
   kernels::EsdfParams p{};
   p.resolution = static_cast<float>(resolution);
+  EsdfScratch scratch(context, out.pixels().size());
   for (const std::uint32_t to_occupied : {1u, 0u}) {
     p.to_occupied = to_occupied;
-    esdf_transform(context, cells, cols, rows, p, esdf);
+    esdf_transform(context, cells, cols, rows, p, scratch, esdf);
   }
   esdf.download(out.pixels());
   return out;
