@@ -200,6 +200,36 @@ TEST_P(FramePyramidTest, BuildsFromDepthAndRejectsBadInput) {
   EXPECT_THROW(registration::make_frame_pyramid(context(), camera, PointImage(10, 10)), Error);
 }
 
+// Levels finer than first_normals_level carry no normals; the others equal a full pyramid's.
+TEST_P(FramePyramidTest, NormalsOnlyFromTheFirstNormalsLevel) {
+  const PinholeIntrinsics camera = testing::qvga_camera();
+  const PointImage points =
+      testing::render(testing::corner_scene(), camera, testing::reference_camera());
+  registration::PyramidParams params;
+  params.first_normals_level = 1;
+  const FramePyramid partial =
+      registration::make_frame_pyramid(context(), camera, points, nullptr, params);
+  const FramePyramid full = registration::make_frame_pyramid(context(), camera, points);
+  EXPECT_EQ(partial.level(0).normals.size(), 0u);
+  EXPECT_EQ(partial.level(0).view().normals, nullptr);
+  for (int level = 1; level < full.level_count(); ++level) {
+    const PointImage a = partial.level(level).normals.to_image();
+    const PointImage b = full.level(level).normals.to_image();
+    ASSERT_EQ(a.pixels().size(), b.pixels().size());
+    std::size_t valid = 0;
+    for (std::size_t i = 0; i < a.pixels().size(); ++i) {
+      if (std::isnan(b.pixels()[i].x())) continue;
+      ++valid;
+      EXPECT_EQ(a.pixels()[i], b.pixels()[i]) << "level " << level << " pixel " << i;
+    }
+    EXPECT_GT(valid, a.pixels().size() / 2) << "level " << level;
+  }
+  params.first_normals_level = 3;  // the default 3 levels: 0..2
+  EXPECT_THROW(FramePyramid(context(), camera, params), Error);
+  params.first_normals_level = -1;
+  EXPECT_THROW(FramePyramid(context(), camera, params), Error);
+}
+
 TEST(PackedRgb, RoundTrips) {
   const Rgb8 color{12, 200, 255};
   EXPECT_EQ(pack_rgb(color), 12u | 200u << 8 | 255u << 16);

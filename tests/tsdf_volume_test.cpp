@@ -215,8 +215,11 @@ TEST_P(TsdfVolumeTest, RayCastSurfaceLiesOnTheScene) {
   const double p99 = errors[hits * 99 / 100], worst = errors.back();
   // Depth quantised to 1 mm, voxels of 1 cm: the surface within a millimetre on the whole. Rays
   // that graze the sphere's outline meet the band behind its edge, up to about a voxel off.
-  EXPECT_LT(sum / hits, 0.001);
-  EXPECT_LT(p99, 0.005);
+  // Where the voxels' signs change before the field's, the crossing is searched on in the field
+  // (tsdf_crossing); taking the voxels' values there instead gave p99 4.4 mm and mean 0.35 mm
+  // (now 1.7 and 0.21 on every backend).
+  EXPECT_LT(sum / hits, 0.0003);
+  EXPECT_LT(p99, 0.0025);
   EXPECT_LT(worst, 0.015);
   RecordProperty("p99_distance_m", testing::scientific(p99));
   RecordProperty("mean_distance_m", testing::scientific(sum / hits));

@@ -56,8 +56,10 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   add_backend_option(command, o.backend, o.backend_source);
   command
       .add_option("--tracking", o.tracking,
-                  "frame: frame-to-frame odometry; model: each frame then registered against the "
-                  "TSDF of the frames before it (KinectFusion's frame-to-model tracking)")
+                  "frame: frame-to-frame odometry; model: each frame registered against the "
+                  "TSDF of the frames before it (KinectFusion's frame-to-model tracking), from "
+                  "the prediction of a frame-to-frame odometry at 160 pixels wide without "
+                  "re-estimates")
       ->check(CLI::IsMember({"frame", "model"}))
       ->capture_default_str();
   command.add_option("--model-voxel", o.model_voxel, "Voxel size of the model [m]")
@@ -66,7 +68,7 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   command
       .add_option("--reestimate-every", o.reestimate_interval,
                   "Re-register every k-th frame against the anchor (the M3 paper's drift "
-                  "reduction; 0: off)")
+                  "reduction; 0: off; --tracking model: off)")
       ->check(CLI::Range(0, 1000))
       ->capture_default_str();
   command

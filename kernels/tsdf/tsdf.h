@@ -529,23 +529,54 @@ KG_FORCE_INLINE float tsdf_trilinear(KG_BUFFER_PARAM(const uint64_t, keys)
   return sum;
 }
 
-// Where the ray crosses zero between depths t0 (field f0 > 0) and t1 (f1 <= 0): linear in the
-// trilinear field where both ends have one, else in the voxels' values.
+// The trilinear field at depth t of the ray origin + direction x t.
+KG_INLINE float tsdf_field_on_ray(KG_BUFFER_PARAM(const uint64_t, keys)
+                                      KG_BUFFER_PARAM(const uint, slot_blocks)
+                                          KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 origin,
+                                  float3 direction, float t, TsdfParams p) {
+  return tsdf_trilinear(
+      KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin + direction * t,
+      p);
+}
+
+// Where the ray crosses zero between depths t0 (voxel value f0 > 0) and t1 (f1 <= 0): linear in
+// the trilinear field, else in the voxels' values. The voxels' signs change up to half a voxel
+// away from the field's: where the field at t1 is still > 0, the crossing lies beyond, and where
+// it is <= 0 at t0 already, before; the bracket moves by half a voxel (at most
+// KG_TSDF_CROSSING_MOVES times) to catch it. Taking the voxels' values there instead biased the surface by up to half
+// a voxel, and frame-to-model tracking drifted with it (synthetic, noise-free: 4.8 mm at 2 cm).
+#define KG_TSDF_CROSSING_MOVES 4u
 KG_INLINE float tsdf_crossing(KG_BUFFER_PARAM(const uint64_t, keys)
                                   KG_BUFFER_PARAM(const uint, slot_blocks)
                                       KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 origin,
                               float3 direction, float t0, float f0, float t1, float f1,
-                              TsdfParams p) {
-  const float s0 = tsdf_trilinear(
-      KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin + direction * t0,
-      p);
-  const float s1 = tsdf_trilinear(
-      KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin + direction * t1,
-      p);
+                              float half_voxel, TsdfParams p) {
+  float s0 = tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks)
+                                   KG_BUFFER_ARG(voxels) origin,
+                               direction, t0, p);
+  float s1 = tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks)
+                                   KG_BUFFER_ARG(voxels) origin,
+                               direction, t1, p);
+  float u0 = t0, u1 = t1;  // the bracket in the field
+  for (uint i = 0u; i < KG_TSDF_CROSSING_MOVES; ++i) {
+    const bool beyond = s1 > 0.0f;  // NaN compares false: no move
+    const bool before = s0 <= 0.0f;
+    if (!beyond && !before) break;
+    // Beyond: the far end becomes the near one; before: the near end becomes the far one.
+    const float kept = beyond ? s1 : s0;
+    const float from = beyond ? u1 : u0;
+    const float to = beyond ? u1 + half_voxel : u0 - half_voxel;
+    const float moved = tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks)
+                                              KG_BUFFER_ARG(voxels) origin,
+                                          direction, to, p);
+    u0 = beyond ? from : to;
+    u1 = beyond ? to : from;
+    s0 = beyond ? kept : moved;
+    s1 = beyond ? moved : kept;
+  }
   const bool interpolated = !kg_isnan(s0) && !kg_isnan(s1) && s0 > 0.0f && s1 <= 0.0f;
-  const float a = interpolated ? s0 : f0;
-  const float b = interpolated ? s1 : f1;
-  return t0 + (t1 - t0) * a / (a - b);
+  if (interpolated) return u0 + (u1 - u0) * s0 / (s0 - s1);
+  return t0 + (t1 - t0) * f0 / (f0 - f1);
 }
 
 // Pixel (x, y)'s ray from depth min to max (metres along the optical axis): the first surface
@@ -582,7 +613,8 @@ KG_FORCE_INLINE float4 tsdf_cast_ray(KG_BUFFER_PARAM(const uint64_t, keys)
       if (kg_isnan(previous)) break;  // the back of a surface, or inside it from the start
       const float hit =
           tsdf_crossing(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin,
-                        direction, previous_t, previous, t, v.tsdf, p);
+                        direction, previous_t, previous, t, v.tsdf, 0.5f * p.voxel_size / per_depth,
+                        p);
       return KG_FLOAT4(ray_c.x * hit, ray_c.y * hit, hit, 1.0f);
     }
     previous = known ? v.tsdf : KG_NAN;

@@ -23,6 +23,7 @@ registration::PyramidParams pyramid_params(const LoopClosureParams& params, int 
   registration::PyramidParams pyramid;
   pyramid.levels =
       std::max(finest_level + static_cast<int>(params.icp.levels.size()), information_level + 1);
+  pyramid.first_normals_level = std::min(finest_level, information_level);
   return pyramid;
 }
 

@@ -20,10 +20,16 @@ PinholeIntrinsics level_camera(PinholeIntrinsics camera, int level) {
   return camera;
 }
 
-registration::PyramidParams pyramid_params(int levels) {
+registration::PyramidParams pyramid_params(int levels, int first_normals_level = 0) {
   registration::PyramidParams p;
   p.levels = levels;
+  p.first_normals_level = first_normals_level;
   return p;
+}
+
+bool same_camera(const PinholeIntrinsics& a, const PinholeIntrinsics& b) {
+  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
+         a.cx == b.cx && a.cy == b.cy;
 }
 
 }  // namespace
@@ -34,6 +40,21 @@ TsdfVolumeParams ModelTrackingParams::default_volume() {
   v.truncation = 0.08;
   v.max_blocks = 1 << 16;
   return v;
+}
+
+registration::IcpParams ModelTrackingParams::default_icp() {
+  registration::IcpParams icp =
+      registration::odometry_icp_params(registration::OdometryMethod::point_to_plane);
+  icp.max_normal_angle_deg = 20;
+  return icp;
+}
+
+registration::OdometryParams ModelTrackingParams::predicting(
+    registration::OdometryParams odometry) const {
+  odometry.icp_width = icp_width;
+  odometry.information_width = information_width;
+  odometry.reestimate_interval = 0;
+  return odometry;
 }
 
 void ModelTrackingParams::validate() const {
@@ -58,9 +79,6 @@ ModelTracker::ModelTracker(const compute::Context& context, const PinholeIntrins
       volume_(context, params.volume),
       projector_(context, camera, range_),
       target_camera_(level_camera(camera, first_level_)),
-      source_(context, camera,
-              pyramid_params(std::max(first_level_ + static_cast<int>(params.icp.levels.size()),
-                                      information_level_ + 1))),
       target_(context, target_camera_, pyramid_params(static_cast<int>(params.icp.levels.size()))),
       engine_(context, params.icp,
               std::make_unique<registration::DepthWeightedFinder>(
@@ -82,8 +100,57 @@ std::string ModelTracker::rejection(const registration::IcpResult& result) const
   return {};
 }
 
+int ModelTracker::source_levels() const {
+  return std::max(first_level_ + static_cast<int>(params_.icp.levels.size()),
+                  information_level_ + 1);
+}
+
+const registration::FramePyramid& ModelTracker::source_pyramid(
+    const registration::FramePyramid* given) {
+  const int finest = std::min(first_level_, information_level_);
+  if (given == nullptr) {
+    if (!source_) source_.emplace(*context_, camera_, pyramid_params(source_levels(), finest));
+    source_->build(projector_, frame_.depth());
+    return *source_;
+  }
+  require(same_camera(given->level(0).camera, camera_),
+          "model tracking: the given pyramid is of another camera than the tracker's");
+  require(given->level_count() >= source_levels() && given->params().first_normals_level <= finest,
+          "model tracking: the given pyramid has " + std::to_string(given->level_count()) +
+              " levels with normals from level " +
+              std::to_string(given->params().first_normals_level) + "; ICP needs " +
+              std::to_string(source_levels()) + " with normals from level " +
+              std::to_string(finest) + " (ModelTrackingParams::predicting)");
+  return *given;
+}
+
+registration::IcpResult ModelTracker::register_frame(const registration::FramePyramid& source,
+                                                     const Eigen::Isometry3d& predicted,
+                                                     ModelTrackingStep& step) {
+  // Cast at ICP's first level only: the finer level would cost 4x and never be read.
+  volume_.raycast(target_camera_, range_, predicted, target_.base_points());
+  target_.build();
+  const std::vector<registration::CloudView> source_views = source.views();
+  const std::vector<registration::CloudView> target_views = target_.views();
+  const std::span<const registration::CloudView> source_span =
+      std::span(source_views)
+          .subspan(static_cast<std::size_t>(first_level_), params_.icp.levels.size());
+  const registration::GeometricInformation geometry = registration::geometric_information(
+      source.level(information_level_).view(), params_.depth_weights.reference_depth,
+      params_.icp.min_eigenvalue_ratio);
+  step.degenerate = geometry.degeneracy.degenerate;
+  const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
+  if (!step.degenerate || params_.motion_prior <= 0) {
+    return engine_.align(source_span, target_views, identity);
+  }
+  return engine_.align(
+      source_span, target_views, identity,
+      {identity, registration::motion_prior_information(geometry, params_.motion_prior)});
+}
+
 ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* color,
-                                      const Eigen::Isometry3d& predicted) {
+                                      const Eigen::Isometry3d& predicted,
+                                      const registration::FramePyramid* pyramid) {
   static const RgbImage kNoColor;
   frame_.upload(depth, color ? *color : kNoColor);
   ModelTrackingStep step;
@@ -91,26 +158,7 @@ ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* c
   if (empty_) {
     step.reason = "first frame";
   } else {
-    source_.build(projector_, frame_.depth());
-    // Cast at ICP's first level only: the finer level would cost 4x and never be read.
-    volume_.raycast(target_camera_, range_, predicted, target_.base_points());
-    target_.build();
-    const auto first = static_cast<std::size_t>(first_level_);
-    const std::vector<registration::CloudView> source_views = source_.views();
-    const std::vector<registration::CloudView> target_views = target_.views();
-    const std::span<const registration::CloudView> source_span =
-        std::span(source_views).subspan(first, params_.icp.levels.size());
-    const registration::GeometricInformation geometry = registration::geometric_information(
-        source_.level(information_level_).view(), params_.depth_weights.reference_depth,
-        params_.icp.min_eigenvalue_ratio);
-    step.degenerate = geometry.degeneracy.degenerate;
-    const Eigen::Isometry3d identity = Eigen::Isometry3d::Identity();
-    const registration::IcpResult result =
-        step.degenerate && params_.motion_prior > 0
-            ? engine_.align(source_span, target_views, identity,
-                            {identity, registration::motion_prior_information(
-                                           geometry, params_.motion_prior)})
-            : engine_.align(source_span, target_views, identity);
+    const registration::IcpResult result = register_frame(source_pyramid(pyramid), predicted, step);
     step.fitness = result.fitness;
     step.inlier_rmse_m = result.inlier_rmse;
     step.reason = rejection(result);

@@ -36,7 +36,9 @@ class Tracker {
   Tracker(const compute::Context& context, const PinholeIntrinsics& camera,
           double depth_units_per_metre, const registration::OdometryParams& params,
           const ModelTrackingParams& model = {})
-      : odometry_(context, camera, with_units(params, depth_units_per_metre)) {
+      : odometry_(
+            context, camera,
+            with_units(model.enabled ? model.predicting(params) : params, depth_units_per_metre)) {
     if (model.enabled) {
       model_.emplace(context, camera, odometry_.params().depth_range, model);
       run_.model_tracking = true;
@@ -75,7 +77,8 @@ class Tracker {
     const std::size_t n = odometry.size() - 1;
     const Eigen::Isometry3d predicted =
         n == 0 ? odometry[0] : model_poses_.back() * (odometry[n - 1].inverse() * odometry[n]);
-    const ModelTrackingStep step = model_->track(images.depth, color_of(images), predicted);
+    const ModelTrackingStep step =
+        model_->track(images.depth, color_of(images), predicted, &odometry_.latest_pyramid());
     model_poses_.push_back(step.pose);
     run_.model_kept += step.from_model ? 1 : 0;
     run_.model_seconds += seconds_since(start);

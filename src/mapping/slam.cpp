@@ -63,6 +63,7 @@ PointCloud fuse_map(
   const int level = registration::pyramid_level_at_most(source.camera().width, 320);
   registration::PyramidParams pyramid;
   pyramid.levels = level + 1;
+  pyramid.first_normals_level = level;
   registration::FramePyramid frame(context, source.camera(), pyramid);
   MapFusion fusion(params.map);
   RgbImage level_colors;

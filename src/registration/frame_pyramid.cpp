@@ -44,7 +44,7 @@ PinholeIntrinsics half_resolution(const PinholeIntrinsics& camera) {
 CloudView PyramidLevel::view() const {
   CloudView view;
   view.points = &points.buffer();
-  view.normals = &normals.buffer();
+  view.normals = normals.size() ? &normals.buffer() : nullptr;
   view.colors = colors.size() ? &colors.buffer() : nullptr;
   view.camera = camera;
   return view;
@@ -58,6 +58,9 @@ FramePyramid::FramePyramid(const compute::Context& context, const PinholeIntrins
           "frame pyramid: levels must be 1..16, got " + std::to_string(params.levels));
   require(std::isfinite(params.max_depth_jump) && params.max_depth_jump > 0,
           "frame pyramid: max_depth_jump must be positive");
+  require(params.first_normals_level >= 0 && params.first_normals_level < params.levels,
+          "frame pyramid: first_normals_level must be 0.." + std::to_string(params.levels - 1) +
+              ", got " + std::to_string(params.first_normals_level));
   PinholeIntrinsics level_camera = camera;
   for (int level = 0; level < params.levels; ++level) {
     if (level > 0) level_camera = half_resolution(level_camera);
@@ -70,7 +73,10 @@ FramePyramid::FramePyramid(const compute::Context& context, const PinholeIntrins
     PyramidLevel& added = levels_.emplace_back();
     added.camera = level_camera;
     added.points = compute::DeviceImage<Point4f>(context, level_camera.width, level_camera.height);
-    added.normals = compute::DeviceImage<Point4f>(context, level_camera.width, level_camera.height);
+    if (level >= params.first_normals_level) {
+      added.normals =
+          compute::DeviceImage<Point4f>(context, level_camera.width, level_camera.height);
+    }
     if (params.with_colors) {
       added.colors =
           compute::DeviceImage<std::uint32_t>(context, level_camera.width, level_camera.height);
@@ -93,8 +99,10 @@ void FramePyramid::build() {
       downsample(*context_, levels_[level - 1], levels_[level], params_.with_colors,
                  params_.max_depth_jump);
     }
-    geometry::estimate_normals(*context_, levels_[level].points, levels_[level].normals,
-                               params_.normals);
+    if (static_cast<int>(level) >= params_.first_normals_level) {
+      geometry::estimate_normals(*context_, levels_[level].points, levels_[level].normals,
+                                 params_.normals);
+    }
   }
 }
 

@@ -38,6 +38,7 @@ PyramidParams pyramid_params(const OdometryParams& params, int finest_level,
   pyramid.levels =
       std::max(finest_level + static_cast<int>(params.icp.levels.size()), information_level + 1);
   pyramid.with_colors = params.method == OdometryMethod::color;
+  pyramid.first_normals_level = std::min(finest_level, information_level);
   return pyramid;
 }
 
@@ -197,6 +198,11 @@ std::size_t RgbdOdometry::claim_slot(std::size_t frame) {
 
 FramePyramid& RgbdOdometry::pyramid_of(std::size_t frame) {
   return ring_[slot_of(frame)];
+}
+
+const FramePyramid& RgbdOdometry::latest_pyramid() const {
+  require(!poses_.empty(), "odometry: no frame tracked yet, so no latest pyramid");
+  return ring_[slot_of(poses_.size() - 1)];
 }
 
 RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,

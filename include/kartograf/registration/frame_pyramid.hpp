@@ -10,7 +10,9 @@
 // and multiplied by the float reciprocal of the count (within ~2 ulp of the exact mean; products,
 // unlike divisions, round identically on every driver). Colours average the same pixels per
 // channel (rounded half up). No valid point: NaN, colour 0.
-// Normals of every level come from geometry::estimate_normals on that level's points.
+// Normals of every level from first_normals_level on come from geometry::estimate_normals on
+// that level's points; finer levels have none (ICP that starts coarser never reads them, and at
+// 640x480 they cost more than all coarser levels together).
 #include <cstdint>
 #include <vector>
 
@@ -35,13 +37,14 @@ struct PyramidParams {
   int levels = 3;                // 640x480 -> 320x240 -> 160x120
   float max_depth_jump = 0.05f;  // relative depth gap that splits a 2x2 block (as for normals)
   geometry::NormalParams normals;
-  bool with_colors = false;  // allocate and downsample colour images
+  bool with_colors = false;     // allocate and downsample colour images
+  int first_normals_level = 0;  // the finest level with normals, 0 .. levels - 1
 };
 
 struct PyramidLevel {
   PinholeIntrinsics camera;
   compute::DeviceImage<Point4f> points;
-  compute::DeviceImage<Point4f> normals;
+  compute::DeviceImage<Point4f> normals;       // empty on levels finer than first_normals_level
   compute::DeviceImage<std::uint32_t> colors;  // empty without colours
   CloudView view() const;
 };
@@ -49,7 +52,8 @@ struct PyramidLevel {
 // Holds every level's device images, so rebuilding it for each new frame allocates nothing.
 class FramePyramid {
  public:
-  // Throws Error on invalid intrinsics, levels < 1, or a coarsest level under 8x8 pixels.
+  // Throws Error on invalid intrinsics, levels < 1, a coarsest level under 8x8 pixels, or
+  // first_normals_level outside the levels.
   FramePyramid(const compute::Context& context, const PinholeIntrinsics& camera,
                const PyramidParams& params = {});
 
@@ -57,7 +61,7 @@ class FramePyramid {
   compute::DeviceImage<Point4f>& base_points() { return levels_[0].points; }
   compute::DeviceImage<std::uint32_t>& base_colors();  // throws without with_colors
 
-  // Level 0 normals, then every coarser level; only dispatches (no wait).
+  // The normals from first_normals_level, and every coarser level; only dispatches (no wait).
   void build();
   // Back-projects `depth` into level 0, then build().
   void build(const geometry::DepthBackprojector& projector,

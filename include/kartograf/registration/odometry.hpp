@@ -249,6 +249,10 @@ class RgbdOdometry {
   // Frame pyramids held: the current frame, the previous one and the anchor of the next
   // re-estimate (at most 3, whatever reestimate_interval and the anchor policy).
   std::size_t kept_pyramids() const { return ring_.size(); }
+  // The last tracked frame's pyramid: the levels ICP and the geometric information read, with
+  // normals from the finest of them on (a tracker that registers the same frame elsewhere reads
+  // it instead of building its own). Throws Error before the first frame.
+  const FramePyramid& latest_pyramid() const;
 
  private:
   struct Attempt {
