@@ -27,6 +27,17 @@ registration::PyramidParams pyramid_params(int levels, int first_normals_level =
   return p;
 }
 
+// The model's pool lowered to the device's largest buffer where that is smaller (lavapipe:
+// 128 MiB, 21845 blocks of 2 cm voxels, about 360 m^2 of surface).
+TsdfVolumeParams fitted_to_device(const compute::Context& context, TsdfVolumeParams volume) {
+  const std::uint64_t largest = context.device_info().limits.max_buffer_bytes;
+  const std::uint64_t block_bytes = kTsdfBlockVoxels * sizeof(TsdfVoxel);
+  if (largest > 0) {
+    volume.max_blocks = std::min<std::size_t>(volume.max_blocks, largest / block_bytes);
+  }
+  return volume;
+}
+
 bool same_camera(const PinholeIntrinsics& a, const PinholeIntrinsics& b) {
   return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
          a.cx == b.cx && a.cy == b.cy;
@@ -76,7 +87,7 @@ ModelTracker::ModelTracker(const compute::Context& context, const PinholeIntrins
       first_level_(registration::pyramid_level_at_most(camera.width, params.icp_width)),
       information_level_(
           registration::pyramid_level_at_most(camera.width, params.information_width)),
-      volume_(context, params.volume),
+      volume_(context, fitted_to_device(context, params.volume)),
       projector_(context, camera, range_),
       target_camera_(level_camera(camera, first_level_)),
       target_(context, target_camera_, pyramid_params(static_cast<int>(params.icp.levels.size()))),

@@ -50,7 +50,9 @@ struct ModelTrackingParams {
   double max_correction_m = 0.05;
   double max_correction_deg = 3;
 
-  static TsdfVolumeParams default_volume();  // 2 cm voxels, 8 cm truncation, 2^16 blocks
+  // 2 cm voxels, 8 cm truncation, 2^16 blocks (fewer where the device's largest buffer holds
+  // fewer: the tracker lowers max_blocks to fit).
+  static TsdfVolumeParams default_volume();
   // The odometry's point-to-plane levels with pairs whose normals agree within 20 degrees (PCL's
   // KinFu's gate), not 45: the model's normals are smooth, and pairs across its rounded edges
   // and corners (a voxel wide) are what the wider gate lets in. On noise-free synthetic frames
