@@ -133,11 +133,31 @@ TEST_F(ModelTracking, AnImplausibleCorrectionLeavesThePrediction) {
   EXPECT_TRUE(step.pose.isApprox(predicted));
 }
 
+// A pool too small for the tour: the model restarts when it is three quarters full, and the
+// frames go on being tracked.
+TEST_F(ModelTracking, AFullModelRestartsFromTheCurrentFrame) {
+  mapping::ModelTrackingParams params = enabled();
+  params.depth_weights.reference_depth = 1.5;  // as in CorrectsNudgedPredictionsAgainstTheModel
+  params.volume.max_blocks = 2400;             // the tour's first 40 frames fill 3000
+  mapping::ModelTracker tracking = tracker(params);
+  std::size_t restarts = 0;
+  for (int i = 0; i < 40; i += 2) {
+    const synth::SyntheticFrame sensed = frame(i);
+    const mapping::ModelTrackingStep step =
+        tracking.track(sensed.depth, nullptr, nudged(pose(i), 0.005, 0.1, i));
+    restarts += step.restarted ? 1 : 0;
+    EXPECT_LE(tracking.volume().block_count(), 2400u);
+    EXPECT_LT(distance(step.pose, pose(i)), 0.01) << "frame " << i;
+  }
+  EXPECT_GE(restarts, 1u);
+}
+
 TEST_F(ModelTracking, BadParametersAreRefused) {
   for (auto change : std::initializer_list<void (*)(mapping::ModelTrackingParams&)>{
            [](mapping::ModelTrackingParams& p) { p.min_fitness = 1.5; },
            [](mapping::ModelTrackingParams& p) { p.max_correction_m = 0; },
            [](mapping::ModelTrackingParams& p) { p.icp_width = 0; },
+           [](mapping::ModelTrackingParams& p) { p.restart_fill = 0; },
            [](mapping::ModelTrackingParams& p) { p.volume.voxel_size = -1; }}) {
     mapping::ModelTrackingParams p;
     change(p);

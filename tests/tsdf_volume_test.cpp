@@ -489,6 +489,33 @@ TEST_P(TsdfVolumeTest, FullVolumeAndBadInputsAreErrors) {
   }
 }
 
+// clear() forgets every block: the volume then sees nothing, and fusing a frame gives what a
+// fresh volume gives.
+TEST_P(TsdfVolumeTest, ClearedVolumeIsAFreshOne) {
+  const Scene scene;
+  const TsdfVolumeParams params = volume_params(0.02, 0.06);
+  const Eigen::Isometry3d pose = pose_at(0.05, 0, 4);
+  TsdfVolume used(context(), params);
+  used.integrate(render(scene, pose_at(0, 0, 0)), {}, kCamera, depth_range(), pose_at(0, 0, 0));
+  used.clear();
+  EXPECT_EQ(used.block_count(), 0u);
+  const PointImage nothing = used.raycast(kCamera, depth_range(), pose);
+  EXPECT_TRUE(std::none_of(nothing.pixels().begin(), nothing.pixels().end(),
+                           [](const Point4f& p) { return is_valid(p); }));
+  TsdfVolume fresh(context(), params);
+  used.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  fresh.integrate(render(scene, pose), {}, kCamera, depth_range(), pose);
+  const TsdfBlocks a = used.download();
+  const TsdfBlocks b = fresh.download();
+  ASSERT_GT(a.coords.size(), 0u);
+  EXPECT_EQ(a.coords, b.coords);
+  ASSERT_EQ(a.voxels.size(), b.voxels.size());
+  for (std::size_t i = 0; i < a.voxels.size(); ++i) {
+    ASSERT_EQ(a.voxels[i].tsdf, b.voxels[i].tsdf) << i;
+    ASSERT_EQ(a.voxels[i].weight, b.voxels[i].weight) << i;
+  }
+}
+
 TEST_P(TsdfVolumeTest, WeightsStopAtTheMaximumAndTheFieldFollowsChange) {
   Scene scene;
   TsdfVolumeParams params;

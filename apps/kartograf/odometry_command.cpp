@@ -68,9 +68,10 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.frames)) << "\n";
   if (result.model_tracking) {
     std::snprintf(line, sizeof(line),
-                  "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame\n",
+                  "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame, "
+                  "%zu restarts of a full model\n",
                   result.model_kept, result.poses.size(),
-                  1000.0 * result.model_seconds / std::max(frames, 1.0));
+                  1000.0 * result.model_seconds / std::max(frames, 1.0), result.model_restarts);
     out << line;
   }
   if (ate) {

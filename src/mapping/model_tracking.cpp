@@ -76,6 +76,7 @@ void ModelTrackingParams::validate() const {
   require(min_fitness >= 0 && min_fitness <= 1, "model tracking: min_fitness must be in [0, 1]");
   require(max_correction_m > 0 && max_correction_deg > 0,
           "model tracking: the largest correction must be > 0");
+  require(restart_fill > 0 && restart_fill <= 1, "model tracking: restart_fill must be in (0, 1]");
 }
 
 ModelTracker::ModelTracker(const compute::Context& context, const PinholeIntrinsics& camera,
@@ -175,6 +176,12 @@ ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* c
     step.reason = rejection(result);
     step.from_model = step.reason.empty();
     if (step.from_model) step.pose = predicted * result.source_to_target;
+  }
+  const auto full = static_cast<std::size_t>(params_.restart_fill *
+                                             static_cast<double>(volume_.params().max_blocks));
+  if (volume_.block_count() >= full) {
+    volume_.clear();
+    step.restarted = true;
   }
   volume_.integrate(frame_.depth(), frame_.colors(), camera_, range_, step.pose);
   empty_ = false;

@@ -81,6 +81,7 @@ class Tracker {
         model_->track(images.depth, color_of(images), predicted, &odometry_.latest_pyramid());
     model_poses_.push_back(step.pose);
     run_.model_kept += step.from_model ? 1 : 0;
+    run_.model_restarts += step.restarted ? 1 : 0;
     run_.model_seconds += seconds_since(start);
   }
 

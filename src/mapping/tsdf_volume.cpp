@@ -144,17 +144,23 @@ TsdfVolume::TsdfVolume(const compute::Context& context, const TsdfVolumeParams& 
               " is larger than the device's largest buffer (" +
               memory_size_text(static_cast<double>(largest)) + "); lower max_blocks");
   keys_ = compute::Buffer<std::uint64_t>(context, slots);
-  keys_.fill_zero();
-  slot_blocks_ = compute::Buffer<std::uint32_t>::from_host(
-      context, std::vector<std::uint32_t>(slots, KG_TSDF_NO_BLOCK));
+  slot_blocks_ = compute::Buffer<std::uint32_t>(context, slots);
   stamps_ = compute::Buffer<std::uint32_t>(context, slots);
-  stamps_.fill_zero();
   block_keys_ = compute::Buffer<std::uint64_t>(context, params_.max_blocks);
   active_ = compute::Buffer<std::uint32_t>(context, params_.max_blocks);
   status_ = compute::Buffer<std::uint32_t>(context, KG_TSDF_STATUS_VALUES);
-  status_.fill_zero();
   voxels_ = compute::Buffer<TsdfVoxel>(context, params_.max_blocks * kTsdfBlockVoxels);
+  clear();
+}
+
+void TsdfVolume::clear() {
+  keys_.fill_zero();
+  slot_blocks_.upload(std::vector<std::uint32_t>(keys_.size(), KG_TSDF_NO_BLOCK));
+  stamps_.fill_zero();
+  status_.fill_zero();
   voxels_.fill_zero();
+  block_count_ = 0;
+  stamp_ = 0;
 }
 
 TsdfIntegration TsdfVolume::integrate(const compute::DeviceImage<std::uint16_t>& depth,

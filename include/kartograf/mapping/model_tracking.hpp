@@ -49,6 +49,10 @@ struct ModelTrackingParams {
   double min_fitness = 0.3;
   double max_correction_m = 0.05;
   double max_correction_deg = 3;
+  // Memory stays bounded: when the model's pool is this full before a frame is fused, the model
+  // restarts from that frame (what came before is forgotten; tracking goes on from the
+  // odometry's prediction). A frame at 2 cm voxels adds at most a few thousand blocks.
+  double restart_fill = 0.75;
 
   // 2 cm voxels, 8 cm truncation, 2^16 blocks (fewer where the device's largest buffer holds
   // fewer: the tracker lowers max_blocks to fit).
@@ -71,7 +75,8 @@ struct ModelTrackingStep {
   bool degenerate = false;  // the frame's geometry left directions to the prediction
   double fitness = 0;       // the model's registration (0 on the first frame)
   double inlier_rmse_m = 0;
-  std::string reason;  // why the prediction stood (empty when the model's pose was kept)
+  bool restarted = false;  // the model was full and restarted from this frame
+  std::string reason;      // why the prediction stood (empty when the model's pose was kept)
 };
 
 class ModelTracker {

@@ -127,6 +127,9 @@ class TsdfVolume {
   PointImage raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,
                      const Eigen::Isometry3d& camera_to_world) const;
 
+  // Forgets every block: the volume as made, its buffers kept.
+  void clear();
+
   std::size_t block_count() const { return block_count_; }
   const TsdfVolumeParams& params() const { return params_; }
   // The pool on the device, for other passes over the field (the first block_count() blocks are
