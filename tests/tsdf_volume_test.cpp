@@ -250,6 +250,25 @@ TEST_P(TsdfVolumeTest, RayCastFromInsideAndBesideTheVolumeMissesNoSurface) {
   }
 }
 
+// A camera inside the block that holds the surface it sees: the block has corners behind the
+// camera, so its range covers the whole image from the nearest depth (tsdf_block_tiles); rays
+// that started at the next block's range instead would begin behind the wall.
+TEST_P(TsdfVolumeTest, RayCastFromInsideTheSurfacesBlockFindsIt) {
+  Scene scene;
+  scene.wall_z = 2.53;  // blocks of 4 cm voxels: z in [2.24, 2.56) holds the wall
+  const TsdfVolumeParams params = volume_params(0.04, 0.12);
+  TsdfVolume volume(context(), params);
+  volume.integrate(render(scene, pose_at(0, 0, 0)), {}, kCamera, depth_range(), pose_at(0, 0, 0));
+  // Beside the sphere's shadow on the wall; the wall 0.27 m ahead, the block's back face behind.
+  Eigen::Isometry3d inside = pose_at(1.0, 0, 0);
+  inside.translation().z() = 2.26;
+  std::size_t surface = 0;
+  const std::vector<double> errors = cast_errors(volume, scene, inside, surface);
+  ASSERT_GT(surface, static_cast<std::size_t>(kCamera.width * kCamera.height / 2));
+  EXPECT_GE(errors.size(), surface * 97 / 100);
+  EXPECT_LT(std::accumulate(errors.begin(), errors.end(), 0.0) / double(errors.size()), 0.004);
+}
+
 // A 2 cm field of the sphere and the wall seen from three yaws.
 std::unique_ptr<TsdfVolume> sphere_and_wall(const compute::Context& context) {
   const Scene scene;
