@@ -96,6 +96,9 @@ rm -rf "$1" && mkdir -p "$1" || exit 1
 cat "$1/model.log"
 grep -q "^  model tracking: the model's pose kept on [0-9]* of 50 frames" "$1/model.log" || { echo "FAIL: model line"; exit 1; }
 grep -q "^  ate_rmse_m [0-9]" "$1/model.log" || { echo "FAIL: no ATE"; exit 1; }
+# The planar odometry's pyramid has one ICP level: the tracker builds its own.
+"$0" odometry "$2/sun3d_studyroom_fragment1" --tracking model --method planar --frames 8 --out "$1/planar.txt" > "$1/planar.log" 2>&1 || { cat "$1/planar.log"; echo "FAIL: planar"; exit 1; }
+grep -q "^  model tracking: the model's pose kept on [0-9]* of 8 frames" "$1/planar.log" || { cat "$1/planar.log"; echo "FAIL: planar model line"; exit 1; }
 "$0" slam "$2/sun3d_studyroom_fragment1" --tracking model --out "$1/slam" > "$1/slam.log" 2>&1 && { echo "FAIL: slam accepted --tracking model"; exit 1; }
 grep -q "slam: --tracking model is only in .kartograf odometry." "$1/slam.log" || { cat "$1/slam.log"; echo "FAIL: message"; exit 1; }
 test ! -e "$1/slam" || { echo "FAIL: output"; exit 1; }

@@ -101,6 +101,8 @@ TEST_F(ModelTracking, AGivenPyramidGivesThePosesOfItsOwn) {
   const synth::SyntheticFrame sensed = frame(3);
   levels.levels = 3;
   const registration::FramePyramid short_one(cpu, kCamera, levels);
+  EXPECT_TRUE(shared.can_register(pyramid));
+  EXPECT_FALSE(shared.can_register(short_one));
   EXPECT_THROW(shared.track(sensed.depth, nullptr, pose(3), &short_one), Error);
   const registration::FramePyramid no_normals(cpu, kCamera, [] {
     registration::PyramidParams p;
@@ -108,10 +110,12 @@ TEST_F(ModelTracking, AGivenPyramidGivesThePosesOfItsOwn) {
     p.first_normals_level = 2;
     return p;
   }());
+  EXPECT_FALSE(shared.can_register(no_normals));
   EXPECT_THROW(shared.track(sensed.depth, nullptr, pose(3), &no_normals), Error);
   const PinholeIntrinsics other{320, 240, 250.0, 250.0, 159.5, 119.5};
   levels.levels = 4;
   const registration::FramePyramid other_camera(cpu, other, levels);
+  EXPECT_FALSE(shared.can_register(other_camera));
   EXPECT_THROW(shared.track(sensed.depth, nullptr, pose(3), &other_camera), Error);
   // The given pyramid is what ICP registers: one of another frame moves the answer.
   pyramid.build(projector, compute::DeviceImage<std::uint16_t>::from_host(cpu, frame(8).depth));

@@ -117,6 +117,12 @@ int ModelTracker::source_levels() const {
                   information_level_ + 1);
 }
 
+bool ModelTracker::can_register(const registration::FramePyramid& pyramid) const {
+  return same_camera(pyramid.level(0).camera, camera_) &&
+         pyramid.level_count() >= source_levels() &&
+         pyramid.params().first_normals_level <= std::min(first_level_, information_level_);
+}
+
 const registration::FramePyramid& ModelTracker::source_pyramid(
     const registration::FramePyramid* given) {
   const int finest = std::min(first_level_, information_level_);

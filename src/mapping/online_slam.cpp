@@ -77,8 +77,10 @@ class Tracker {
     const std::size_t n = odometry.size() - 1;
     const Eigen::Isometry3d predicted =
         n == 0 ? odometry[0] : model_poses_.back() * (odometry[n - 1].inverse() * odometry[n]);
+    const registration::FramePyramid& pyramid = odometry_.latest_pyramid();
     const ModelTrackingStep step =
-        model_->track(images.depth, color_of(images), predicted, &odometry_.latest_pyramid());
+        model_->track(images.depth, color_of(images), predicted,
+                      model_->can_register(pyramid) ? &pyramid : nullptr);
     model_poses_.push_back(step.pose);
     run_.model_kept += step.from_model ? 1 : 0;
     run_.model_restarts += step.restarted ? 1 : 0;

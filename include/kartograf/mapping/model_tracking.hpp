@@ -93,6 +93,10 @@ class ModelTracker {
                           const Eigen::Isometry3d& predicted,
                           const registration::FramePyramid* pyramid = nullptr);
 
+  // Whether `pyramid` can stand for the tracker's own (track()'s pyramid argument): the same
+  // camera, ICP's levels, normals on them. Not so for the planar odometry's (one ICP level).
+  bool can_register(const registration::FramePyramid& pyramid) const;
+
   const TsdfVolume& volume() const { return volume_; }
 
  private:
