@@ -30,17 +30,8 @@ registration::PyramidParams pyramid_params(int levels, int first_normals_level =
 // The model's pool lowered to the device's largest buffer where that is smaller (lavapipe:
 // 128 MiB, 21845 blocks of 2 cm voxels, about 360 m^2 of surface).
 TsdfVolumeParams fitted_to_device(const compute::Context& context, TsdfVolumeParams volume) {
-  const std::uint64_t largest = context.device_info().limits.max_buffer_bytes;
-  const std::uint64_t block_bytes = kTsdfBlockVoxels * sizeof(TsdfVoxel);
-  if (largest > 0) {
-    volume.max_blocks = std::min<std::size_t>(volume.max_blocks, largest / block_bytes);
-  }
+  volume.max_blocks = std::min(volume.max_blocks, TsdfVolume::largest_pool(context));
   return volume;
-}
-
-bool same_camera(const PinholeIntrinsics& a, const PinholeIntrinsics& b) {
-  return a.width == b.width && a.height == b.height && a.fx == b.fx && a.fy == b.fy &&
-         a.cx == b.cx && a.cy == b.cy;
 }
 
 }  // namespace
@@ -117,10 +108,13 @@ int ModelTracker::source_levels() const {
                   information_level_ + 1);
 }
 
-bool ModelTracker::can_register(const registration::FramePyramid& pyramid) const {
-  return same_camera(pyramid.level(0).camera, camera_) &&
-         pyramid.level_count() >= source_levels() &&
+bool ModelTracker::has_icp_levels(const registration::FramePyramid& pyramid) const {
+  return pyramid.level_count() >= source_levels() &&
          pyramid.params().first_normals_level <= std::min(first_level_, information_level_);
+}
+
+bool ModelTracker::can_register(const registration::FramePyramid& pyramid) const {
+  return pyramid.level(0).camera == camera_ && has_icp_levels(pyramid);
 }
 
 const registration::FramePyramid& ModelTracker::source_pyramid(
@@ -131,9 +125,9 @@ const registration::FramePyramid& ModelTracker::source_pyramid(
     source_->build(projector_, frame_.depth());
     return *source_;
   }
-  require(same_camera(given->level(0).camera, camera_),
+  require(given->level(0).camera == camera_,
           "model tracking: the given pyramid is of another camera than the tracker's");
-  require(given->level_count() >= source_levels() && given->params().first_normals_level <= finest,
+  require(has_icp_levels(*given),
           "model tracking: the given pyramid has " + std::to_string(given->level_count()) +
               " levels with normals from level " +
               std::to_string(given->params().first_normals_level) + "; ICP needs " +

@@ -4,6 +4,7 @@
 #include <array>
 #include <bit>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <string>
 #include <tuple>
@@ -127,6 +128,12 @@ const TsdfVoxel* TsdfBlocks::voxel(const Eigen::Vector3i& v) const {
                  64 * local.z()];
 }
 
+std::size_t TsdfVolume::largest_pool(const compute::Context& context) {
+  const std::uint64_t largest = context.device_info().limits.max_buffer_bytes;
+  if (largest == 0) return std::numeric_limits<std::size_t>::max();  // the device states none
+  return static_cast<std::size_t>(largest / (kTsdfBlockVoxels * sizeof(TsdfVoxel)));
+}
+
 TsdfVolume::TsdfVolume(const compute::Context& context, const TsdfVolumeParams& params)
     : context_(&context), params_(params), upload_(context) {
   params_.validate();
@@ -136,13 +143,11 @@ TsdfVolume::TsdfVolume(const compute::Context& context, const TsdfVolumeParams& 
       static_cast<double>(params_.max_blocks) * (kTsdfBlockVoxels * sizeof(TsdfVoxel) + 12) +
       static_cast<double>(slots) * 16;
   require_fits_in_memory(bytes, "TSDF volume of " + blocks_text(params_.max_blocks));
-  const std::uint64_t largest = context.device_info().limits.max_buffer_bytes;
-  const double pool_bytes =
-      static_cast<double>(params_.max_blocks) * kTsdfBlockVoxels * sizeof(TsdfVoxel);
-  require(largest == 0 || pool_bytes <= static_cast<double>(largest),
+  require(params_.max_blocks <= largest_pool(context),
           "TSDF volume: a pool of " + blocks_text(params_.max_blocks) +
               " is larger than the device's largest buffer (" +
-              memory_size_text(static_cast<double>(largest)) + "); lower max_blocks");
+              memory_size_text(static_cast<double>(context.device_info().limits.max_buffer_bytes)) +
+              "); lower max_blocks");
   keys_ = compute::Buffer<std::uint64_t>(context, slots);
   slot_blocks_ = compute::Buffer<std::uint32_t>(context, slots);
   stamps_ = compute::Buffer<std::uint32_t>(context, slots);

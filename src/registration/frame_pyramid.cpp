@@ -110,9 +110,7 @@ void FramePyramid::build(const geometry::DepthBackprojector& projector,
                          const compute::DeviceImage<std::uint16_t>& depth) {
   const PinholeIntrinsics& camera = projector.intrinsics();
   const PinholeIntrinsics& base = levels_[0].camera;
-  require(camera.width == base.width && camera.height == base.height && camera.fx == base.fx &&
-              camera.fy == base.fy && camera.cx == base.cx && camera.cy == base.cy,
-          "frame pyramid: the back-projector's camera differs from the pyramid's");
+  require(camera == base, "frame pyramid: the back-projector's camera differs from the pyramid's");
   projector.run(depth, levels_[0].points);
   build();
 }

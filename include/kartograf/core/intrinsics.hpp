@@ -16,6 +16,8 @@ struct PinholeIntrinsics {
   double cx = 0;
   double cy = 0;
 
+  bool operator==(const PinholeIntrinsics&) const = default;
+
   // Throws Error naming `what` when the intrinsics cannot describe a camera.
   void validate(const std::string& what) const {
     require(width > 0 && height > 0, what + ": image size must be positive, got " +

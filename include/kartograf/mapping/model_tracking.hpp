@@ -102,6 +102,7 @@ class ModelTracker {
  private:
   std::string rejection(const registration::IcpResult& result) const;
   int source_levels() const;
+  bool has_icp_levels(const registration::FramePyramid& pyramid) const;
   const registration::FramePyramid& source_pyramid(const registration::FramePyramid* given);
   registration::IcpResult register_frame(const registration::FramePyramid& source,
                                          const Eigen::Isometry3d& predicted,

@@ -127,6 +127,9 @@ class TsdfVolume {
   PointImage raycast(const PinholeIntrinsics& camera, const geometry::DepthRange& range,
                      const Eigen::Isometry3d& camera_to_world) const;
 
+  // The most blocks the device's largest buffer holds in one pool (max_blocks may not exceed it).
+  static std::size_t largest_pool(const compute::Context& context);
+
   // Forgets every block: the volume as made, its buffers kept.
   void clear();
 
