@@ -87,8 +87,8 @@ printf '0 0 0 0 0 0 0 1\n' > "$1/one.txt"
 "$0" fuse "$2/sun3d_studyroom_fragment1" --poses "$1/one.txt" --out "$1/one" > "$1/one.log" 2>&1 && { echo "FAIL: a short trajectory was accepted"; exit 1; }
 grep -q "fuse --poses: '.*one.txt' has no pose within 20 ms of frame 1" "$1/one.log" || { cat "$1/one.log"; echo "FAIL: message"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-fuse ${KARTOGRAF_DATA_DIR})
-# odometry --tracking model: the frame-to-model line and an ATE; slam refuses the option (it has
-# no model tracking yet) before reading anything.
+# odometry, slam and map --tracking model: the frame-to-model line and an ATE; slam's stats and
+# map's report record the model's tracking.
 add_test(NAME Cli.odometry_tracking_model
   COMMAND sh -c [=[
 rm -rf "$1" && mkdir -p "$1" || exit 1
@@ -99,9 +99,14 @@ grep -q "^  ate_rmse_m [0-9]" "$1/model.log" || { echo "FAIL: no ATE"; exit 1; }
 # The planar odometry's pyramid has one ICP level: the tracker builds its own.
 "$0" odometry "$2/sun3d_studyroom_fragment1" --tracking model --method planar --frames 8 --out "$1/planar.txt" > "$1/planar.log" 2>&1 || { cat "$1/planar.log"; echo "FAIL: planar"; exit 1; }
 grep -q "^  model tracking: the model's pose kept on [0-9]* of 8 frames" "$1/planar.log" || { cat "$1/planar.log"; echo "FAIL: planar model line"; exit 1; }
-"$0" slam "$2/sun3d_studyroom_fragment1" --tracking model --out "$1/slam" > "$1/slam.log" 2>&1 && { echo "FAIL: slam accepted --tracking model"; exit 1; }
-grep -q "slam: --tracking model is only in .kartograf odometry." "$1/slam.log" || { cat "$1/slam.log"; echo "FAIL: message"; exit 1; }
-test ! -e "$1/slam" || { echo "FAIL: output"; exit 1; }
+"$0" slam "$2/sun3d_studyroom_fragment1" --tracking model --no-map --out "$1/slam" > "$1/slam.log" 2>&1 || { cat "$1/slam.log"; echo "FAIL: slam"; exit 1; }
+cat "$1/slam.log"
+grep -q "^  model tracking: the model's pose kept on [0-9]* of 50 frames" "$1/slam.log" || { echo "FAIL: slam model line"; exit 1; }
+grep -q "^  slam_ate_rmse_m [0-9]" "$1/slam.log" || { echo "FAIL: no SLAM ATE"; exit 1; }
+grep -q '"kind": "model"' "$1/slam/stats.json" || { cat "$1/slam/stats.json"; echo "FAIL: stats"; exit 1; }
+"$0" map "$2/sun3d_studyroom_fragment1" --tracking model --out "$1/map" > "$1/map.log" 2>&1 || { cat "$1/map.log"; echo "FAIL: map"; exit 1; }
+grep -q "^  model tracking: the model's pose kept on [0-9]* of 50 frames" "$1/map.log" || { cat "$1/map.log"; echo "FAIL: map model line"; exit 1; }
+grep -q '"tracking": "model"' "$1/map/report.json" || { echo "FAIL: map report"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-odometry-model ${KARTOGRAF_DATA_DIR})
 set_tests_properties(Cli.input_slam_on_7scenes_frames_300_to_599 Cli.input_map_on_7scenes_frames_300_to_599
   Cli.input_slam_and_map_on_sun3d Cli.input_slam_with_features_on_7scenes Cli.input_map_with_known_poses

@@ -143,6 +143,39 @@ class BrokenSource final : public mapping::FrameSource {
   testing::MemoryFrameSource inner_;
 };
 
+// Frame-to-model tracking under SLAM: the graph's odometry is the model's, one edge per step
+// whose motion joins the model's poses, the same poses as the odometry alone with the model, and
+// the loops do not make them worse.
+TEST(Slam, ModelTrackingGivesTheGraphTheModelsPoses) {
+  const testing::MemoryFrameSource source(testing::out_and_back());
+  const compute::Context context = compute::Context::cpu();
+  mapping::SlamParams params = loop_params();
+  params.build_map = false;
+  params.model.enabled = true;
+  const mapping::SlamResult result = mapping::run_slam(context, source, params);
+  const mapping::OdometryRun alone =
+      mapping::run_odometry(context, source, params.odometry, {}, params.model);
+
+  const std::vector<Eigen::Isometry3d>& poses = result.odometry.poses;
+  ASSERT_TRUE(result.odometry.model_tracking);
+  ASSERT_EQ(poses.size(), static_cast<std::size_t>(kFrames));
+  EXPECT_GT(result.odometry.model_kept, static_cast<std::size_t>(kFrames) / 2);
+  ASSERT_EQ(result.odometry.constraints.size(), poses.size() - 1);
+  for (std::size_t i = 1; i < poses.size(); ++i) {
+    const registration::RelativePose& edge = result.odometry.constraints[i - 1];
+    EXPECT_EQ(edge.from, i - 1);
+    EXPECT_EQ(edge.to, i);
+    EXPECT_TRUE(edge.motion.isApprox(poses[i - 1].inverse() * poses[i], 1e-9)) << i;
+    EXPECT_TRUE(poses[i].isApprox(alone.poses[i], 1e-9)) << i;
+  }
+  const double odometry_ate = testing::ate_rmse(poses, testing::out_and_back().truth);
+  const double slam_ate = testing::ate_rmse(result.poses, testing::out_and_back().truth);
+  RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
+  RecordProperty("slam_ate_m", testing::scientific(slam_ate));
+  EXPECT_LT(slam_ate, 0.01);
+  EXPECT_LE(slam_ate, odometry_ate * 1.1);
+}
+
 TEST(Slam, PassesFrameErrorsToTheCaller) {
   const BrokenSource source(testing::out_and_back());
   const compute::Context context = compute::Context::cpu();

@@ -38,7 +38,7 @@ void print_summary(std::ostream& out, const pipeline::MapPipelineResult& r,
                 r.poses.size(), r.labelled_views, r.planes.size(), r.semantic.objects.size(),
                 r.semantic.width(), r.semantic.height(), r.rooms.records.size(),
                 r.rooms.method.c_str());
-  out << line << "  seconds";
+  out << line << model_tracking_line(r.slam.odometry) << "  seconds";
   for (const pipeline::StageTiming& t : r.timings) {
     std::snprintf(line, sizeof(line), " %s %.1f,", t.stage.c_str(), t.seconds);
     out << line;
@@ -119,12 +119,12 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<std::string> known_files = io::map_output_files();
   known_files.push_back("evaluation.png");
   OutputFolder folder("map", o.out_dir, o.force, known_files);
-  require_frame_tracking("map", o.run);
   const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   pipeline::MapperParams params;
   pipeline::MapPipelineParams& stages = params.pipeline;
   stages.slam.odometry = odometry_params(o.run);
+  stages.slam.model = model_tracking_params(o.run);
   stages.label_step = o.label_step;
   stages.max_views = o.max_views;
   stages.features = !o.no_features && o.poses.empty();

@@ -66,14 +66,7 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
                 1000.0 * result.timing.load_seconds / std::max(frames, 1.0));
   out << line;
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.frames)) << "\n";
-  if (result.model_tracking) {
-    std::snprintf(line, sizeof(line),
-                  "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame, "
-                  "%zu restarts of a full model\n",
-                  result.model_kept, result.poses.size(),
-                  1000.0 * result.model_seconds / std::max(frames, 1.0), result.model_restarts);
-    out << line;
-  }
+  out << model_tracking_line(result);
   if (ate) {
     std::snprintf(line, sizeof(line), "  ate_rmse_m %.6f (max %.6f, %zu poses with ground truth)\n",
                   ate->translation_m.rmse, ate->translation_m.max, ate->translation_m.count);

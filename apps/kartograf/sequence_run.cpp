@@ -59,7 +59,7 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
                   "frame: frame-to-frame odometry; model: each frame registered against the "
                   "TSDF of the frames before it (KinectFusion's frame-to-model tracking), from "
                   "the prediction of a frame-to-frame odometry at 160 pixels wide without "
-                  "re-estimates")
+                  "re-estimates (slam, map: the pose graph's odometry is the model's)")
       ->check(CLI::IsMember({"frame", "model"}))
       ->capture_default_str();
   command.add_option("--model-voxel", o.model_voxel, "Voxel size of the model [m]")
@@ -127,11 +127,16 @@ mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& opt
   return params;
 }
 
-void require_frame_tracking(std::string_view command, const SequenceRunOptions& options) {
-  require(options.tracking == "frame",
-          std::string(command) +
-              ": --tracking model is only in `kartograf odometry` for now "
-              "(docs/volumetric.md)");
+std::string model_tracking_line(const mapping::OdometryRun& run) {
+  if (!run.model_tracking) return {};
+  const double frames = static_cast<double>(std::max<std::size_t>(run.poses.size(), 1));
+  char line[160];
+  std::snprintf(line, sizeof(line),
+                "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame, "
+                "%zu restarts of a full model\n",
+                run.model_kept, run.poses.size(), 1000.0 * run.model_seconds / frames,
+                run.model_restarts);
+  return line;
 }
 
 compute::Context make_run_context(const SequenceRunOptions& options) {

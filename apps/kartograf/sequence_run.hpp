@@ -47,9 +47,9 @@ registration::OdometryParams odometry_params(const SequenceRunOptions& options);
 compute::Context make_run_context(const SequenceRunOptions& options);
 // --tracking and --model-voxel.
 mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& options);
-// An Error naming `command` when --tracking model was asked of a command that has no model
-// tracking yet (only `odometry` has).
-void require_frame_tracking(std::string_view command, const SequenceRunOptions& options);
+// The summary's line on model tracking (empty without it): frames that kept the model's pose,
+// its time per frame and the model's restarts.
+std::string model_tracking_line(const mapping::OdometryRun& run);
 // The options and the context as the stats documents record them.
 io::SequenceRunRecord run_record(const SequenceRunOptions& options,
                                  const compute::Context& context);

@@ -70,6 +70,7 @@ void print_slam_summary(std::ostream& out, const SlamOptions& o, const OpenedRun
       << record.backend << " (" << record.device << ")\n";
   out << "  " << io::describe_input(run.opened) << "\n";
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.odometry.frames)) << "\n";
+  out << model_tracking_line(result.odometry);
   std::snprintf(line, sizeof(line),
                 "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",
                 f.loops.accepted, result.loop_candidates, f.loops.pruned);
@@ -117,7 +118,6 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   OutputFolder folder("slam", o.out_dir, o.force,
                       {"trajectory.txt", "odometry.txt", "groundtruth.txt", "map.ply",
                        "top_view.png", "stats.json"});
-  require_frame_tracking("slam", o.run);
   const OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
   mapping::SlamParams params;
@@ -125,6 +125,7 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   params.loop_closure = !o.no_loop_closure;
   params.build_map = !o.no_map;
   params.map.voxel_size = o.voxel_size;
+  params.model = model_tracking_params(o.run);
   if (o.features) {
     params.features = std::make_shared<const features::OrbFrontEnd>(pipeline::map_orb_params());
     params.odometry.features = params.features;

@@ -13,6 +13,8 @@ detail::RunJson parameters_json(const std::string& method, const pipeline::Mappe
   const pipeline::MapPipelineParams& p = mapper.pipeline;
   return {{"method", method},
           {"reestimate_interval", p.slam.odometry.reestimate_interval},
+          {"tracking", p.slam.model.enabled ? "model" : "frame"},
+          {"model_voxel_m", p.slam.model.volume.voxel_size},
           {"label_step", p.label_step},
           {"max_views", p.max_views},
           {"label_width", p.label_width},

@@ -61,6 +61,16 @@ RunJson ate_rmse_json(const std::optional<eval::AteResult>& ate) {
   return ate ? RunJson(ate->translation_m.rmse) : RunJson();
 }
 
+// Frame-to-frame, or frame-to-model with what the model did.
+RunJson tracking_json(const mapping::SlamParams& params, const mapping::OdometryRun& run) {
+  if (!run.model_tracking) return {{"kind", "frame"}};
+  return {{"kind", "model"},
+          {"voxel_size_m", params.model.volume.voxel_size},
+          {"model_kept", run.model_kept},
+          {"model_restarts", run.model_restarts},
+          {"model_seconds", run.model_seconds}};
+}
+
 }  // namespace
 
 LoopClosureCounts count_loop_closures(const mapping::SlamResult& result) {
@@ -86,6 +96,7 @@ std::string slam_stats_json(const SequenceRunRecord& record, const OpenedSequenc
   json["backend"] = record.backend;
   json["device"] = record.device;
   json["reestimate_interval"] = params.odometry.reestimate_interval;
+  json["tracking"] = tracking_json(params, result.odometry);
   json["odometry_ate_rmse_m"] = ate_rmse_json(odometry_ate);
   json["slam_ate_rmse_m"] = ate_rmse_json(slam_ate);
   json["timing_s"] = {{"total", t.total_seconds},

@@ -62,6 +62,10 @@ struct SlamParams {
   std::shared_ptr<const registration::FeatureFrontEnd> features;
   PoseGraphParams graph = slam_graph_options();
   LoopConsistency consistency;
+  // Frame-to-model tracking (model.enabled): the graph's odometry poses and edges are the
+  // model's, predicted by params.odometry's frame-to-frame odometry (ModelTrackingParams::
+  // predicting).
+  ModelTrackingParams model;
   bool build_map = true;
   MapFusionParams map;
 };
