@@ -134,9 +134,11 @@ int run(const Options& o) {
   std::printf("seed %llu noise %s voxel %.3f frames %d blocks %zu vertices %zu triangles %zu\n",
               static_cast<unsigned long long>(o.seed), o.noise ? "kinect" : "none", o.voxel, fused,
               volume.block_count(), mesh.vertices.size(), mesh.triangles.size());
-  std::printf("accuracy mean %.2f mm p90 %.2f mm; completeness (2 cm) %.1f %% of %zu seen voxels\n",
-              1000 * accuracy.mean_m, 1000 * accuracy.p90_m,
-              100 * eval::mesh_completeness(mesh, truth, 0.02), truth.size());
+  std::printf(
+      "accuracy mean %.2f mm p90 %.2f mm (by area %.2f mm); completeness (2 cm) %.1f %% of %zu "
+      "seen voxels\n",
+      1000 * accuracy.mean_m, 1000 * accuracy.p90_m, 1000 * accuracy.area_mean_m,
+      100 * eval::mesh_completeness(mesh, truth, 0.02), truth.size());
   std::printf("integration %.2f ms/frame (%s), meshing %.2f s\n", 1000 * fuse_seconds / fused,
               o.backend.c_str(), mesh_seconds);
   return 0;

@@ -5,7 +5,7 @@
 //   tsdf_integrate/<backend>/<voxel>   one frame's upload, block allocation and integration
 //                                      (frames 5-39, after 5 that build the volume)
 //   tsdf_raycast/<backend>/<voxel>     depth and colour of the 40-frame volume from a frame's pose
-//   tsdf_mesh/<backend>/<voxel>        download and marching tetrahedra of that volume (host)
+//   tsdf_mesh/<backend>/<voxel>        download and marching cubes of that volume (host)
 //   tsdf_mesh_device/<backend>/<voxel> the same mesh made on the device, joined on the host
 //   tsdf_esdf/<backend>/<voxel>        its height-band occupancy and the grid's ESDF, both on the
 //                                      device (the 7-Scenes world's z as up)

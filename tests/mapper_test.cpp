@@ -113,16 +113,25 @@ TEST(Mapper, MeshFromGivenPosesLiesOnTheTrueSurfaces) {
   ASSERT_GT(mesh.vertices.size(), 10000u);
   // Poses are relative to the first frame's: back to the world's.
   const Eigen::Isometry3f world_from_first = walk.truth.front().cast<float>();
+  const auto distance = [&](const Eigen::Vector3f& v) {
+    return synth::distance_to_surfaces(testing::test_world(),
+                                       (world_from_first * v).cast<double>());
+  };
   double sum = 0;
-  std::size_t far = 0;
-  for (const Eigen::Vector3f& v : mesh.vertices) {
-    const double d =
-        synth::distance_to_surfaces(testing::test_world(), (world_from_first * v).cast<double>());
-    sum += d;
-    far += d > 0.04;
-  }
+  for (const Eigen::Vector3f& v : mesh.vertices) sum += distance(v);
   EXPECT_LT(sum / mesh.vertices.size(), 0.01);
-  EXPECT_LT(static_cast<double>(far) / mesh.vertices.size(), 0.02);
+  // Surface more than 4 cm off (flying pixels at outlines), by area: a share of vertices would
+  // depend on how densely the mesher places them (marching tetrahedra 1.6 % of its vertices, 1.45 %
+  // of its area; marching cubes 2.1 % and 1.29 %).
+  double area = 0, far_area = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3f &a = mesh.vertices[t[0]], &b = mesh.vertices[t[1]],
+                          &c = mesh.vertices[t[2]];
+    const double triangle_area = 0.5 * (b - a).cross(c - a).norm();
+    area += triangle_area;
+    if (distance((a + b + c) / 3) > 0.04) far_area += triangle_area;
+  }
+  EXPECT_LT(far_area / area, 0.02);
   EXPECT_EQ(mapper.volume_stats().evictions, 0u);
   EXPECT_TRUE(mapper.volume_stats().covers_all_frames);
 }

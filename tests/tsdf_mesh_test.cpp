@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <map>
+#include <random>
 #include <utility>
 
 #include "kartograf/mapping/tsdf_mesh.hpp"
@@ -64,6 +65,40 @@ TEST(TsdfMesh, SphereIsClosedOnTheSurfaceAndFacesOut) {
   EXPECT_EQ(facing_out, mesh.triangles.size());
   EXPECT_EQ(mesh.colors.size(), mesh.vertices.size());
   EXPECT_EQ(mesh.colors.front(), 0x204080u);
+}
+
+// Marching cubes' cases on random fields: every sign pattern a cell can have turns up, and the
+// surface must still be closed and consistently oriented: each edge run as often one way as the
+// other (by two triangles, or four where two cells' fans meet on an ambiguous face they share).
+// A field whose outer voxels are all outside closes every surface.
+TEST(TsdfMesh, RandomFieldsGiveClosedConsistentlyOrientedSurfaces) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<float> value(-0.9f, 0.9f);
+  for (int trial = 0; trial < 4; ++trial) {
+    TsdfBlocks field = sphere_field({0, 0, 0}, 0.1, 0.01, 0.04, 1);  // 16^3 voxels
+    for (std::size_t b = 0; b < field.size(); ++b)
+      for (std::size_t i = 0; i < kTsdfBlockVoxels; ++i) {
+        const Eigen::Vector3i v = field.coords[b] * kTsdfBlockSide +
+                                  Eigen::Vector3i(int(i % 8), int(i / 8 % 8), int(i / 64));
+        const bool border = (v.array() == -8).any() || (v.array() == 7).any();
+        field.voxels[b * kTsdfBlockVoxels + i].tsdf = border ? 0.9f : value(random);
+      }
+    const TriangleMesh mesh = mapping::extract_mesh(field);
+    ASSERT_GT(mesh.triangles.size(), 1000u);
+    std::map<std::pair<int, int>, int> directed;
+    for (const Eigen::Vector3i& t : mesh.triangles)
+      for (int k = 0; k < 3; ++k) ++directed[{t[k], t[(k + 1) % 3]}];
+    std::size_t shared_on_faces = 0;
+    for (const auto& [edge, uses] : directed) {
+      const auto back = directed.find({edge.second, edge.first});
+      ASSERT_TRUE(back != directed.end() && back->second == uses)
+          << "trial " << trial << ": edge " << edge.first << "-" << edge.second << " is open";
+      ASSERT_LE(uses, 2);
+      shared_on_faces += uses == 2;
+    }
+    RecordProperty("edges_shared_on_faces_" + std::to_string(trial), int(shared_on_faces));
+    EXPECT_LT(shared_on_faces, directed.size() / 100);
+  }
 }
 
 TEST(TsdfMesh, UnobservedCornersAndJumpsMakeNoSurface) {

@@ -321,7 +321,7 @@ void expect_same_mesh(const TsdfVolume& volume, const std::string& what) {
   EXPECT_LE(worst_color, 1) << what;
 }
 
-// Marching tetrahedra on the device (kernels/tsdf/tsdf_mesh.h) on a synthetic and a real field.
+// Marching cubes on the device (kernels/tsdf/tsdf_mesh.h) on a synthetic and a real field.
 TEST_P(TsdfVolumeTest, MeshOnTheDeviceEqualsTheHostsOnSyntheticAndRealFields) {
   expect_same_mesh(*sphere_and_wall(context()), "sphere and wall");
   expect_same_mesh(*kitchen_frames(context(), true), "7-Scenes frames 0 and 10");

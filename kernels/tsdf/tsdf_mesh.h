@@ -1,22 +1,18 @@
 // The zero surface of the TSDF on the device (rules in include/kartograf/mapping/tsdf_mesh.hpp:
-// marching tetrahedra, 6 per cell around its main diagonal), one work item per cell, the cell
+// marching cubes, its triangles from tsdf_mc_triangles below), one work item per cell, the cell
 // whose lowest corner is voxel `cell % 512` of pool block `cell / 512`. A cell with every corner
 // observed (weight >= min_weight) and corners on both sides of zero appends its triangles: each
 // with its 3 vertices (position in metres, colour) and the keys of the edges they lie on, so that
 // the host can join the vertices that triangles share, and an order key (cell x 16 + its k-th
-// triangle) that gives the host mesher's order. An edge between two truncated values
-// (|value| >= max_jump) is a jump, not a surface: its tetrahedron makes no triangle.
+// triangle) that gives the host mesher's order. A triangle with a vertex on an edge between two
+// truncated values (|value| >= max_jump) lies on a jump, not a surface, and is left out.
 #ifndef KARTOGRAF_KERNELS_TSDF_MESH_H
 #define KARTOGRAF_KERNELS_TSDF_MESH_H
 #include "kernels/tsdf/tsdf.h"
 #include "kernels/tsdf/tsdf_voxel.h"
 
 #define KG_TSDF_MESH_VOXEL_BIAS 524288  // 2^19: voxel coordinates an edge key holds each way
-// The tetrahedra's middle corners, a nibble each (the first is corner 0, the last corner 7):
-// 0-1-3-7, 0-3-2-7, 0-2-6-7, 0-6-4-7, 0-4-5-7, 0-5-1-7.
-#define KG_TSDF_MESH_SECOND 0x546231u
-#define KG_TSDF_MESH_THIRD 0x154623u
-#define KG_TSDF_MESH_FLIP 0x1000000u  // in a triangle's first colour: swap its last two vertices
+#define KG_TSDF_MC_NONE 15u             // no edge: after a case's last triangle
 
 KG_RULES_BEGIN
 
@@ -46,6 +42,71 @@ uint color;
 uint64_t key;  // its edge: lower end's biased coordinates, then the step to the other end
 KG_STRUCT_END(TsdfMeshVertex)
 
+// Marching cubes. Corner c of a cell is at offset (c & 1, c >> 1 & 1, c >> 2 & 1) from its lowest
+// voxel; edge e (0-11) is the (e % 4)-th edge along axis e / 4, counted by its lower corner.
+
+// The lower corner of edge e; the upper one is that plus 1 << (e / 4).
+KG_INLINE uint tsdf_mc_edge_lower(uint e) {
+  const uint axis = e / 4u, k = e % 4u;
+  return ((k >> axis) << (axis + 1u)) | (k & ((1u << axis) - 1u));
+}
+
+// The edge between corners a and b (which differ in one bit).
+KG_INLINE uint tsdf_mc_edge(uint a, uint b) {
+  const uint lower = min(a, b), bit = a ^ b;
+  const uint axis = bit == 1u ? 0u : (bit == 2u ? 1u : 2u);
+  return 4u * axis + (((lower >> (axis + 1u)) << axis) | (lower & ((1u << axis) - 1u)));
+}
+
+// Corner i (0-3, counter-clockwise seen from outside the cell) of face f (0-5: axis f / 2, low
+// side for even f).
+KG_INLINE uint tsdf_mc_face_corner(uint f, uint i) {
+  const uint axis = f / 2u, u = 1u << ((axis + 1u) % 3u), v = 1u << ((axis + 2u) % 3u);
+  const uint j = f % 2u == 1u ? i : 3u - i;  // the low side is seen from the other way
+  const uint base = (f % 2u) << axis;
+  return base | (j == 1u || j == 2u ? u : 0u) | (j >= 2u ? v : 0u);
+}
+
+// The triangles of the cell whose corners below zero are the bits of `inside`: edge numbers a
+// nibble each, 3 per triangle, then KG_TSDF_MC_NONE (at most 5 triangles). On each face the
+// surface separates every run of inside corners (along the face's boundary) from the rest: two
+// inside corners on a diagonal are kept apart. The rule sees only the face's own corners, so
+// the two cells that share a face cut it alike and the surface has no cracks. Each run gives a
+// segment from the edge where the boundary leaves it to the edge where it enters it, so that
+// the inside lies on its left seen from outside the cell; the segments join into loops, each cut
+// into a fan of triangles that faces the + side.
+KG_INLINE uint64_t tsdf_mc_triangles(uint inside) {
+  uint next[12];
+  for (uint e = 0u; e < 12u; ++e) next[e] = KG_TSDF_MC_NONE;
+  for (uint f = 0u; f < 6u; ++f) {
+    for (uint i = 0u; i < 4u; ++i) {
+      const uint c = tsdf_mc_face_corner(f, i), before = tsdf_mc_face_corner(f, (i + 3u) % 4u);
+      if (((inside >> c) & 1u) == 0u || ((inside >> before) & 1u) != 0u) continue;
+      uint last = i;  // the run's last corner; `before` is outside, so the walk ends
+      while (((inside >> tsdf_mc_face_corner(f, (last + 1u) % 4u)) & 1u) != 0u)
+        last = (last + 1u) % 4u;
+      next[tsdf_mc_edge(tsdf_mc_face_corner(f, last), tsdf_mc_face_corner(f, (last + 1u) % 4u))] =
+          tsdf_mc_edge(before, c);
+    }
+  }
+  uint64_t triangles = ~KG_UINT64(0);
+  uint count = 0u, seen = 0u;
+  for (uint first = 0u; first < 12u; ++first) {
+    if (next[first] == KG_TSDF_MC_NONE || ((seen >> first) & 1u) != 0u) continue;
+    uint previous = next[first];
+    seen |= (1u << first) | (1u << previous);
+    for (uint current = next[previous]; current != first; current = next[current]) {
+      const uint64_t triangle = KG_UINT64(first | (current << 4u) | (previous << 8u));
+      triangles &= ~(KG_UINT64(0xfffu) << (12u * count));
+      triangles |= triangle << (12u * count);
+      ++count;
+      seen |= 1u << current;
+      previous = current;
+    }
+  }
+  return triangles;
+}
+
 // One colour channel between a and b at t, rounded to the nearest level.
 KG_INLINE uint tsdf_mesh_mix(uint a, uint b, uint shift, float t) {
   const float x = KG_FLOAT((a >> shift) & 0xffu), y = KG_FLOAT((b >> shift) & 0xffu);
@@ -74,7 +135,7 @@ KG_INLINE TsdfMeshVertex tsdf_mesh_vertex(TsdfMeshCorner i, TsdfMeshCorner o, Ts
   return v;
 }
 
-// Whether the tetrahedron's corner pairs across zero include a jump.
+// Whether the edge between two corners across zero is a jump (both values truncated).
 KG_INLINE bool tsdf_mesh_jump(float a, float b, TsdfMeshParams p) {
   return kg_fabs(a) >= p.max_jump && kg_fabs(b) >= p.max_jump;
 }
@@ -83,39 +144,31 @@ KG_INLINE bool tsdf_mesh_jump(float a, float b, TsdfMeshParams p) {
 // The shader declares keys, slot_blocks, block_keys, voxels, status, order, edge_keys, points and
 // colors.
 
-// Appends the triangle on edges (i0, o0), (i1, o1), (i2, o2) (inside corner, outside corner),
-// facing outside, as triangle k of the cell.
+// Appends the triangle (v0, v1, v2) as triangle k of the cell.
 KG_INLINE void tsdf_mesh_emit(KG_BUFFER_PARAM(uint, status) KG_BUFFER_PARAM(uint, order)
                                   KG_BUFFER_PARAM(uint64_t, edge_keys)
                                       KG_BUFFER_PARAM(float, points) KG_BUFFER_PARAM(uint, colors)
                                           TsdfMeshVertex v0,
-                              TsdfMeshVertex v1, TsdfMeshVertex v2, float3 outward, uint cell,
-                              uint k, TsdfMeshParams p) {
-  const float3 a = KG_FLOAT3(v0.x, v0.y, v0.z), b = KG_FLOAT3(v1.x, v1.y, v1.z),
-               c = KG_FLOAT3(v2.x, v2.y, v2.z);
-  // Written in the edges' order, which decides the vertices' numbers; whether the second and
-  // third swap to face outside goes in the first colour's top byte.
-  const bool flip = dot(cross(b - a, c - a), outward) < 0.0f;
-  const TsdfMeshVertex second = v1;
-  const TsdfMeshVertex third = v2;
+                              TsdfMeshVertex v1, TsdfMeshVertex v2, uint cell, uint k,
+                              TsdfMeshParams p) {
   const uint slot = kg_atomic_add_u32(status, 0u, 1u);
   if (slot >= p.capacity) return;  // the host sees the count and runs again with room
   order[slot] = cell * 16u + k;
   edge_keys[3u * slot] = v0.key;
-  edge_keys[3u * slot + 1u] = second.key;
-  edge_keys[3u * slot + 2u] = third.key;
+  edge_keys[3u * slot + 1u] = v1.key;
+  edge_keys[3u * slot + 2u] = v2.key;
   points[9u * slot] = v0.x;
   points[9u * slot + 1u] = v0.y;
   points[9u * slot + 2u] = v0.z;
-  points[9u * slot + 3u] = second.x;
-  points[9u * slot + 4u] = second.y;
-  points[9u * slot + 5u] = second.z;
-  points[9u * slot + 6u] = third.x;
-  points[9u * slot + 7u] = third.y;
-  points[9u * slot + 8u] = third.z;
-  colors[3u * slot] = v0.color | (flip ? KG_TSDF_MESH_FLIP : 0u);
-  colors[3u * slot + 1u] = second.color;
-  colors[3u * slot + 2u] = third.color;
+  points[9u * slot + 3u] = v1.x;
+  points[9u * slot + 4u] = v1.y;
+  points[9u * slot + 5u] = v1.z;
+  points[9u * slot + 6u] = v2.x;
+  points[9u * slot + 7u] = v2.y;
+  points[9u * slot + 8u] = v2.z;
+  colors[3u * slot] = v0.color;
+  colors[3u * slot + 1u] = v1.color;
+  colors[3u * slot + 2u] = v2.color;
 }
 
 // Corner c (offset c & 1, c >> 1 & 1, c >> 2 & 1 from the cell's lowest voxel) of the cell; weight
@@ -151,7 +204,7 @@ KG_INLINE TsdfMeshCorner tsdf_mesh_corner(KG_BUFFER_PARAM(const uint64_t, keys)
   return corner;
 }
 
-// The cell's triangles, appended (at most 12: 2 per tetrahedron).
+// The cell's triangles, appended (at most 5).
 KG_FORCE_INLINE void tsdf_mesh_cell(
     KG_BUFFER_PARAM(const uint64_t, keys) KG_BUFFER_PARAM(const uint, slot_blocks)
         KG_BUFFER_PARAM(const uint64_t, block_keys) KG_BUFFER_PARAM(const TsdfVoxel, voxels)
@@ -162,65 +215,35 @@ KG_FORCE_INLINE void tsdf_mesh_cell(
   const uint block = cell / KG_TSDF_BLOCK_VOXELS, in_block = cell % KG_TSDF_BLOCK_VOXELS;
   const uint64_t key = block_keys[block];
   TsdfMeshCorner corners[8];
-  bool inside = false, outside = false;
+  uint inside = 0u;
   for (uint c = 0u; c < 8u; ++c) {
     corners[c] =
         tsdf_mesh_corner(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) key,
                          block, in_block, c, p);
     if (corners[c].weight < 0.0f) return;  // no block holds it
-    inside = inside || corners[c].value < 0.0f;
-    outside = outside || !(corners[c].value < 0.0f);
+    if (corners[c].value < 0.0f) inside |= 1u << c;
   }
-  if (!inside || !outside) return;
+  if (inside == 0u || inside == 255u) return;
   for (uint c = 0u; c < 8u; ++c)
     if (corners[c].weight < p.min_weight) return;
-  uint k = 0u;
-  for (uint t = 0u; t < 6u; ++t) {
-    const uint tet = (((KG_TSDF_MESH_SECOND >> (4u * t)) & 15u) << 4u) |
-                     (((KG_TSDF_MESH_THIRD >> (4u * t)) & 15u) << 8u) | (7u << 12u);
-    uint ins = 0u, outs = 0u, n_in = 0u, n_out = 0u;  // corner numbers, a nibble each
-    for (uint i = 0u; i < 4u; ++i) {
-      const uint c = (tet >> (4u * i)) & 15u;
-      if (corners[c].value < 0.0f) {
-        ins |= c << (4u * n_in);
-        ++n_in;
-      } else {
-        outs |= c << (4u * n_out);
-        ++n_out;
-      }
-    }
-    if (n_in == 0u || n_out == 0u) continue;
-    bool jump = false;
-    for (uint i = 0u; i < n_in; ++i)
-      for (uint o = 0u; o < n_out; ++o)
-        jump = jump || tsdf_mesh_jump(corners[(ins >> (4u * i)) & 15u].value,
-                                      corners[(outs >> (4u * o)) & 15u].value, p);
-    if (jump) continue;
-    const TsdfMeshCorner i0 = corners[ins & 15u], i1 = corners[(ins >> 4u) & 15u],
-                         i2 = corners[(ins >> 8u) & 15u];
-    const TsdfMeshCorner o0 = corners[outs & 15u], o1 = corners[(outs >> 4u) & 15u],
-                         o2 = corners[(outs >> 8u) & 15u];
-    const float3 outward =
-        KG_FLOAT3(KG_FLOAT(o0.x - i0.x), KG_FLOAT(o0.y - i0.y), KG_FLOAT(o0.z - i0.z));
-    const TsdfMeshVertex first = tsdf_mesh_vertex(i0, o0, p);
-    if (n_in == 1u || n_out == 1u) {
-      const bool lone_inside = n_in == 1u;
-      tsdf_mesh_emit(KG_BUFFER_ARG(status) KG_BUFFER_ARG(order) KG_BUFFER_ARG(edge_keys)
-                         KG_BUFFER_ARG(points) KG_BUFFER_ARG(colors) first,
-                     tsdf_mesh_vertex(lone_inside ? i0 : i1, lone_inside ? o1 : o0, p),
-                     tsdf_mesh_vertex(lone_inside ? i0 : i2, lone_inside ? o2 : o0, p), outward,
-                     cell, k, p);
-      ++k;
+  const uint64_t triangles = tsdf_mc_triangles(inside);
+  for (uint k = 0u; k < 5u; ++k) {
+    const uint t = KG_UINT((triangles >> (12u * k)) & KG_UINT64(0xfffu));
+    if ((t & 15u) == KG_TSDF_MC_NONE) break;
+    const uint e0 = t & 15u, e1 = (t >> 4u) & 15u, e2 = (t >> 8u) & 15u;
+    const uint a0 = tsdf_mc_edge_lower(e0), a1 = tsdf_mc_edge_lower(e1),
+               a2 = tsdf_mc_edge_lower(e2);
+    const uint b0 = a0 | (1u << (e0 / 4u)), b1 = a1 | (1u << (e1 / 4u)),
+               b2 = a2 | (1u << (e2 / 4u));
+    if (tsdf_mesh_jump(corners[a0].value, corners[b0].value, p) ||
+        tsdf_mesh_jump(corners[a1].value, corners[b1].value, p) ||
+        tsdf_mesh_jump(corners[a2].value, corners[b2].value, p))
       continue;
-    }
-    const TsdfMeshVertex across = tsdf_mesh_vertex(i1, o1, p);
     tsdf_mesh_emit(KG_BUFFER_ARG(status) KG_BUFFER_ARG(order) KG_BUFFER_ARG(edge_keys)
-                       KG_BUFFER_ARG(points) KG_BUFFER_ARG(colors) first,
-                   tsdf_mesh_vertex(i0, o1, p), across, outward, cell, k, p);
-    tsdf_mesh_emit(KG_BUFFER_ARG(status) KG_BUFFER_ARG(order) KG_BUFFER_ARG(edge_keys)
-                       KG_BUFFER_ARG(points) KG_BUFFER_ARG(colors) first,
-                   across, tsdf_mesh_vertex(i1, o0, p), outward, cell, k + 1u, p);
-    k += 2u;
+                       KG_BUFFER_ARG(points) KG_BUFFER_ARG(colors)
+                           tsdf_mesh_vertex(corners[a0], corners[b0], p),
+                   tsdf_mesh_vertex(corners[a1], corners[b1], p),
+                   tsdf_mesh_vertex(corners[a2], corners[b2], p), cell, k, p);
   }
 }
 

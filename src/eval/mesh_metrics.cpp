@@ -6,6 +6,8 @@
 #include <unordered_map>
 #include <vector>
 
+#include <Eigen/Geometry>
+
 #include "kartograf/core/error.hpp"
 
 namespace kartograf::eval {
@@ -16,6 +18,21 @@ std::uint64_t cell_key(const Eigen::Vector3d& p, double size) {
   const Eigen::Array3d k = (p / size).array().floor() + double(1 << 20);
   return static_cast<std::uint64_t>(k.x()) | static_cast<std::uint64_t>(k.y()) << 21 |
          static_cast<std::uint64_t>(k.z()) << 42;
+}
+
+double area_weighted_distance(
+    const TriangleMesh& mesh,
+    const std::function<double(const Eigen::Vector3d&)>& distance_to_truth) {
+  double area = 0, weighted = 0;
+  for (const Eigen::Vector3i& t : mesh.triangles) {
+    const Eigen::Vector3d a = mesh.vertices[t[0]].cast<double>(),
+                          b = mesh.vertices[t[1]].cast<double>(),
+                          c = mesh.vertices[t[2]].cast<double>();
+    const double triangle = 0.5 * (b - a).cross(c - a).norm();
+    area += triangle;
+    weighted += triangle * distance_to_truth((a + b + c) / 3.0);
+  }
+  return area > 0 ? weighted / area : 0.0;
 }
 
 }  // namespace
@@ -35,6 +52,7 @@ MeshAccuracy mesh_accuracy(const TriangleMesh& mesh,
   std::nth_element(d.begin(), p90, d.end());
   out.p90_m = *p90;
   out.max_m = *std::max_element(d.begin(), d.end());
+  out.area_mean_m = area_weighted_distance(mesh, distance_to_truth);
   return out;
 }
 

@@ -8,17 +8,24 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
+#include "kernels/tsdf/tsdf_mesh.h"
 #include "mapping/edge_index.hpp"
 
 namespace kartograf::mapping {
 
 namespace {
 
-// Corner c of a cell is at offset (c & 1, c >> 1 & 1, c >> 2 & 1) from its lowest voxel. The six
-// tetrahedra around the diagonal 0-7: each a chain of corners whose offsets only grow, so every
-// edge's far end is its near end plus an offset in {0, 1}^3.
-constexpr std::array<std::array<int, 4>, 6> kTetrahedra{
-    {{0, 1, 3, 7}, {0, 3, 2, 7}, {0, 2, 6, 7}, {0, 6, 4, 7}, {0, 4, 5, 7}, {0, 5, 1, 7}}};
+// Marching cubes' triangles of each case (kernels/tsdf/tsdf_mesh.h's rule), made once.
+const std::array<std::uint64_t, 256>& marching_cubes_cases() {
+  static const std::array<std::uint64_t, 256> cases = [] {
+    std::array<std::uint64_t, 256> table{};
+    for (unsigned inside = 0; inside < 256; ++inside)
+      table[inside] = kernels::tsdf_mc_triangles(inside);
+    return table;
+  }();
+  return cases;
+}
+
 constexpr int kVoxelLimit = 1 << 19;  // voxel coordinates an edge key holds
 
 struct Corner {
@@ -27,6 +34,7 @@ struct Corner {
   std::uint32_t color = 0;
 };
 
+// Corner c of a cell is at offset (c & 1, c >> 1 & 1, c >> 2 & 1) from its lowest voxel.
 Eigen::Vector3i corner_offset(int c) {
   return {c & 1, (c >> 1) & 1, (c >> 2) & 1};
 }
@@ -71,8 +79,13 @@ class MeshBuilder {
           blocks_.coords[block] * kTsdfBlockSide + local + corner_offset(c);
       corners[c] = {voxel, voxels[c]->tsdf, voxels[c]->color};
     }
-    for (const auto& t : kTetrahedra) {
-      tetrahedron({corners[t[0]], corners[t[1]], corners[t[2]], corners[t[3]]});
+    unsigned inside = 0;
+    for (int c = 0; c < 8; ++c) inside |= corners[c].value < 0 ? 1u << c : 0u;
+    const std::uint64_t triangles = marching_cubes_cases()[inside];
+    for (unsigned k = 0; k < 5; ++k) {
+      const auto edges = static_cast<unsigned>((triangles >> (12 * k)) & 0xfff);
+      if ((edges & 15) == KG_TSDF_MC_NONE) break;
+      triangle(corners, {edges & 15, (edges >> 4) & 15, (edges >> 8) & 15});
     }
   }
 
@@ -118,42 +131,17 @@ class MeshBuilder {
     return std::abs(a.value) >= params_.max_jump && std::abs(b.value) >= params_.max_jump;
   }
 
-  // The triangle on three crossing edges (each: inside corner, outside corner), facing outside.
-  void triangle(const std::array<std::pair<const Corner*, const Corner*>, 3>& edges) {
+  // The triangle on three crossing edges of the cell, unless one is a jump.
+  void triangle(const std::array<Corner, 8>& corners, const std::array<unsigned, 3>& edges) {
+    std::array<std::pair<const Corner*, const Corner*>, 3> ends;
+    for (int i = 0; i < 3; ++i) {
+      const unsigned lower = kernels::tsdf_mc_edge_lower(edges[i]);
+      ends[i] = {&corners[lower], &corners[lower | 1u << (edges[i] / 4)]};
+      if (is_jump(*ends[i].first, *ends[i].second)) return;
+    }
     std::array<int, 3> v{};
-    for (int i = 0; i < 3; ++i) v[i] = vertex_on(*edges[i].first, *edges[i].second);
-    const Eigen::Vector3f normal = (mesh_.vertices[v[1]] - mesh_.vertices[v[0]])
-                                       .cross(mesh_.vertices[v[2]] - mesh_.vertices[v[0]]);
-    const Eigen::Vector3f outward = (edges[0].second->voxel - edges[0].first->voxel).cast<float>();
-    if (normal.dot(outward) < 0) std::swap(v[1], v[2]);
+    for (int i = 0; i < 3; ++i) v[i] = vertex_on(*ends[i].first, *ends[i].second);
     mesh_.triangles.emplace_back(v[0], v[1], v[2]);
-  }
-
-  void tetrahedron(const std::array<Corner, 4>& t) {
-    std::array<const Corner*, 4> inside{}, outside{};
-    int n_in = 0, n_out = 0;
-    for (const Corner& c : t) (c.value < 0 ? inside[n_in++] : outside[n_out++]) = &c;
-    if (n_in == 0 || n_out == 0) return;
-    for (int i = 0; i < n_in; ++i) {
-      for (int o = 0; o < n_out; ++o) {
-        if (is_jump(*inside[i], *outside[o])) return;
-      }
-    }
-    // Edges are (inside, outside); a corner's order in the chain decides which end is lower.
-    const auto edge = [](const Corner* in, const Corner* out) { return std::make_pair(in, out); };
-    if (n_in == 1 || n_out == 1) {
-      const bool lone_inside = n_in == 1;
-      std::array<std::pair<const Corner*, const Corner*>, 3> e;
-      for (int k = 0; k < 3; ++k) {
-        e[k] = lone_inside ? edge(inside[0], outside[k]) : edge(inside[k], outside[0]);
-      }
-      triangle(e);
-      return;
-    }
-    triangle(
-        {edge(inside[0], outside[0]), edge(inside[0], outside[1]), edge(inside[1], outside[1])});
-    triangle(
-        {edge(inside[0], outside[0]), edge(inside[1], outside[1]), edge(inside[1], outside[0])});
   }
 
   const TsdfBlocks& blocks_;

@@ -118,9 +118,8 @@ TriangleMesh extract_mesh(const TsdfVolume& volume, const MeshParams& params) {
       if (!inserted) continue;
       const float* point = &found.points[9 * t + 3 * i];
       mesh.vertices.emplace_back(point[0], point[1], point[2]);
-      mesh.colors.push_back(found.colors[3 * t + i] & 0xffffffu);
+      mesh.colors.push_back(found.colors[3 * t + i]);
     }
-    if ((found.colors[3 * t] & KG_TSDF_MESH_FLIP) != 0) std::swap(v[1], v[2]);
     mesh.triangles.emplace_back(v[0], v[1], v[2]);
   }
   return mesh;

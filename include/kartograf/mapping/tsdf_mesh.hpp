@@ -3,13 +3,15 @@
 // copy of the field.
 //
 // Cells are the cubes between 8 neighbouring voxel centres; a cell with an unobserved corner is
-// skipped. Each cell is cut into 6 tetrahedra around its main diagonal (marching tetrahedra: no
-// ambiguous cases, and neighbouring cells cut their shared faces the same way, so the surface
-// has no cracks). A vertex lies on every edge whose ends differ in sign, placed by linear
-// interpolation, and is shared by the triangles that use that edge; its colour is interpolated
-// alike. An edge whose two values are both at the truncation (|value| >= max_jump) is a jump in
-// the field, not a surface (the boundary between what a view saw in front of a surface and what
-// it saw behind another), and makes no vertex. Triangles face the + side (the viewer).
+// skipped. Marching cubes: a vertex lies on every cell edge whose ends differ in sign, placed by
+// linear interpolation, and is shared by the triangles that use that edge; its colour is
+// interpolated alike. Each cell's triangles come from its corners' signs by one rule
+// (kernels/tsdf/tsdf_mesh.h, tsdf_mc_triangles): on each face the surface cuts off every run of
+// corners below zero, so two on a diagonal stay apart, and the cells on both sides of a face cut
+// it alike (no cracks); the cuts join into loops, each a fan of triangles. A triangle with a
+// vertex on an edge whose two values are both at the truncation (|value| >= max_jump) lies on a
+// jump in the field, not a surface (the boundary between what a view saw in front of a surface
+// and what it saw behind another), and is left out. Triangles face the + side (the viewer).
 #include <cstdint>
 #include <vector>
 
