@@ -72,6 +72,28 @@ TEST(Mapper, GivesTheBatchSlamPosesFrameByFrame) {
   EXPECT_EQ(result.mesh.vertices.size(), result.map.size());
 }
 
+// With frame-to-model tracking the mapper still gives the batch SLAM's poses (and so its
+// odometry is the model's).
+TEST(Mapper, WithModelTrackingGivesTheBatchSlamPoses) {
+  const compute::Context cpu = compute::Context::cpu();
+  pipeline::MapperParams params = loop_params();
+  params.pipeline.slam.model.enabled = true;
+  const testing::MemoryFrameSource source(testing::out_and_back());
+  mapping::SlamParams batch_params = params.pipeline.slam;
+  batch_params.build_map = false;
+  const mapping::SlamResult batch = mapping::run_slam(cpu, source, batch_params);
+  ASSERT_TRUE(batch.odometry.model_tracking);
+
+  pipeline::Mapper mapper(cpu, source.camera(), source.depth_units_per_metre(), params);
+  feed(mapper, testing::out_and_back(), false);
+  const pipeline::MapPipelineResult result = mapper.finish();
+  EXPECT_TRUE(result.slam.odometry.model_tracking);
+  EXPECT_EQ(result.slam.odometry.model_kept, batch.odometry.model_kept);
+  ASSERT_EQ(result.slam.poses.size(), batch.poses.size());
+  for (std::size_t i = 0; i < batch.poses.size(); ++i)
+    EXPECT_TRUE(result.slam.poses[i].isApprox(batch.poses[i], 1e-12)) << "frame " << i;
+}
+
 // A budget of 1000 blocks (4 cm voxels: about 100 m^2 of surface) on a walk through several rooms:
 // the volume evicts, never holds more than its budget, and keeps what is around the camera.
 TEST(Mapper, EvictsFarBlocksWithinItsBudget) {
