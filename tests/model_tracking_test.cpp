@@ -137,23 +137,31 @@ TEST_F(ModelTracking, AnImplausibleCorrectionLeavesThePrediction) {
   EXPECT_TRUE(step.pose.isApprox(predicted));
 }
 
-// A pool too small for the tour: the model restarts when it is three quarters full, and the
-// frames go on being tracked.
-TEST_F(ModelTracking, AFullModelRestartsFromTheCurrentFrame) {
+// A pool too small for the tour: when it is three quarters full the blocks the camera has not
+// seen for longest go, down to half of that, and the frames go on being tracked against what
+// stayed (what the camera was looking at: the next frame adds few blocks back).
+TEST_F(ModelTracking, AFullModelEvictsWhatTheCameraHasNotSeenLately) {
   mapping::ModelTrackingParams params = enabled();
   params.depth_weights.reference_depth = 1.5;  // as in CorrectsNudgedPredictionsAgainstTheModel
-  params.volume.max_blocks = 2400;             // the tour's first 40 frames fill 3000
+  params.volume.max_blocks = 3000;             // the tour's first 60 frames fill about 4000
   mapping::ModelTracker tracking = tracker(params);
-  std::size_t restarts = 0;
-  for (int i = 0; i < 40; i += 2) {
+  std::size_t evictions = 0, from_model = 0;
+  for (int i = 0; i < 60; i += 2) {
     const synth::SyntheticFrame sensed = frame(i);
+    const std::size_t before = tracking.volume().block_count();
     const mapping::ModelTrackingStep step =
         tracking.track(sensed.depth, nullptr, nudged(pose(i), 0.005, 0.1, i));
-    restarts += step.restarted ? 1 : 0;
     EXPECT_LE(tracking.volume().block_count(), 2400u);
     EXPECT_LT(distance(step.pose, pose(i)), 0.01) << "frame " << i;
+    from_model += step.from_model ? 1 : 0;
+    if (step.evicted_blocks == 0) continue;
+    ++evictions;
+    EXPECT_GE(before, 1800u);                                         // three quarters of the pool
+    EXPECT_EQ(before - step.evicted_blocks, 1125u) << "frame " << i;  // half of 3/4
+    EXPECT_LT(tracking.volume().block_count(), 1125u + 400u) << "frame " << i;
   }
-  EXPECT_GE(restarts, 1u);
+  EXPECT_GE(evictions, 1u);
+  EXPECT_GE(from_model, 15u);
 }
 
 TEST_F(ModelTracking, BadParametersAreRefused) {
@@ -161,7 +169,7 @@ TEST_F(ModelTracking, BadParametersAreRefused) {
            [](mapping::ModelTrackingParams& p) { p.min_fitness = 1.5; },
            [](mapping::ModelTrackingParams& p) { p.max_correction_m = 0; },
            [](mapping::ModelTrackingParams& p) { p.icp_width = 0; },
-           [](mapping::ModelTrackingParams& p) { p.restart_fill = 0; },
+           [](mapping::ModelTrackingParams& p) { p.evict_fill = 0; },
            [](mapping::ModelTrackingParams& p) { p.volume.voxel_size = -1; }}) {
     mapping::ModelTrackingParams p;
     change(p);

@@ -535,6 +535,62 @@ TEST_P(TsdfVolumeTest, ClearedVolumeIsAFreshOne) {
   }
 }
 
+// assign() makes a volume hold the blocks given: a copy of another volume's download (or part
+// of it) downloads as that, ray casts as that, and takes the next frame as the original does,
+// block for block (new blocks come after the assigned ones). Bad sets are refused.
+TEST_P(TsdfVolumeTest, AssignedBlocksAreTheVolumesOwn) {
+  const Scene scene;
+  const TsdfVolumeParams params = volume_params(0.02, 0.06);
+  const Eigen::Isometry3d first = pose_at(0, 0, 0), second = pose_at(0.08, 0.02, 6);
+  TsdfVolume original(context(), params);
+  original.integrate(render(scene, first), {}, kCamera, depth_range(), first);
+  TsdfVolume copy(context(), params);
+  copy.assign(original.download());
+  EXPECT_EQ(copy.block_count(), original.block_count());
+  const PointImage a = original.raycast(kCamera, depth_range(), second);
+  const PointImage b = copy.raycast(kCamera, depth_range(), second);
+  for (std::size_t i = 0; i < a.size(); ++i) {
+    ASSERT_EQ(is_valid(a.pixels()[i]), is_valid(b.pixels()[i])) << i;
+    if (is_valid(a.pixels()[i])) {
+      ASSERT_EQ(a.pixels()[i], b.pixels()[i]) << i;
+    }
+  }
+  original.integrate(render(scene, second), {}, kCamera, depth_range(), second);
+  copy.integrate(render(scene, second), {}, kCamera, depth_range(), second);
+  const TsdfBlocks x = original.download(), y = copy.download();
+  ASSERT_GT(x.size(), 0u);
+  EXPECT_EQ(x.coords, y.coords);
+  ASSERT_EQ(x.voxels.size(), y.voxels.size());
+  for (std::size_t i = 0; i < x.voxels.size(); ++i) {
+    ASSERT_EQ(x.voxels[i].tsdf, y.voxels[i].tsdf) << i;
+    ASSERT_EQ(x.voxels[i].weight, y.voxels[i].weight) << i;
+  }
+  // Half the blocks, with when each was last touched: the other half is gone, the times stay,
+  // and the next frame's blocks are touched later than any of them.
+  TsdfBlocks half = x;
+  half.coords.resize(x.size() / 2);
+  half.voxels.resize(half.coords.size() * mapping::kTsdfBlockVoxels);
+  std::vector<std::uint32_t> touched = original.last_touched();
+  ASSERT_EQ(touched.size(), x.size());
+  EXPECT_EQ(*std::max_element(touched.begin(), touched.end()), 2u);  // two integrations
+  touched.resize(half.size());
+  copy.assign(half, touched);
+  EXPECT_EQ(copy.download().coords, half.coords);
+  EXPECT_EQ(copy.last_touched(), touched);
+  copy.integrate(render(scene, first), {}, kCamera, depth_range(), first);
+  const std::vector<std::uint32_t> later = copy.last_touched();
+  EXPECT_EQ(*std::max_element(later.begin(), later.end()), 3u);
+  EXPECT_THROW(copy.assign(half, std::vector<std::uint32_t>(half.size() + 1, 1u)), Error);
+  TsdfBlocks twice = half;
+  twice.coords.push_back(twice.coords.front());
+  twice.voxels.insert(twice.voxels.end(), half.voxels.begin(),
+                      half.voxels.begin() + mapping::kTsdfBlockVoxels);
+  EXPECT_THROW(copy.assign(twice), Error);
+  TsdfBlocks other = half;
+  other.voxel_size = 0.01;
+  EXPECT_THROW(copy.assign(other), Error);
+}
+
 TEST_P(TsdfVolumeTest, WeightsStopAtTheMaximumAndTheFieldFollowsChange) {
   Scene scene;
   TsdfVolumeParams params;

@@ -133,9 +133,9 @@ std::string model_tracking_line(const mapping::OdometryRun& run) {
   char line[160];
   std::snprintf(line, sizeof(line),
                 "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame, "
-                "%zu restarts of a full model\n",
+                "%zu evictions of far blocks\n",
                 run.model_kept, run.poses.size(), 1000.0 * run.model_seconds / frames,
-                run.model_restarts);
+                run.model_evictions);
   return line;
 }
 

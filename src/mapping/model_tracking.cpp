@@ -4,6 +4,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <numeric>
 #include <span>
 
 #include "kartograf/core/error.hpp"
@@ -67,7 +68,7 @@ void ModelTrackingParams::validate() const {
   require(min_fitness >= 0 && min_fitness <= 1, "model tracking: min_fitness must be in [0, 1]");
   require(max_correction_m > 0 && max_correction_deg > 0,
           "model tracking: the largest correction must be > 0");
-  require(restart_fill > 0 && restart_fill <= 1, "model tracking: restart_fill must be in (0, 1]");
+  require(evict_fill > 0 && evict_fill <= 1, "model tracking: evict_fill must be in (0, 1]");
 }
 
 ModelTracker::ModelTracker(const compute::Context& context, const PinholeIntrinsics& camera,
@@ -160,6 +161,39 @@ registration::IcpResult ModelTracker::register_frame(const registration::FramePy
       {identity, registration::motion_prior_information(geometry, params_.motion_prior)});
 }
 
+std::size_t ModelTracker::evict_far_blocks(const Eigen::Isometry3d& camera_to_world) {
+  const TsdfBlocks all = volume_.download();
+  const std::vector<std::uint32_t> touched = volume_.last_touched();
+  const double block_metres = kTsdfBlockSide * volume_.params().voxel_size;
+  std::vector<double> distance(all.size());
+  for (std::size_t b = 0; b < all.size(); ++b) {
+    const Eigen::Vector3d centre = (all.coords[b].cast<double>().array() + 0.5) * block_metres;
+    distance[b] = (centre - camera_to_world.translation()).norm();
+  }
+  // The most recently seen first; among those seen last together, the nearest.
+  std::vector<std::size_t> order(all.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(), [&](std::size_t a, std::size_t b) {
+    return touched[a] != touched[b] ? touched[a] > touched[b] : distance[a] < distance[b];
+  });
+  const auto half = static_cast<std::size_t>(0.5 * params_.evict_fill *
+                                             static_cast<double>(volume_.params().max_blocks));
+  order.resize(std::min(order.size(), half));
+  std::sort(order.begin(), order.end());  // download()'s order
+  TsdfBlocks kept;
+  kept.voxel_size = all.voxel_size;
+  kept.truncation = all.truncation;
+  std::vector<std::uint32_t> kept_touched;
+  for (const std::size_t b : order) {
+    kept.coords.push_back(all.coords[b]);
+    const auto first = all.voxels.begin() + static_cast<std::ptrdiff_t>(b * kTsdfBlockVoxels);
+    kept.voxels.insert(kept.voxels.end(), first, first + kTsdfBlockVoxels);
+    kept_touched.push_back(touched[b]);
+  }
+  volume_.assign(kept, kept_touched);
+  return all.size() - kept.size();
+}
+
 ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* color,
                                       const Eigen::Isometry3d& predicted,
                                       const registration::FramePyramid* pyramid) {
@@ -177,12 +211,9 @@ ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* c
     step.from_model = step.reason.empty();
     if (step.from_model) step.pose = predicted * result.source_to_target;
   }
-  const auto full = static_cast<std::size_t>(params_.restart_fill *
+  const auto full = static_cast<std::size_t>(params_.evict_fill *
                                              static_cast<double>(volume_.params().max_blocks));
-  if (volume_.block_count() >= full) {
-    volume_.clear();
-    step.restarted = true;
-  }
+  if (volume_.block_count() >= full) step.evicted_blocks = evict_far_blocks(step.pose);
   volume_.integrate(frame_.depth(), frame_.colors(), camera_, range_, step.pose);
   empty_ = false;
   return step;

@@ -92,7 +92,7 @@ class Tracker {
     model_poses_.push_back(step.pose);
     add_model_constraints(n);
     run_.model_kept += step.from_model ? 1 : 0;
-    run_.model_restarts += step.restarted ? 1 : 0;
+    run_.model_evictions += step.evicted_blocks > 0 ? 1 : 0;
     run_.model_seconds += seconds_since(start);
   }
 

@@ -9,6 +9,7 @@
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
+#include "kartograf/core/sort_order.hpp"
 #include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kernels/tsdf/tsdf_mesh.h"
 #include "mapping/edge_index.hpp"
@@ -69,10 +70,8 @@ std::vector<std::size_t> host_order(const TsdfVolume& volume, std::size_t blocks
       require(std::abs(kernels::tsdf_key_axis(key, shift)) < limit,
               "mesh extraction: a block lies beyond 2^19 voxels from the origin");
   }
-  std::vector<std::uint32_t> by_key(blocks), rank(blocks);
-  std::iota(by_key.begin(), by_key.end(), 0u);
-  std::sort(by_key.begin(), by_key.end(),
-            [&](std::uint32_t a, std::uint32_t b) { return keys[a] < keys[b]; });
+  const std::vector<std::size_t> by_key = ascending_order(std::span<const std::uint64_t>(keys));
+  std::vector<std::uint32_t> rank(blocks);
   for (std::uint32_t r = 0; r < blocks; ++r) rank[by_key[r]] = r;
   std::vector<std::uint64_t> sort_keys(order.size());
   for (std::size_t i = 0; i < order.size(); ++i) {
@@ -82,11 +81,7 @@ std::vector<std::size_t> host_order(const TsdfVolume& volume, std::size_t blocks
          << 4) |
         k;
   }
-  std::vector<std::size_t> triangles(order.size());
-  std::iota(triangles.begin(), triangles.end(), std::size_t{0});
-  std::sort(triangles.begin(), triangles.end(),
-            [&](std::size_t a, std::size_t b) { return sort_keys[a] < sort_keys[b]; });
-  return triangles;
+  return ascending_order(std::span<const std::uint64_t>(sort_keys));
 }
 
 }  // namespace

@@ -12,6 +12,7 @@
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/memory_budget.hpp"
 #include "kartograf/core/pose.hpp"
+#include "kartograf/core/sort_order.hpp"
 #include "kernels/tsdf/tsdf.h"
 
 namespace kartograf::mapping {
@@ -168,6 +169,49 @@ void TsdfVolume::clear() {
   stamp_ = 0;
 }
 
+void TsdfVolume::assign(const TsdfBlocks& blocks, std::span<const std::uint32_t> last_touched) {
+  require(blocks.voxel_size == params_.voxel_size && blocks.truncation == params_.truncation,
+          "TSDF volume: the blocks assigned have another voxel size or truncation");
+  require(blocks.voxels.size() == blocks.size() * kTsdfBlockVoxels,
+          "TSDF volume: the blocks assigned hold the wrong number of voxels");
+  require(blocks.size() <= params_.max_blocks, "TSDF volume: " + blocks_text(blocks.size()) +
+                                                   " assigned to a pool of " +
+                                                   blocks_text(params_.max_blocks));
+  require(last_touched.empty() || last_touched.size() == blocks.size(),
+          "TSDF volume: last_touched must be empty or one per block assigned");
+  const std::uint32_t stamp = stamp_;
+  clear();
+  const std::size_t n = blocks.size();
+  if (n == 0) return;
+  // Integrations go on counting from where they were, above every stamp kept.
+  stamp_ = last_touched.empty()
+               ? 0
+               : std::max(stamp, *std::max_element(last_touched.begin(), last_touched.end()));
+  std::vector<std::uint32_t> stamps(keys_.size(), 0);
+  // The table as the device's insertions would make it, built here with the same rule.
+  std::vector<std::uint64_t> table(keys_.size(), KG_EMPTY_VOXEL_KEY);
+  std::vector<std::uint32_t> slot_blocks(keys_.size(), KG_TSDF_NO_BLOCK);
+  std::vector<std::uint64_t> block_keys(n);
+  for (std::size_t b = 0; b < n; ++b) {
+    const Eigen::Vector3i& c = blocks.coords[b];
+    block_keys[b] = kernels::tsdf_block_key(c.x(), c.y(), c.z());
+    const int slot = kernels::voxel_insert_key(table.data(), block_keys[b], capacity_log2_);
+    require(slot >= 0 && slot_blocks[static_cast<std::size_t>(slot)] == KG_TSDF_NO_BLOCK,
+            "TSDF volume: a block assigned twice");
+    slot_blocks[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(b);
+    if (!last_touched.empty()) stamps[static_cast<std::size_t>(slot)] = last_touched[b];
+  }
+  keys_.upload(table);
+  stamps_.upload(stamps);
+  slot_blocks_.upload(slot_blocks);
+  block_keys_.upload(block_keys);
+  voxels_.upload(blocks.voxels);
+  std::vector<std::uint32_t> status(KG_TSDF_STATUS_VALUES, 0);
+  status[KG_TSDF_STATUS_BLOCKS] = static_cast<std::uint32_t>(n);
+  status_.upload(status);
+  block_count_ = n;
+}
+
 TsdfIntegration TsdfVolume::integrate(const compute::DeviceImage<std::uint16_t>& depth,
                                       const compute::Buffer<std::uint32_t>* colors,
                                       const PinholeIntrinsics& camera,
@@ -275,6 +319,24 @@ PointImage TsdfVolume::raycast(const PinholeIntrinsics& camera, const geometry::
   return points.to_image();
 }
 
+std::vector<std::uint32_t> TsdfVolume::last_touched() const {
+  const std::size_t n = std::min(block_count_, params_.max_blocks);
+  std::vector<std::uint32_t> by_block(n, 0);
+  std::vector<std::uint64_t> block_keys(n);
+  if (n == 0) return by_block;
+  const std::vector<std::uint32_t> slot_blocks = slot_blocks_.to_vector();
+  const std::vector<std::uint32_t> stamps = stamps_.to_vector();
+  for (std::size_t slot = 0; slot < slot_blocks.size(); ++slot) {
+    if (slot_blocks[slot] < n) by_block[slot_blocks[slot]] = stamps[slot];
+  }
+  block_keys_.download(block_keys);
+  const std::vector<std::size_t> order =
+      ascending_order(std::span<const std::uint64_t>(block_keys));  // download()'s
+  std::vector<std::uint32_t> out(n);
+  for (std::size_t i = 0; i < n; ++i) out[i] = by_block[order[i]];
+  return out;
+}
+
 TsdfBlocks TsdfVolume::download() const {
   TsdfBlocks out;
   out.voxel_size = params_.voxel_size;
@@ -286,10 +348,7 @@ TsdfBlocks TsdfVolume::download() const {
     block_keys_.download(keys);
     voxels_.download(voxels);
   }
-  std::vector<std::size_t> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](std::size_t a, std::size_t b) { return keys[a] < keys[b]; });
+  const std::vector<std::size_t> order = ascending_order(std::span<const std::uint64_t>(keys));
   out.coords.reserve(n);
   out.voxels.reserve(n * kTsdfBlockVoxels);
   for (const std::size_t b : order) {

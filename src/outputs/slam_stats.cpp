@@ -67,7 +67,7 @@ RunJson tracking_json(const mapping::SlamParams& params, const mapping::Odometry
   return {{"kind", "model"},
           {"voxel_size_m", params.model.volume.voxel_size},
           {"model_kept", run.model_kept},
-          {"model_restarts", run.model_restarts},
+          {"model_evictions", run.model_evictions},
           {"model_seconds", run.model_seconds}};
 }
 

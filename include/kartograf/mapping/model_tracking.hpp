@@ -49,10 +49,11 @@ struct ModelTrackingParams {
   double min_fitness = 0.3;
   double max_correction_m = 0.05;
   double max_correction_deg = 3;
-  // Memory stays bounded: when the model's pool is this full before a frame is fused, the model
-  // restarts from that frame (what came before is forgotten; tracking goes on from the
-  // odometry's prediction). A frame at 2 cm voxels adds at most a few thousand blocks.
-  double restart_fill = 0.75;
+  // Memory stays bounded: when the model's pool is this full before a frame is fused, the
+  // blocks the camera has not seen for longest are evicted, down to half this (among those
+  // last seen together, the farthest first): what the camera has been looking at stays. What
+  // it sees again is fused anew. A frame at 2 cm voxels adds at most a few thousand blocks.
+  double evict_fill = 0.75;
 
   // 2 cm voxels, 8 cm truncation, 2^16 blocks (fewer where the device's largest buffer holds
   // fewer: the tracker lowers max_blocks to fit).
@@ -75,8 +76,8 @@ struct ModelTrackingStep {
   bool degenerate = false;  // the frame's geometry left directions to the prediction
   double fitness = 0;       // the model's registration (0 on the first frame)
   double inlier_rmse_m = 0;
-  bool restarted = false;  // the model was full and restarted from this frame
-  std::string reason;      // why the prediction stood (empty when the model's pose was kept)
+  std::size_t evicted_blocks = 0;  // the model was full: blocks least recently seen went
+  std::string reason;  // why the prediction stood (empty when the model's pose was kept)
 };
 
 class ModelTracker {
@@ -102,6 +103,9 @@ class ModelTracker {
  private:
   std::string rejection(const registration::IcpResult& result) const;
   int source_levels() const;
+  // The blocks least recently seen evicted (see evict_fill; `camera_to_world` breaks ties by
+  // distance); how many.
+  std::size_t evict_far_blocks(const Eigen::Isometry3d& camera_to_world);
   bool has_icp_levels(const registration::FramePyramid& pyramid) const;
   const registration::FramePyramid& source_pyramid(const registration::FramePyramid* given);
   registration::IcpResult register_frame(const registration::FramePyramid& source,

@@ -90,8 +90,9 @@ struct OdometryRun {
   // how many frames kept the model's registration.
   bool model_tracking = false;
   std::size_t model_kept = 0;
-  std::size_t model_restarts = 0;  // ModelTrackingParams::restart_fill
-  double model_seconds = 0;        // ray casting, registration and fusion
+  std::size_t model_evictions =
+      0;                     // frames that evicted far blocks (ModelTrackingParams::evict_fill)
+  double model_seconds = 0;  // ray casting, registration and fusion
 };
 
 // Odometry alone over the whole source.

@@ -21,6 +21,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -132,6 +133,15 @@ class TsdfVolume {
 
   // Forgets every block: the volume as made, its buffers kept.
   void clear();
+  // The volume holds exactly these blocks (a download(), or part of one, of a volume with the
+  // same voxel size and truncation): what eviction keeps. last_touched (empty, or one per block,
+  // as last_touched() gives them): when each was last touched, kept for the next eviction.
+  // Throws Error on other voxels, more blocks than max_blocks, a block twice, or a count of
+  // last_touched that is neither 0 nor the blocks'.
+  void assign(const TsdfBlocks& blocks, std::span<const std::uint32_t> last_touched = {});
+  // Per block, in download()'s order: the number of the last integration that touched it
+  // (counted from the volume's making or clear(); higher is more recent).
+  std::vector<std::uint32_t> last_touched() const;
 
   std::size_t block_count() const { return block_count_; }
   const TsdfVolumeParams& params() const { return params_; }
