@@ -585,7 +585,9 @@ TEST_P(TsdfVolumeTest, AssignedBlocksAreTheVolumesOwn) {
   twice.coords.push_back(twice.coords.front());
   twice.voxels.insert(twice.voxels.end(), half.voxels.begin(),
                       half.voxels.begin() + mapping::kTsdfBlockVoxels);
+  const std::vector<Eigen::Vector3i> held = copy.download().coords;
   EXPECT_THROW(copy.assign(twice), Error);
+  EXPECT_EQ(copy.download().coords, held);  // a refused set changes nothing
   TsdfBlocks other = half;
   other.voxel_size = 0.01;
   EXPECT_THROW(copy.assign(other), Error);

@@ -179,16 +179,10 @@ void TsdfVolume::assign(const TsdfBlocks& blocks, std::span<const std::uint32_t>
                                                    blocks_text(params_.max_blocks));
   require(last_touched.empty() || last_touched.size() == blocks.size(),
           "TSDF volume: last_touched must be empty or one per block assigned");
-  const std::uint32_t stamp = stamp_;
-  clear();
+  // The table as the device's insertions would make it, built here with the same rule, before
+  // anything is forgotten: a refused set leaves the volume as it was.
   const std::size_t n = blocks.size();
-  if (n == 0) return;
-  // Integrations go on counting from where they were, above every stamp kept.
-  stamp_ = last_touched.empty()
-               ? 0
-               : std::max(stamp, *std::max_element(last_touched.begin(), last_touched.end()));
   std::vector<std::uint32_t> stamps(keys_.size(), 0);
-  // The table as the device's insertions would make it, built here with the same rule.
   std::vector<std::uint64_t> table(keys_.size(), KG_EMPTY_VOXEL_KEY);
   std::vector<std::uint32_t> slot_blocks(keys_.size(), KG_TSDF_NO_BLOCK);
   std::vector<std::uint64_t> block_keys(n);
@@ -201,6 +195,13 @@ void TsdfVolume::assign(const TsdfBlocks& blocks, std::span<const std::uint32_t>
     slot_blocks[static_cast<std::size_t>(slot)] = static_cast<std::uint32_t>(b);
     if (!last_touched.empty()) stamps[static_cast<std::size_t>(slot)] = last_touched[b];
   }
+  const std::uint32_t stamp = stamp_;
+  clear();
+  if (n == 0) return;
+  // Integrations go on counting from where they were, above every stamp kept.
+  stamp_ = last_touched.empty()
+               ? 0
+               : std::max(stamp, *std::max_element(last_touched.begin(), last_touched.end()));
   keys_.upload(table);
   stamps_.upload(stamps);
   slot_blocks_.upload(slot_blocks);
