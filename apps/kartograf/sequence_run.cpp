@@ -133,7 +133,7 @@ std::string model_tracking_line(const mapping::OdometryRun& run) {
   char line[160];
   std::snprintf(line, sizeof(line),
                 "  model tracking: the model's pose kept on %zu of %zu frames, %.1f ms/frame, "
-                "%zu evictions of far blocks\n",
+                "%zu evictions of the blocks least recently seen\n",
                 run.model_kept, run.poses.size(), 1000.0 * run.model_seconds / frames,
                 run.model_evictions);
   return line;

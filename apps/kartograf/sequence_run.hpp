@@ -48,7 +48,7 @@ compute::Context make_run_context(const SequenceRunOptions& options);
 // --tracking and --model-voxel.
 mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& options);
 // The summary's line on model tracking (empty without it): frames that kept the model's pose,
-// its time per frame and how often a full model evicted far blocks.
+// its time per frame and how often a full model evicted blocks.
 std::string model_tracking_line(const mapping::OdometryRun& run);
 // The options and the context as the stats documents record them.
 io::SequenceRunRecord run_record(const SequenceRunOptions& options,

@@ -161,7 +161,7 @@ registration::IcpResult ModelTracker::register_frame(const registration::FramePy
       {identity, registration::motion_prior_information(geometry, params_.motion_prior)});
 }
 
-std::size_t ModelTracker::evict_far_blocks(const Eigen::Isometry3d& camera_to_world) {
+std::size_t ModelTracker::evict_least_recently_seen(const Eigen::Isometry3d& camera_to_world) {
   const TsdfBlocks all = volume_.download();
   const std::vector<std::uint32_t> touched = volume_.last_touched();
   const double block_metres = kTsdfBlockSide * volume_.params().voxel_size;
@@ -213,7 +213,7 @@ ModelTrackingStep ModelTracker::track(const DepthImage& depth, const RgbImage* c
   }
   const auto full = static_cast<std::size_t>(params_.evict_fill *
                                              static_cast<double>(volume_.params().max_blocks));
-  if (volume_.block_count() >= full) step.evicted_blocks = evict_far_blocks(step.pose);
+  if (volume_.block_count() >= full) step.evicted_blocks = evict_least_recently_seen(step.pose);
   volume_.integrate(frame_.depth(), frame_.colors(), camera_, range_, step.pose);
   empty_ = false;
   return step;

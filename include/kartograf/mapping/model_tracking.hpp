@@ -105,7 +105,7 @@ class ModelTracker {
   int source_levels() const;
   // The blocks least recently seen evicted (see evict_fill; `camera_to_world` breaks ties by
   // distance); how many.
-  std::size_t evict_far_blocks(const Eigen::Isometry3d& camera_to_world);
+  std::size_t evict_least_recently_seen(const Eigen::Isometry3d& camera_to_world);
   bool has_icp_levels(const registration::FramePyramid& pyramid) const;
   const registration::FramePyramid& source_pyramid(const registration::FramePyramid* given);
   registration::IcpResult register_frame(const registration::FramePyramid& source,

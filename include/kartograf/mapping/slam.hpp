@@ -90,8 +90,8 @@ struct OdometryRun {
   // how many frames kept the model's registration.
   bool model_tracking = false;
   std::size_t model_kept = 0;
-  std::size_t model_evictions =
-      0;                     // frames that evicted far blocks (ModelTrackingParams::evict_fill)
+  // Frames whose model, full, evicted the blocks least recently seen (evict_fill).
+  std::size_t model_evictions = 0;
   double model_seconds = 0;  // ray casting, registration and fusion
 };
 
