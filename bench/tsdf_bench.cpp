@@ -9,6 +9,10 @@
 //   tsdf_mesh_device/<backend>/<voxel> the same mesh made on the device, joined on the host
 //   tsdf_esdf/<backend>/<voxel>        its height-band occupancy and the grid's ESDF, both on the
 //                                      device (the 7-Scenes world's z as up)
+//   tsdf_esdf3d/<backend>/<voxel>      the 3-D ESDF's update after one more frame (frames 5-39; the
+//                                      integration not timed): mapping/esdf_volume.hpp's defaults
+//                                      (1 m, cells of 8 cm at 1 cm voxels and 5 cm at 5 cm)
+//   tsdf_esdf3d_whole/<backend>/<voxel> the 3-D ESDF of the 40-frame volume made from nothing
 // KARTOGRAF_DATA_DIR overrides the data folder; KARTOGRAF_BENCH_BACKENDS=cpu,... the backends.
 // bench/peer/tsdf_side_by_side.sh runs this and Open3D in one go and prints the ratios.
 #include <benchmark/benchmark.h>
@@ -21,6 +25,7 @@
 
 #include "bench_support.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/mapping/esdf_volume.hpp"
 #include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
@@ -77,7 +82,26 @@ std::unique_ptr<mapping::TsdfVolume> fused(const compute::Context& context, doub
   return volume;
 }
 
-enum class Operation { integrate, raycast, mesh, device_mesh, esdf };
+enum class Operation { integrate, raycast, mesh, device_mesh, esdf, esdf3d, esdf3d_whole };
+
+// The 3-D ESDF's update after each frame, the frame's integration not timed.
+void run_esdf3d_updates(benchmark::State& state, mapping::TsdfVolume& volume) {
+  const Frames& f = frames();
+  mapping::EsdfVolume esdf(volume.context(), volume.params());
+  esdf.update(volume);
+  std::size_t k = kWarmUp;
+  double recomputed = 0;
+  for (auto _ : state) {
+    state.PauseTiming();
+    const std::size_t i = k++ % kFrames;
+    volume.integrate(f.images[i].depth, f.images[i].color, f.camera, f.range, f.poses[i]);
+    state.ResumeTiming();
+    const mapping::EsdfUpdate update = esdf.update(volume);
+    recomputed += double(update.cells_recomputed) / double(update.grid_cells);
+  }
+  state.counters["grid_cells"] = double(esdf.dims().cast<double>().prod());
+  state.counters["recomputed_share"] = recomputed / double(k - kWarmUp);
+}
 
 void run_case(benchmark::State& state, compute::BackendKind backend, Operation operation,
               double voxel) {
@@ -87,9 +111,10 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
     return;
   }
   const compute::Context context(bench::context_options(backend));
-  const bool integrating = operation == Operation::integrate;
+  const bool integrating = operation == Operation::integrate || operation == Operation::esdf3d;
   const std::unique_ptr<mapping::TsdfVolume> volume =
       fused(context, voxel, integrating ? kWarmUp : kFrames);
+  if (operation == Operation::esdf3d) return run_esdf3d_updates(state, *volume);
   std::size_t k = kWarmUp, active = 0;
   for (auto _ : state) {
     const std::size_t i = k++ % kFrames;
@@ -103,12 +128,15 @@ void run_case(benchmark::State& state, compute::BackendKind backend, Operation o
       benchmark::DoNotOptimize(mapping::extract_mesh(volume->download()));
     } else if (operation == Operation::device_mesh) {
       benchmark::DoNotOptimize(mapping::extract_mesh(*volume));
-    } else {
+    } else if (operation == Operation::esdf) {
       benchmark::DoNotOptimize(mapping::tsdf_band_maps(*volume, {}));
+    } else {
+      mapping::EsdfVolume esdf(context, volume->params());
+      benchmark::DoNotOptimize(esdf.update(*volume));
     }
   }
   state.counters["blocks"] = static_cast<double>(volume->block_count());
-  if (integrating)  // blocks a frame touches, mean
+  if (operation == Operation::integrate)  // blocks a frame touches, mean
     state.counters["active"] = static_cast<double>(active) / static_cast<double>(k - kWarmUp);
 }
 
@@ -118,12 +146,15 @@ void register_cases() {
       {Operation::raycast, "tsdf_raycast"},
       {Operation::mesh, "tsdf_mesh"},
       {Operation::device_mesh, "tsdf_mesh_device"},
-      {Operation::esdf, "tsdf_esdf"}};
+      {Operation::esdf, "tsdf_esdf"},
+      {Operation::esdf3d, "tsdf_esdf3d"},
+      {Operation::esdf3d_whole, "tsdf_esdf3d_whole"}};
   for (const compute::BackendKind backend : bench::backends_to_run()) {
     for (const double voxel : {0.01, 0.05}) {
       for (const auto& [operation, name] : operations) {
         const std::string size = voxel == 0.01 ? "640x480_1cm" : "640x480_5cm";
-        const int iterations = operation == Operation::integrate ? int(kFrames - kWarmUp) : 10;
+        const bool per_frame = operation == Operation::integrate || operation == Operation::esdf3d;
+        const int iterations = per_frame ? int(kFrames - kWarmUp) : 10;
         benchmark::RegisterBenchmark(bench::case_name(name, backend, size).c_str(), run_case,
                                      backend, operation, voxel)
             ->Iterations(iterations)

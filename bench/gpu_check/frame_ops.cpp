@@ -6,6 +6,7 @@
 #include "kartograf/geometry/segment_moments.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/geometry/voxel_downsample.hpp"
+#include "kartograf/mapping/esdf_volume.hpp"
 #include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
@@ -39,7 +40,8 @@ struct Workspace {
         hash(context),
         grower(context),
         tsdf_fine(context, tsdf_params(0.01)),
-        tsdf_coarse(context, tsdf_params(0.05)) {}
+        tsdf_coarse(context, tsdf_params(0.05)),
+        esdf_fine(context, tsdf_params(0.01)) {}
 
   static mapping::TsdfVolumeParams tsdf_params(double voxel) {
     mapping::TsdfVolumeParams params;
@@ -83,6 +85,7 @@ struct Workspace {
   // again at the identity, so the block set stays that of one frame (the steady state of a
   // camera at rest).
   mapping::TsdfVolume tsdf_fine, tsdf_coarse;
+  mapping::EsdfVolume esdf_fine;  // of tsdf_fine
   compute::DeviceImage<std::uint16_t> tsdf_depth;
   compute::DeviceImage<Point4f> cast;
 };
@@ -259,6 +262,11 @@ const std::vector<Operation>& frame_operations() {
       {"TSDF band occupancy 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine, false); }},
       {"TSDF band + ESDF 1 cm", 0, [](Workspace& w) { band_occupancy(w, w.tsdf_fine, true); }},
       {"TSDF mesh 1 cm", 0, [](Workspace& w) { mesh(w, w.tsdf_fine); }},
+      {"TSDF integrate + 3-D ESDF update 1 cm", 0,
+       [](Workspace& w) {
+         integrate(w, w.tsdf_fine);
+         w.esdf_fine.update(w.tsdf_fine);
+       }},
       {"region growing (Lab)", 0,
        [](Workspace& w) {
          w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});

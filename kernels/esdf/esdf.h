@@ -9,7 +9,8 @@
 //             every backend gives the same squared distances.
 //   write     every cell the transform is for: resolution x sqrt(squared distance) (+infinity
 //             where the grid has no zero), negated for the occupied cells.
-// Cells hold the band kernel's marks (kernels/tsdf/tsdf_band.h), row-major.
+// Cells hold the band kernel's marks (kernels/tsdf/tsdf_band.h), row-major. The envelope pass
+// also serves the 3-D field (kernels/esdf/esdf3.h), one axis at a time.
 #ifndef KARTOGRAF_KERNELS_ESDF_H
 #define KARTOGRAF_KERNELS_ESDF_H
 #include "shaders/prelude.h"
@@ -21,9 +22,13 @@
 KG_RULES_BEGIN
 
 KG_PARAMS_BEGIN(EsdfParams)
-KG_PARAM(uint, count)        // seed, write: cells; envelope: lines
-KG_PARAM(uint, line_cells)   // envelope: cells per line
-KG_PARAM(uint, line_stride)  // envelope: index of line i's first cell = i x line_stride
+KG_PARAM(uint, count)       // seed, write: cells; envelope: lines
+KG_PARAM(uint, line_cells)  // envelope: cells per line
+// envelope: line i's first cell is (i / lines_per_plane) x plane_stride + (i % lines_per_plane) x
+// line_stride (a 2-D grid: one plane of every line; a 3-D box: the y lines, a plane per z)
+KG_PARAM(uint, line_stride)
+KG_PARAM(uint, lines_per_plane)
+KG_PARAM(uint, plane_stride)
 KG_PARAM(uint, cell_stride)  // envelope: index step from a cell to the next on its line
 KG_PARAM(uint, to_occupied)  // 1: distances to occupied cells; 0: to the other cells
 KG_PARAM(float, resolution)  // metres per cell
@@ -48,7 +53,8 @@ KG_FORCE_INLINE void esdf_envelope_line(KG_BUFFER_PARAM(const int64_t, line_in)
                                                 KG_BUFFER_PARAM(int64_t, start_num)
                                                     KG_BUFFER_PARAM(int64_t, start_den) uint line,
                                         EsdfParams p) {
-  const uint first = line * p.line_stride;
+  const uint first =
+      (line / p.lines_per_plane) * p.plane_stride + (line % p.lines_per_plane) * p.line_stride;
   uint count = 0u;
   for (uint q = 0u; q < p.line_cells; ++q) {
     const int64_t fq = line_in[first + q * p.cell_stride];

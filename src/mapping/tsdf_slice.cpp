@@ -12,6 +12,7 @@
 #include "kartograf/geometry/distance_transform.hpp"
 #include "kernels/esdf/esdf.h"
 #include "kernels/tsdf/tsdf_band.h"
+#include "mapping/esdf_lines.hpp"
 
 namespace kartograf::mapping {
 
@@ -19,7 +20,6 @@ namespace {
 
 constexpr compute::KernelSpec kBandKernel{"tsdf_band", KG_TSDF_LOCAL_X, 1};
 constexpr compute::KernelSpec kEsdfSeedKernel{"esdf_seed", KG_ESDF_LOCAL_X, 1};
-constexpr compute::KernelSpec kEsdfEnvelopeKernel{"esdf_envelope", KG_ESDF_LOCAL_X, 1};
 constexpr compute::KernelSpec kEsdfWriteKernel{"esdf_write", KG_ESDF_LOCAL_X, 1};
 static_assert(KG_ESDF_OCCUPIED == KG_TSDF_BAND_OCCUPIED);
 
@@ -159,41 +159,21 @@ void set_states(const std::vector<std::uint32_t>& marks, OccupancyGrid& grid) {
   }
 }
 
-// The transforms' working buffers, one element per cell, made once for both transforms.
-struct EsdfScratch {
-  EsdfScratch(const compute::Context& context, std::size_t n)
-      : a(context, n),
-        b(context, n),
-        start_num(context, n),
-        start_den(context, n),
-        apex(context, n) {}
-  compute::Buffer<std::int64_t> a, b, start_num, start_den;
-  compute::Buffer<std::uint32_t> apex;
-};
-
 // One transform of kernels/esdf/esdf.h (to the occupied cells or to the others) into `esdf`.
 void esdf_transform(const compute::Context& context, const compute::Buffer<std::uint32_t>& cells,
-                    int cols, int rows, kernels::EsdfParams p, EsdfScratch& scratch,
+                    int cols, int rows, kernels::EsdfParams p, detail::EsdfScratch& scratch,
                     compute::Buffer<float>& esdf) {
   const std::size_t n = std::size_t(cols) * rows;
-  auto& [a, b, start_num, start_den, apex] = scratch;
   p.count = static_cast<std::uint32_t>(n);
-  compute::dispatch(context, kEsdfSeedKernel, {cells, a}, p,
+  compute::dispatch(context, kEsdfSeedKernel, {cells, scratch.a}, p,
                     {compute::groups_for(n, KG_ESDF_LOCAL_X), 1});
-  const auto lines = [&](int count, int length, int line_stride, int cell_stride,
-                         const compute::Buffer<std::int64_t>& in,
-                         compute::Buffer<std::int64_t>& out) {
-    kernels::EsdfParams q = p;
-    q.count = static_cast<std::uint32_t>(count);
-    q.line_cells = static_cast<std::uint32_t>(length);
-    q.line_stride = static_cast<std::uint32_t>(line_stride);
-    q.cell_stride = static_cast<std::uint32_t>(cell_stride);
-    compute::dispatch(context, kEsdfEnvelopeKernel, {in, out, apex, start_num, start_den}, q,
-                      {compute::groups_for(std::size_t(count), KG_ESDF_LOCAL_X), 1});
+  const auto plane = [](std::size_t count, std::size_t length, std::size_t line_stride,
+                        std::size_t cell_stride) {
+    return detail::EsdfLines{count, length, line_stride, count, 0, cell_stride};
   };
-  lines(cols, rows, 1, cols, a, b);  // columns
-  lines(rows, cols, cols, 1, b, a);  // rows
-  compute::dispatch(context, kEsdfWriteKernel, {a, cells, esdf}, p,
+  detail::esdf_envelope(plane(cols, rows, 1, cols), scratch.a, scratch.b, scratch);  // columns
+  detail::esdf_envelope(plane(rows, cols, cols, 1), scratch.b, scratch.a, scratch);  // rows
+  compute::dispatch(context, kEsdfWriteKernel, {scratch.a, cells, esdf}, p,
                     {compute::groups_for(n, KG_ESDF_LOCAL_X), 1});
 }
 
@@ -205,7 +185,7 @@ Image<float> device_esdf(const compute::Context& context,
   require(cells_count < 4294967296.0, "ESDF: a grid of 2^32 cells or more");
   // Per cell: the result, two squared distances and the envelope's apex and crossing.
   require_fits_in_memory(
-      cells_count * (4 + 8 + 8 + 4 + 8 + 8),
+      cells_count * (4 + detail::kEsdfScratchBytesPerCell),
       "ESDF of a " + std::to_string(cols) + "x" + std::to_string(rows) + " grid");
   Image<float> out(cols, rows);
   if (out.empty()) return out;
@@ -213,7 +193,8 @@ Image<float> device_esdf(const compute::Context& context,
   esdf.fill_zero();
   kernels::EsdfParams p{};
   p.resolution = static_cast<float>(resolution);
-  EsdfScratch scratch(context, out.pixels().size());
+  detail::EsdfScratch scratch(context);
+  scratch.reserve(out.pixels().size());
   for (const std::uint32_t to_occupied : {1u, 0u}) {
     p.to_occupied = to_occupied;
     esdf_transform(context, cells, cols, rows, p, scratch, esdf);

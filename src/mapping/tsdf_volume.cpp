@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -167,6 +168,9 @@ void TsdfVolume::clear() {
   voxels_.fill_zero();
   block_count_ = 0;
   stamp_ = 0;
+  // Unique across volumes: a pass that followed another volume (or this one before) starts again.
+  static std::atomic<std::uint64_t> generations{0};
+  generation_ = ++generations;
 }
 
 void TsdfVolume::assign(const TsdfBlocks& blocks, std::span<const std::uint32_t> last_touched) {
@@ -320,21 +324,45 @@ PointImage TsdfVolume::raycast(const PinholeIntrinsics& camera, const geometry::
   return points.to_image();
 }
 
-std::vector<std::uint32_t> TsdfVolume::last_touched() const {
+std::vector<std::uint32_t> TsdfVolume::stamps_by_pool_block() const {
   const std::size_t n = std::min(block_count_, params_.max_blocks);
   std::vector<std::uint32_t> by_block(n, 0);
-  std::vector<std::uint64_t> block_keys(n);
-  if (n == 0) return by_block;
   const std::vector<std::uint32_t> slot_blocks = slot_blocks_.to_vector();
   const std::vector<std::uint32_t> stamps = stamps_.to_vector();
   for (std::size_t slot = 0; slot < slot_blocks.size(); ++slot) {
     if (slot_blocks[slot] < n) by_block[slot_blocks[slot]] = stamps[slot];
   }
+  return by_block;
+}
+
+std::vector<std::uint32_t> TsdfVolume::last_touched() const {
+  const std::size_t n = std::min(block_count_, params_.max_blocks);
+  if (n == 0) return {};
+  const std::vector<std::uint32_t> by_block = stamps_by_pool_block();
+  std::vector<std::uint64_t> block_keys(n);
   block_keys_.download(block_keys);
   const std::vector<std::size_t> order =
       ascending_order(std::span<const std::uint64_t>(block_keys));  // download()'s
   std::vector<std::uint32_t> out(n);
   for (std::size_t i = 0; i < n; ++i) out[i] = by_block[order[i]];
+  return out;
+}
+
+std::vector<TsdfBlockRef> TsdfVolume::blocks_touched_since(
+    std::optional<std::uint32_t> integration) const {
+  const std::size_t n = std::min(block_count_, params_.max_blocks);
+  std::vector<TsdfBlockRef> out;
+  if (n == 0) return out;
+  const std::vector<std::uint32_t> by_block = stamps_by_pool_block();
+  std::vector<std::uint64_t> block_keys(n);
+  block_keys_.download(block_keys);
+  for (std::size_t b = 0; b < n; ++b) {
+    if (integration && by_block[b] <= *integration) continue;
+    const std::uint64_t key = block_keys[b];
+    out.push_back({static_cast<std::uint32_t>(b),
+                   Eigen::Vector3i(kernels::tsdf_key_axis(key, 0), kernels::tsdf_key_axis(key, 21),
+                                   kernels::tsdf_key_axis(key, 42))});
+  }
   return out;
 }
 

@@ -172,6 +172,7 @@ void MapperParams::validate() const {
   require(std::isfinite(keep_radius_m) && keep_radius_m > 0,
           "mapper: keep_radius_m must be finite and positive");
   slice.validate();
+  distance_field.validate();
 }
 
 const char* to_string(FrameStatus status) {
@@ -213,6 +214,13 @@ struct Mapper::State {
     return params;
   }
 
+  // The live volume at the current poses: re-fused if they moved since it fused its frames.
+  const mapping::TsdfVolume& current_volume() {
+    if (stale && store.size() > 0) volume.refuse(poses());
+    stale = false;
+    return volume.volume();
+  }
+
   // Stages 2-5 and the volume's products at the poses of `slam`.
   MapPipelineResult complete(mapping::SlamResult slam);
 
@@ -235,6 +243,8 @@ struct Mapper::State {
   Eigen::Isometry3d first_inverse = Eigen::Isometry3d::Identity();
   bool stale = false;  // poses moved since the volume fused its frames
   std::optional<MapPipelineResult> snapshot;
+  std::optional<mapping::EsdfVolume> distance_field;  // made when first asked for
+  mapping::EsdfGrid distance_grid;
   double adding_seconds = 0;
   bool finished = false;
 };
@@ -339,9 +349,17 @@ VolumeStats Mapper::volume_stats() const {
 
 TriangleMesh Mapper::mesh() {
   State& s = *state_;
-  if (s.stale && s.store.size() > 0) s.volume.refuse(s.poses());
-  s.stale = false;
-  return mapping::extract_mesh(s.volume.volume().download(), s.params.mesh);
+  return mapping::extract_mesh(s.current_volume().download(), s.params.mesh);
+}
+
+const mapping::EsdfGrid& Mapper::distance_field() {
+  State& s = *state_;
+  const mapping::TsdfVolume& volume = s.current_volume();
+  if (!s.distance_field)
+    s.distance_field.emplace(*s.context, s.params.volume, s.params.distance_field);
+  s.distance_field->update(volume);
+  s.distance_grid = s.distance_field->download();
+  return s.distance_grid;
 }
 
 const MapPipelineResult& Mapper::snapshot() {

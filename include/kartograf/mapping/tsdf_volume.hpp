@@ -21,6 +21,7 @@
 #include <array>
 #include <cstddef>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -76,6 +77,12 @@ struct TsdfBlocks {
   std::ptrdiff_t find(const Eigen::Vector3i& block) const;
   // The voxel (integral voxel coordinates), or nullptr where no block holds it.
   const TsdfVoxel* voxel(const Eigen::Vector3i& v) const;
+};
+
+// A block of the pool: its index there and its coordinates.
+struct TsdfBlockRef {
+  std::uint32_t pool_index = 0;
+  Eigen::Vector3i coords = Eigen::Vector3i::Zero();
 };
 
 // What one integration did.
@@ -143,6 +150,17 @@ class TsdfVolume {
   // (counted from the volume's making or clear(); higher is more recent).
   std::vector<std::uint32_t> last_touched() const;
 
+  // The blocks integrations after the first `integration` ones touched (by their numbers, as
+  // last_touched() gives them), in pool order: what changed since a pass over the field that saw
+  // that many integrations. nullopt: every block.
+  std::vector<TsdfBlockRef> blocks_touched_since(std::optional<std::uint32_t> integration) const;
+  // Integrations so far (counted as last_touched()'s numbers).
+  std::uint32_t integration_count() const { return stamp_; }
+  // A number no other volume or earlier block set had: it changes when the block set is replaced
+  // (clear(), assign()), and then passes that follow changes by integration count
+  // (blocks_touched_since) must start again.
+  std::uint64_t generation() const { return generation_; }
+
   std::size_t block_count() const { return block_count_; }
   const TsdfVolumeParams& params() const { return params_; }
   // The pool on the device, for other passes over the field (the first block_count() blocks are
@@ -157,10 +175,13 @@ class TsdfVolume {
   TsdfBlocks download() const;
 
  private:
+  std::vector<std::uint32_t> stamps_by_pool_block() const;  // last integration per pool block
+
   const compute::Context* context_;
   TsdfVolumeParams params_;
   unsigned capacity_log2_ = 0;
   std::uint32_t stamp_ = 0;
+  std::uint64_t generation_ = 0;
   std::size_t block_count_ = 0;
   compute::Buffer<std::uint64_t> keys_;         // the table: block keys
   compute::Buffer<std::uint32_t> slot_blocks_;  // the table: pool index per slot

@@ -7,6 +7,8 @@
 //               decimated (mapping/frame_store.hpp: a temporary file, not memory) and fuses it
 //               into the live TSDF (mapping/tsdf_volume.hpp) at its current pose.
 //   mesh        the TSDF's surface (mapping/tsdf_mesh.hpp).
+//   distance_field  the TSDF's 3-D distance field (mapping/esdf_volume.hpp), brought up to date
+//               with the frames fused since it was last asked for (milliseconds, not seconds).
 //   snapshot    the map as the batch pipeline makes it at the current poses: views labelled and
 //               pooled, gravity, the semantic grid, rooms (map_pipeline.hpp's stages 2-5), plus the
 //               occupancy grid of the robot's height band from the TSDF and its distance field.
@@ -29,6 +31,7 @@
 
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/triangle_mesh.hpp"
+#include "kartograf/mapping/esdf_volume.hpp"
 #include "kartograf/mapping/tsdf_mesh.hpp"
 #include "kartograf/mapping/tsdf_slice.hpp"
 #include "kartograf/mapping/tsdf_volume.hpp"
@@ -52,6 +55,7 @@ struct MapperParams {
   bool live_fusion = true;
   mapping::MeshParams mesh;
   mapping::TsdfSliceParams slice;  // world_to_level and floor_z come from the snapshot's gravity
+  mapping::EsdfVolumeParams distance_field;
 
   void validate() const;  // Error naming the first bad field
 };
@@ -97,6 +101,9 @@ class Mapper {
   const std::vector<Eigen::Isometry3d>& poses() const;  // SLAM frame, current estimates
   // The live volume's surface in the SLAM frame (re-fused first if poses moved).
   TriangleMesh mesh();
+  // The live volume's 3-D distance field in the SLAM frame (re-fused first if poses moved; the
+  // field then starts again), updated incrementally; valid until the next call.
+  const mapping::EsdfGrid& distance_field();
   // Stages 2-5 at the current poses; Error when no view can be labelled or no floor was seen.
   const MapPipelineResult& snapshot();
   const semantic::SemanticGrid& semantic() { return snapshot().semantic; }
