@@ -18,6 +18,7 @@ packages=(
   libgtest-dev libbenchmark-dev                    # tests and benchmarks
   libjs-three                                      # io: three.js, inlined into report.html
   chromium                                         # tests: report.html in headless Chromium
+  python3-dev python3-venv                         # the Python package (pip from PyPI in a venv)
 )
 
 missing=()

@@ -4,12 +4,14 @@
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
+#include <iterator>
 #include <limits>
 #include <string>
 #include <vector>
 
 #include "kartograf/compute/backend.hpp"
 #include "kartograf/core/intrinsics.hpp"
+#include "kartograf/pipeline/tracking_choices.hpp"
 
 namespace CLI {
 class App;
@@ -82,14 +84,15 @@ struct SequenceInputOptions {
 struct SequenceRunOptions {
   std::filesystem::path sequence;  // a folder in any supported layout (io/sequence_detect.hpp)
   SequenceInputOptions input;
-  std::string method = "p2plane";  // p2p | p2plane | color | planar
+  // Defaults and meaning: pipeline/tracking_choices.hpp.
+  std::string method = pipeline::TrackingChoices{}.method;
   std::string backend = "auto";
   std::string backend_source = "--backend";  // names the setting in errors
-  int reestimate_interval = 5;
-  // The re-estimates' anchor bounds: metres, degrees, frames (registration::AnchorPolicy).
-  std::vector<double> anchor_bounds{0.4, 25, 100};
-  std::string tracking = "frame";  // frame | model (mapping/model_tracking.hpp)
-  double model_voxel = 0.02;       // metres: the model's voxels with --tracking model
+  int reestimate_interval = pipeline::TrackingChoices{}.reestimate_interval;
+  std::vector<double> anchor_bounds{std::begin(pipeline::TrackingChoices{}.anchor_bounds),
+                                    std::end(pipeline::TrackingChoices{}.anchor_bounds)};
+  std::string tracking = pipeline::TrackingChoices{}.tracking;
+  double model_voxel = pipeline::TrackingChoices{}.model_voxel;
   bool progress = true;
 };
 

@@ -14,6 +14,7 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
+#include "kartograf/pipeline/tracking_choices.hpp"
 #include "option_checks.hpp"
 
 namespace kartograf::cli {
@@ -106,25 +107,20 @@ io::OpenedSequence open_input(const std::filesystem::path& folder, const Sequenc
   return opened;
 }
 
+pipeline::TrackingChoices tracking_choices(const SequenceRunOptions& options) {
+  return {options.method,
+          options.reestimate_interval,
+          {options.anchor_bounds.at(0), options.anchor_bounds.at(1), options.anchor_bounds.at(2)},
+          options.tracking,
+          options.model_voxel};
+}
+
 registration::OdometryParams odometry_params(const SequenceRunOptions& options) {
-  registration::OdometryParams params;
-  params.method = options.method == "p2p"      ? registration::OdometryMethod::point_to_point
-                  : options.method == "color"  ? registration::OdometryMethod::color
-                  : options.method == "planar" ? registration::OdometryMethod::planar
-                                               : registration::OdometryMethod::point_to_plane;
-  params.icp = registration::odometry_icp_params(params.method);
-  params.reestimate_interval = options.reestimate_interval;
-  params.anchor = {options.anchor_bounds.at(0), options.anchor_bounds.at(1),
-                   static_cast<int>(options.anchor_bounds.at(2))};
-  return params;
+  return pipeline::odometry_params(tracking_choices(options));
 }
 
 mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& options) {
-  mapping::ModelTrackingParams params;
-  params.enabled = options.tracking == "model";
-  params.volume.voxel_size = options.model_voxel;
-  params.volume.truncation = 4 * options.model_voxel;
-  return params;
+  return pipeline::model_tracking_params(tracking_choices(options));
 }
 
 std::string model_tracking_line(const mapping::OdometryRun& run) {

@@ -91,6 +91,15 @@ std::string_view to_string(StepFrame frame) {
   return "unknown";
 }
 
+OdometryMethod parse_odometry_method(std::string_view name, std::string_view what) {
+  if (name == "p2p") return OdometryMethod::point_to_point;
+  if (name == "p2plane") return OdometryMethod::point_to_plane;
+  if (name == "color") return OdometryMethod::color;
+  if (name == "planar") return OdometryMethod::planar;
+  throw Error(std::string(what) + ": '" + std::string(name) +
+              "' is not an odometry method (p2p, p2plane, color, planar)");
+}
+
 IcpParams odometry_icp_params(OdometryMethod method) {
   IcpParams params;
   // 4-neighbour normals of Kinect-noisy depth scatter by tens of degrees: a 30 degree gate drops

@@ -1,6 +1,7 @@
 #pragma once
-// Where Kartograf's trained models are (rooms/ and semantic/ classifiers): the source tree's
-// models/ when this build still sees it, else the installed copy (share/kartograf/models).
+// Where Kartograf's trained models are (rooms/ and semantic/ classifiers): $KARTOGRAF_MODELS_DIR
+// when set (a relocated install: the Python package), else the source tree's models/ when this
+// build still sees it, else the installed copy (share/kartograf/models).
 #include <filesystem>
 
 namespace kartograf {

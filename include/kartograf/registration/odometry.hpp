@@ -73,6 +73,9 @@ enum class OdometryMethod {
 // The ICP parameters of each method; levels[0] runs on the pyramid level of
 // OdometryParams::icp_width.
 IcpParams odometry_icp_params(OdometryMethod method);
+// The methods by the names the CLI and the Python package use: p2p, p2plane, color, planar.
+// Throws Error naming `what` and the name otherwise.
+OdometryMethod parse_odometry_method(std::string_view name, std::string_view what);
 
 enum class MotionModel { still, velocity, acceleration };
 

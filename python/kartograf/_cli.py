@@ -1,0 +1,75 @@
+"""The `kartograf` command the package installs: the C++ CLI carried inside the package. A ROS
+bag given where a command takes a sequence folder is converted first (kartograf.rosbag), with
+--color-topic, --depth-topic and --camera-info-topic to choose the topics; `kartograf batch`
+maps many sequences on Ray (kartograf.batch)."""
+
+import os
+import sys
+import tempfile
+from pathlib import Path
+
+SEQUENCE_COMMANDS = {"odometry", "slam", "map", "fuse", "planes"}
+TOPIC_OPTIONS = {"--color-topic": "color_topic", "--depth-topic": "depth_topic",
+                 "--camera-info-topic": "camera_info_topic"}
+
+
+def _take_topic_options(args):
+    """The arguments without the topic options, and those options."""
+    rest, topics, i = [], {}, 0
+    while i < len(args):
+        name, _, value = args[i].partition("=")
+        if name in TOPIC_OPTIONS:
+            if not value:
+                i += 1
+                value = args[i] if i < len(args) else ""
+            topics[TOPIC_OPTIONS[name]] = value
+        else:
+            rest.append(args[i])
+        i += 1
+    return rest, topics
+
+
+def _convert_bags(args, scratch):
+    """The arguments with the sequence argument, when it is a bag, replaced by its frames."""
+    if not args or args[0] not in SEQUENCE_COMMANDS:
+        return args
+    from . import rosbag
+
+    args, topics = _take_topic_options(args)
+    for i, arg in enumerate(args[1:], start=1):
+        if not arg.startswith("-") and not args[i - 1].startswith("--") and rosbag.is_bag(arg):
+            converted = rosbag.bag_to_folder(arg, Path(scratch) / "frames", **topics)
+            print(f"bag: {arg}: {converted.depth_frames} depth and {converted.color_frames} colour "
+                  f"images from {converted.topics.depth} and {converted.topics.color}",
+                  file=sys.stderr)
+            return [*args[:i], str(converted.folder), *args[i + 1:]]
+    return args
+
+
+def main() -> None:
+    here = Path(__file__).parent
+    executable = here / "bin" / "kartograf"
+    if not executable.is_file():
+        sys.exit(f"kartograf: the CLI is missing from the package ({executable})")
+    environment = dict(os.environ)
+    if (here / "models").is_dir():
+        environment.setdefault("KARTOGRAF_MODELS_DIR", str(here / "models"))
+    if sys.argv[1:2] == ["batch"]:  # many sequences on Ray (kartograf.batch)
+        from .batch import main as batch_main
+
+        os.environ.update(environment)
+        sys.exit(batch_main(sys.argv[2:]))
+    with tempfile.TemporaryDirectory(prefix="kartograf-bag-") as scratch:
+        try:
+            args = _convert_bags(sys.argv[1:], scratch)
+        except Exception as error:  # a bag that cannot be read: say so as the CLI would
+            sys.exit(f"kartograf: {error}")
+        if args == sys.argv[1:]:
+            os.execve(executable, [str(executable), *args], environment)
+        import subprocess
+
+        sys.exit(subprocess.run([str(executable), *args], env=environment).returncode)
+
+
+if __name__ == "__main__":
+    main()

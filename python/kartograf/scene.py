@@ -1,0 +1,94 @@
+"""Planes of RGB-D frames (the M1 method) and rooms of 2-D maps (the M4 methods)."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+
+import numpy as np
+
+from . import _kartograf
+from .results import Grid, grid_from
+
+
+@dataclass
+class Plane:
+    """n . p + offset = 0 in the camera frame, n towards the camera."""
+
+    id: int
+    normal: tuple
+    offset: float
+    centroid: tuple
+    inlier_count: int
+    rms_error: float
+
+
+@dataclass
+class PlaneSet:
+    planes: list  # Plane, by decreasing pixel count
+    labels: np.ndarray  # H x W uint16 plane id per pixel, 0 = none
+    milliseconds: float
+
+
+def extract_planes(context: _kartograf.Context, camera: _kartograf.PinholeIntrinsics,
+                   depth: np.ndarray, color: np.ndarray, depth_units: float = 1000.0) -> PlaneSet:
+    """The planes of one frame (Lab region growing, fits, merging), as `kartograf planes`."""
+    d = _kartograf.extract_planes(context, camera, depth, color, depth_units)
+    return PlaneSet(planes=[Plane(**p) for p in d["planes"]], labels=d["labels"],
+                    milliseconds=d["milliseconds"])
+
+
+@dataclass
+class Room:
+    id: int
+    area_m2: float
+    centroid: tuple  # map frame [m]
+    neighbours: list
+
+
+@dataclass
+class RoomSegmentation:
+    rooms: np.ndarray  # H x W uint16 room id per cell, 0 = none
+    records: list  # Room
+    method: str
+    seconds: float
+
+
+@dataclass
+class RoomScores:
+    recall: float
+    precision: float
+    mcc: float
+    ground_truth_rooms: int
+    segments: int
+
+
+def room_methods() -> list:
+    """morphological, distance, voronoi, feature, vrf."""
+    return _kartograf.room_methods()
+
+
+def read_map(path: str | os.PathLike, resolution: float = 0.05) -> Grid:
+    """A ROS map_server .yaml or an ipa-style PNG map as a Grid."""
+    return grid_from(_kartograf.read_map(os.fspath(path), resolution))
+
+
+def read_room_ground_truth(path: str | os.PathLike) -> np.ndarray:
+    """Ground-truth rooms: an ipa *_gt_segmentation.png or a 16-bit label PNG."""
+    return _kartograf.read_room_ground_truth(os.fspath(path))
+
+
+def segment_rooms(context: _kartograf.Context, grid: Grid,
+                  method: str = "voronoi") -> RoomSegmentation:
+    """The rooms of a 2-D map by one of room_methods()."""
+    d = _kartograf.segment_rooms(context, np.ascontiguousarray(grid.cells, dtype=np.uint8),
+                                 grid.resolution, tuple(grid.origin), method)
+    return RoomSegmentation(rooms=d["rooms"], records=[Room(**r) for r in d["records"]],
+                            method=d["method"], seconds=d["seconds"])
+
+
+def evaluate_rooms(ground_truth: np.ndarray, segmentation: np.ndarray) -> RoomScores:
+    """Recall, precision (means over rooms and segments) and MCC, as `kartograf rooms-eval`."""
+    return RoomScores(**_kartograf.evaluate_rooms(
+        np.ascontiguousarray(ground_truth, dtype=np.uint16),
+        np.ascontiguousarray(segmentation, dtype=np.uint16)))

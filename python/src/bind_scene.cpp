@@ -1,0 +1,143 @@
+// Planes of RGB-D frames (M1) and rooms of 2-D maps (M4).
+#include <nanobind/stl/array.h>
+#include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/string.h>
+#include <nanobind/stl/vector.h>
+
+#include <array>
+#include <filesystem>
+#include <string>
+
+#include "bindings.hpp"
+#include "convert.hpp"
+#include "kartograf/core/error.hpp"
+#include "kartograf/eval/room_metrics.hpp"
+#include "kartograf/formats/occupancy_map_io.hpp"
+#include "kartograf/geometry/backproject.hpp"
+#include "kartograf/rooms/room_methods.hpp"
+#include "kartograf/segmentation/plane_extraction.hpp"
+#include "map_dicts.hpp"
+
+namespace kartograf::python {
+
+namespace {
+
+using CellArray = nb::ndarray<const std::uint8_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+using LabelArray = nb::ndarray<const std::uint16_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
+
+std::array<double, 3> xyz(const Eigen::Vector3d& v) {
+  return {v.x(), v.y(), v.z()};
+}
+
+nb::dict plane_dict(const segmentation::Plane& p) {
+  nb::dict d;
+  d["id"] = p.id;
+  d["normal"] = xyz(p.normal);
+  d["offset"] = p.offset;
+  d["centroid"] = xyz(p.centroid);
+  d["inlier_count"] = p.inlier_count;
+  d["rms_error"] = p.rms_error;
+  return d;
+}
+
+// The planes of one frame: depth (in depth_units per metre) back-projected, then extracted.
+nb::dict extract_planes(const compute::Context& context, const PinholeIntrinsics& camera,
+                        const DepthArray& depth, const ColorArray& color, double depth_units) {
+  geometry::DepthRange range;
+  range.units_per_metre = depth_units;
+  const PointImage points = geometry::backproject(context, borrow_depth(depth), camera, range);
+  segmentation::PlaneExtractor extractor(context, camera);
+  segmentation::PlaneSet set = extractor.extract(points, borrow_color(color));
+  nb::list planes;
+  for (const segmentation::Plane& p : set.planes) planes.append(plane_dict(p));
+  nb::dict d;
+  d["planes"] = planes;
+  d["labels"] = plane_array<std::uint16_t>(std::move(set.labels));
+  d["milliseconds"] = set.timings.total();
+  return d;
+}
+
+LabelImage labels_of(const LabelArray& labels) {
+  return LabelImage::borrow(const_cast<std::uint16_t*>(labels.data()),
+                            static_cast<int>(labels.shape(1)), static_cast<int>(labels.shape(0)));
+}
+
+OccupancyGrid grid_of(const CellArray& cells, double resolution,
+                      const std::array<double, 3>& origin) {
+  OccupancyGrid grid;
+  grid.resolution = resolution;
+  grid.origin = {origin[0], origin[1], origin[2]};
+  grid.cells = Image<CellState>(static_cast<int>(cells.shape(1)), static_cast<int>(cells.shape(0)));
+  const std::uint8_t* values = cells.data();
+  for (std::size_t i = 0; i < grid.cells.size(); ++i) {
+    require(values[i] <= 2, "rooms: cell values are 0 (unknown), 1 (free) or 2 (occupied), not " +
+                                std::to_string(values[i]));
+    grid.cells.pixels()[i] = static_cast<CellState>(values[i]);
+  }
+  return grid;
+}
+
+nb::dict room_dict(const rooms::RoomRecord& r) {
+  nb::dict d;
+  d["id"] = r.id;
+  d["area_m2"] = r.area_m2;
+  d["centroid"] = std::array<double, 2>{r.centroid.x(), r.centroid.y()};
+  d["neighbours"] = std::vector<int>(r.neighbours.begin(), r.neighbours.end());
+  return d;
+}
+
+nb::dict segment(const compute::Context& context, const CellArray& cells, double resolution,
+                 const std::array<double, 3>& origin, const std::string& method) {
+  rooms::RoomSegmentation result = rooms::segment_rooms(context, grid_of(cells, resolution, origin),
+                                                        rooms::parse_room_method(method));
+  nb::list records;
+  for (const rooms::RoomRecord& r : result.records) records.append(room_dict(r));
+  nb::dict d;
+  d["rooms"] = plane_array<std::uint16_t>(std::move(result.rooms));
+  d["records"] = records;
+  d["method"] = result.method;
+  d["seconds"] = result.seconds;
+  return d;
+}
+
+nb::dict evaluate(const LabelArray& ground_truth, const LabelArray& segmentation) {
+  const eval::RoomSegmentationScores s =
+      eval::evaluate_room_segmentation(labels_of(ground_truth), labels_of(segmentation));
+  nb::dict d;
+  d["recall"] = s.recall_mean;
+  d["precision"] = s.precision_mean;
+  d["mcc"] = s.mcc;
+  d["ground_truth_rooms"] = s.ground_truth_rooms;
+  d["segments"] = s.segments;
+  return d;
+}
+
+std::vector<std::string> method_names() {
+  std::vector<std::string> names;
+  for (const rooms::RoomMethod m : rooms::all_room_methods()) names.push_back(rooms::to_string(m));
+  return names;
+}
+
+}  // namespace
+
+void bind_scene(nb::module_& m) {
+  m.def("extract_planes", &extract_planes, nb::arg("context"), nb::arg("camera"), nb::arg("depth"),
+        nb::arg("color"), nb::arg("depth_units") = 1000.0);
+  m.def(
+      "read_map",
+      [](const std::filesystem::path& path, double resolution) {
+        const bool yaml = path.extension() == ".yaml" || path.extension() == ".yml";
+        return grid_dict(yaml ? io::read_ros_map(path) : io::read_png_map(path, resolution));
+      },
+      nb::arg("path"), nb::arg("resolution") = 0.05,
+      "A ROS map_server .yaml (with its image) or an ipa-style PNG (free white) as a grid");
+  m.def("read_room_ground_truth", [](const std::filesystem::path& path) {
+    return plane_array<std::uint16_t>(io::read_ground_truth_rooms(path));
+  });
+  m.def("room_methods", &method_names);
+  m.def("segment_rooms", &segment, nb::arg("context"), nb::arg("cells"), nb::arg("resolution"),
+        nb::arg("origin"), nb::arg("method"));
+  m.def("evaluate_rooms", &evaluate, nb::arg("ground_truth"), nb::arg("segmentation"));
+}
+
+}  // namespace kartograf::python

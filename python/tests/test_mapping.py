@@ -1,0 +1,65 @@
+"""SLAM and the online mapper from Python; Open3D interop."""
+
+import pickle
+
+import numpy as np
+import pytest
+
+import kartograf as kg
+
+
+def test_slam_runs_and_pickles(cpu, synthetic):
+    slam = kg.run_slam(cpu, kg.open_sequence(synthetic), build_map=True)
+    assert slam.poses.shape == (30, 4, 4)
+    assert slam.ate().rmse_m < 0.05
+    assert slam.odometry.poses.shape == (30, 4, 4)
+    assert slam.map.points.shape[1] == 3 and len(slam.map.points) > 1000
+    copy = pickle.loads(pickle.dumps(slam))
+    assert np.array_equal(copy.poses, slam.poses)
+    assert copy.map.points.shape == slam.map.points.shape
+
+
+def mapped(cpu, synthetic):
+    sequence = kg.open_sequence(synthetic)
+    mapper = kg.Mapper(cpu, sequence.camera, sequence.depth_units_per_metre, features=False)
+    for i in range(len(sequence)):
+        frame = sequence.frame(i)
+        step = mapper.add_frame(frame["depth"], frame["color"], frame["pose"])
+        assert step["status"] == "given"
+    return mapper
+
+
+def test_the_mappers_mesh_and_distance_field_agree(cpu, synthetic):
+    mapper = mapped(cpu, synthetic)
+    mesh = mapper.mesh()
+    assert len(mesh.triangles) > 1000 and mesh.colors.shape == mesh.vertices.shape
+    field = mapper.distance_field()
+    assert field.distances.shape == field.occupied.shape
+    assert field.occupied.any()
+    # The mesh's vertices are surface: within a cell's diagonal of an occupied cell.
+    diagonal = np.sqrt(3) * field.resolution
+    near = [field.distance(v) <= diagonal for v in mesh.vertices[::50]]
+    assert np.mean(near) > 0.97
+    assert field.distance((1e3, 1e3, 1e3)) == field.max_distance
+    copy = pickle.loads(pickle.dumps(field))
+    assert np.array_equal(copy.distances, field.distances)
+
+
+def test_the_mapper_refuses_a_pose_that_is_not_rigid(cpu, synthetic):
+    sequence = kg.open_sequence(synthetic, frames=2)
+    mapper = kg.Mapper(cpu, sequence.camera, sequence.depth_units_per_metre, features=False)
+    frame = sequence.frame(0)
+    with pytest.raises(kg.Error, match="rigid"):
+        mapper.add_frame(frame["depth"], frame["color"], np.eye(4) * 2)
+
+
+def test_open3d_round_trip(cpu, synthetic):
+    o3d = pytest.importorskip("open3d")
+    mesh = mapped(cpu, synthetic).mesh()
+    back = kg.Mesh.from_open3d(mesh.to_open3d())
+    assert isinstance(mesh.to_open3d(), o3d.geometry.TriangleMesh)
+    assert np.allclose(back.vertices, mesh.vertices)
+    assert np.array_equal(back.triangles, mesh.triangles)
+    assert np.array_equal(back.colors, mesh.colors)
+    cloud = kg.Cloud(points=mesh.vertices, colors=mesh.colors)
+    assert np.allclose(kg.Cloud.from_open3d(cloud.to_open3d()).points, cloud.points)

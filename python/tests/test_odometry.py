@@ -1,0 +1,96 @@
+"""The odometry from Python: no copy of the depth image, the same poses as over the whole
+sequence and as the CLI, picklable results."""
+
+import pickle
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import kartograf as kg
+
+
+def frames_of(sequence):
+    return [sequence.frame(i) for i in range(len(sequence))]
+
+
+def test_the_depth_array_is_read_in_place(cpu, synthetic):
+    sequence = kg.open_sequence(synthetic)
+    odometry = kg.Odometry(cpu, sequence.camera, sequence.depth_units_per_metre)
+    depth = np.ascontiguousarray(sequence.frame(0)["depth"])
+    odometry.track(depth)
+    assert odometry.last_depth_address == depth.ctypes.data
+    # A layout the library cannot read in place is copied first (and still tracked).
+    flipped = np.ascontiguousarray(sequence.frame(1)["depth"][::-1, :])[::-1, :]
+    assert not flipped.flags["C_CONTIGUOUS"]
+    report = odometry.track(flipped)
+    assert odometry.last_depth_address != flipped.ctypes.data
+    assert report.index == 1
+    with pytest.raises(TypeError):
+        odometry.track(np.zeros((240, 320, 2), np.uint16))
+
+
+def test_frame_by_frame_equals_the_sequence_run(cpu, synthetic):
+    sequence = kg.open_sequence(synthetic)
+    odometry = kg.Odometry(cpu, sequence.camera, sequence.depth_units_per_metre)
+    reports = [odometry.track(f["depth"], f["color"]) for f in frames_of(sequence)]
+    run = kg.run_odometry(cpu, sequence)
+    assert run.poses.shape == (30, 4, 4)
+    assert np.allclose(odometry.poses, run.poses, atol=1e-9)
+    assert [r.keyframe for r in reports] == [f.keyframe for f in run.frames]
+    ate = run.ate()
+    assert ate is not None and ate.count == 30
+    assert ate.rmse_m < 0.05, ate
+
+
+def test_results_pickle(cpu, synthetic):
+    run = kg.run_odometry(cpu, kg.open_sequence(synthetic, frames=8))
+    copy = pickle.loads(pickle.dumps(run))
+    assert np.array_equal(copy.poses, run.poses)
+    assert copy.frames[3] == run.frames[3]
+    assert copy.ate() == run.ate()
+
+
+def read_tum(path):
+    rows = [line.split() for line in Path(path).read_text().splitlines()
+            if line and not line.startswith("#")]
+    return np.array([[float(v) for v in row[1:]] for row in rows])
+
+
+def pose_rows(poses):
+    """TUM rows (tx ty tz qx qy qz qw) of 4 x 4 poses."""
+    from_matrix = []
+    for pose in poses:
+        r = pose[:3, :3]
+        w = np.sqrt(max(0.0, 1 + np.trace(r))) / 2
+        q = np.array([r[2, 1] - r[1, 2], r[0, 2] - r[2, 0], r[1, 0] - r[0, 1]]) / (4 * w)
+        from_matrix.append([*pose[:3, 3], *q, w])
+    return np.array(from_matrix)
+
+
+def test_the_same_trajectory_as_the_cli(cpu, synthetic, tmp_path):
+    out = tmp_path / "trajectory.txt"
+    subprocess.run([sys.executable, "-m", "kartograf._cli", "odometry", str(synthetic),
+                    "--out", str(out), "--backend", "cpu", "--no-progress"],
+                   check=True, capture_output=True)
+    run = kg.run_odometry(cpu, kg.open_sequence(synthetic))
+    assert np.allclose(read_tum(out), pose_rows(run.poses), atol=2e-6)
+
+
+def test_bad_choices_are_errors(cpu, synthetic):
+    sequence = kg.open_sequence(synthetic, frames=3)
+    with pytest.raises(kg.Error, match="'icp' is not an odometry method"):
+        kg.run_odometry(cpu, sequence, method="icp")
+    with pytest.raises(kg.Error, match="tracking"):
+        kg.run_odometry(cpu, sequence, tracking="dense")
+    odometry = kg.Odometry(cpu, sequence.camera, sequence.depth_units_per_metre)
+    with pytest.raises(kg.Error, match="320x240|size"):
+        odometry.track(np.zeros((10, 10), np.uint16))
+
+
+def test_real_frames_track_and_score(cpu, data_dir):
+    run = kg.run_odometry(cpu, kg.open_sequence(data_dir / "7scenes_redkitchen", frames=20))
+    assert run.ate().rmse_m < 0.05
+    assert run.frames_per_second > 0

@@ -1,0 +1,56 @@
+"""ROS 1 and ROS 2 bags, written here from a synthetic folder, map to the folder's trajectory:
+through the Python API and through the CLI."""
+
+import subprocess
+import sys
+
+import numpy as np
+
+import kartograf as kg
+from bag_writer import write_bag
+from test_odometry import read_tum
+
+
+def test_a_ros2_and_a_ros1_bag_give_the_folders_trajectory(cpu, synthetic, tmp_path):
+    sequence = kg.open_sequence(synthetic)
+    folder_run = kg.run_odometry(cpu, sequence)
+    for ros1, bag in ((False, tmp_path / "ros2_bag"), (True, tmp_path / "run.bag")):
+        write_bag(sequence, synthetic, bag, ros1)
+        assert kg.rosbag.is_bag(bag)
+        converted = kg.rosbag.bag_to_folder(bag, tmp_path / f"frames_{ros1}")
+        assert converted.topics.depth == "/camera/aligned_depth_to_color/image_raw"
+        assert converted.topics.camera_info == "/camera/color/camera_info"
+        assert converted.color_frames == converted.depth_frames == len(sequence)
+        assert converted.camera == sequence.camera
+        from_bag = kg.open_sequence(converted.folder)
+        first = from_bag.frame(3)
+        assert np.array_equal(first["depth"], sequence.frame(3)["depth"])
+        assert np.array_equal(first["color"], sequence.frame(3)["color"])
+        run = kg.run_odometry(cpu, from_bag)
+        assert np.array_equal(run.poses, folder_run.poses), f"ros1={ros1}"
+
+
+def test_the_cli_reads_a_bag(cpu, synthetic, tmp_path):
+    sequence = kg.open_sequence(synthetic)
+    bag = tmp_path / "cli_bag"
+    write_bag(sequence, synthetic, bag, ros1=False)
+    out = tmp_path / "trajectory.txt"
+    done = subprocess.run([sys.executable, "-m", "kartograf._cli", "odometry", str(bag), "--out",
+                           str(out), "--backend", "cpu", "--no-progress"],
+                          check=True, capture_output=True, text=True)
+    assert "bag:" in done.stderr
+    from_folder = tmp_path / "folder_trajectory.txt"
+    subprocess.run([sys.executable, "-m", "kartograf._cli", "odometry", str(synthetic), "--out",
+                    str(from_folder), "--backend", "cpu", "--no-progress"], check=True,
+                   capture_output=True)
+    assert np.array_equal(read_tum(out), read_tum(from_folder))
+
+
+def test_missing_topics_are_named(tmp_path, synthetic):
+    import pytest
+
+    sequence = kg.open_sequence(synthetic, frames=2)
+    bag = tmp_path / "bag"
+    write_bag(sequence, synthetic, bag, ros1=False)
+    with pytest.raises(kg.Error, match="no topic /nothing"):
+        kg.rosbag.bag_to_folder(bag, tmp_path / "out", depth_topic="/nothing")
