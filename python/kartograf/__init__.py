@@ -40,6 +40,7 @@ from .results import (  # noqa: E402
     MapResult,
     Mesh,
     OdometryRun,
+    SemanticGrid,
     SlamRun,
     ate,
 )
@@ -80,6 +81,7 @@ __all__ = [
     "Room",
     "RoomScores",
     "RoomSegmentation",
+    "SemanticGrid",
     "Sequence",
     "SlamRun",
     "ate",

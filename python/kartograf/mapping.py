@@ -8,8 +8,8 @@ import numpy as np
 
 from . import _kartograf
 from .odometry import DEFAULTS
-from .results import (DistanceField, Grid, MapResult, OdometryRun, SlamRun, cloud_from,
-                      grid_from, mesh_from)
+from .results import (DistanceField, Grid, MapResult, OdometryRun, SemanticGrid, SlamRun,
+                      cloud_from, grid_from, mesh_from)
 
 
 def run_slam(context: _kartograf.Context, sequence: _kartograf.Sequence,
@@ -70,4 +70,6 @@ class Mapper:
                          mesh=mesh_from(d["mesh"]), band_occupancy=grid_from(d["band_occupancy"]),
                          occupancy=grid_from(d["occupancy"]), rooms=d["rooms"],
                          room_count=d["room_count"], planes=d["planes"],
+                         semantic=SemanticGrid(**{**d["semantic"],
+                                                  "origin": tuple(d["semantic"]["origin"])}),
                          total_seconds=d["total_seconds"])

@@ -166,6 +166,26 @@ class SlamRun:
         return ate(self.poses, self.ground_truth, align) if _has_truth(self.ground_truth) else None
 
 
+SEMANTIC_CLASSES = ("unknown", "floor", "wall", "ceiling", "door", "furniture")
+
+
+@dataclass
+class SemanticGrid:
+    """The metric-semantic grid (M2): classes[row, col] (SEMANTIC_CLASSES' indices; row 0 is the
+    top) and the traversability weight per cell in [0, 1] (NaN: unobserved)."""
+
+    classes: np.ndarray
+    weight: np.ndarray
+    resolution: float
+    origin: tuple  # lower-left corner [m]
+    floor_z: float
+    objects: int
+
+    def share(self, name: str) -> float:
+        """The share of cells of one class."""
+        return float(np.mean(self.classes == SEMANTIC_CLASSES.index(name)))
+
+
 @dataclass
 class MapResult:
     poses: np.ndarray  # camera-to-map
@@ -175,6 +195,7 @@ class MapResult:
     occupancy: Grid
     rooms: np.ndarray  # room id per occupancy cell, 0 = none
     room_count: int
+    semantic: SemanticGrid
     planes: int
     total_seconds: float
 

@@ -1,6 +1,8 @@
+#include <nanobind/stl/array.h>
 #include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 
+#include <array>
 #include <optional>
 #include <string>
 
@@ -26,6 +28,18 @@ nb::dict step_dict(const pipeline::MapperStep& step) {
   return d;
 }
 
+// The metric-semantic grid (M2): classes and traversability weight per cell.
+nb::dict semantic_dict(semantic::SemanticGrid grid) {
+  nb::dict d;
+  d["resolution"] = grid.resolution;
+  d["origin"] = std::array<double, 2>{grid.origin.x(), grid.origin.y()};
+  d["floor_z"] = grid.floor_z;
+  d["classes"] = plane_array<std::uint8_t>(std::move(grid.classes));
+  d["weight"] = plane_array<float>(std::move(grid.weight));
+  d["objects"] = grid.objects.size();
+  return d;
+}
+
 nb::dict result_dict(pipeline::MapPipelineResult result) {
   nb::dict d;
   d["poses"] = pose_stack(result.poses);
@@ -35,6 +49,7 @@ nb::dict result_dict(pipeline::MapPipelineResult result) {
   d["occupancy"] = grid_dict(std::move(result.occupancy));
   d["rooms"] = plane_array<std::uint16_t>(std::move(result.rooms.rooms));
   d["room_count"] = result.rooms.records.size();
+  d["semantic"] = semantic_dict(std::move(result.semantic));
   d["planes"] = result.planes.size();
   d["total_seconds"] = result.total_seconds();
   return d;

@@ -45,6 +45,18 @@ def test_the_mappers_mesh_and_distance_field_agree(cpu, synthetic):
     assert np.array_equal(copy.distances, field.distances)
 
 
+def test_the_mappers_finished_map_has_rooms_and_a_semantic_grid(cpu, synthetic):
+    result = mapped(cpu, synthetic).finish()
+    assert result.poses.shape == (30, 4, 4)
+    assert len(result.mesh.triangles) > 1000
+    assert result.semantic.classes.shape == result.semantic.weight.shape
+    assert result.semantic.share("floor") > 0.05 and result.semantic.share("wall") > 0.01
+    assert result.room_count >= 1 and result.rooms.max() == result.room_count
+    assert result.occupancy.cells.shape == result.rooms.shape
+    assert pickle.loads(pickle.dumps(result)).semantic.classes.tobytes() == \
+        result.semantic.classes.tobytes()
+
+
 def test_the_mapper_refuses_a_pose_that_is_not_rigid(cpu, synthetic):
     sequence = kg.open_sequence(synthetic, frames=2)
     mapper = kg.Mapper(cpu, sequence.camera, sequence.depth_units_per_metre, features=False)
