@@ -10,4 +10,4 @@ if [ ! -x "$venv/bin/python" ]; then
 fi
 "$venv/bin/python" -m pip install --quiet --disable-pip-version-check \
   "scikit-build-core>=0.10" "nanobind>=2.0" "numpy>=1.21" "pytest>=7" "rosbags>=0.10" "ray>=2.9" >&2
-echo "$venv/bin/python"
+echo "$(cd "$venv" && pwd)/bin/python"  # absolute: CMake takes it from any folder
