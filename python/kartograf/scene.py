@@ -39,6 +39,29 @@ def extract_planes(context: _kartograf.Context, camera: _kartograf.PinholeIntrin
 
 
 @dataclass
+class ViewLabels:
+    """The M2 labelling of one view: classes per pixel (kartograf.SEMANTIC_CLASSES' indices),
+    the regions it grew, and the up direction it found (camera frame)."""
+
+    classes: np.ndarray  # H x W uint8
+    regions: np.ndarray  # H x W uint16, 0 = no region
+    region_count: int
+    up: tuple
+
+
+def label_view(context: _kartograf.Context, camera: _kartograf.PinholeIntrinsics,
+               depth: np.ndarray, depth_units: float = 1000.0) -> ViewLabels:
+    """Normals, regions, gravity and the floor / wall / ceiling / door / furniture rules on one
+    depth frame (docs/methods.md M2 steps 1-3)."""
+    return ViewLabels(**_kartograf.label_view(context, camera, depth, depth_units))
+
+
+def read_semantic_png(path: str | os.PathLike) -> np.ndarray:
+    """An 8-bit semantic image (a synthetic data set's gt/semantic/*.png)."""
+    return _kartograf.read_semantic_png(os.fspath(path))
+
+
+@dataclass
 class Room:
     id: int
     area_m2: float

@@ -16,6 +16,7 @@
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/rooms/room_methods.hpp"
 #include "kartograf/segmentation/plane_extraction.hpp"
+#include "kartograf/semantic/classify.hpp"
 #include "map_dicts.hpp"
 
 namespace kartograf::python {
@@ -112,6 +113,21 @@ nb::dict evaluate(const LabelArray& ground_truth, const LabelArray& segmentation
   return d;
 }
 
+// M2 steps 1-3 on one depth frame: per-pixel classes, regions and the up direction.
+nb::dict label_view(const compute::Context& context, const PinholeIntrinsics& camera,
+                    const DepthArray& depth, double depth_units) {
+  geometry::DepthRange range;
+  range.units_per_metre = depth_units;
+  const PointImage points = geometry::backproject(context, borrow_depth(depth), camera, range);
+  semantic::SemanticLabelling labelling = semantic::label_organized_points(context, points);
+  nb::dict d;
+  d["classes"] = plane_array<std::uint8_t>(std::move(labelling.semantic));
+  d["regions"] = plane_array<std::uint16_t>(std::move(labelling.regions.labels));
+  d["region_count"] = labelling.regions.region_count;
+  d["up"] = xyz(labelling.gravity.up);
+  return d;
+}
+
 std::vector<std::string> method_names() {
   std::vector<std::string> names;
   for (const rooms::RoomMethod m : rooms::all_room_methods()) names.push_back(rooms::to_string(m));
@@ -133,6 +149,11 @@ void bind_scene(nb::module_& m) {
       "A ROS map_server .yaml (with its image) or an ipa-style PNG (free white) as a grid");
   m.def("read_room_ground_truth", [](const std::filesystem::path& path) {
     return plane_array<std::uint16_t>(io::read_ground_truth_rooms(path));
+  });
+  m.def("label_view", &label_view, nb::arg("context"), nb::arg("camera"), nb::arg("depth"),
+        nb::arg("depth_units") = 1000.0);
+  m.def("read_semantic_png", [](const std::filesystem::path& path) {
+    return plane_array<std::uint8_t>(io::read_semantic_png(path));
   });
   m.def("room_methods", &method_names);
   m.def("segment_rooms", &segment, nb::arg("context"), nb::arg("cells"), nb::arg("resolution"),

@@ -77,8 +77,6 @@ nb::dict synthesize(const std::filesystem::path& folder, std::uint64_t seed, int
   return d;
 }
 
-}  // namespace
-
 // Image files as the library reads and writes them (the bag converter uses them).
 void bind_image_files(nb::module_& m) {
   m.def("read_depth_png",
@@ -94,6 +92,8 @@ void bind_image_files(nb::module_& m) {
   m.def("write_camera_intrinsics_json", &io::write_camera_intrinsics_json, nb::arg("path"),
         nb::arg("camera"));
 }
+
+}  // namespace
 
 void bind_sequence(nb::module_& m) {
   bind_image_files(m);

@@ -75,3 +75,32 @@ def test_open3d_round_trip(cpu, synthetic):
     assert np.array_equal(back.colors, mesh.colors)
     cloud = kg.Cloud(points=mesh.vertices, colors=mesh.colors)
     assert np.allclose(kg.Cloud.from_open3d(cloud.to_open3d()).points, cloud.points)
+
+
+def cli(*args):
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, "-m", "kartograf._cli", *map(str, args)], check=True,
+                   capture_output=True)
+
+
+def test_slam_and_the_mapper_give_the_clis_trajectories(cpu, synthetic, tmp_path):
+    from test_odometry import pose_rows, read_tum
+
+    sequence = kg.open_sequence(synthetic)
+    cli("slam", synthetic, "--out", tmp_path / "slam", "--no-map", "--backend", "cpu",
+        "--no-progress")
+    slam = kg.run_slam(cpu, sequence)
+    assert np.allclose(read_tum(tmp_path / "slam" / "trajectory.txt"), pose_rows(slam.poses),
+                       atol=2e-6)
+    # The online mapper fed frame by frame (features on, as `kartograf map`'s default) against
+    # the CLI's map of the whole sequence: the same SLAM, the same map frame.
+    cli("map", synthetic, "--out", tmp_path / "map", "--backend", "cpu", "--no-progress")
+    mapper = kg.Mapper(cpu, sequence.camera, sequence.depth_units_per_metre)
+    for i in range(len(sequence)):
+        frame = sequence.frame(i)
+        mapper.add_frame(frame["depth"], frame["color"])
+    result = mapper.finish()
+    assert np.allclose(read_tum(tmp_path / "map" / "trajectory.txt"), pose_rows(result.poses),
+                       atol=2e-6)

@@ -49,3 +49,22 @@ def test_rooms_of_a_real_map_equal_the_clis_and_score(cpu, data_dir, tmp_path):
     assert scores.recall > 0.7 and scores.precision > 0.7, scores
     with pytest.raises(kg.Error, match="room"):
         kg.segment_rooms(cpu, grid, "watershed")
+
+
+def test_a_synthetic_views_labels_agree_with_its_ground_truth(cpu, synthetic):
+    sequence = kg.open_sequence(synthetic)
+    frame = sequence.frame(10)
+    labels = kg.label_view(cpu, sequence.camera, frame["depth"], sequence.depth_units_per_metre)
+    assert labels.classes.shape == frame["depth"].shape
+    assert labels.region_count > 3
+    up = np.asarray(labels.up)
+    assert abs(np.linalg.norm(up) - 1) < 1e-9
+    # The true up in the camera frame: the world's z seen from the frame's pose.
+    true_up = frame["pose"][:3, :3].T @ np.array([0.0, 0.0, 1.0])
+    assert np.degrees(np.arccos(np.clip(up @ true_up, -1, 1))) < 5
+    stamp = f"{frame['timestamp']:.6f}"
+    truth = kg.read_semantic_png(synthetic / "gt" / "semantic" / f"{stamp}.png")
+    labelled = (labels.classes != 0) & (truth != 0)
+    assert labelled.mean() > 0.3
+    agree = (labels.classes == truth)[labelled].mean()
+    assert agree > 0.8, agree
