@@ -1,6 +1,7 @@
 """The `kartograf` command the package installs: the C++ CLI carried inside the package. A ROS
 bag given where a command takes a sequence folder is converted first (kartograf.rosbag), with
---color-topic, --depth-topic and --camera-info-topic to choose the topics; `kartograf batch`
+--color-topic, --depth-topic and --camera-info-topic to choose the topics, and --bag-poses (with
+--odometry-topic) to take the camera's poses from the bag's odometry and /tf; `kartograf batch`
 maps many sequences on Ray (kartograf.batch)."""
 
 import os
@@ -10,7 +11,9 @@ from pathlib import Path
 
 SEQUENCE_COMMANDS = {"odometry", "slam", "map", "fuse", "planes"}
 TOPIC_OPTIONS = {"--color-topic": "color_topic", "--depth-topic": "depth_topic",
-                 "--camera-info-topic": "camera_info_topic"}
+                 "--camera-info-topic": "camera_info_topic", "--odometry-topic": "odometry_topic"}
+# Use the bag's odometry (and /tf) as the camera's poses: `--poses` of the converted prior.
+POSES_FLAG = "--bag-poses"
 
 
 def _take_topic_options(args):
@@ -18,7 +21,9 @@ def _take_topic_options(args):
     rest, topics, i = [], {}, 0
     while i < len(args):
         name, _, value = args[i].partition("=")
-        if name in TOPIC_OPTIONS:
+        if name == POSES_FLAG:
+            topics["pose_prior"] = True
+        elif name in TOPIC_OPTIONS:
             if not value:
                 i += 1
                 value = args[i] if i < len(args) else ""
@@ -42,7 +47,8 @@ def _convert_bags(args, scratch):
             print(f"bag: {arg}: {converted.depth_frames} depth and {converted.color_frames} colour "
                   f"images from {converted.topics.depth} and {converted.topics.color}",
                   file=sys.stderr)
-            return [*args[:i], str(converted.folder), *args[i + 1:]]
+            poses = ["--poses", str(converted.prior)] if converted.prior else []
+            return [*args[:i], str(converted.folder), *args[i + 1:], *poses]
     return args
 
 

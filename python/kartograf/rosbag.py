@@ -12,6 +12,10 @@ Images: sensor_msgs/Image (depth 16UC1 in millimetres or 32FC1 in metres; colour
 rgba8, bgra8, mono8) and sensor_msgs/CompressedImage (colour png or jpeg; depth
 "compressedDepth png", millimetres). Depth is written in TUM's 5000 units per metre. Intrinsics:
 the camera_info topic's K (sensor_msgs/CameraInfo).
+
+A pose prior (pose_prior=True; the CLI's --bag-poses): the camera's poses from a nav_msgs/Odometry
+topic (its child frame's pose) and the fixed chain from that frame to the images' frame in
+/tf_static (or /tf), written as prior.txt (TUM) for `--poses`.
 """
 
 from __future__ import annotations
@@ -24,11 +28,13 @@ from typing import Optional
 
 import numpy as np
 
-from . import _kartograf
+from . import _kartograf, bag_poses
 
 IMAGE = "sensor_msgs/msg/Image"
 COMPRESSED = "sensor_msgs/msg/CompressedImage"
 CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
+ODOMETRY = "nav_msgs/msg/Odometry"
+TF = "tf2_msgs/msg/TFMessage"
 TUM_UNITS = 5000.0  # depth units per metre in the folder
 
 
@@ -37,6 +43,7 @@ class BagTopics:
     color: str
     depth: str
     camera_info: Optional[str]
+    odometry: Optional[str] = None  # the pose prior's (nav_msgs/Odometry), when asked for
 
 
 @dataclass
@@ -46,6 +53,7 @@ class BagConversion:
     color_frames: int
     depth_frames: int
     camera: _kartograf.PinholeIntrinsics
+    prior: Optional[Path] = None  # prior.txt: camera poses from the odometry topic (TUM)
 
 
 def is_bag(path: str | os.PathLike) -> bool:
@@ -98,6 +106,18 @@ def choose_topics(topics: dict, color: Optional[str] = None, depth: Optional[str
     return BagTopics(color=color, depth=depth, camera_info=camera_info)
 
 
+def choose_odometry_topic(topics: dict, odometry: Optional[str] = None) -> str:
+    """The nav_msgs/Odometry topic: given, else the bag's only one (else an Error naming them)."""
+    found = sorted(t for t, i in topics.items() if i.msgtype == ODOMETRY)
+    if odometry is None and len(found) != 1:
+        raise _kartograf.Error(f"bag: {len(found)} odometry topics ({', '.join(found) or 'none'});"
+                               " name one")
+    odometry = odometry or found[0]
+    if odometry not in topics or topics[odometry].msgtype != ODOMETRY:
+        raise _kartograf.Error(f"bag: {odometry} is not a nav_msgs/Odometry topic")
+    return odometry
+
+
 def _stamp(msg) -> float:
     return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
@@ -146,24 +166,38 @@ def _camera(msg) -> _kartograf.PinholeIntrinsics:
 def bag_to_folder(bag: str | os.PathLike, folder: str | os.PathLike,
                   color_topic: Optional[str] = None, depth_topic: Optional[str] = None,
                   camera_info_topic: Optional[str] = None,
-                  camera: Optional[_kartograf.PinholeIntrinsics] = None) -> BagConversion:
-    """Writes the bag's colour and depth frames as a TUM folder; returns what it used."""
+                  camera: Optional[_kartograf.PinholeIntrinsics] = None,
+                  pose_prior: bool = False, odometry_topic: Optional[str] = None) -> BagConversion:
+    """Writes the bag's colour and depth frames as a TUM folder; returns what it used. With
+    pose_prior: also prior.txt, the camera's poses from the odometry topic and /tf (a TUM
+    trajectory for `--poses`)."""
     bag, folder = Path(bag), Path(folder)
     if folder.exists() and any(folder.iterdir()):
         raise _kartograf.Error(f"bag: {folder} exists and is not empty")
     (folder / "rgb").mkdir(parents=True, exist_ok=True)
     (folder / "depth").mkdir(exist_ok=True)
+    tree, odometry, camera_frame = bag_poses.FrameTree(), [], None
     with _reader(bag) as reader, tempfile.TemporaryDirectory() as scratch:
         topics = choose_topics(reader.topics, color_topic, depth_topic, camera_info_topic)
+        if pose_prior:
+            topics.odometry = choose_odometry_topic(reader.topics, odometry_topic)
+        tf_topics = {t for t, i in reader.topics.items() if i.msgtype == TF} if pose_prior else set()
+        wanted = {topics.color, topics.depth, topics.camera_info, topics.odometry, *tf_topics}
         lists = {"rgb": [], "depth": []}
         for connection, _, raw in reader.messages(
-                connections=[c for c in reader.connections
-                             if c.topic in (topics.color, topics.depth, topics.camera_info)]):
+                connections=[c for c in reader.connections if c.topic in wanted]):
             msg = reader.deserialize(raw, connection.msgtype)
             if connection.topic == topics.camera_info:
                 camera = camera or _camera(msg)
-                continue
-            _write_frame(folder, msg, connection, topics, lists, Path(scratch) / "image")
+            elif connection.topic in tf_topics:
+                for stamped in msg.transforms:
+                    tree.add(stamped)
+            elif connection.topic == topics.odometry:
+                odometry.append((_stamp(msg), msg))
+            else:
+                if connection.topic == topics.depth and camera_frame is None:
+                    camera_frame = msg.header.frame_id
+                _write_frame(folder, msg, connection, topics, lists, Path(scratch) / "image")
     if camera is None:
         raise _kartograf.Error(f"bag: {bag} has no camera_info topic; give the camera")
     _kartograf.write_camera_intrinsics_json(folder / "camera_intrinsics.json", camera)
@@ -174,8 +208,14 @@ def bag_to_folder(bag: str | os.PathLike, folder: str | os.PathLike,
     if not lists["rgb"] or not lists["depth"]:
         raise _kartograf.Error(f"bag: {bag} holds no {'colour' if not lists['rgb'] else 'depth'} "
                                "images on the chosen topics")
+    prior = None
+    if pose_prior:
+        if not odometry:
+            raise _kartograf.Error(f"bag: {topics.odometry} holds no message")
+        prior = folder / "prior.txt"
+        bag_poses.write_tum(prior, bag_poses.camera_poses(odometry, tree, camera_frame))
     return BagConversion(folder=folder, topics=topics, color_frames=len(lists["rgb"]),
-                         depth_frames=len(lists["depth"]), camera=camera)
+                         depth_frames=len(lists["depth"]), camera=camera, prior=prior)
 
 
 def _write_frame(folder: Path, msg, connection, topics: BagTopics, lists: dict,

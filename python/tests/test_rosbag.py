@@ -54,3 +54,24 @@ def test_missing_topics_are_named(tmp_path, synthetic):
     write_bag(sequence, synthetic, bag, ros1=False)
     with pytest.raises(kg.Error, match="no topic /nothing"):
         kg.rosbag.bag_to_folder(bag, tmp_path / "out", depth_topic="/nothing")
+
+
+def test_the_bags_odometry_and_tf_give_the_cameras_poses(cpu, synthetic, tmp_path):
+    from test_odometry import pose_rows
+
+    sequence = kg.open_sequence(synthetic)
+    truth = np.array([sequence.frame(i)["pose"] for i in range(len(sequence))])
+    for ros1, bag in ((False, tmp_path / "ros2_odom"), (True, tmp_path / "odom.bag")):
+        write_bag(sequence, synthetic, bag, ros1, odometry=True)
+        converted = kg.rosbag.bag_to_folder(bag, tmp_path / f"prior_{ros1}", pose_prior=True)
+        assert converted.topics.odometry == "/odom"
+        assert np.allclose(read_tum(converted.prior), pose_rows(truth), atol=1e-6), f"ros1={ros1}"
+    # The CLI: --bag-poses maps at those poses, as --poses groundtruth does on the folder.
+    run = [sys.executable, "-m", "kartograf._cli", "map"]
+    common = ["--backend", "cpu", "--no-progress"]
+    subprocess.run([*run, str(tmp_path / "ros2_odom"), "--bag-poses", "--out", str(tmp_path / "a"),
+                    *common], check=True, capture_output=True)
+    subprocess.run([*run, str(synthetic), "--poses", "groundtruth", "--out", str(tmp_path / "b"),
+                    *common], check=True, capture_output=True)
+    assert np.allclose(read_tum(tmp_path / "a" / "trajectory.txt"),
+                       read_tum(tmp_path / "b" / "trajectory.txt"), atol=1e-5)
