@@ -72,11 +72,14 @@ def pose_rows(poses):
 
 def test_the_same_trajectory_as_the_cli(cpu, synthetic, tmp_path):
     out = tmp_path / "trajectory.txt"
-    subprocess.run([sys.executable, "-m", "kartograf._cli", "odometry", str(synthetic),
-                    "--out", str(out), "--backend", "cpu", "--no-progress"],
-                   check=True, capture_output=True)
+    done = subprocess.run([sys.executable, "-m", "kartograf._cli", "odometry", str(synthetic),
+                           "--out", str(out), "--backend", "cpu", "--no-progress"],
+                          check=True, capture_output=True, text=True)
     run = kg.run_odometry(cpu, kg.open_sequence(synthetic))
     assert np.allclose(read_tum(out), pose_rows(run.poses), atol=2e-6)
+    # The ATE the CLI prints (6 decimals) is the API's.
+    printed = [line.split()[1] for line in done.stdout.splitlines() if "ate_rmse_m" in line]
+    assert printed and abs(float(printed[0]) - run.ate().rmse_m) < 1e-6
 
 
 def test_bad_choices_are_errors(cpu, synthetic):

@@ -44,6 +44,13 @@ def test_the_cli_reads_a_bag(cpu, synthetic, tmp_path):
                     str(from_folder), "--backend", "cpu", "--no-progress"], check=True,
                    capture_output=True)
     assert np.array_equal(read_tum(out), read_tum(from_folder))
+    # The whole map (SLAM, views, grid, rooms) of the bag and of the folder: the same trajectory.
+    for source, name in ((bag, "map_bag"), (synthetic, "map_folder")):
+        subprocess.run([sys.executable, "-m", "kartograf._cli", "map", str(source), "--out",
+                        str(tmp_path / name), "--backend", "cpu", "--no-progress"], check=True,
+                       capture_output=True)
+    assert np.array_equal(read_tum(tmp_path / "map_bag" / "trajectory.txt"),
+                          read_tum(tmp_path / "map_folder" / "trajectory.txt"))
 
 
 def test_missing_topics_are_named(tmp_path, synthetic):

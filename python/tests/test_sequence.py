@@ -29,6 +29,20 @@ def test_synthesize_returns_the_poses_it_wrote(synthetic, tmp_path):
     assert np.allclose(summary["poses"][7], sequence.frame(7)["pose"], atol=1e-6)
 
 
+def test_synthesize_writes_what_the_cli_writes(synthetic, tmp_path):
+    import subprocess
+    import sys
+
+    subprocess.run([sys.executable, "-m", "kartograf._cli", "synth", "--out", str(tmp_path / "cli"),
+                    "--seed", "3", "--frames", "30", "--trajectory", "handheld", "--width", "320",
+                    "--height", "240"], check=True, capture_output=True)
+    for name in ("groundtruth.txt", "rgb.txt", "depth.txt", "world.json"):
+        assert (tmp_path / "cli" / name).read_bytes() == (synthetic / name).read_bytes(), name
+    first = sorted((synthetic / "depth").glob("*.png"))[5].name
+    assert (tmp_path / "cli" / "depth" / first).read_bytes() == \
+        (synthetic / "depth" / first).read_bytes()
+
+
 def test_frame_ranges_and_bad_input(synthetic, tmp_path):
     part = kg.open_sequence(synthetic, first=10, frames=5, step=2)
     assert len(part) == 5
