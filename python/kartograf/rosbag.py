@@ -122,14 +122,19 @@ def _stamp(msg) -> float:
     return msg.header.stamp.sec + msg.header.stamp.nanosec * 1e-9
 
 
+def _tum_depth(millimetres: np.ndarray) -> np.ndarray:
+    """Depth in millimetres as the folder's TUM units (5000 per metre)."""
+    scaled = millimetres.astype(np.float64) * TUM_UNITS / 1000.0
+    return np.clip(scaled, 0, 65535).round().astype(np.uint16)
+
+
 def _raw_image(msg) -> np.ndarray:
     """A sensor_msgs/Image as uint16 depth (TUM units), or H x W x 3 uint8 RGB."""
     data = np.frombuffer(bytes(msg.data), dtype=np.uint8)
     rows = data.reshape(msg.height, msg.step)
     encoding = msg.encoding.lower()
     if encoding in ("16uc1", "mono16"):
-        mm = rows[:, : msg.width * 2].copy().view(">u2" if msg.is_bigendian else "<u2")
-        return np.clip(mm.astype(np.float64) * TUM_UNITS / 1000.0, 0, 65535).round().astype(np.uint16)
+        return _tum_depth(rows[:, : msg.width * 2].copy().view(">u2" if msg.is_bigendian else "<u2"))
     if encoding == "32fc1":
         metres = rows[:, : msg.width * 4].copy().view(">f4" if msg.is_bigendian else "<f4")
         metres = np.nan_to_num(metres.astype(np.float64), nan=0.0, posinf=0.0, neginf=0.0)
@@ -152,14 +157,13 @@ def _compressed_image(msg, depth: bool, scratch: Path) -> np.ndarray:
         if "compresseddepth" in msg.format.lower():
             data = data[12:]
         scratch.write_bytes(data)
-        mm = _kartograf.read_depth_png(scratch)
-        return np.clip(mm.astype(np.float64) * TUM_UNITS / 1000.0, 0, 65535).round().astype(np.uint16)
+        return _tum_depth(_kartograf.read_depth_png(scratch))
     scratch.write_bytes(data)
     return _kartograf.read_color_image(scratch)
 
 
 def _camera(msg) -> _kartograf.PinholeIntrinsics:
-    k = np.asarray(getattr(msg, "k", None) if hasattr(msg, "k") else msg.K, dtype=np.float64)
+    k = np.asarray(msg.k if hasattr(msg, "k") else msg.K, dtype=np.float64)  # ROS 2, ROS 1
     return _kartograf.PinholeIntrinsics(int(msg.width), int(msg.height), k[0], k[4], k[2], k[5])
 
 

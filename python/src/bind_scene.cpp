@@ -24,7 +24,6 @@ namespace kartograf::python {
 namespace {
 
 using CellArray = nb::ndarray<const std::uint8_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
-using LabelArray = nb::ndarray<const std::uint16_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 
 std::array<double, 3> xyz(const Eigen::Vector3d& v) {
   return {v.x(), v.y(), v.z()};
@@ -41,12 +40,18 @@ nb::dict plane_dict(const segmentation::Plane& p) {
   return d;
 }
 
+// A depth array (depth_units per metre) as camera-frame points, on the context's device.
+PointImage points_of(const compute::Context& context, const PinholeIntrinsics& camera,
+                     const DepthArray& depth, double depth_units) {
+  geometry::DepthRange range;
+  range.units_per_metre = depth_units;
+  return geometry::backproject(context, borrow_depth(depth), camera, range);
+}
+
 // The planes of one frame: depth (in depth_units per metre) back-projected, then extracted.
 nb::dict extract_planes(const compute::Context& context, const PinholeIntrinsics& camera,
                         const DepthArray& depth, const ColorArray& color, double depth_units) {
-  geometry::DepthRange range;
-  range.units_per_metre = depth_units;
-  const PointImage points = geometry::backproject(context, borrow_depth(depth), camera, range);
+  const PointImage points = points_of(context, camera, depth, depth_units);
   segmentation::PlaneExtractor extractor(context, camera);
   segmentation::PlaneSet set = extractor.extract(points, borrow_color(color));
   nb::list planes;
@@ -56,11 +61,6 @@ nb::dict extract_planes(const compute::Context& context, const PinholeIntrinsics
   d["labels"] = plane_array<std::uint16_t>(std::move(set.labels));
   d["milliseconds"] = set.timings.total();
   return d;
-}
-
-LabelImage labels_of(const LabelArray& labels) {
-  return LabelImage::borrow(const_cast<std::uint16_t*>(labels.data()),
-                            static_cast<int>(labels.shape(1)), static_cast<int>(labels.shape(0)));
 }
 
 OccupancyGrid grid_of(const CellArray& cells, double resolution,
@@ -101,9 +101,9 @@ nb::dict segment(const compute::Context& context, const CellArray& cells, double
   return d;
 }
 
-nb::dict evaluate(const LabelArray& ground_truth, const LabelArray& segmentation) {
+nb::dict evaluate(const DepthArray& ground_truth, const DepthArray& segmentation) {
   const eval::RoomSegmentationScores s =
-      eval::evaluate_room_segmentation(labels_of(ground_truth), labels_of(segmentation));
+      eval::evaluate_room_segmentation(borrow_labels(ground_truth), borrow_labels(segmentation));
   nb::dict d;
   d["recall"] = s.recall_mean;
   d["precision"] = s.precision_mean;
@@ -116,9 +116,7 @@ nb::dict evaluate(const LabelArray& ground_truth, const LabelArray& segmentation
 // M2 steps 1-3 on one depth frame: per-pixel classes, regions and the up direction.
 nb::dict label_view(const compute::Context& context, const PinholeIntrinsics& camera,
                     const DepthArray& depth, double depth_units) {
-  geometry::DepthRange range;
-  range.units_per_metre = depth_units;
-  const PointImage points = geometry::backproject(context, borrow_depth(depth), camera, range);
+  const PointImage points = points_of(context, camera, depth, depth_units);
   semantic::SemanticLabelling labelling = semantic::label_organized_points(context, points);
   nb::dict d;
   d["classes"] = plane_array<std::uint8_t>(std::move(labelling.semantic));

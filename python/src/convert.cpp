@@ -1,6 +1,7 @@
 #include "convert.hpp"
 
 #include <cmath>
+#include <span>
 #include <string>
 
 #include "kartograf/core/error.hpp"
@@ -40,19 +41,25 @@ Eigen::Isometry3d to_pose(const PoseArray& matrix, const char* what) {
   return pose;
 }
 
-NumpyArray<double> pose_array(const Eigen::Isometry3d& pose) {
-  std::vector<double> values(16);
-  for (int r = 0; r < 4; ++r)
-    for (int c = 0; c < 4; ++c) values[std::size_t(r * 4 + c)] = pose.matrix()(r, c);
-  return owned_array(std::move(values), {4, 4});
-}
+namespace {
 
-NumpyArray<double> pose_stack(const std::vector<Eigen::Isometry3d>& poses) {
+// The poses' 4 x 4 matrices, row-major, one after the other.
+std::vector<double> row_major(std::span<const Eigen::Isometry3d> poses) {
   std::vector<double> values(poses.size() * 16);
   for (std::size_t i = 0; i < poses.size(); ++i)
     for (int r = 0; r < 4; ++r)
       for (int c = 0; c < 4; ++c) values[i * 16 + std::size_t(r * 4 + c)] = poses[i].matrix()(r, c);
-  return owned_array(std::move(values), {poses.size(), 4, 4});
+  return values;
+}
+
+}  // namespace
+
+NumpyArray<double> pose_array(const Eigen::Isometry3d& pose) {
+  return owned_array(row_major({&pose, 1}), {4, 4});
+}
+
+NumpyArray<double> pose_stack(const std::vector<Eigen::Isometry3d>& poses) {
+  return owned_array(row_major(poses), {poses.size(), 4, 4});
 }
 
 nb::list optional_poses(const std::vector<std::optional<Eigen::Isometry3d>>& poses) {

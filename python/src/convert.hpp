@@ -14,12 +14,14 @@
 #include <Eigen/Geometry>
 
 #include "kartograf/core/color.hpp"
+#include "kartograf/core/label_image.hpp"
 #include "kartograf/core/point_image.hpp"
 
 namespace kartograf::python {
 
 namespace nb = nanobind;
 
+// Depth images and label images alike: H x W uint16.
 using DepthArray = nb::ndarray<const std::uint16_t, nb::ndim<2>, nb::c_contig, nb::device::cpu>;
 using ColorArray =
     nb::ndarray<const std::uint8_t, nb::shape<-1, -1, 3>, nb::c_contig, nb::device::cpu>;
@@ -29,6 +31,9 @@ using NumpyArray = nb::ndarray<nb::numpy, T>;
 
 // Images over the arrays' memory (the caller keeps the array alive while the image is used).
 DepthImage borrow_depth(const DepthArray& depth);
+inline LabelImage borrow_labels(const DepthArray& labels) {
+  return borrow_depth(labels);
+}
 RgbImage borrow_color(const ColorArray& color);
 RgbImage borrow_color(const std::optional<ColorArray>& color);  // empty when none
 

@@ -101,7 +101,8 @@ EsdfUpdate EsdfVolume::update(const TsdfVolume& tsdf) {
       tsdf.params().voxel_size == tsdf_.voxel_size && tsdf.params().truncation == tsdf_.truncation,
       "ESDF: the TSDF has another voxel size or truncation than the ESDF was made for");
   EsdfUpdate out;
-  const bool restart = tsdf.generation() != generation_ || tsdf.integration_count() < integrations_;
+  // Integration counts only go back when the block set is replaced, which changes the generation.
+  const bool restart = tsdf.generation() != generation_;
   if (restart && !empty_) {
     clear();
     out.restarted = true;
