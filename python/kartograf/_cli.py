@@ -1,8 +1,8 @@
 """The `kartograf` command the package installs: the C++ CLI carried inside the package. A ROS
 bag given where a command takes a sequence folder is converted first (kartograf.rosbag), with
 --color-topic, --depth-topic and --camera-info-topic to choose the topics, and --bag-poses (with
---odometry-topic) to take the camera's poses from the bag's odometry and /tf; `kartograf batch`
-maps many sequences on Ray (kartograf.batch)."""
+--odometry-topic or --tf-world) to take the camera's poses from the bag's odometry or /tf;
+`kartograf batch` maps many sequences on Ray (kartograf.batch)."""
 
 import os
 import sys
@@ -11,8 +11,9 @@ from pathlib import Path
 
 SEQUENCE_COMMANDS = {"odometry", "slam", "map", "fuse", "planes"}
 TOPIC_OPTIONS = {"--color-topic": "color_topic", "--depth-topic": "depth_topic",
-                 "--camera-info-topic": "camera_info_topic", "--odometry-topic": "odometry_topic"}
-# Use the bag's odometry (and /tf) as the camera's poses: `--poses` of the converted prior.
+                 "--camera-info-topic": "camera_info_topic", "--odometry-topic": "odometry_topic",
+                 "--tf-world": "tf_world"}
+# Use the bag's odometry or /tf as the camera's poses: `--poses` of the converted prior.
 POSES_FLAG = "--bag-poses"
 
 

@@ -13,9 +13,13 @@ rgba8, bgra8, mono8) and sensor_msgs/CompressedImage (colour png or jpeg; depth
 "compressedDepth png", millimetres). Depth is written in TUM's 5000 units per metre. Intrinsics:
 the camera_info topic's K (sensor_msgs/CameraInfo).
 
-A pose prior (pose_prior=True; the CLI's --bag-poses): the camera's poses from a nav_msgs/Odometry
-topic (its child frame's pose) and the fixed chain from that frame to the images' frame in
-/tf_static (or /tf), written as prior.txt (TUM) for `--poses`.
+A pose prior (pose_prior=True; the CLI's --bag-poses): the camera's pose at every depth image's
+stamp, written as prior.txt (TUM) for `--poses`. It is the chain of transforms from a world frame
+to the images' frame (kartograf.bag_poses): a nav_msgs/Odometry topic (the bag's only one, or
+odometry_topic) gives its child frame's pose in its header's frame, which is then the world;
+without one, /tf's changing transforms do (odom -> base_link, ...) from the images' topmost frame
+or from tf_world. /tf_static adds the fixed links (base to camera); changing ones are interpolated
+at each image's stamp.
 """
 
 from __future__ import annotations
@@ -44,6 +48,7 @@ class BagTopics:
     depth: str
     camera_info: Optional[str]
     odometry: Optional[str] = None  # the pose prior's (nav_msgs/Odometry), when asked for
+    world: Optional[str] = None  # the pose prior's world frame (the odometry's, or /tf's root)
 
 
 @dataclass
@@ -106,12 +111,14 @@ def choose_topics(topics: dict, color: Optional[str] = None, depth: Optional[str
     return BagTopics(color=color, depth=depth, camera_info=camera_info)
 
 
-def choose_odometry_topic(topics: dict, odometry: Optional[str] = None) -> str:
-    """The nav_msgs/Odometry topic: given, else the bag's only one (else an Error naming them)."""
+def choose_odometry_topic(topics: dict, odometry: Optional[str] = None) -> Optional[str]:
+    """The nav_msgs/Odometry topic: given, else the bag's only one, else None (the prior then
+    comes from /tf); an Error naming them when there are several."""
     found = sorted(t for t, i in topics.items() if i.msgtype == ODOMETRY)
-    if odometry is None and len(found) != 1:
-        raise _kartograf.Error(f"bag: {len(found)} odometry topics ({', '.join(found) or 'none'});"
-                               " name one")
+    if odometry is None and len(found) > 1:
+        raise _kartograf.Error(f"bag: {len(found)} odometry topics ({', '.join(found)}); name one")
+    if odometry is None and not found:
+        return None
     odometry = odometry or found[0]
     if odometry not in topics or topics[odometry].msgtype != ODOMETRY:
         raise _kartograf.Error(f"bag: {odometry} is not a nav_msgs/Odometry topic")
@@ -167,37 +174,87 @@ def _camera(msg) -> _kartograf.PinholeIntrinsics:
     return _kartograf.PinholeIntrinsics(int(msg.width), int(msg.height), k[0], k[4], k[2], k[5])
 
 
+class _PoseRecords:
+    """What the pose prior is made of, gathered while the bag is read."""
+
+    def __init__(self, topics: dict, odometry_topic: Optional[str]):
+        self.odometry_topic = choose_odometry_topic(topics, odometry_topic)
+        self.tf_topics = {t for t, i in topics.items() if i.msgtype == TF}
+        self.fixed, self.changing, self.odometry = [], [], []
+
+    def take(self, topic: str, msg) -> None:
+        if topic == self.odometry_topic:
+            self.odometry.append(msg)
+            return
+        static = topic.rstrip("/").endswith("tf_static")
+        for stamped in msg.transforms:
+            (self.fixed if static else self.changing).append(stamped)
+
+    def tree(self) -> bag_poses.FrameTree:
+        """The odometry's poses win over /tf's samples of the same link."""
+        tree = bag_poses.FrameTree()
+        for msg in self.odometry:
+            pose = bag_poses.message_matrix(msg.pose.pose.position, msg.pose.pose.orientation)
+            tree.add_sample(msg.header.frame_id, msg.child_frame_id, _stamp(msg), pose)
+        for stamped in self.changing:
+            parent, child = stamped.header.frame_id, stamped.child_frame_id
+            if not (self.odometry and tree.has_edge(parent, child)):
+                transform = stamped.transform
+                tree.add_sample(parent, child, _stamp(stamped),
+                                bag_poses.message_matrix(transform.translation, transform.rotation))
+        for stamped in self.fixed:
+            transform = stamped.transform
+            tree.add_fixed(stamped.header.frame_id, stamped.child_frame_id,
+                           bag_poses.message_matrix(transform.translation, transform.rotation))
+        tree.finish()
+        return tree
+
+    def write(self, path: Path, camera_frame: str, stamps: list, world: Optional[str]) -> str:
+        """prior.txt at the depth images' stamps; returns the world frame."""
+        if self.odometry_topic and not self.odometry:
+            raise _kartograf.Error(f"bag: {self.odometry_topic} holds no message")
+        if not self.odometry_topic and not self.changing:
+            raise _kartograf.Error("bag: no nav_msgs/Odometry topic and no /tf transform to take "
+                                   "the camera's poses from")
+        tree = self.tree()
+        world = world or (self.odometry[0].header.frame_id.lstrip("/") if self.odometry
+                          else tree.root(camera_frame))
+        source = self.odometry_topic or f"/tf from '{world}'"
+        bag_poses.write_tum(path, bag_poses.camera_poses(tree, world, camera_frame, stamps),
+                            f"{source} to '{camera_frame}'")
+        return world
+
+
 def bag_to_folder(bag: str | os.PathLike, folder: str | os.PathLike,
                   color_topic: Optional[str] = None, depth_topic: Optional[str] = None,
                   camera_info_topic: Optional[str] = None,
                   camera: Optional[_kartograf.PinholeIntrinsics] = None,
-                  pose_prior: bool = False, odometry_topic: Optional[str] = None) -> BagConversion:
+                  pose_prior: bool = False, odometry_topic: Optional[str] = None,
+                  tf_world: Optional[str] = None) -> BagConversion:
     """Writes the bag's colour and depth frames as a TUM folder; returns what it used. With
-    pose_prior: also prior.txt, the camera's poses from the odometry topic and /tf (a TUM
-    trajectory for `--poses`)."""
+    pose_prior: also prior.txt, the camera's pose at each depth image (a TUM trajectory for
+    `--poses`) from the odometry topic or /tf (from tf_world, default the topmost frame)."""
     bag, folder = Path(bag), Path(folder)
     if folder.exists() and any(folder.iterdir()):
         raise _kartograf.Error(f"bag: {folder} exists and is not empty")
     (folder / "rgb").mkdir(parents=True, exist_ok=True)
     (folder / "depth").mkdir(exist_ok=True)
-    tree, odometry, camera_frame = bag_poses.FrameTree(), [], None
+    camera_frame, records = None, None
     with _reader(bag) as reader, tempfile.TemporaryDirectory() as scratch:
         topics = choose_topics(reader.topics, color_topic, depth_topic, camera_info_topic)
         if pose_prior:
-            topics.odometry = choose_odometry_topic(reader.topics, odometry_topic)
-        tf_topics = {t for t, i in reader.topics.items() if i.msgtype == TF} if pose_prior else set()
-        wanted = {topics.color, topics.depth, topics.camera_info, topics.odometry, *tf_topics}
+            records = _PoseRecords(reader.topics, odometry_topic)
+            topics.odometry = records.odometry_topic
+        pose_topics = {records.odometry_topic, *records.tf_topics} if records else set()
+        wanted = {topics.color, topics.depth, topics.camera_info, *pose_topics}
         lists = {"rgb": [], "depth": []}
         for connection, _, raw in reader.messages(
                 connections=[c for c in reader.connections if c.topic in wanted]):
             msg = reader.deserialize(raw, connection.msgtype)
             if connection.topic == topics.camera_info:
                 camera = camera or _camera(msg)
-            elif connection.topic in tf_topics:
-                for stamped in msg.transforms:
-                    tree.add(stamped)
-            elif connection.topic == topics.odometry:
-                odometry.append((_stamp(msg), msg))
+            elif connection.topic in pose_topics:
+                records.take(connection.topic, msg)
             else:
                 if connection.topic == topics.depth and camera_frame is None:
                     camera_frame = msg.header.frame_id
@@ -212,12 +269,9 @@ def bag_to_folder(bag: str | os.PathLike, folder: str | os.PathLike,
     if not lists["rgb"] or not lists["depth"]:
         raise _kartograf.Error(f"bag: {bag} holds no {'colour' if not lists['rgb'] else 'depth'} "
                                "images on the chosen topics")
-    prior = None
-    if pose_prior:
-        if not odometry:
-            raise _kartograf.Error(f"bag: {topics.odometry} holds no message")
-        prior = folder / "prior.txt"
-        bag_poses.write_tum(prior, bag_poses.camera_poses(odometry, tree, camera_frame))
+    prior = folder / "prior.txt" if records else None
+    if records:
+        topics.world = records.write(prior, camera_frame, lists["depth"], tf_world)
     return BagConversion(folder=folder, topics=topics, color_frames=len(lists["rgb"]),
                          depth_frames=len(lists["depth"]), camera=camera, prior=prior)
 

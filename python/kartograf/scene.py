@@ -49,11 +49,27 @@ class ViewLabels:
     up: tuple
 
 
+def backproject(context: _kartograf.Context, camera: _kartograf.PinholeIntrinsics,
+                depth: np.ndarray, depth_units: float = 1000.0) -> np.ndarray:
+    """A depth frame as an organized cloud in the camera frame: H x W x 4 float32 (x, y, z, 1;
+    NaN where the depth is missing or out of range), handed over without a copy."""
+    return _kartograf.backproject(context, camera, depth, depth_units)
+
+
+def label_points(context: _kartograf.Context, points: np.ndarray) -> ViewLabels:
+    """Normals, regions, gravity and the floor / wall / ceiling / door / furniture rules on one
+    organized view (H x W x 3 or 4 float32 in the sensor's frame, NaN where there is no point),
+    as `kartograf semantic SCAN.pcd` labels an organized scan (docs/methods.md M2 steps 1-3)."""
+    points = np.asarray(points, dtype=np.float32)
+    if points.ndim == 3 and points.shape[2] == 3:
+        points = np.concatenate([points, np.ones(points.shape[:2] + (1,), np.float32)], axis=2)
+    return ViewLabels(**_kartograf.label_points(context, np.ascontiguousarray(points)))
+
+
 def label_view(context: _kartograf.Context, camera: _kartograf.PinholeIntrinsics,
                depth: np.ndarray, depth_units: float = 1000.0) -> ViewLabels:
-    """Normals, regions, gravity and the floor / wall / ceiling / door / furniture rules on one
-    depth frame (docs/methods.md M2 steps 1-3)."""
-    return ViewLabels(**_kartograf.label_view(context, camera, depth, depth_units))
+    """label_points of a depth frame's back-projection."""
+    return label_points(context, backproject(context, camera, depth, depth_units))
 
 
 def read_semantic_png(path: str | os.PathLike) -> np.ndarray:

@@ -5,6 +5,7 @@
 #include <nanobind/stl/vector.h>
 
 #include <array>
+#include <cmath>
 #include <filesystem>
 #include <string>
 
@@ -113,10 +114,23 @@ nb::dict evaluate(const DepthArray& ground_truth, const DepthArray& segmentation
   return d;
 }
 
-// M2 steps 1-3 on one depth frame: per-pixel classes, regions and the up direction.
-nb::dict label_view(const compute::Context& context, const PinholeIntrinsics& camera,
-                    const DepthArray& depth, double depth_units) {
-  const PointImage points = points_of(context, camera, depth, depth_units);
+// H x W x 4 float32 (x, y, z, 1; NaN where there is no point) as an organized point image. Copied:
+// the library's points are 16-byte aligned Eigen vectors, an array's memory need not be.
+using PointArray = nb::ndarray<const float, nb::shape<-1, -1, 4>, nb::c_contig, nb::device::cpu>;
+
+PointImage copy_points(const PointArray& array) {
+  PointImage points(static_cast<int>(array.shape(1)), static_cast<int>(array.shape(0)));
+  const float* values = array.data();
+  for (Point4f& p : points.pixels()) {
+    p = std::isnan(values[0]) ? invalid_point() : Point4f(values[0], values[1], values[2], 1.0f);
+    values += 4;
+  }
+  return points;
+}
+
+// M2 steps 1-3 on one organized view: per-pixel classes, regions and the up direction.
+nb::dict label_points(const compute::Context& context, const PointArray& array) {
+  const PointImage points = copy_points(array);
   semantic::SemanticLabelling labelling = semantic::label_organized_points(context, points);
   nb::dict d;
   d["classes"] = plane_array<std::uint8_t>(std::move(labelling.semantic));
@@ -148,8 +162,16 @@ void bind_scene(nb::module_& m) {
   m.def("read_room_ground_truth", [](const std::filesystem::path& path) {
     return plane_array<std::uint16_t>(io::read_ground_truth_rooms(path));
   });
-  m.def("label_view", &label_view, nb::arg("context"), nb::arg("camera"), nb::arg("depth"),
-        nb::arg("depth_units") = 1000.0);
+  m.def(
+      "backproject",
+      [](const compute::Context& context, const PinholeIntrinsics& camera, const DepthArray& depth,
+         double depth_units) {
+        PointImage points = points_of(context, camera, depth, depth_units);
+        const auto w = std::size_t(points.width()), h = std::size_t(points.height());
+        return image_array<float>(std::move(points), {h, w, 4});
+      },
+      nb::arg("context"), nb::arg("camera"), nb::arg("depth"), nb::arg("depth_units") = 1000.0);
+  m.def("label_points", &label_points, nb::arg("context"), nb::arg("points"));
   m.def("read_semantic_png", [](const std::filesystem::path& path) {
     return plane_array<std::uint8_t>(io::read_semantic_png(path));
   });

@@ -66,36 +66,46 @@ EXTRINSICS = (("base_link", "camera_link", (0.1, 0.0, 0.3), (0.0, 0.0, 0.0871557
 
 
 def base_T_camera():
-    from kartograf.bag_poses import _matrix
-
-    class V:  # the message fields _matrix reads
-        def __init__(self, *v):
-            self.x, self.y, self.z = v[:3]
-            self.w = v[3] if len(v) > 3 else 0.0
+    from kartograf.bag_poses import matrix_of
 
     pose = np.eye(4)
     for _, _, t, q in EXTRINSICS:
-        pose = pose @ _matrix(V(*t), V(*q))
+        pose = pose @ matrix_of(t, q)
     return pose
 
 
-def _tf_static(types, ros1):
-    transforms = [types["geometry_msgs/msg/TransformStamped"](
-        header=_header(types, ros1, 0.0),
-        child_frame_id=child,
+def _stamped(types, ros1, t, parent, child, translation, q):
+    header = _header(types, ros1, t)
+    header.frame_id = parent
+    return types["geometry_msgs/msg/TransformStamped"](
+        header=header, child_frame_id=child,
         transform=types["geometry_msgs/msg/Transform"](
-            translation=_vector(types, "geometry_msgs/msg/Vector3", t),
+            translation=_vector(types, "geometry_msgs/msg/Vector3", translation),
             rotation=_quaternion_msg(types, q)))
-        for _, child, t, q in EXTRINSICS]
-    for stamped, (parent, _, _, _) in zip(transforms, EXTRINSICS):
-        stamped.header.frame_id = parent
-    return types["tf2_msgs/msg/TFMessage"](transforms=transforms)
+
+
+def _tf_static(types, ros1):
+    return types["tf2_msgs/msg/TFMessage"](transforms=[
+        _stamped(types, ros1, 0.0, parent, child, t, q) for parent, child, t, q in EXTRINSICS])
+
+
+def _base_pose(camera_pose):
+    return camera_pose @ np.linalg.inv(base_T_camera())
+
+
+def _tf_base(types, ros1, t, camera_pose):
+    """/tf's odom -> base_link at t, as a robot's base controller publishes it."""
+    from kartograf.bag_poses import quaternion
+
+    base = _base_pose(camera_pose)
+    return types["tf2_msgs/msg/TFMessage"](transforms=[
+        _stamped(types, ros1, t, "odom", "base_link", base[:3, 3], quaternion(base[:3, :3]))])
 
 
 def _odometry(types, ros1, t, camera_pose):
     from kartograf.bag_poses import quaternion
 
-    base = camera_pose @ np.linalg.inv(base_T_camera())
+    base = _base_pose(camera_pose)
     zeros = np.zeros(36)
     pose = types["geometry_msgs/msg/Pose"](
         position=types["geometry_msgs/msg/Point"](x=base[0, 3], y=base[1, 3], z=base[2, 3]),
@@ -111,9 +121,10 @@ def _odometry(types, ros1, t, camera_pose):
         twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros))
 
 
-def write_bag(sequence, folder, path, ros1, odometry=False):
+def write_bag(sequence, folder, path, ros1, odometry=False, tf_every=0):
     """The sequence's frames into a bag at path; colour from the folder's PNGs for ROS 1. With
-    odometry: /odom (the base's ground-truth pose) and /tf_static (base to camera)."""
+    odometry: /odom (the base's ground-truth pose) and /tf_static (base to camera). With tf_every
+    k: /tf's odom -> base_link (the true pose) at every k-th frame and the last, and /tf_static."""
     store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
     if ros1 and "tf2_msgs/msg/TFMessage" not in store.types:  # noetic's store lacks tf2_msgs
         store.register(get_types_from_msg("geometry_msgs/TransformStamped[] transforms",
@@ -130,8 +141,11 @@ def write_bag(sequence, folder, path, ros1, odometry=False):
         rgb_files = sorted((Path(folder) / "rgb").glob("*.png"))
         if odometry:
             odom = add("/odom", "nav_msgs/msg/Odometry")
-            tf = add("/tf_static", "tf2_msgs/msg/TFMessage")
-            writer.write(tf, 1, serialize(_tf_static(types, ros1), "tf2_msgs/msg/TFMessage"))
+        if tf_every:
+            tf = add("/tf", "tf2_msgs/msg/TFMessage")
+        if odometry or tf_every:
+            static = add("/tf_static", "tf2_msgs/msg/TFMessage")
+            writer.write(static, 1, serialize(_tf_static(types, ros1), "tf2_msgs/msg/TFMessage"))
         writer.write(info, 1, serialize(_camera_info(types, ros1, sequence.camera),
                                         "sensor_msgs/msg/CameraInfo"))
         for i in range(len(sequence)):
@@ -145,3 +159,6 @@ def write_bag(sequence, folder, path, ros1, odometry=False):
             if odometry:
                 writer.write(odom, ns, serialize(_odometry(types, ros1, t, frame["pose"]),
                                                  "nav_msgs/msg/Odometry"))
+            if tf_every and (i % tf_every == 0 or i == len(sequence) - 1):
+                writer.write(tf, ns, serialize(_tf_base(types, ros1, t, frame["pose"]),
+                                               "tf2_msgs/msg/TFMessage"))

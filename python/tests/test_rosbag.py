@@ -5,6 +5,7 @@ import subprocess
 import sys
 
 import numpy as np
+import pytest
 
 import kartograf as kg
 from bag_writer import write_bag
@@ -54,7 +55,6 @@ def test_the_cli_reads_a_bag(cpu, synthetic, tmp_path):
 
 
 def test_missing_topics_are_named(tmp_path, synthetic):
-    import pytest
 
     sequence = kg.open_sequence(synthetic, frames=2)
     bag = tmp_path / "bag"
@@ -82,3 +82,40 @@ def test_the_bags_odometry_and_tf_give_the_cameras_poses(cpu, synthetic, tmp_pat
                     *common], check=True, capture_output=True)
     assert np.allclose(read_tum(tmp_path / "a" / "trajectory.txt"),
                        read_tum(tmp_path / "b" / "trajectory.txt"), atol=1e-5)
+
+
+def test_tf_alone_gives_the_cameras_poses_between_its_samples(cpu, synthetic, tmp_path):
+    """No odometry topic: /tf's odom -> base_link at every 2nd frame, interpolated at the others,
+    chained with /tf_static's base -> camera."""
+    from kartograf.bag_poses import matrix_of
+    from test_odometry import pose_rows
+
+    sequence = kg.open_sequence(synthetic)
+    truth = pose_rows([sequence.frame(i)["pose"] for i in range(len(sequence))])
+    sampled = np.array([i % 2 == 0 or i == len(sequence) - 1 for i in range(len(sequence))])
+    for ros1, bag in ((False, tmp_path / "ros2_tf"), (True, tmp_path / "tf.bag")):
+        write_bag(sequence, synthetic, bag, ros1, tf_every=2)
+        converted = kg.rosbag.bag_to_folder(bag, tmp_path / f"tf_{ros1}", pose_prior=True)
+        assert converted.topics.odometry is None and converted.topics.world == "odom"
+        prior = read_tum(converted.prior)
+        error = np.linalg.norm(prior[:, :3] - truth[:, :3], axis=1)
+        assert error[sampled].max() < 1e-6 and np.allclose(prior[sampled], truth[sampled],
+                                                           atol=1e-6), f"ros1={ros1}"
+        # Between samples: far closer to the true pose than the neighbouring samples are.
+        step = np.linalg.norm(np.diff(truth[:, :3], axis=0), axis=1)
+        between = np.flatnonzero(~sampled)
+        neighbour = np.minimum(step[between - 1], step[between])
+        assert (error[between] < 0.25 * neighbour).all(), (error[between], neighbour)
+        assert error[between].max() < 0.003, error[between].max()
+    with pytest.raises(kg.Error, match="no transform from 'map' to 'camera_optical'"):
+        kg.rosbag.bag_to_folder(tmp_path / "ros2_tf", tmp_path / "no_map", pose_prior=True,
+                                tf_world="map")
+    # The CLI's --bag-poses --tf-world: the map is made at the prior's poses (its trajectory is
+    # in the map's frame: one rigid motion away from the prior).
+    subprocess.run([sys.executable, "-m", "kartograf._cli", "map", str(tmp_path / "ros2_tf"),
+                    "--bag-poses", "--tf-world", "odom", "--out", str(tmp_path / "map"),
+                    "--backend", "cpu", "--no-progress"], check=True, capture_output=True)
+    mapped = [matrix_of(r[:3], r[3:]) for r in read_tum(tmp_path / "map" / "trajectory.txt")]
+    given = [matrix_of(r[:3], r[3:]) for r in read_tum(tmp_path / "tf_False" / "prior.txt")]
+    offsets = np.array([m @ np.linalg.inv(g) for m, g in zip(mapped, given)])
+    assert len(mapped) == len(given) and np.allclose(offsets, offsets[0], atol=1e-5)

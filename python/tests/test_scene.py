@@ -68,3 +68,34 @@ def test_a_synthetic_views_labels_agree_with_its_ground_truth(cpu, synthetic):
     assert labelled.mean() > 0.3
     agree = (labels.classes == truth)[labelled].mean()
     assert agree > 0.8, agree
+
+
+def write_organized_pcd(path, points):
+    """A binary organized PCD (x y z float32) of an H x W x 4 point array."""
+    height, width = points.shape[:2]
+    header = ("VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n"
+              f"WIDTH {width}\nHEIGHT {height}\nVIEWPOINT 0 0 0 1 0 0 0\n"
+              f"POINTS {width * height}\nDATA binary\n")
+    path.write_bytes(header.encode() + np.ascontiguousarray(points[..., :3]).tobytes())
+
+
+@pytest.mark.parametrize("source, index", [("synthetic", 10), ("7scenes", 0)])
+def test_a_views_labels_equal_the_clis_on_its_organized_scan(cpu, synthetic, data_dir, tmp_path,
+                                                              source, index):
+    folder = synthetic if source == "synthetic" else data_dir / "7scenes_redkitchen"
+    sequence = kg.open_sequence(folder, frames=index + 1)
+    frame = sequence.frame(index)
+    points = kg.backproject(cpu, sequence.camera, frame["depth"], sequence.depth_units_per_metre)
+    assert points.shape == frame["depth"].shape + (4,) and points.dtype == np.float32
+    missing = frame["depth"] == 0
+    assert np.isnan(points[missing, 0]).all() and not np.isnan(points[~missing, 2]).any()
+    # z is the depth in metres where there is one.
+    z = frame["depth"][~missing] / sequence.depth_units_per_metre
+    assert np.allclose(points[~missing, 2], z, rtol=1e-6)
+    labels = kg.label_view(cpu, sequence.camera, frame["depth"], sequence.depth_units_per_metre)
+    assert np.array_equal(kg.label_points(cpu, points[..., :3]).classes, labels.classes)
+    write_organized_pcd(tmp_path / "view.pcd", points)
+    cli("semantic", tmp_path / "view.pcd", "--backend", "cpu", "--out", tmp_path / "semantic")
+    from_cli = kg.read_semantic_png(tmp_path / "semantic" / "labels.png")
+    assert np.array_equal(from_cli, labels.classes)
+    assert len(np.unique(labels.classes)) >= 3  # floor, walls and more: not a blank view
