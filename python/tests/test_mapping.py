@@ -1,6 +1,7 @@
 """SLAM and the online mapper from Python; Open3D interop."""
 
 import pickle
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -85,7 +86,22 @@ def cli(*args):
                    capture_output=True)
 
 
-def test_slam_and_the_mapper_give_the_clis_trajectories(cpu, synthetic, tmp_path):
+def read_mesh_ply(path):
+    """Kartograf's binary mesh.ply: float x y z and uchar r g b per vertex, triangles."""
+    data = Path(path).read_bytes()
+    end = data.index(b"end_header\n") + len(b"end_header\n")
+    header = data[:end].decode()
+    counts = {line.split()[1]: int(line.split()[2]) for line in header.splitlines()
+              if line.startswith("element")}
+    vertex = np.dtype([("xyz", "<f4", 3), ("rgb", "u1", 3)])
+    face = np.dtype([("n", "u1"), ("v", "<i4", 3)])
+    vertices = np.frombuffer(data, vertex, counts["vertex"], end)
+    faces = np.frombuffer(data, face, counts["face"], end + vertex.itemsize * counts["vertex"])
+    assert (faces["n"] == 3).all()
+    return vertices["xyz"], vertices["rgb"], faces["v"]
+
+
+def test_slam_and_the_mapper_give_the_clis_results(cpu, synthetic, tmp_path):
     from test_odometry import pose_rows, read_tum
 
     sequence = kg.open_sequence(synthetic)
@@ -104,3 +120,13 @@ def test_slam_and_the_mapper_give_the_clis_trajectories(cpu, synthetic, tmp_path
     result = mapper.finish()
     assert np.allclose(read_tum(tmp_path / "map" / "trajectory.txt"), pose_rows(result.poses),
                        atol=2e-6)
+    # The mesh, the occupancy grid and the rooms `kartograf map` wrote.
+    vertices, colors, triangles = read_mesh_ply(tmp_path / "map" / "mesh.ply")
+    assert len(triangles) > 1000 and np.array_equal(triangles, result.mesh.triangles)
+    assert np.allclose(vertices, result.mesh.vertices, atol=1e-5)
+    assert np.array_equal(colors, result.mesh.colors)
+    grid = kg.read_map(tmp_path / "map" / "occupancy.yaml")
+    assert np.array_equal(grid.cells, result.occupancy.cells)
+    assert np.allclose(grid.origin[:2], result.occupancy.origin[:2], atol=1e-6)
+    rooms = kg.read_room_ground_truth(tmp_path / "map" / "rooms_labels.png")
+    assert result.room_count >= 1 and np.array_equal(rooms, result.rooms)
