@@ -15,24 +15,31 @@
 namespace kartograf {
 namespace {
 
-TEST(PlaneExtraction, RecoversTheMosdTablePlane) {
+// The best plane's IoU with the table on each of the six organized frames.
+std::vector<double> mosd_table_ious(segmentation::PlaneExtractionMode mode) {
   const compute::Context context = compute::Context::cpu();
-  segmentation::PlaneExtractor extractor(context, PinholeIntrinsics::kinect_7scenes());
+  segmentation::PlaneExtractionParams params;
+  params.mode = mode;
+  segmentation::PlaneExtractor extractor(context, PinholeIntrinsics::kinect_7scenes(), params);
   // test43 and test56 are stored unorganized (valid points only, WIDTH = point count): region
   // growing needs the pixel grid, so they are not used.
-  for (const char* name : {"test43", "test56"}) {
+  for (const char* name : {"test43", "test56"}) {  // (checked on every call: cheap)
     EXPECT_FALSE(
         io::read_pcd(testing::data_dir() / "pcl_mosd" / (std::string(name) + ".pcd")).organized())
         << name;
   }
-  int files = 0;
+  std::vector<double> ious;
   for (const char* name : {"test0", "test16", "test24", "test31", "test55", "test57"}) {
     const io::PcdCloud cloud =
         io::read_pcd(testing::data_dir() / "pcl_mosd" / (std::string(name) + ".pcd"));
-    ASSERT_EQ(cloud.width, 640);
-    ASSERT_EQ(cloud.height, 480);
-    ASSERT_EQ(cloud.labels.size(), cloud.size());
-    ASSERT_EQ(cloud.colors.size(), cloud.size());
+    EXPECT_EQ(cloud.width, 640);
+    EXPECT_EQ(cloud.height, 480);
+    EXPECT_EQ(cloud.labels.size(), cloud.size());
+    EXPECT_EQ(cloud.colors.size(), cloud.size());
+    if (cloud.width != 640 || cloud.height != 480 || cloud.labels.size() != cloud.size() ||
+        cloud.colors.size() != cloud.size()) {
+      return {};  // expect_table_found fails on the missing frames
+    }
     const PointImage points = cloud.to_point_image();
     RgbImage rgb(640, 480);
     std::copy(cloud.colors.begin(), cloud.colors.end(), rgb.data());
@@ -54,11 +61,29 @@ TEST(PlaneExtraction, RecoversTheMosdTablePlane) {
     }
     std::printf("mOSD %s: table %lld points, best plane IoU %.4f (%zu planes)\n", name,
                 static_cast<long long>(table), best, set.planes.size());
-    RecordProperty(std::string("iou_") + name, std::to_string(best));
-    EXPECT_GE(best, 0.95) << name;
-    ++files;
+    ious.push_back(best);
   }
-  EXPECT_EQ(files, 6);
+  return ious;
+}
+
+void expect_table_found(const std::vector<double>& ious, double min_mean, double min_each) {
+  ASSERT_EQ(ious.size(), 6u);
+  double mean = 0;
+  for (const double iou : ious) mean += iou / static_cast<double>(ious.size());
+  std::printf("mOSD table IoU mean %.4f, worst %.4f\n", mean,
+              *std::min_element(ious.begin(), ious.end()));
+  ::testing::Test::RecordProperty("iou_mean", std::to_string(mean));
+  EXPECT_GE(mean, min_mean);
+  for (const double iou : ious) EXPECT_GE(iou, min_each);
+}
+
+TEST(PlaneExtraction, RecoversTheMosdTablePlane) {
+  expect_table_found(mosd_table_ious(segmentation::PlaneExtractionMode::regions), 0.98, 0.95);
+}
+
+// Issue 26's quality line (mean >= 0.98, each >= 0.95) for the cells mode.
+TEST(PlaneExtraction, CellsModeRecoversTheMosdTablePlane) {
+  expect_table_found(mosd_table_ious(segmentation::PlaneExtractionMode::cells), 0.98, 0.95);
 }
 
 }  // namespace

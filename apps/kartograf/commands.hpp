@@ -133,6 +133,7 @@ struct PlanesOptions {
   std::uint64_t min_plane_pixels = 300;
   std::string neighbours = "pixel";  // pixel | bbox
   std::string fit = "tls";           // tls | eq6
+  std::string mode = "regions";      // regions (M1) | cells
   std::string backend = "auto";
   std::string backend_source = "--backend";
   bool force = false;

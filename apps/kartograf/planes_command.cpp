@@ -57,6 +57,8 @@ segmentation::PlaneExtractionParams extraction_params(const PlanesOptions& o) {
                                 : segmentation::NeighbourTest::pixel_adjacency;
   params.merge.fit.method = o.fit == "eq6" ? segmentation::PlaneFitMethod::paper_eq6
                                            : segmentation::PlaneFitMethod::total_least_squares;
+  params.mode = o.mode == "cells" ? segmentation::PlaneExtractionMode::cells
+                                  : segmentation::PlaneExtractionMode::regions;
   return params;
 }
 
@@ -213,6 +215,12 @@ CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
       ->check(CLI::IsMember({"tls", "eq6"}))
       ->capture_default_str();
   add_backend_option(*command, o.backend, o.backend_source);
+  command
+      ->add_option("--mode", o.mode,
+                   "regions (the M1 paper's Lab region growing) | cells (planar cells first, "
+                   "colour only to join planes apart; docs/planes.md)")
+      ->check(CLI::IsMember({"regions", "cells"}))
+      ->capture_default_str();
   command->add_flag("--force", o.force, "Replace the folder of an earlier run as a whole");
   command->add_flag("!--no-progress", o.progress, "No progress bar on stderr (sequences)");
   return command;

@@ -1,6 +1,7 @@
-// Kartograf's side of the plane comparison: segmentation::PlaneExtractor with its defaults (Lab
-// region growing, per-segment plane fits, merging, pixel refinement), one extractor per camera
-// kept across frames as a caller keeps it across a sequence.
+// Kartograf's side of the plane comparison: segmentation::PlaneExtractor in each mode with its
+// defaults (regions: Lab region growing, per-segment plane fits, merging, pixel refinement;
+// cells: planar cells merged, pixels assigned per cell), one extractor per camera kept across
+// frames as a caller keeps it across a sequence.
 #include <map>
 #include <memory>
 #include <sstream>
@@ -16,30 +17,45 @@
 namespace kartograf::peer {
 namespace {
 
-PlaneMethod extractor_method(std::string name, std::string threads, ContextPtr context) {
+std::string settings_text(const segmentation::PlaneExtractionParams& p) {
+  std::ostringstream settings;
+  if (p.mode == segmentation::PlaneExtractionMode::cells) {
+    settings << "cells mode: " << p.cells.cell_size
+             << " px cells, planar when >= " << 100 * p.cells.min_valid_fraction
+             << " % valid, no depth jump over " << 100 * p.growing.max_depth_jump
+             << " %, RMS <= " << 1000 * p.cells.rms_base << " mm + " << 1000 * p.cells.rms_per_z2
+             << " mm z^2; merging over pixel adjacency; pixels assigned per cell; planes of at "
+                "least "
+             << p.min_plane_pixels << " pixels; colour only to join planes apart";
+    return settings.str();
+  }
+  settings << "regions mode (defaults): Lab threshold " << p.growing.lab_threshold << ", "
+           << p.growing.tile_size << " px tiles, depth jump " << 100 * p.growing.max_depth_jump
+           << " %, merging over pixel adjacency, pixel refinement, planes of at least "
+           << p.min_plane_pixels << " pixels; uses the colour (Lab growing)";
+  return settings.str();
+}
+
+PlaneMethod extractor_method(std::string name, std::string threads, ContextPtr context,
+                             segmentation::PlaneExtractionMode mode) {
   using CameraKey = std::tuple<int, int, double, double, double, double>;
   struct State {
     std::map<CameraKey, std::unique_ptr<segmentation::PlaneExtractor>> extractors;
     segmentation::PlaneSet last;
   };
   auto state = std::make_shared<State>();
-  const segmentation::PlaneExtractionParams defaults;
+  segmentation::PlaneExtractionParams params;
+  params.mode = mode;
   PlaneMethod method;
   method.name = std::move(name);
   method.library = "kartograf";
   method.threads = std::move(threads);
-  std::ostringstream settings;
-  settings << "defaults: Lab threshold " << defaults.growing.lab_threshold << ", "
-           << defaults.growing.tile_size << " px tiles, depth jump "
-           << 100 * defaults.growing.max_depth_jump
-           << " %, merging over pixel adjacency, pixel refinement, planes of at least "
-           << defaults.min_plane_pixels << " pixels; uses the colour (Lab growing)";
-  method.settings = settings.str();
-  method.prepare = [state, context](const PlaneFrame& frame) {
+  method.settings = settings_text(params);
+  method.prepare = [state, context, params](const PlaneFrame& frame) {
     const PinholeIntrinsics& c = frame.camera;
     auto& extractor = state->extractors[{c.width, c.height, c.fx, c.fy, c.cx, c.cy}];
     // Made untimed on first use (device buffers, scratch); every frame reuses it.
-    if (!extractor) extractor = std::make_unique<segmentation::PlaneExtractor>(*context, c);
+    if (!extractor) extractor = std::make_unique<segmentation::PlaneExtractor>(*context, c, params);
     segmentation::PlaneExtractor* planes = extractor.get();
     return PlaneRun{
         [state, planes, &frame] {
@@ -62,14 +78,19 @@ PlaneMethod extractor_method(std::string name, std::string threads, ContextPtr c
 }  // namespace
 
 std::vector<PlaneMethod> kartograf_plane_methods(bool device_backends) {
+  using segmentation::PlaneExtractionMode;
   std::vector<PlaneMethod> methods;
-  methods.push_back(extractor_method(kKartografPlanes, kartograf_threads(),
-                                     make_context(compute::BackendChoice::cpu)));
+  const ContextPtr cpu = make_context(compute::BackendChoice::cpu);
+  methods.push_back(
+      extractor_method(kKartografPlanes, kartograf_threads(), cpu, PlaneExtractionMode::regions));
+  methods.push_back(
+      extractor_method(kKartografCellPlanes, kartograf_threads(), cpu, PlaneExtractionMode::cells));
   if (device_backends) {
     // CPU-hosted drivers here (lavapipe, PoCL): for the record, not a speed claim.
     for (const DeviceContext& device : device_contexts()) {
       methods.push_back(extractor_method("kartograf PlaneExtractor (" + device.label + ")",
-                                         "driver's own", device.context));
+                                         "driver's own", device.context,
+                                         PlaneExtractionMode::regions));
     }
   }
   return methods;

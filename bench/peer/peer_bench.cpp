@@ -236,6 +236,8 @@ void run_planes(const Options& options) {
   planes.only = options.only;
   planes.details = options.details;
   planes.timing = options.timing;
+  for (auto&& list : {pcl_plane_methods(), open3d_plane_methods(planes.ransac_max_planes)})
+    planes.peers.insert(planes.peers.end(), list.begin(), list.end());
   run_plane_bench(planes, std::cout);
 }
 

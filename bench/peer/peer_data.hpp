@@ -16,8 +16,8 @@
 #include "kartograf/core/intrinsics.hpp"
 #include "kartograf/core/point_cloud.hpp"
 #include "kartograf/core/point_image.hpp"
-#include "kartograf/geometry/backproject.hpp"
 #include "kartograf/formats/sequence.hpp"
+#include "kartograf/geometry/backproject.hpp"
 
 namespace kartograf::peer {
 

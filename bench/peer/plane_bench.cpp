@@ -43,8 +43,7 @@ std::vector<PlaneFrame> load_frames(const PlaneBenchOptions& options) {
 
 std::vector<PlaneMethod> all_methods(const PlaneBenchOptions& options) {
   std::vector<PlaneMethod> methods;
-  for (auto&& list : {kartograf_plane_methods(options.device_backends), pcl_plane_methods(),
-                      open3d_plane_methods(options.ransac_max_planes)}) {
+  for (auto&& list : {kartograf_plane_methods(options.device_backends), options.peers}) {
     for (const PlaneMethod& method : list) {
       // Kartograf's CPU row stays: every ratio refers to it.
       if (options.only.empty() || method.name.find(options.only) != std::string::npos ||

@@ -1,6 +1,7 @@
 #pragma once
-// The plane part of kartograf_peer_bench (issue 5, part 8): Kartograf's PlaneExtractor, PCL's
-// OrganizedMultiPlaneSegmentation and Open3D's SegmentPlane loop on the same frames, in one run.
+// The plane benchmark: Kartograf's PlaneExtractor in both modes (kartograf_plane_bench), and in
+// kartograf_peer_bench (issue 5, part 8) beside PCL's OrganizedMultiPlaneSegmentation and Open3D's
+// SegmentPlane loop on the same frames, in one run.
 #include <cstddef>
 #include <filesystem>
 #include <iosfwd>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include "peer_timing.hpp"
+#include "plane_methods.hpp"
 
 namespace kartograf::peer {
 
@@ -22,6 +24,7 @@ struct PlaneBenchOptions {
   bool details = false;            // every frame's time and scores on stderr
   std::filesystem::path overlays;  // write each method's planes over each frame here (PNG)
   TimingOptions timing;
+  std::vector<PlaneMethod> peers;  // run after Kartograf's own rows
 };
 
 // Prints the section's heading, what was run and its tables (Markdown) to out; progress to stderr.

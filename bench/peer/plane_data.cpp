@@ -4,8 +4,8 @@
 
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/error.hpp"
-#include "kartograf/geometry/backproject.hpp"
 #include "kartograf/formats/pcd.hpp"
+#include "kartograf/geometry/backproject.hpp"
 #include "kartograf/synth/render.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "kartograf/synth/world.hpp"

@@ -50,6 +50,7 @@ inline constexpr double kPlaneDistance = 0.02;  // metres
 // the reference of every ratio) and, with device_backends, on every available device backend.
 std::vector<PlaneMethod> kartograf_plane_methods(bool device_backends);
 inline constexpr const char* kKartografPlanes = "kartograf PlaneExtractor (cpu)";
+inline constexpr const char* kKartografCellPlanes = "kartograf PlaneExtractor cells (cpu)";
 
 // PCL: IntegralImageNormalEstimation + OrganizedMultiPlaneSegmentation, without and with its
 // refinement step.

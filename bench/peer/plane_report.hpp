@@ -14,8 +14,9 @@ namespace kartograf::peer {
 
 // One method's planes on one frame.
 struct PlaneScore {
-  int planes = 0;       // planes with at least one pixel
-  double coverage = 0;  // fraction of the valid pixels in a plane
+  int planes = 0;             // planes with at least one pixel
+  double coverage = 0;        // fraction of the valid pixels in a plane
+  double large_coverage = 0;  // ... in a plane over 1 % of the image
   // synthetic frames: ground-truth planes over 1 % of the image (the test's rule) and those of
   // them correctly detected (SegComp, overlap >= 80 % both ways), with each one's normal error
   // (sign-free angle); the SegComp counts over every ground-truth plane.

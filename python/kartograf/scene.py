@@ -31,9 +31,11 @@ class PlaneSet:
 
 
 def extract_planes(context: _kartograf.Context, camera: _kartograf.PinholeIntrinsics,
-                   depth: np.ndarray, color: np.ndarray, depth_units: float = 1000.0) -> PlaneSet:
-    """The planes of one frame (Lab region growing, fits, merging), as `kartograf planes`."""
-    d = _kartograf.extract_planes(context, camera, depth, color, depth_units)
+                   depth: np.ndarray, color: np.ndarray, depth_units: float = 1000.0,
+                   mode: str = "regions") -> PlaneSet:
+    """The planes of one frame, as `kartograf planes --mode MODE`: "regions" (the M1 paper's Lab
+    region growing, fits, merging) or "cells" (planar cells first, about 3x faster)."""
+    d = _kartograf.extract_planes(context, camera, depth, color, depth_units, mode)
     return PlaneSet(planes=[Plane(**p) for p in d["planes"]], labels=d["labels"],
                     milliseconds=d["milliseconds"])
 

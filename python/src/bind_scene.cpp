@@ -51,9 +51,15 @@ PointImage points_of(const compute::Context& context, const PinholeIntrinsics& c
 
 // The planes of one frame: depth (in depth_units per metre) back-projected, then extracted.
 nb::dict extract_planes(const compute::Context& context, const PinholeIntrinsics& camera,
-                        const DepthArray& depth, const ColorArray& color, double depth_units) {
+                        const DepthArray& depth, const ColorArray& color, double depth_units,
+                        const std::string& mode) {
+  require(mode == "regions" || mode == "cells",
+          "planes: mode is 'regions' or 'cells', not '" + mode + "'");
   const PointImage points = points_of(context, camera, depth, depth_units);
-  segmentation::PlaneExtractor extractor(context, camera);
+  segmentation::PlaneExtractionParams params;
+  params.mode = mode == "cells" ? segmentation::PlaneExtractionMode::cells
+                                : segmentation::PlaneExtractionMode::regions;
+  segmentation::PlaneExtractor extractor(context, camera, params);
   segmentation::PlaneSet set = extractor.extract(points, borrow_color(color));
   nb::list planes;
   for (const segmentation::Plane& p : set.planes) planes.append(plane_dict(p));
@@ -150,7 +156,7 @@ std::vector<std::string> method_names() {
 
 void bind_scene(nb::module_& m) {
   m.def("extract_planes", &extract_planes, nb::arg("context"), nb::arg("camera"), nb::arg("depth"),
-        nb::arg("color"), nb::arg("depth_units") = 1000.0);
+        nb::arg("color"), nb::arg("depth_units") = 1000.0, nb::arg("mode") = "regions");
   m.def(
       "read_map",
       [](const std::filesystem::path& path, double resolution) {

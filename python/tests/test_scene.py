@@ -31,6 +31,17 @@ def test_planes_of_a_real_frame_equal_the_clis(cpu, data_dir, tmp_path):
         "--backend", "cpu", "--out", tmp_path / "planes")
     labels = kg.read_room_ground_truth(tmp_path / "planes" / "labels.png")
     assert np.array_equal(labels, result.labels)
+    # The cells mode, through both.
+    cells = kg.extract_planes(cpu, sequence.camera, frame["depth"], frame["color"],
+                              sequence.depth_units_per_metre, mode="cells")
+    assert len(cells.planes) >= 3 and not np.array_equal(cells.labels, result.labels)
+    cli("planes", frames / "frame-000000.depth.png", "--color", frames / "frame-000000.color.jpg",
+        "--fx", camera.fx, "--fy", camera.fy, "--cx", camera.cx, "--cy", camera.cy,
+        "--backend", "cpu", "--mode", "cells", "--out", tmp_path / "cells")
+    labels = kg.read_room_ground_truth(tmp_path / "cells" / "labels.png")
+    assert np.array_equal(labels, cells.labels)
+    with pytest.raises(kg.Error, match="mode"):
+        kg.extract_planes(cpu, sequence.camera, frame["depth"], frame["color"], mode="fast")
 
 
 def test_rooms_of_a_real_map_equal_the_clis_and_score(cpu, data_dir, tmp_path):

@@ -8,13 +8,18 @@
 #include <numeric>
 #include <string>
 
+#include "cell_planes.hpp"
 #include "compute/cpu_parallel.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
+#include "plane_output.hpp"
 
 namespace kartograf::segmentation {
 
 namespace {
 
+using detail::PixelPoint;
+using detail::plane_record;
+using detail::plane_score;
 using Clock = std::chrono::steady_clock;
 
 double elapsed_ms(Clock::time_point& since) {
@@ -55,27 +60,6 @@ bool moment_frame(const PointImage& points, Eigen::Vector3f& origin, float& max_
   origin = (0.5f * (lo + hi)).matrix();
   max_offset = 0.5f * (hi - lo).maxCoeff() * 1.01f + 0.01f;
   return true;
-}
-
-// A pixel's point with what every plane's distance allowance there needs.
-struct PixelPoint {
-  Eigen::Vector3d p;
-  double inverse_range;  // 1 / |p|
-  double base;           // distance_base + distance_per_z2 z^2
-
-  PixelPoint(const Point4f& point, const PlaneMergeParams& params)
-      : p(point.head<3>().cast<double>()),
-        inverse_range(1.0 / p.norm()),
-        base(params.distance_base + params.distance_per_z2 * p.z() * p.z()) {}
-};
-
-// Distance of the pixel's point to the plane over the merge's distance allowance there (< 1:
-// within it); distance_allowance without its square root per plane.
-double plane_score(const SegmentPlane& plane, const PixelPoint& pixel,
-                   const PlaneMergeParams& params) {
-  const double along = plane.normal.dot(pixel.p);
-  const double facing = std::max(std::fabs(along) * pixel.inverse_range, params.min_facing_factor);
-  return std::fabs(along + plane.offset) / (pixel.base * facing);
 }
 
 // Pixels of segments along plane borders (left out of every plane, or touching another plane's
@@ -137,18 +121,6 @@ void for_each_pixel_near(std::uint32_t i, int width, int height, int radius, Vis
     for (int nx = std::max(0, x - radius); nx <= std::min(width - 1, x + radius); ++nx)
       visit(static_cast<std::uint32_t>(ny * width + nx));
   }
-}
-
-// The output record of a fitted plane (extents and counts filled by the caller).
-Plane plane_record(Label id, const SegmentPlane& fit) {
-  Plane plane;
-  plane.id = id;
-  plane.normal = fit.normal;
-  plane.offset = fit.offset;
-  plane.centroid = fit.centroid;
-  plane.major_axis = fit.major_axis;
-  plane.minor_axis = fit.minor_axis;
-  return plane;
 }
 
 // Planes grow pixel by pixel (breadth first) into valid pixels that no plane took, while a pixel
@@ -246,9 +218,25 @@ void plane_leftover_regions(const PointImage& points, const PlaneExtractionParam
 
 }  // namespace
 
+void CellPlaneParams::validate() const {
+  require(cell_size >= 4 && cell_size <= 256 && cell_size % 2 == 0,
+          "plane extraction: cells.cell_size must be even, 4..256 pixels, got " +
+              std::to_string(cell_size));
+  require(
+      reach_passes >= 1 && reach_passes <= 64,
+      "plane extraction: cells.reach_passes must be 1..64, got " + std::to_string(reach_passes));
+  require(min_valid_fraction > 0 && min_valid_fraction <= 1,
+          "plane extraction: cells.min_valid_fraction must be in (0, 1], got " +
+              std::to_string(min_valid_fraction));
+  require(std::isfinite(rms_base) && std::isfinite(rms_per_z2) && rms_base >= 0 &&
+              rms_per_z2 >= 0 && rms_base + rms_per_z2 > 0,
+          "plane extraction: cells.rms_base and cells.rms_per_z2 must be >= 0, not both 0");
+}
+
 void PlaneExtractionParams::validate() const {
   growing.validate();
   merge.validate();
+  cells.validate();
 }
 
 PlaneExtractor::PlaneExtractor(const compute::Context& context, const PinholeIntrinsics& intrinsics,
@@ -270,79 +258,6 @@ void check_frame(const PointImage& points, const RgbImage& rgb, int width, int h
   require(rgb.width() == width && rgb.height() == height,
           "plane extraction: colour image is " + size_text(rgb.width(), rgb.height()) +
               " but the camera is " + size_text(width, height));
-}
-
-// The output planes: valid, with at least min_pixels pixels, by decreasing size (then merge
-// order), ids 1..n (extents and counts to be measured); plane_label: each merged plane's id.
-void output_planes(const MergedPlanes& merged, const std::vector<std::uint32_t>& pixel_plane,
-                   std::uint64_t min_pixels, std::vector<Plane>& planes,
-                   std::vector<Label>& plane_label) {
-  std::vector<std::uint64_t> pixels_of(merged.planes.size(), 0);
-  for (const std::uint32_t m : pixel_plane) {
-    if (m != geometry::kNoLabel) ++pixels_of[m];
-  }
-  std::vector<std::uint32_t> kept;
-  for (std::uint32_t i = 0; i < merged.planes.size(); ++i) {
-    if (merged.planes[i].valid && pixels_of[i] >= min_pixels) kept.push_back(i);
-  }
-  std::stable_sort(kept.begin(), kept.end(),
-                   [&](std::uint32_t a, std::uint32_t b) { return pixels_of[a] > pixels_of[b]; });
-  kept.resize(std::min<std::size_t>(kept.size(), std::numeric_limits<Label>::max()));
-  plane_label.assign(merged.planes.size(), kUnlabeled);
-  for (std::size_t k = 0; k < kept.size(); ++k) {
-    Plane plane = plane_record(static_cast<Label>(k + 1), merged.planes[kept[k]]);
-    plane.extent_min = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-    plane.extent_max = -plane.extent_min;
-    planes.push_back(plane);
-    plane_label[kept[k]] = plane.id;
-  }
-}
-
-// Labels, extents, inlier counts and errors of the output planes: per chunk, combined in chunk
-// order (the same sums for any thread count).
-void measure_planes(const PointImage& points, const std::vector<std::uint32_t>& pixel_plane,
-                    const std::vector<Label>& plane_label, PlaneSet& result) {
-  struct PlaneSums {
-    Eigen::Vector2d lo = Eigen::Vector2d::Constant(std::numeric_limits<double>::infinity());
-    Eigen::Vector2d hi = -lo;
-    double squared_error = 0;
-    std::uint64_t count = 0;
-  };
-  std::array<std::vector<PlaneSums>, compute::detail::kCpuChunks> chunk_sums;
-  const Point4f* point = points.data();
-  Label* out = result.labels.data();
-  const std::size_t pixel_count = pixel_plane.size();
-  compute::detail::for_each_chunk(
-      pixel_count, pixel_count, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
-        std::vector<PlaneSums>& sums = chunk_sums[chunk];
-        sums.assign(result.planes.size(), PlaneSums{});
-        for (std::size_t i = begin; i < end; ++i) {
-          if (pixel_plane[i] == geometry::kNoLabel) continue;
-          const Label id = plane_label[pixel_plane[i]];
-          if (id == kUnlabeled) continue;
-          out[i] = id;
-          const Plane& plane = result.planes[id - 1];
-          PlaneSums& sum = sums[id - 1];
-          const Eigen::Vector3d d = point[i].head<3>().cast<double>() - plane.centroid;
-          const Eigen::Vector2d uv(d.dot(plane.major_axis), d.dot(plane.minor_axis));
-          sum.lo = sum.lo.cwiseMin(uv);
-          sum.hi = sum.hi.cwiseMax(uv);
-          const double distance = d.dot(plane.normal);
-          sum.squared_error += distance * distance;
-          ++sum.count;
-        }
-      });
-  for (Plane& plane : result.planes) {
-    double squared_error = 0;
-    for (const std::vector<PlaneSums>& sums : chunk_sums) {
-      const PlaneSums& sum = sums[plane.id - 1];
-      plane.extent_min = plane.extent_min.cwiseMin(sum.lo);
-      plane.extent_max = plane.extent_max.cwiseMax(sum.hi);
-      squared_error += sum.squared_error;
-      plane.inlier_count += sum.count;
-    }
-    plane.rms_error = std::sqrt(squared_error / static_cast<double>(plane.inlier_count));
-  }
 }
 
 }  // namespace
@@ -376,6 +291,48 @@ void PlaneExtractor::assign_pixels(const PointImage& points, MergedPlanes& merge
 
 PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) {
   check_frame(points, rgb, intrinsics_.width, intrinsics_.height);
+  return params_.mode == PlaneExtractionMode::cells ? extract_cells(points, rgb)
+                                                    : extract_regions(points, rgb);
+}
+
+PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage& rgb) {
+  PlaneSet result;
+  result.labels = LabelImage(intrinsics_.width, intrinsics_.height, kUnlabeled);
+  Clock::time_point clock = Clock::now();
+  // The moments are double sums (no fixed point to scale): any valid point is a fine origin.
+  const auto first = std::find_if(points.pixels().begin(), points.pixels().end(),
+                                  [](const Point4f& p) { return is_valid(p); });
+  if (first == points.pixels().end()) return result;  // no valid point
+  const Eigen::Vector3f origin = first->head<3>();
+  detail::CellGrid cells;
+  detail::measure_cells(points, rgb, params_.cells.cell_size, params_.growing.max_depth_jump,
+                        static_cast<float>(params_.cells.jump_per_z2), origin.cast<double>(),
+                        cells);
+  if (segments_.width() != points.width() || segments_.height() != points.height())
+    segments_ = SegmentLabelImage(points.width(), points.height());
+  geometry::SegmentMomentSet moments;
+  std::vector<Eigen::Vector3f> colours;
+  result.segment_count = detail::planar_cell_segments(
+      params_.cells, params_.merge, origin.cast<double>(), cells, segments_, moments, colours);
+  result.timings.moments = elapsed_ms(clock);
+  if (result.segment_count == 0) return result;
+
+  const SegmentGraph graph = detail::cell_segment_graph(cells, result.segment_count);
+  MergedPlanes merged =
+      merge_segments(segments_, moments, params_.merge, {colours, &points, &graph});
+  result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
+  result.timings.merging = elapsed_ms(clock);
+
+  detail::assign_cell_pixels(points, cells, merged.segment_plane, merged.planes, params_.merge,
+                             params_.cells.reach_passes, pixel_plane_);
+  result.timings.refinement = elapsed_ms(clock);
+
+  detail::write_planes(points, merged.planes, pixel_plane_, params_.min_plane_pixels, result);
+  result.timings.output = elapsed_ms(clock);
+  return result;
+}
+
+PlaneSet PlaneExtractor::extract_regions(const PointImage& points, const RgbImage& rgb) {
   PlaneSet result;
   result.labels = LabelImage(intrinsics_.width, intrinsics_.height, kUnlabeled);
   Clock::time_point clock = Clock::now();
@@ -400,9 +357,7 @@ PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) 
   assign_pixels(points, merged);
   result.timings.refinement = elapsed_ms(clock);
 
-  std::vector<Label> plane_label;
-  output_planes(merged, pixel_plane_, params_.min_plane_pixels, result.planes, plane_label);
-  measure_planes(points, pixel_plane_, plane_label, result);
+  detail::write_planes(points, merged.planes, pixel_plane_, params_.min_plane_pixels, result);
   result.timings.output = elapsed_ms(clock);
   return result;
 }

@@ -32,6 +32,9 @@ void check_inputs(const SegmentLabelImage& labels, std::uint32_t segment_count,
   require(segment_colours.empty() || segment_colours.size() == segment_count,
           "plane merge: " + std::to_string(segment_colours.size()) + " segment colours for " +
               std::to_string(segment_count) + " segments");
+  require(inputs.graph == nullptr || inputs.graph->offsets.size() == std::size_t{segment_count} + 1,
+          "plane merge: the given neighbour graph is not of the " + std::to_string(segment_count) +
+              " segments");
 }
 
 // Each segment's own plane fit, and the cosine of its widened angle test (-1: none).
@@ -272,7 +275,8 @@ MergedPlanes merge_segments(const SegmentLabelImage& labels,
   params.validate();
   const auto segment_count = static_cast<std::uint32_t>(moments.segments.size());
   check_inputs(labels, segment_count, inputs);
-  const SegmentGraph graph = params.neighbours == NeighbourTest::pixel_adjacency
+  const SegmentGraph graph = inputs.graph ? *inputs.graph
+                             : params.neighbours == NeighbourTest::pixel_adjacency
                                  ? pixel_adjacency_graph(labels, segment_count)
                                  : bounding_box_graph(labels, segment_count);
   const SegmentFits fits = fit_segments(moments, params);

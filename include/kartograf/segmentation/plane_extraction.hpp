@@ -17,7 +17,39 @@
 
 namespace kartograf::segmentation {
 
+enum class PlaneExtractionMode : std::uint8_t {
+  // docs/methods.md M1: CIE-Lab region growing over pixels, segment plane fits, merging (the
+  // paper's method; the reference for docs/planes.md's tables).
+  regions,
+  // Depth first: square cells whose points are planar become the segments merging joins
+  // (colour decides only whether planes apart are one surface); pixels are assigned per cell,
+  // tested one by one only in cells at a plane's border (docs/planes.md "Cells").
+  cells,
+};
+
+// The cells mode's cells and their planarity test.
+struct CellPlaneParams {
+  int cell_size = 16;  // pixels a side (even: a cell is 2 x 2 blocks, tested when it is not planar)
+  // A cell is planar when at least this share of its pixels is valid, ...
+  double min_valid_fraction = 0.2;
+  // ... its depth is continuous (neighbouring pixels jump by more than growing.max_depth_jump of
+  // their depth z and more than jump_per_z2 z^2 [1/m] at most cell_size / 2 times: far away, a
+  // structured-light sensor's noise and quantization alone exceed the relative part), and the RMS
+  // distance of its points to their plane is within rms_base + rms_per_z2 z^2 [m] (z: the
+  // cell's mean depth; the depth noise and quantization of a structured-light sensor grow as z^2).
+  double rms_base = 0.0015;
+  double rms_per_z2 = 0.0025;
+  double jump_per_z2 = 0.008;
+  // Passes of the pixel assignment: the first reaches the cells next to a plane's cells, each
+  // further one a ring of cells further (around objects, across gaps of no depth).
+  int reach_passes = 4;
+
+  void validate() const;  // throws Error naming the first bad field
+};
+
 struct PlaneExtractionParams {
+  PlaneExtractionMode mode = PlaneExtractionMode::regions;
+  CellPlaneParams cells;
   // The paper's Lab growing (threshold 15) with two variants on, tuned on synthetic Kinect frames:
   // 16 px tiles (a segment cannot span a crease between two planes of one colour) and a 2 %
   // depth-jump test (nor an occlusion edge or a step: a table leg set 4 cm back from the top's
@@ -101,6 +133,8 @@ class PlaneExtractor {
   std::uint32_t grow_segments(const PointImage& points, geometry::SegmentMomentSet& moments);
   // pixel_plane_: each pixel's merged plane, refined (params_.refine_pixels).
   void assign_pixels(const PointImage& points, MergedPlanes& merged);
+  PlaneSet extract_regions(const PointImage& points, const RgbImage& rgb);
+  PlaneSet extract_cells(const PointImage& points, const RgbImage& rgb);
 
   RegionGrower grower_;
   compute::Buffer<Point4f> points_;          // the frame's points on the context

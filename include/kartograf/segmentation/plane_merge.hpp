@@ -126,6 +126,9 @@ struct MergedPlanes {
 struct MergeInputs {
   std::span<const Eigen::Vector3f> colours;  // each segment's mean CIE-Lab (planes apart)
   const PointImage* points = nullptr;        // the organized cloud of the labels (see-through)
+  // The segments' neighbours when the caller knows them (the cells mode: cells and blocks next
+  // to each other); otherwise found in the labels by params.neighbours.
+  const SegmentGraph* graph = nullptr;
 };
 
 // moments.segments and the label image cover the same segment_count segments.

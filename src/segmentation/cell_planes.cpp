@@ -1,0 +1,385 @@
+#include "cell_planes.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "compute/cpu_parallel.hpp"
+#include "kartograf/segmentation/lab_color.hpp"
+#include "kartograf/segmentation/plane_fit.hpp"
+#include "plane_output.hpp"
+
+namespace kartograf::segmentation::detail {
+
+namespace {
+
+// Sums of one block in float about a point of it (its first valid one): the offsets are
+// centimetres, so float keeps the covariance to far below the depth noise.
+struct CellSums {
+  Eigen::Vector3f reference = Eigen::Vector3f::Zero();
+  std::uint32_t count = 0;
+  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
+  float xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  std::uint32_t red = 0, green = 0, blue = 0;
+
+  Eigen::Vector3d colour() const { return Eigen::Vector3d(red, green, blue); }
+
+  // The moments about `origin` in double (the shift of sums of outer products is exact algebra).
+  geometry::SegmentMoments moments(const Eigen::Vector3d& origin) const {
+    geometry::SegmentMoments m;
+    m.count = count;
+    if (count == 0) return m;
+    const Eigen::Vector3d s = sum.cast<double>();
+    const Eigen::Vector3d shift = reference.cast<double>() - origin;
+    Eigen::Matrix3d outer;
+    outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+    const double n = count;
+    m.sum = s + n * shift;
+    m.sum_outer =
+        outer + s * shift.transpose() + shift * s.transpose() + n * shift * shift.transpose();
+    return m;
+  }
+};
+
+// What a jump between neighbouring depths is: more than `relative` of the depth and more than
+// `per_z2` z^2 (far away, noise and quantization alone exceed the relative part).
+struct JumpRule {
+  float relative = 0;
+  float per_z2 = 0;
+  bool operator()(float a, float b) const {  // false when either is NaN (no depth)
+    const float z = std::min(a, b);
+    return std::fabs(a - b) > z * std::max(relative, per_z2 * z);
+  }
+};
+
+// A block of a cell: its pixel rectangle, and where its cell starts (jumps are counted between
+// pixels of one cell: `inside` those of this block only, `edge` those with the neighbouring block).
+struct BlockRect {
+  int x0, y0, x1, y1;
+  int cell_x0, cell_y0;
+};
+
+struct BlockSums {
+  CellSums sums;
+  std::uint32_t inside_jumps = 0, edge_jumps = 0;
+};
+
+// The block's first valid point (the reference of its float sums), or nullptr when it has none.
+const Point4f* first_valid(const PointImage& points, const BlockRect& r) {
+  for (int y = r.y0; y < r.y1; ++y) {
+    const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
+    for (int x = r.x0; x < r.x1; ++x) {
+      if (is_valid(row[x])) return &row[x];
+    }
+  }
+  return nullptr;
+}
+
+// Jumps between the pixels of row `row` in [x0, x1) and their left neighbours from `left_from`
+// on (an invalid pixel's NaN depth compares as no jump).
+std::uint32_t row_jumps(const Point4f* row, int left_from, int x1, const JumpRule& jumps) {
+  std::uint32_t count = 0;
+  for (int x = left_from; x < x1; ++x) count += jumps(row[x].z(), row[x - 1].z());
+  return count;
+}
+
+BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRect& r,
+                    const JumpRule& jumps) {
+  BlockSums out;
+  const Point4f* reference = first_valid(points, r);
+  if (!reference) return out;
+  CellSums& sums = out.sums;
+  sums.reference = reference->head<3>();
+  const float rx = sums.reference.x(), ry = sums.reference.y(), rz = sums.reference.z();
+  float sx = 0, sy = 0, sz = 0;
+  for (int y = r.y0; y < r.y1; ++y) {
+    const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
+    const Rgb8* colours = rgb.data() + static_cast<std::size_t>(y) * rgb.width();
+    for (int x = r.x0; x < r.x1; ++x) {
+      const Point4f& p = row[x];
+      if (!is_valid(p)) continue;
+      const float dx = p.x() - rx, dy = p.y() - ry, dz = p.z() - rz;
+      ++sums.count;
+      sx += dx, sy += dy, sz += dz;
+      sums.xx += dx * dx, sums.xy += dx * dy, sums.xz += dx * dz;
+      sums.yy += dy * dy, sums.yz += dy * dz, sums.zz += dz * dz;
+      sums.red += colours[x][0], sums.green += colours[x][1], sums.blue += colours[x][2];
+    }
+    // Jumps within the block, and with the neighbouring blocks of the same cell (left, above).
+    out.inside_jumps += row_jumps(row, r.x0 + 1, r.x1, jumps);
+    if (r.x0 > r.cell_x0) out.edge_jumps += jumps(row[r.x0].z(), row[r.x0 - 1].z());
+    if (y == r.y0 && y == r.cell_y0) continue;
+    const Point4f* above = row - points.width();
+    std::uint32_t vertical = 0;
+    for (int x = r.x0; x < r.x1; ++x) vertical += jumps(row[x].z(), above[x].z());
+    (y > r.y0 ? out.inside_jumps : out.edge_jumps) += vertical;
+  }
+  sums.sum = Eigen::Vector3f(sx, sy, sz);
+  return out;
+}
+
+void add_moments(geometry::SegmentMoments& into, const geometry::SegmentMoments& m) {
+  into.count += m.count;
+  into.sum += m.sum;
+  into.sum_outer += m.sum_outer;
+}
+
+}  // namespace
+
+void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
+                   float max_depth_jump, float jump_per_z2, const Eigen::Vector3d& origin,
+                   CellGrid& cells) {
+  const JumpRule jumps{max_depth_jump, jump_per_z2};
+  const int half = cell_size / 2;
+  cells.cell_size = cell_size;
+  cells.columns = (points.width() + cell_size - 1) / cell_size;
+  cells.rows = (points.height() + cell_size - 1) / cell_size;
+  const std::size_t count = static_cast<std::size_t>(cells.columns) * cells.rows;
+  cells.moments.assign(count, {});
+  cells.continuous.assign(count, 0);
+  cells.block_moments.assign(4 * count, {});
+  cells.block_continuous.assign(4 * count, 0);
+  cells.block_colours.assign(4 * count, Eigen::Vector3d::Zero());
+  compute::detail::for_each_chunk(
+      count, points.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (std::size_t c = begin; c < end; ++c) {
+          const int x0 = cells.first_x(c), y0 = cells.first_y(c);
+          std::uint32_t cell_jumps = 0;
+          for (int b = 0; b < 4; ++b) {
+            const int bx = x0 + (b % 2) * half, by = y0 + (b / 2) * half;
+            const BlockRect rect{std::min(bx, points.width()),
+                                 std::min(by, points.height()),
+                                 std::min(bx + half, points.width()),
+                                 std::min(by + half, points.height()),
+                                 x0,
+                                 y0};
+            const BlockSums sums = sum_block(points, rgb, rect, jumps);
+            const std::size_t k = 4 * c + static_cast<std::size_t>(b);
+            cells.block_moments[k] = sums.sums.moments(origin);
+            cells.block_colours[k] = sums.sums.colour();
+            // An edge across a block jumps on every row or column it crosses; depth noise and
+            // quantization far away jump here and there.
+            cells.block_continuous[k] = 2 * sums.inside_jumps <= static_cast<std::uint32_t>(half);
+            cell_jumps += sums.inside_jumps + sums.edge_jumps;
+            add_moments(cells.moments[c], cells.block_moments[k]);
+          }
+          cells.continuous[c] = 2 * cell_jumps <= static_cast<std::uint32_t>(cell_size);
+        }
+      });
+}
+
+namespace {
+
+bool planar_piece(const CellPlaneParams& params, const PlaneMergeParams& merge,
+                  const geometry::SegmentMoments& moments, const Eigen::Vector3d& origin,
+                  std::uint64_t min_count) {
+  if (moments.count < std::max<std::uint64_t>(min_count, 3)) return false;
+  const SegmentPlane fit = fit_plane(moments, origin, merge.fit);
+  if (!fit.valid) return false;
+  const double z = fit.centroid.z();
+  if (fit.rms_error > params.rms_base + params.rms_per_z2 * z * z) return false;
+  // A surface seen edge-on is no plane to this sensor (the merge's incidence limit).
+  const double facing = std::fabs(fit.normal.dot(fit.centroid.normalized()));
+  return facing >= std::cos(merge.max_incidence_deg * M_PI / 180.0);
+}
+
+Eigen::Vector3f mean_lab(const Eigen::Vector3d& colour_sum, std::uint64_t count) {
+  const Eigen::Vector3d mean = colour_sum / static_cast<double>(count);
+  const Rgb8 rgb{static_cast<std::uint8_t>(std::lround(mean.x())),
+                 static_cast<std::uint8_t>(std::lround(mean.y())),
+                 static_cast<std::uint8_t>(std::lround(mean.z()))};
+  return rgb_to_lab(rgb);
+}
+
+void fill_labels(SegmentLabelImage& labels, int x0, int y0, int size, std::uint32_t label) {
+  const int x1 = std::min(labels.width(), x0 + size), y1 = std::min(labels.height(), y0 + size);
+  for (int y = y0; y < y1; ++y) std::fill(&labels(x0, y), &labels(x0, y) + (x1 - x0), label);
+}
+
+}  // namespace
+
+std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
+                                   const Eigen::Vector3d& origin, CellGrid& cells,
+                                   SegmentLabelImage& labels, geometry::SegmentMomentSet& moments,
+                                   std::vector<Eigen::Vector3f>& lab_colours) {
+  const int size = cells.cell_size, half = size / 2;
+  const auto min_count = [&](int side) {
+    return static_cast<std::uint64_t>(std::ceil(params.min_valid_fraction * side * side));
+  };
+  constexpr std::uint32_t kNone = geometry::kNoLabel;
+  cells.segments.assign(cells.size(), {kNone, kNone, kNone, kNone});
+  moments.origin = origin;
+  moments.segments.clear();
+  lab_colours.clear();
+  std::fill(labels.pixels().begin(), labels.pixels().end(), kNone);
+  const auto add_segment = [&](const geometry::SegmentMoments& m, const Eigen::Vector3d& colour,
+                               int x0, int y0, int side) {
+    const auto segment = static_cast<std::uint32_t>(moments.segments.size());
+    moments.segments.push_back(m);
+    lab_colours.push_back(mean_lab(colour, m.count));
+    fill_labels(labels, x0, y0, side, segment);
+    return segment;
+  };
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    const int x0 = cells.first_x(c), y0 = cells.first_y(c);
+    if (cells.continuous[c] &&
+        planar_piece(params, merge, cells.moments[c], origin, min_count(size))) {
+      const std::size_t k = 4 * c;
+      const Eigen::Vector3d colour = cells.block_colours[k] + cells.block_colours[k + 1] +
+                                     cells.block_colours[k + 2] + cells.block_colours[k + 3];
+      cells.segments[c].fill(add_segment(cells.moments[c], colour, x0, y0, size));
+      continue;
+    }
+    for (std::size_t b = 0; b < 4; ++b) {
+      const std::size_t k = 4 * c + b;
+      if (!cells.block_continuous[k] ||
+          !planar_piece(params, merge, cells.block_moments[k], origin, min_count(half)))
+        continue;
+      cells.segments[c][b] = add_segment(cells.block_moments[k], cells.block_colours[k],
+                                         x0 + static_cast<int>(b % 2) * half,
+                                         y0 + static_cast<int>(b / 2) * half, half);
+    }
+  }
+  return static_cast<std::uint32_t>(moments.segments.size());
+}
+
+SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count) {
+  const int columns = 2 * cells.columns, rows = 2 * cells.rows;  // blocks
+  const auto segment_at = [&](int x, int y) {
+    const std::size_t cell = static_cast<std::size_t>(y / 2) * cells.columns + x / 2;
+    return cells.segments[cell][static_cast<std::size_t>((y % 2) * 2 + x % 2)];
+  };
+  std::vector<std::uint64_t> edges;
+  for (int y = 0; y < rows; ++y) {
+    for (int x = 0; x < columns; ++x) {
+      const std::uint32_t a = segment_at(x, y);
+      if (a == geometry::kNoLabel) continue;
+      // Right, down-left, down, down-right: each neighbouring pair once.
+      const int steps[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
+      for (const auto& step : steps) {
+        const int nx = x + step[0], ny = y + step[1];
+        if (nx < 0 || nx >= columns || ny >= rows) continue;
+        const std::uint32_t b = segment_at(nx, ny);
+        if (b != geometry::kNoLabel && b != a) edges.push_back(segment_edge(a, b));
+      }
+    }
+  }
+  return graph_from_edges(edges, segment_count);
+}
+
+namespace {
+
+// The distinct planes of a cell and its 8 neighbours (kNoLabel left out), the cell's own first;
+// `whole`: the cell and all its neighbours inside the image lie in one plane.
+struct CellCandidates {
+  std::array<std::uint32_t, 36> planes;
+  int count = 0;
+  bool whole = false;
+
+  void add(std::uint32_t plane) {
+    if (plane != geometry::kNoLabel &&
+        std::find(planes.begin(), planes.begin() + count, plane) == planes.begin() + count)
+      planes[count++] = plane;
+  }
+};
+
+// PlanesOf(cell): the cell's planes (a std::array of 4, kNoLabel where none); a cell is whole in
+// a plane when all four are it.
+template <class PlanesOf>
+CellCandidates candidates_of(const CellGrid& cells, std::size_t cell, PlanesOf&& planes_of) {
+  CellCandidates out;
+  const auto in_one = [](const std::array<std::uint32_t, 4>& p) {
+    return p[0] != geometry::kNoLabel && p[0] == p[1] && p[0] == p[2] && p[0] == p[3];
+  };
+  const std::array<std::uint32_t, 4> own = planes_of(cell);
+  for (const std::uint32_t p : own) out.add(p);
+  out.whole = in_one(own);
+  const int cx = static_cast<int>(cell % cells.columns),
+            cy = static_cast<int>(cell / cells.columns);
+  for (int y = std::max(0, cy - 1); y <= std::min(cells.rows - 1, cy + 1); ++y) {
+    for (int x = std::max(0, cx - 1); x <= std::min(cells.columns - 1, cx + 1); ++x) {
+      const std::array<std::uint32_t, 4> p =
+          planes_of(static_cast<std::size_t>(y) * cells.columns + x);
+      out.whole = out.whole && in_one(p) && p[0] == own[0];
+      for (const std::uint32_t plane : p) out.add(plane);
+    }
+  }
+  return out;
+}
+
+// Assigns the cell's valid pixels among the candidates; returns the plane that took the most of
+// them when that is at least a quarter of the cell's valid pixels (kNoLabel otherwise).
+std::uint32_t assign_cell(const PointImage& points, const CellGrid& cells, std::size_t cell,
+                          const CellCandidates& candidates, const std::vector<SegmentPlane>& planes,
+                          const PlaneMergeParams& params, std::vector<std::uint32_t>& pixel_plane) {
+  const int x0 = cells.first_x(cell), y0 = cells.first_y(cell);
+  const int x1 = std::min(points.width(), x0 + cells.cell_size);
+  const int y1 = std::min(points.height(), y0 + cells.cell_size);
+  std::array<std::uint32_t, 36> taken{};
+  for (int y = y0; y < y1; ++y) {
+    for (int x = x0; x < x1; ++x) {
+      const std::size_t i = static_cast<std::size_t>(y) * points.width() + x;
+      if (!is_valid(points.data()[i])) continue;
+      int choice = candidates.whole ? 0 : -1;
+      if (!candidates.whole) {
+        const PixelPoint pixel(points.data()[i], params);
+        double best = 1.0;
+        for (int k = 0; k < candidates.count; ++k) {
+          const double score = plane_score(planes[candidates.planes[k]], pixel, params);
+          if (score < best) best = score, choice = k;
+        }
+      }
+      if (choice < 0) continue;
+      pixel_plane[i] = candidates.planes[choice];
+      ++taken[choice];
+    }
+  }
+  const auto most =
+      std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
+  const bool enough = candidates.count > 0 && 4 * taken[most] >= cells.moments[cell].count;
+  return enough ? candidates.planes[most] : geometry::kNoLabel;
+}
+
+}  // namespace
+
+void assign_cell_pixels(const PointImage& points, const CellGrid& cells,
+                        const std::vector<std::uint32_t>& segment_plane,
+                        const std::vector<SegmentPlane>& planes, const PlaneMergeParams& params,
+                        int passes, std::vector<std::uint32_t>& pixel_plane) {
+  constexpr std::uint32_t kNone = geometry::kNoLabel;
+  using Planes = std::array<std::uint32_t, 4>;
+  pixel_plane.assign(points.size(), kNone);
+  // Per cell: its segments' planes; the pass that assigned it (-1: none yet); the plane it
+  // carries on to the next passes' cells (the one most of its pixels took).
+  std::vector<Planes> cell_planes(cells.size(), {kNone, kNone, kNone, kNone});
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    for (std::size_t b = 0; b < 4; ++b) {
+      const std::uint32_t s = cells.segments[c][b];
+      if (s != kNone) cell_planes[c][b] = segment_plane[s];
+    }
+  }
+  std::vector<int> assigned_in(cells.size(), -1);
+  std::vector<std::uint32_t> carried(cells.size(), kNone);
+  for (int pass = 0; pass < std::max(1, passes); ++pass) {
+    const auto planes_of = [&](std::size_t c) {
+      if (pass == 0) return cell_planes[c];
+      const bool earlier = assigned_in[c] >= 0 && assigned_in[c] < pass;
+      return Planes{earlier ? carried[c] : kNone, kNone, kNone, kNone};
+    };
+    std::vector<std::size_t> now;
+    for (std::size_t c = 0; c < cells.size(); ++c) {
+      if (assigned_in[c] < 0 && candidates_of(cells, c, planes_of).count > 0) now.push_back(c);
+    }
+    if (now.empty()) break;
+    compute::detail::for_each_chunk(
+        now.size(), points.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
+          for (std::size_t k = begin; k < end; ++k) {
+            const std::size_t c = now[k];
+            carried[c] = assign_cell(points, cells, c, candidates_of(cells, c, planes_of), planes,
+                                     params, pixel_plane);
+          }
+        });
+    for (const std::size_t c : now) assigned_in[c] = pass;
+  }
+}
+
+}  // namespace kartograf::segmentation::detail

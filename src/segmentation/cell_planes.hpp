@@ -1,0 +1,75 @@
+#pragma once
+// The cells mode of plane extraction (plane_extraction.hpp, PlaneExtractionMode::cells): the
+// image cut into square cells, each cell's moments and depth continuity measured in one pass, the
+// planar cells as the segments that merging joins, and pixels assigned cell by cell.
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "kartograf/core/color.hpp"
+#include "kartograf/core/point_image.hpp"
+#include "kartograf/geometry/segment_moments.hpp"
+#include "kartograf/segmentation/plane_extraction.hpp"
+#include "kartograf/segmentation/plane_merge.hpp"
+#include "kartograf/segmentation/region_growing.hpp"
+#include "kartograf/segmentation/segment_graph.hpp"
+
+namespace kartograf::segmentation::detail {
+
+// Cells of cell_size pixels a side, each made of 2 x 2 blocks (half a cell a side): a cell
+// that is not planar as a whole may still hold planar blocks (a strip of table between objects).
+struct CellGrid {
+  int cell_size = 0;
+  int columns = 0, rows = 0;  // cells across and down (the last ones may be cut by the border)
+  std::vector<geometry::SegmentMoments> moments;  // per cell, about the moment origin
+  std::vector<std::uint8_t> continuous;           // per cell: no edge's depth jump across it
+  // Per block (cell c's blocks are 4 c .. 4 c + 3, row by row; absent ones are empty).
+  std::vector<geometry::SegmentMoments> block_moments;
+  std::vector<std::uint8_t> block_continuous;
+  std::vector<Eigen::Vector3d> block_colours;  // sum of the block's valid pixels' RGB
+  // Per cell: its segment if the whole cell is planar, else those of its planar blocks
+  // (kNoLabel where none).
+  std::vector<std::array<std::uint32_t, 4>> segments;
+
+  std::size_t size() const { return moments.size(); }
+  int first_x(std::size_t cell) const { return static_cast<int>(cell % columns) * cell_size; }
+  int first_y(std::size_t cell) const { return static_cast<int>(cell / columns) * cell_size; }
+};
+
+// One pass over the frame: every block's moments about `origin` and colour sum, and every
+// block's and cell's depth continuity: neighbouring valid pixels in a row or column of it jump
+// (by more than max_depth_jump of their depth z and more than jump_per_z2 z^2) at most half its
+// side's times (an edge across it jumps on each row or column it crosses). Cells sum their blocks.
+void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
+                   float max_depth_jump, float jump_per_z2, const Eigen::Vector3d& origin,
+                   CellGrid& cells);
+
+// Planar cells, and the planar blocks of the other cells, become segments 0..n-1 (grid.segments;
+// their pixels labelled in `labels`, the rest kNoLabel), with their moments and mean CIE-Lab
+// colours. A cell or block is planar when enough of it is valid, its depth is continuous and
+// its plane fit's RMS is within the noise allowance.
+std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
+                                   const Eigen::Vector3d& origin, CellGrid& cells,
+                                   SegmentLabelImage& labels, geometry::SegmentMomentSet& moments,
+                                   std::vector<Eigen::Vector3f>& lab_colours);
+
+// The segments' neighbours (8-adjacent blocks of different segments), as merging takes them.
+SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count);
+
+// Every valid pixel's plane (index into `planes`, or kNoLabel), in passes over the cells:
+// - first, cells inside one plane (their 8 neighbours in it too) take it whole; pixels of cells
+//   at a plane's border or next to one take, among the planes of their cell and its neighbours
+//   (those of their segments), the one whose distance allowance they are deepest within (merge's
+//   plane score);
+// - then (passes - 1 times) cells not yet reached do the same with the planes their reached
+//   neighbours carry: the plane most of a cell's pixels took.
+// Planes thus reach past the cells next to them, around objects and across gaps of no depth.
+// segment_plane: each segment's plane (kNoLabel: none).
+void assign_cell_pixels(const PointImage& points, const CellGrid& cells,
+                        const std::vector<std::uint32_t>& segment_plane,
+                        const std::vector<SegmentPlane>& planes, const PlaneMergeParams& params,
+                        int passes, std::vector<std::uint32_t>& pixel_plane);
+
+}  // namespace kartograf::segmentation::detail
