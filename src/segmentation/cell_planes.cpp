@@ -83,10 +83,14 @@ std::uint32_t row_jumps(const Point4f* row, int left_from, int x1, const JumpRul
 }
 
 BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRect& r,
-                    const JumpRule& jumps) {
+                    const JumpRule& jumps, std::uint8_t* valid) {
   BlockSums out;
   const Point4f* reference = first_valid(points, r);
-  if (!reference) return out;
+  if (!reference) {
+    for (int y = r.y0; y < r.y1; ++y)
+      std::fill_n(valid + static_cast<std::size_t>(y) * points.width() + r.x0, r.x1 - r.x0, 0);
+    return out;
+  }
   CellSums& sums = out.sums;
   sums.reference = reference->head<3>();
   const float rx = sums.reference.x(), ry = sums.reference.y(), rz = sums.reference.z();
@@ -94,9 +98,11 @@ BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRe
   for (int y = r.y0; y < r.y1; ++y) {
     const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
     const Rgb8* colours = rgb.data() + static_cast<std::size_t>(y) * rgb.width();
+    std::uint8_t* valid_row = valid + static_cast<std::size_t>(y) * points.width();
     for (int x = r.x0; x < r.x1; ++x) {
       const Point4f& p = row[x];
-      if (!is_valid(p)) continue;
+      valid_row[x] = is_valid(p);
+      if (!valid_row[x]) continue;
       const float dx = p.x() - rx, dy = p.y() - ry, dz = p.z() - rz;
       ++sums.count;
       sx += dx, sy += dy, sz += dz;
@@ -139,6 +145,7 @@ void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
   cells.block_moments.assign(4 * count, {});
   cells.block_continuous.assign(4 * count, 0);
   cells.block_colours.assign(4 * count, Eigen::Vector3d::Zero());
+  cells.valid.resize(points.size());
   compute::detail::for_each_chunk(
       count, points.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
         for (std::size_t c = begin; c < end; ++c) {
@@ -152,7 +159,7 @@ void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
                                  std::min(by + half, points.height()),
                                  x0,
                                  y0};
-            const BlockSums sums = sum_block(points, rgb, rect, jumps);
+            const BlockSums sums = sum_block(points, rgb, rect, jumps, cells.valid.data());
             const std::size_t k = 4 * c + static_cast<std::size_t>(b);
             cells.block_moments[k] = sums.sums.moments(origin);
             cells.block_colours[k] = sums.sums.colour();
@@ -306,47 +313,133 @@ CellCandidates candidates_of(const CellGrid& cells, std::size_t cell, PlanesOf&&
   return out;
 }
 
-// Assigns the cell's valid pixels among the candidates; returns the plane that took the most of
-// them when that is at least a quarter of the cell's valid pixels (kNoLabel otherwise).
-std::uint32_t assign_cell(const PointImage& points, const CellGrid& cells, std::size_t cell,
-                          const CellCandidates& candidates, const std::vector<SegmentPlane>& planes,
-                          const PlaneMergeParams& params, std::vector<std::uint32_t>& pixel_plane) {
-  const int x0 = cells.first_x(cell), y0 = cells.first_y(cell);
-  const int x1 = std::min(points.width(), x0 + cells.cell_size);
-  const int y1 = std::min(points.height(), y0 + cells.cell_size);
+// A plane as the per-pixel score reads it, in float (plane_score's rule).
+struct ScoredPlane {
+  Eigen::Vector3f normal;
+  float offset;
+};
+
+struct ScoreRule {
+  float distance_base, distance_per_z2, min_facing;
+
+  // plane_score: the distance to the plane over the allowance there (< 1: within it).
+  float operator()(const ScoredPlane& plane, const Eigen::Vector3f& p, float inverse_range) const {
+    const float along = plane.normal.dot(p);
+    const float facing = std::max(std::fabs(along) * inverse_range, min_facing);
+    return std::fabs(along + plane.offset) /
+           ((distance_base + distance_per_z2 * p.z() * p.z()) * facing);
+  }
+};
+
+// What every cell's assignment reads.
+struct AssignInputs {
+  const PointImage& points;
+  const CellGrid& cells;
+  const std::vector<SegmentPlane>& planes;
+  Eigen::Vector3d origin;  // of the cells' moments
+  std::vector<ScoredPlane> scored;
+  std::vector<PlaneFrame> frames;
+  ScoreRule rule;
+};
+
+// A cell inside one plane, away from the image's edge: its valid pixels take the plane, its
+// moments give the plane's count and squared distances, and it adds nothing to the extent. A
+// plane's image and its in-plane coordinates are related by a homography, which keeps convex
+// hulls: the extreme points lie on the plane's outline in the image, in cells at its border or at
+// the image's edge, never inside.
+void assign_interior_cell(const AssignInputs& in, std::size_t cell, std::uint32_t plane,
+                          std::vector<PlanePixelSums>& sums,
+                          std::vector<std::uint32_t>& pixel_plane) {
+  const int width = in.points.width();
+  const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
+  for (int y = y0; y < y0 + in.cells.cell_size; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * width;
+    for (int x = x0; x < x0 + in.cells.cell_size; ++x) {
+      if (in.cells.valid[row + x]) pixel_plane[row + x] = plane;
+    }
+  }
+  const geometry::SegmentMoments& m = in.cells.moments[cell];
+  const Eigen::Vector3d& n = in.planes[plane].normal;
+  // sum (n . p + offset)^2 with p = origin + q: n^T (sum q q^T) n + 2 e n . (sum q) + count e^2.
+  const double e = n.dot(in.origin) + in.planes[plane].offset;
+  PlanePixelSums& sum = sums[plane];
+  sum.squared_error += n.dot(m.sum_outer * n) + 2 * e * n.dot(m.sum) + double(m.count) * e * e;
+  sum.count += m.count;
+}
+
+bool at_image_edge(const CellGrid& cells, std::size_t cell) {
+  const std::size_t cx = cell % cells.columns, cy = cell / cells.columns;
+  return cx == 0 || cy == 0 || cx + 1 == std::size_t(cells.columns) ||
+         cy + 1 == std::size_t(cells.rows);
+}
+
+// Assigns the cell's valid pixels among the candidates, adding them to their planes' sums;
+// returns the plane that took the most of them when that is at least a quarter of the cell's
+// valid pixels (kNoLabel otherwise).
+std::uint32_t assign_cell(const AssignInputs& in, std::size_t cell,
+                          const CellCandidates& candidates, std::vector<PlanePixelSums>& sums,
+                          std::vector<std::uint32_t>& pixel_plane) {
+  if (candidates.whole && !at_image_edge(in.cells, cell)) {
+    assign_interior_cell(in, cell, candidates.planes[0], sums, pixel_plane);
+    return candidates.planes[0];
+  }
+  const PointImage& points = in.points;
+  const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
+  const int x1 = std::min(points.width(), x0 + in.cells.cell_size);
+  const int y1 = std::min(points.height(), y0 + in.cells.cell_size);
   std::array<std::uint32_t, 36> taken{};
   for (int y = y0; y < y1; ++y) {
     for (int x = x0; x < x1; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * points.width() + x;
-      if (!is_valid(points.data()[i])) continue;
+      const Point4f& point = points.data()[i];
+      if (!is_valid(point)) continue;
       int choice = candidates.whole ? 0 : -1;
       if (!candidates.whole) {
-        const PixelPoint pixel(points.data()[i], params);
-        double best = 1.0;
+        const Eigen::Vector3f p = point.head<3>();
+        const float inverse_range = 1.0f / p.norm();
+        float best = 1.0f;
         for (int k = 0; k < candidates.count; ++k) {
-          const double score = plane_score(planes[candidates.planes[k]], pixel, params);
+          const float score = in.rule(in.scored[candidates.planes[k]], p, inverse_range);
           if (score < best) best = score, choice = k;
         }
       }
       if (choice < 0) continue;
-      pixel_plane[i] = candidates.planes[choice];
+      const std::uint32_t plane = candidates.planes[choice];
+      pixel_plane[i] = plane;
+      sums[plane].add(in.frames[plane], point);
       ++taken[choice];
     }
   }
   const auto most =
       std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
-  const bool enough = candidates.count > 0 && 4 * taken[most] >= cells.moments[cell].count;
+  const bool enough = candidates.count > 0 && 4 * taken[most] >= in.cells.moments[cell].count;
   return enough ? candidates.planes[most] : geometry::kNoLabel;
+}
+
+AssignInputs assign_inputs(const PointImage& points, const CellGrid& cells,
+                           const std::vector<SegmentPlane>& planes, const Eigen::Vector3d& origin,
+                           const PlaneMergeParams& params) {
+  AssignInputs in{points, cells, planes, origin, {}, {}, {}};
+  for (const SegmentPlane& plane : planes) {
+    in.scored.push_back({plane.normal.cast<float>(), static_cast<float>(plane.offset)});
+    in.frames.push_back(PlaneFrame::of(plane));
+  }
+  in.rule = {static_cast<float>(params.distance_base), static_cast<float>(params.distance_per_z2),
+             static_cast<float>(params.min_facing_factor)};
+  return in;
 }
 
 }  // namespace
 
-void assign_cell_pixels(const PointImage& points, const CellGrid& cells,
-                        const std::vector<std::uint32_t>& segment_plane,
-                        const std::vector<SegmentPlane>& planes, const PlaneMergeParams& params,
-                        int passes, std::vector<std::uint32_t>& pixel_plane) {
+std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const CellGrid& cells,
+                                               const std::vector<std::uint32_t>& segment_plane,
+                                               const std::vector<SegmentPlane>& planes,
+                                               const Eigen::Vector3d& origin,
+                                               const PlaneMergeParams& params, int passes,
+                                               std::vector<std::uint32_t>& pixel_plane) {
   constexpr std::uint32_t kNone = geometry::kNoLabel;
   using Planes = std::array<std::uint32_t, 4>;
+  const AssignInputs in = assign_inputs(points, cells, planes, origin, params);
   pixel_plane.assign(points.size(), kNone);
   // Per cell: its segments' planes; the pass that assigned it (-1: none yet); the plane it
   // carries on to the next passes' cells (the one most of its pixels took).
@@ -359,6 +452,8 @@ void assign_cell_pixels(const PointImage& points, const CellGrid& cells,
   }
   std::vector<int> assigned_in(cells.size(), -1);
   std::vector<std::uint32_t> carried(cells.size(), kNone);
+  std::vector<PlanePixelSums> total(planes.size());
+  std::array<std::vector<PlanePixelSums>, compute::detail::kCpuChunks> chunk_sums;
   for (int pass = 0; pass < std::max(1, passes); ++pass) {
     const auto planes_of = [&](std::size_t c) {
       if (pass == 0) return cell_planes[c];
@@ -371,15 +466,20 @@ void assign_cell_pixels(const PointImage& points, const CellGrid& cells,
     }
     if (now.empty()) break;
     compute::detail::for_each_chunk(
-        now.size(), points.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
+        now.size(), points.size(), [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+          chunk_sums[chunk].assign(planes.size(), PlanePixelSums{});
           for (std::size_t k = begin; k < end; ++k) {
             const std::size_t c = now[k];
-            carried[c] = assign_cell(points, cells, c, candidates_of(cells, c, planes_of), planes,
-                                     params, pixel_plane);
+            carried[c] = assign_cell(in, c, candidates_of(cells, c, planes_of), chunk_sums[chunk],
+                                     pixel_plane);
           }
         });
+    for (const std::vector<PlanePixelSums>& sums : chunk_sums) {  // in chunk order
+      for (std::size_t m = 0; m < sums.size(); ++m) total[m].add(sums[m]);
+    }
     for (const std::size_t c : now) assigned_in[c] = pass;
   }
+  return total;
 }
 
 }  // namespace kartograf::segmentation::detail

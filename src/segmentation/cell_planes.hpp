@@ -15,6 +15,7 @@
 #include "kartograf/segmentation/plane_merge.hpp"
 #include "kartograf/segmentation/region_growing.hpp"
 #include "kartograf/segmentation/segment_graph.hpp"
+#include "plane_output.hpp"
 
 namespace kartograf::segmentation::detail {
 
@@ -29,6 +30,7 @@ struct CellGrid {
   std::vector<geometry::SegmentMoments> block_moments;
   std::vector<std::uint8_t> block_continuous;
   std::vector<Eigen::Vector3d> block_colours;  // sum of the block's valid pixels' RGB
+  std::vector<std::uint8_t> valid;             // per pixel: 1 where it has a point
   // Per cell: its segment if the whole cell is planar, else those of its planar blocks
   // (kNoLabel where none).
   std::vector<std::array<std::uint32_t, 4>> segments;
@@ -38,7 +40,8 @@ struct CellGrid {
   int first_y(std::size_t cell) const { return static_cast<int>(cell / columns) * cell_size; }
 };
 
-// One pass over the frame: every block's moments about `origin` and colour sum, and every
+// One pass over the frame: which pixels have a point, every block's moments about `origin` and
+// colour sum, and every
 // block's and cell's depth continuity: neighbouring valid pixels in a row or column of it jump
 // (by more than max_depth_jump of their depth z and more than jump_per_z2 z^2) at most half its
 // side's times (an edge across it jumps on each row or column it crosses). Cells sum their blocks.
@@ -66,10 +69,14 @@ SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_cou
 // - then (passes - 1 times) cells not yet reached do the same with the planes their reached
 //   neighbours carry: the plane most of a cell's pixels took.
 // Planes thus reach past the cells next to them, around objects and across gaps of no depth.
-// segment_plane: each segment's plane (kNoLabel: none).
-void assign_cell_pixels(const PointImage& points, const CellGrid& cells,
-                        const std::vector<std::uint32_t>& segment_plane,
-                        const std::vector<SegmentPlane>& planes, const PlaneMergeParams& params,
-                        int passes, std::vector<std::uint32_t>& pixel_plane);
+// segment_plane: each segment's plane (kNoLabel: none); origin: the cells' moments'. Returns the
+// sums of each plane's pixels (cells inside a plane add their moments' count and squared
+// distances, but not to the extent: their pixels cannot be extreme, see assign_interior_cell).
+std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const CellGrid& cells,
+                                               const std::vector<std::uint32_t>& segment_plane,
+                                               const std::vector<SegmentPlane>& planes,
+                                               const Eigen::Vector3d& origin,
+                                               const PlaneMergeParams& params, int passes,
+                                               std::vector<std::uint32_t>& pixel_plane);
 
 }  // namespace kartograf::segmentation::detail

@@ -323,11 +323,13 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
   result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
   result.timings.merging = elapsed_ms(clock);
 
-  detail::assign_cell_pixels(points, cells, merged.segment_plane, merged.planes, params_.merge,
-                             params_.cells.reach_passes, pixel_plane_);
+  // The assignment sums each plane's pixels as it goes: no second pass over the points.
+  const std::vector<detail::PlanePixelSums> sums = detail::assign_cell_pixels(
+      points, cells, merged.segment_plane, merged.planes, origin.cast<double>(), params_.merge,
+      params_.cells.reach_passes, pixel_plane_);
   result.timings.refinement = elapsed_ms(clock);
 
-  detail::write_planes(points, merged.planes, pixel_plane_, params_.min_plane_pixels, result);
+  detail::write_planes(merged.planes, sums, pixel_plane_, params_.min_plane_pixels, result);
   result.timings.output = elapsed_ms(clock);
   return result;
 }
@@ -357,7 +359,8 @@ PlaneSet PlaneExtractor::extract_regions(const PointImage& points, const RgbImag
   assign_pixels(points, merged);
   result.timings.refinement = elapsed_ms(clock);
 
-  detail::write_planes(points, merged.planes, pixel_plane_, params_.min_plane_pixels, result);
+  detail::write_planes(merged.planes, detail::sum_plane_pixels(points, pixel_plane_, merged.planes),
+                       pixel_plane_, params_.min_plane_pixels, result);
   result.timings.output = elapsed_ms(clock);
   return result;
 }
