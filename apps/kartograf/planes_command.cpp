@@ -63,7 +63,8 @@ segmentation::PlaneExtractionParams extraction_params(const PlanesOptions& o) {
 }
 
 io::PlaneRunRecord run_record(const PlanesOptions& o, const compute::Context& context) {
-  return {.lab_threshold = o.lab_threshold,
+  return {.mode = o.mode,
+          .lab_threshold = o.lab_threshold,
           .normal_angle_deg = o.normal_angle_deg,
           .min_plane_pixels = o.min_plane_pixels,
           .neighbours = o.neighbours,

@@ -21,12 +21,13 @@ std::string settings_text(const segmentation::PlaneExtractionParams& p) {
   std::ostringstream settings;
   if (p.mode == segmentation::PlaneExtractionMode::cells) {
     settings << "cells mode: " << p.cells.cell_size
-             << " px cells, planar when >= " << 100 * p.cells.min_valid_fraction
-             << " % valid, no depth jump over " << 100 * p.growing.max_depth_jump
-             << " %, RMS <= " << 1000 * p.cells.rms_base << " mm + " << 1000 * p.cells.rms_per_z2
-             << " mm z^2; merging over pixel adjacency; pixels assigned per cell; planes of at "
-                "least "
-             << p.min_plane_pixels << " pixels; colour only to join planes apart";
+             << " px cells of 2 x 2 blocks, planar when >= " << 100 * p.cells.min_valid_fraction
+             << " % valid, at most half a side of depth jumps (" << 100 * p.growing.max_depth_jump
+             << " % and " << p.cells.jump_per_z2 << " z^2), RMS <= " << 1000 * p.cells.rms_base
+             << " mm + " << 1000 * p.cells.rms_per_z2
+             << " mm z^2; merging over cell and block adjacency; pixels assigned per cell in "
+             << p.cells.reach_passes << " passes; planes of at least " << p.min_plane_pixels
+             << " pixels; colour only to join planes apart";
     return settings.str();
   }
   settings << "regions mode (defaults): Lab threshold " << p.growing.lab_threshold << ", "

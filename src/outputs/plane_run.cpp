@@ -11,7 +11,8 @@ namespace {
 using detail::RunJson;
 
 RunJson run_json(const PlaneRunRecord& run) {
-  return {{"lab_threshold", run.lab_threshold},
+  return {{"mode", run.mode},
+          {"lab_threshold", run.lab_threshold},
           {"normal_angle_deg", run.normal_angle_deg},
           {"min_plane_pixels", run.min_plane_pixels},
           {"neighbours", run.neighbours},

@@ -12,6 +12,7 @@ namespace kartograf::io {
 
 // The extraction's parameters as given to the command, and where it ran.
 struct PlaneRunRecord {
+  std::string mode;  // regions | cells
   double lab_threshold = 0;
   double normal_angle_deg = 0;
   std::uint64_t min_plane_pixels = 0;
