@@ -117,9 +117,11 @@ TEST(RunDocuments, LoopClosureCounts) {
 }
 
 TEST(RunDocuments, PlaneRunIsOneLine) {
-  const std::string text = io::plane_run_json({15, 30, 300, "pixel", "tls", "cpu", "host"});
-  EXPECT_EQ(text, R"({"lab_threshold":15.0,"normal_angle_deg":30.0,"min_plane_pixels":300,)"
-                  R"("neighbours":"pixel","fit":"tls","backend":"cpu","device":"host"})");
+  const std::string text =
+      io::plane_run_json({"cells", 15, 30, 300, "pixel", "tls", "cpu", "host"});
+  EXPECT_EQ(text, R"({"mode":"cells","lab_threshold":15.0,"normal_angle_deg":30.0,)"
+                  R"("min_plane_pixels":300,"neighbours":"pixel","fit":"tls","backend":"cpu",)"
+                  R"("device":"host"})");
 }
 
 TEST(RunDocuments, EvalReportAsTableAndJson) {
