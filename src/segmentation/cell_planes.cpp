@@ -94,21 +94,25 @@ BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRe
   CellSums& sums = out.sums;
   sums.reference = reference->head<3>();
   const float rx = sums.reference.x(), ry = sums.reference.y(), rz = sums.reference.z();
-  float sx = 0, sy = 0, sz = 0;
+  // Local accumulators: the validity mask's byte stores may alias anything, so sums kept in the
+  // struct would be stored and reloaded for every pixel.
+  float sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
+  std::uint32_t count = 0, red = 0, green = 0, blue = 0;
   for (int y = r.y0; y < r.y1; ++y) {
     const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
     const Rgb8* colours = rgb.data() + static_cast<std::size_t>(y) * rgb.width();
     std::uint8_t* valid_row = valid + static_cast<std::size_t>(y) * points.width();
     for (int x = r.x0; x < r.x1; ++x) {
       const Point4f& p = row[x];
-      valid_row[x] = is_valid(p);
-      if (!valid_row[x]) continue;
+      const bool is = is_valid(p);
+      valid_row[x] = is;
+      if (!is) continue;
       const float dx = p.x() - rx, dy = p.y() - ry, dz = p.z() - rz;
-      ++sums.count;
+      ++count;
       sx += dx, sy += dy, sz += dz;
-      sums.xx += dx * dx, sums.xy += dx * dy, sums.xz += dx * dz;
-      sums.yy += dy * dy, sums.yz += dy * dz, sums.zz += dz * dz;
-      sums.red += colours[x][0], sums.green += colours[x][1], sums.blue += colours[x][2];
+      xx += dx * dx, xy += dx * dy, xz += dx * dz;
+      yy += dy * dy, yz += dy * dz, zz += dz * dz;
+      red += colours[x][0], green += colours[x][1], blue += colours[x][2];
     }
     // Jumps within the block, and with the neighbouring blocks of the same cell (left, above).
     out.inside_jumps += row_jumps(row, r.x0 + 1, r.x1, jumps);
@@ -120,6 +124,9 @@ BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRe
     (y > r.y0 ? out.inside_jumps : out.edge_jumps) += vertical;
   }
   sums.sum = Eigen::Vector3f(sx, sy, sz);
+  sums.count = count;
+  sums.xx = xx, sums.xy = xy, sums.xz = xz, sums.yy = yy, sums.yz = yz, sums.zz = zz;
+  sums.red = red, sums.green = green, sums.blue = blue;
   return out;
 }
 

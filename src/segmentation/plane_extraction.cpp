@@ -231,6 +231,11 @@ void CellPlaneParams::validate() const {
   require(std::isfinite(rms_base) && std::isfinite(rms_per_z2) && rms_base >= 0 &&
               rms_per_z2 >= 0 && rms_base + rms_per_z2 > 0,
           "plane extraction: cells.rms_base and cells.rms_per_z2 must be >= 0, not both 0");
+  require(std::isfinite(jump_per_z2) && jump_per_z2 >= 0,
+          "plane extraction: cells.jump_per_z2 must be >= 0, got " + std::to_string(jump_per_z2));
+  require(std::isfinite(reference_focal) && reference_focal > 0,
+          "plane extraction: cells.reference_focal must be > 0 px, got " +
+              std::to_string(reference_focal));
 }
 
 void PlaneExtractionParams::validate() const {
@@ -304,16 +309,20 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
                                   [](const Point4f& p) { return is_valid(p); });
   if (first == points.pixels().end()) return result;  // no valid point
   const Eigen::Vector3f origin = first->head<3>();
+  // The noise terms at this camera's focal length (CellPlaneParams::reference_focal).
+  CellPlaneParams cell_params = params_.cells;
+  const double focal_scale = cell_params.reference_focal / intrinsics_.fx;
+  cell_params.rms_per_z2 *= focal_scale;
+  cell_params.jump_per_z2 *= focal_scale;
   detail::CellGrid cells;
-  detail::measure_cells(points, rgb, params_.cells.cell_size, params_.growing.max_depth_jump,
-                        static_cast<float>(params_.cells.jump_per_z2), origin.cast<double>(),
-                        cells);
+  detail::measure_cells(points, rgb, cell_params.cell_size, params_.growing.max_depth_jump,
+                        static_cast<float>(cell_params.jump_per_z2), origin.cast<double>(), cells);
   if (segments_.width() != points.width() || segments_.height() != points.height())
     segments_ = SegmentLabelImage(points.width(), points.height());
   geometry::SegmentMomentSet moments;
   std::vector<Eigen::Vector3f> colours;
   result.segment_count = detail::planar_cell_segments(
-      params_.cells, params_.merge, origin.cast<double>(), cells, segments_, moments, colours);
+      cell_params, params_.merge, origin.cast<double>(), cells, segments_, moments, colours);
   result.timings.moments = elapsed_ms(clock);
   if (result.segment_count == 0) return result;
 

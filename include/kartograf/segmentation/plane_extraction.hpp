@@ -40,6 +40,11 @@ struct CellPlaneParams {
   double rms_base = 0.0015;
   double rms_per_z2 = 0.0025;
   double jump_per_z2 = 0.008;
+  // The per-z^2 terms hold at this focal length [px] and scale with reference_focal / fx: a
+  // structured-light sensor's disparity step is z^2 / (f b) in depth, so a coarser image of it
+  // (a smaller f) is noisier per pixel. (A finer sensor subsampled keeps its own noise: the
+  // scaling then only makes the tests more lenient.)
+  double reference_focal = 525.0;
   // Passes of the pixel assignment: the first reaches the cells next to a plane's cells, each
   // further one a ring of cells further (around objects, across gaps of no depth).
   int reach_passes = 4;
