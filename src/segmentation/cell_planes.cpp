@@ -473,7 +473,8 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
     }
     if (now.empty()) break;
     compute::detail::for_each_chunk(
-        now.size(), points.size(), [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+        now.size(), now.size() * static_cast<std::size_t>(cells.cell_size * cells.cell_size),
+        [&](std::size_t begin, std::size_t end, std::size_t chunk) {
           chunk_sums[chunk].assign(planes.size(), PlanePixelSums{});
           for (std::size_t k = begin; k < end; ++k) {
             const std::size_t c = now[k];
