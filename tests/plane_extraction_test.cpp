@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <map>
 #include <utility>
 #include <vector>
@@ -455,6 +456,16 @@ TEST(PlaneExtraction, RejectsBadInput) {
   bad_cells = {};
   bad_cells.cells.reach_passes = 0;
   EXPECT_ERROR_MENTIONS(segmentation::PlaneExtractor(context, camera, bad_cells), "reach_passes");
+  // A point at infinity is named, in both modes (not silently summed into inf / NaN planes).
+  PointImage infinite(8, 6, Point4f(0.1f, 0.2f, 1.0f, 1.0f));
+  infinite(3, 2) = Point4f(std::numeric_limits<float>::infinity(), 0.0f, 1.0f, 1.0f);
+  for (const auto mode :
+       {segmentation::PlaneExtractionMode::regions, segmentation::PlaneExtractionMode::cells}) {
+    segmentation::PlaneExtractionParams with_mode;
+    with_mode.mode = mode;
+    segmentation::PlaneExtractor modal(context, camera, with_mode);
+    EXPECT_ERROR_MENTIONS(modal.extract(infinite, RgbImage(8, 6)), "infinite coordinate");
+  }
   bad_cells = {};
   bad_cells.cells.min_valid_fraction = 1.5;
   EXPECT_ERROR_MENTIONS(segmentation::PlaneExtractor(context, camera, bad_cells),

@@ -4,6 +4,7 @@
 #include <cmath>
 
 #include "compute/cpu_parallel.hpp"
+#include "kartograf/core/error.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
 #include "kartograf/segmentation/plane_fit.hpp"
 #include "plane_output.hpp"
@@ -179,6 +180,11 @@ void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
           cells.continuous[c] = 2 * cell_jumps <= static_cast<std::uint32_t>(cell_size);
         }
       });
+  // After the loop: an Error thrown on a helper thread would end the process.
+  for (const geometry::SegmentMoments& m : cells.moments) {
+    require(m.sum.allFinite() && m.sum_outer.allFinite(),
+            "plane extraction: a point has an infinite coordinate");
+  }
 }
 
 namespace {
