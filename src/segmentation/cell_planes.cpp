@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "compute/cpu_parallel.hpp"
 #include "kartograf/core/error.hpp"
@@ -189,17 +190,26 @@ void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
 
 namespace {
 
-bool planar_piece(const CellPlaneParams& params, const PlaneMergeParams& merge,
-                  const geometry::SegmentMoments& moments, const Eigen::Vector3d& origin,
-                  std::uint64_t min_count) {
-  if (moments.count < std::max<std::uint64_t>(min_count, 3)) return false;
-  const SegmentPlane fit = fit_plane(moments, origin, merge.fit);
-  if (!fit.valid) return false;
+// The piece's fit when it is planar, else none.
+std::optional<SegmentPlane> planar_piece(const CellPlaneParams& params,
+                                         const PlaneMergeParams& merge,
+                                         const geometry::SegmentMoments& moments,
+                                         const Eigen::Vector3d& origin, std::uint64_t min_count) {
+  if (moments.count < std::max<std::uint64_t>(min_count, 3)) return std::nullopt;
+  SegmentPlane fit = fit_plane(moments, origin, merge.fit);
+  if (!fit.valid) return std::nullopt;
   const double z = fit.centroid.z();
-  if (fit.rms_error > params.rms_base + params.rms_per_z2 * z * z) return false;
+  if (fit.rms_error > params.rms_base + params.rms_per_z2 * z * z) return std::nullopt;
   // A surface seen edge-on is no plane to this sensor (the merge's incidence limit).
   const double facing = std::fabs(fit.normal.dot(fit.centroid.normalized()));
-  return facing >= std::cos(merge.max_incidence_deg * M_PI / 180.0);
+  if (facing < std::cos(merge.max_incidence_deg * M_PI / 180.0)) return std::nullopt;
+  return fit;
+}
+
+// Sum of x, sum of y and count of the pixels of the rectangle [x0, x1) x [y0, y1).
+Eigen::Vector3d rectangle_pixel_sums(int x0, int y0, int x1, int y1) {
+  const double w = x1 - x0, h = y1 - y0;
+  return {h * (x0 + x1 - 1) * w / 2, w * (y0 + y1 - 1) * h / 2, w * h};
 }
 
 Eigen::Vector3f mean_lab(const Eigen::Vector3d& colour_sum, std::uint64_t count) {
@@ -210,56 +220,61 @@ Eigen::Vector3f mean_lab(const Eigen::Vector3d& colour_sum, std::uint64_t count)
   return rgb_to_lab(rgb);
 }
 
-void fill_labels(SegmentLabelImage& labels, int x0, int y0, int size, std::uint32_t label) {
+// Labels the square of `size` pixels at (x0, y0), cut by the image; returns its pixel sums.
+Eigen::Vector3d fill_labels(SegmentLabelImage& labels, int x0, int y0, int size,
+                            std::uint32_t label) {
   const int x1 = std::min(labels.width(), x0 + size), y1 = std::min(labels.height(), y0 + size);
   for (int y = y0; y < y1; ++y) std::fill(&labels(x0, y), &labels(x0, y) + (x1 - x0), label);
+  return rectangle_pixel_sums(x0, y0, x1, y1);
 }
 
 }  // namespace
 
 std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
                                    const Eigen::Vector3d& origin, CellGrid& cells,
-                                   SegmentLabelImage& labels, geometry::SegmentMomentSet& moments,
-                                   std::vector<Eigen::Vector3f>& lab_colours) {
+                                   SegmentLabelImage& labels, CellSegments& segments) {
   const int size = cells.cell_size, half = size / 2;
   const auto min_count = [&](int side) {
     return static_cast<std::uint64_t>(std::ceil(params.min_valid_fraction * side * side));
   };
   constexpr std::uint32_t kNone = geometry::kNoLabel;
   cells.segments.assign(cells.size(), {kNone, kNone, kNone, kNone});
-  moments.origin = origin;
-  moments.segments.clear();
-  lab_colours.clear();
+  segments = {};
+  segments.moments.origin = origin;
   std::fill(labels.pixels().begin(), labels.pixels().end(), kNone);
-  const auto add_segment = [&](const geometry::SegmentMoments& m, const Eigen::Vector3d& colour,
-                               int x0, int y0, int side) {
-    const auto segment = static_cast<std::uint32_t>(moments.segments.size());
-    moments.segments.push_back(m);
-    lab_colours.push_back(mean_lab(colour, m.count));
-    fill_labels(labels, x0, y0, side, segment);
+  const auto add_segment = [&](const geometry::SegmentMoments& m, const SegmentPlane& fit,
+                               const Eigen::Vector3d& colour, int x0, int y0, int side) {
+    const auto segment = static_cast<std::uint32_t>(segments.fits.size());
+    segments.moments.segments.push_back(m);
+    segments.fits.push_back(fit);
+    segments.lab_colours.push_back(mean_lab(colour, m.count));
+    segments.pixel_sums.push_back(fill_labels(labels, x0, y0, side, segment));
     return segment;
   };
   for (std::size_t c = 0; c < cells.size(); ++c) {
     const int x0 = cells.first_x(c), y0 = cells.first_y(c);
-    if (cells.continuous[c] &&
-        planar_piece(params, merge, cells.moments[c], origin, min_count(size))) {
+    const std::optional<SegmentPlane> cell_fit =
+        cells.continuous[c] ? planar_piece(params, merge, cells.moments[c], origin, min_count(size))
+                            : std::nullopt;
+    if (cell_fit) {
       const std::size_t k = 4 * c;
       const Eigen::Vector3d colour = cells.block_colours[k] + cells.block_colours[k + 1] +
                                      cells.block_colours[k + 2] + cells.block_colours[k + 3];
-      cells.segments[c].fill(add_segment(cells.moments[c], colour, x0, y0, size));
+      cells.segments[c].fill(add_segment(cells.moments[c], *cell_fit, colour, x0, y0, size));
       continue;
     }
     for (std::size_t b = 0; b < 4; ++b) {
       const std::size_t k = 4 * c + b;
-      if (!cells.block_continuous[k] ||
-          !planar_piece(params, merge, cells.block_moments[k], origin, min_count(half)))
-        continue;
-      cells.segments[c][b] = add_segment(cells.block_moments[k], cells.block_colours[k],
+      if (!cells.block_continuous[k]) continue;
+      const std::optional<SegmentPlane> fit =
+          planar_piece(params, merge, cells.block_moments[k], origin, min_count(half));
+      if (!fit) continue;
+      cells.segments[c][b] = add_segment(cells.block_moments[k], *fit, cells.block_colours[k],
                                          x0 + static_cast<int>(b % 2) * half,
                                          y0 + static_cast<int>(b / 2) * half, half);
     }
   }
-  return static_cast<std::uint32_t>(moments.segments.size());
+  return static_cast<std::uint32_t>(segments.fits.size());
 }
 
 SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count) {

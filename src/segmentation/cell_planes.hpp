@@ -49,14 +49,20 @@ void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
                    float max_depth_jump, float jump_per_z2, const Eigen::Vector3d& origin,
                    CellGrid& cells);
 
+// The segments of the cells mode, as merging takes them.
+struct CellSegments {
+  geometry::SegmentMomentSet moments;
+  std::vector<SegmentPlane> fits;            // each one's fit (made to test its planarity)
+  std::vector<Eigen::Vector3d> pixel_sums;   // each one's pixels: sum of x, sum of y, count
+  std::vector<Eigen::Vector3f> lab_colours;  // each one's mean colour, CIE-Lab
+};
+
 // Planar cells, and the planar blocks of the other cells, become segments 0..n-1 (grid.segments;
-// their pixels labelled in `labels`, the rest kNoLabel), with their moments and mean CIE-Lab
-// colours. A cell or block is planar when enough of it is valid, its depth is continuous and
-// its plane fit's RMS is within the noise allowance.
+// their pixels labelled in `labels`, the rest kNoLabel). A cell or block is planar when enough of
+// it is valid, its depth is continuous and its plane fit's RMS is within the noise allowance.
 std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
                                    const Eigen::Vector3d& origin, CellGrid& cells,
-                                   SegmentLabelImage& labels, geometry::SegmentMomentSet& moments,
-                                   std::vector<Eigen::Vector3f>& lab_colours);
+                                   SegmentLabelImage& labels, CellSegments& segments);
 
 // The segments' neighbours (8-adjacent blocks of different segments), as merging takes them.
 SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count);

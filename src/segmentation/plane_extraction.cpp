@@ -319,16 +319,17 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
                         static_cast<float>(cell_params.jump_per_z2), origin.cast<double>(), cells);
   if (segments_.width() != points.width() || segments_.height() != points.height())
     segments_ = SegmentLabelImage(points.width(), points.height());
-  geometry::SegmentMomentSet moments;
-  std::vector<Eigen::Vector3f> colours;
+  detail::CellSegments pieces;
   result.segment_count = detail::planar_cell_segments(
-      cell_params, params_.merge, origin.cast<double>(), cells, segments_, moments, colours);
+      cell_params, params_.merge, origin.cast<double>(), cells, segments_, pieces);
   result.timings.moments = elapsed_ms(clock);
   if (result.segment_count == 0) return result;
 
+  // Merging takes what the cells know: adjacency, fits and pixel sums (no pass over the pixels).
   const SegmentGraph graph = detail::cell_segment_graph(cells, result.segment_count);
   MergedPlanes merged =
-      merge_segments(segments_, moments, params_.merge, {colours, &points, &graph});
+      merge_segments(segments_, pieces.moments, params_.merge,
+                     {pieces.lab_colours, &points, &graph, pieces.fits, pieces.pixel_sums});
   result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
   result.timings.merging = elapsed_ms(clock);
 

@@ -75,7 +75,8 @@ struct AngleShare {
 class PlaneJoiner {
  public:
   PlaneJoiner(const SegmentLabelImage& labels, const PointImage* points,
-              const PlaneMergeParams& params, const Eigen::Vector3d& origin, MergedPlanes& merged);
+              std::span<const Eigen::Vector3d> segment_pixel_sums, const PlaneMergeParams& params,
+              const Eigen::Vector3d& origin, MergedPlanes& merged);
   void join_cheapest_pairs();  // while some pair costs below 1
   void compact();              // drops absorbed planes, renumbers in order
 
@@ -99,6 +100,7 @@ class PlaneJoiner {
 
   const SegmentLabelImage& labels_;
   const PointImage* points_;
+  std::span<const Eigen::Vector3d> segment_pixel_sums_;  // per segment, or empty
   const PlaneMergeParams& params_;
   const Eigen::Vector3d& origin_;
   MergedPlanes& merged_;
@@ -117,10 +119,12 @@ class PlaneJoiner {
 };
 
 PlaneJoiner::PlaneJoiner(const SegmentLabelImage& labels, const PointImage* points,
+                         std::span<const Eigen::Vector3d> segment_pixel_sums,
                          const PlaneMergeParams& params, const Eigen::Vector3d& origin,
                          MergedPlanes& merged)
     : labels_(labels),
       points_(points),
+      segment_pixel_sums_(segment_pixel_sums),
       params_(params),
       origin_(origin),
       merged_(merged),
@@ -148,6 +152,13 @@ std::uint32_t PlaneJoiner::plane_of_segment(std::uint32_t s) const {
 
 void PlaneJoiner::sum_pixels() {
   pixel_sums_.assign(plane_count_, Eigen::Vector3d::Zero());
+  if (!segment_pixel_sums_.empty()) {  // the caller's; integers in double: exact in any order
+    for (std::uint32_t s = 0; s < segment_pixel_sums_.size(); ++s) {
+      if (plane_of_segment(s) != kNoLabel)
+        pixel_sums_[plane_of_segment(s)] += segment_pixel_sums_[s];
+    }
+    return;
+  }
   for (int y = 0; y < labels_.height(); ++y) {
     for (int x = 0; x < labels_.width(); ++x) {
       const std::uint32_t s = labels_(x, y);
@@ -382,9 +393,10 @@ void PlaneJoiner::compact() {
 }  // namespace
 
 void join_adjacent_planes(const SegmentLabelImage& labels, const PointImage* points,
+                          std::span<const Eigen::Vector3d> segment_pixel_sums,
                           const PlaneMergeParams& params, const Eigen::Vector3d& origin,
                           MergedPlanes& merged) {
-  PlaneJoiner joiner(labels, points, params, origin, merged);
+  PlaneJoiner joiner(labels, points, segment_pixel_sums, params, origin, merged);
   joiner.join_cheapest_pairs();
   joiner.compact();
 }

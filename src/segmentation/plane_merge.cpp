@@ -32,6 +32,9 @@ void check_inputs(const SegmentLabelImage& labels, std::uint32_t segment_count,
   require(segment_colours.empty() || segment_colours.size() == segment_count,
           "plane merge: " + std::to_string(segment_colours.size()) + " segment colours for " +
               std::to_string(segment_count) + " segments");
+  require((inputs.fits.empty() || inputs.fits.size() == segment_count) &&
+              (inputs.pixel_sums.empty() || inputs.pixel_sums.size() == segment_count),
+          "plane merge: the given fits or pixel sums are not one per segment");
   require(inputs.graph == nullptr || inputs.graph->offsets.size() == std::size_t{segment_count} + 1,
           "plane merge: the given neighbour graph is not of the " + std::to_string(segment_count) +
               " segments");
@@ -43,9 +46,10 @@ struct SegmentFits {
   std::vector<double> min_cos;
 };
 
-// Fits only where a test needs them (most segments of a textured frame are tiny).
-SegmentFits fit_segments(const geometry::SegmentMomentSet& moments,
-                         const PlaneMergeParams& params) {
+// Fits only where a test needs them (most segments of a textured frame are tiny); `given`: the
+// caller's fits of every segment (MergeInputs::fits), taken instead of fitting again.
+SegmentFits fit_segments(const geometry::SegmentMomentSet& moments, const PlaneMergeParams& params,
+                         std::span<const SegmentPlane> given) {
   const std::vector<geometry::SegmentMoments>& segments = moments.segments;
   const auto segment_count = static_cast<std::uint32_t>(segments.size());
   const std::uint64_t min_fit_pixels =
@@ -58,7 +62,7 @@ SegmentFits fit_segments(const geometry::SegmentMomentSet& moments,
       segment_count, segment_count * 64, [&](std::size_t begin, std::size_t end, std::size_t) {
         for (std::size_t s = begin; s < end; ++s) {
           if (segments[s].count < min_fit_pixels) continue;
-          fits[s] = fit_plane(segments[s], moments.origin, params.fit);
+          fits[s] = given.empty() ? fit_plane(segments[s], moments.origin, params.fit) : given[s];
           if (!fits[s].valid || segments[s].count < params.min_pixels_for_angle) continue;
           const double max_deg =
               params.max_normal_angle_deg + normal_uncertainty_deg(params, fits[s]);
@@ -279,7 +283,7 @@ MergedPlanes merge_segments(const SegmentLabelImage& labels,
                              : params.neighbours == NeighbourTest::pixel_adjacency
                                  ? pixel_adjacency_graph(labels, segment_count)
                                  : bounding_box_graph(labels, segment_count);
-  const SegmentFits fits = fit_segments(moments, params);
+  const SegmentFits fits = fit_segments(moments, params, inputs.fits);
   MergedPlanes result;
   result.segment_plane.assign(segment_count, kNoLabel);
   PlaneGrower grower(moments, fits, graph, params, result);
@@ -287,7 +291,8 @@ MergedPlanes merge_segments(const SegmentLabelImage& labels,
   if (!inputs.colours.empty()) sum_colours(inputs.colours, moments.segments, result);
   result.graph = graph;
   if (params.join_planes)
-    detail::join_adjacent_planes(labels, inputs.points, params, moments.origin, result);
+    detail::join_adjacent_planes(labels, inputs.points, inputs.pixel_sums, params, moments.origin,
+                                 result);
   return result;
 }
 

@@ -129,6 +129,12 @@ struct MergeInputs {
   // The segments' neighbours when the caller knows them (the cells mode: cells and blocks next
   // to each other); otherwise found in the labels by params.neighbours.
   const SegmentGraph* graph = nullptr;
+  // Each segment's fit_plane(its moments, moments.origin, params.fit) when the caller has it (the
+  // cells mode fitted them to test planarity); otherwise fitted here.
+  std::span<const SegmentPlane> fits = {};
+  // Each segment's labelled pixels: sum of x, sum of y, count (where the see-through test draws
+  // its lines from) when the caller knows them; otherwise summed over the labels.
+  std::span<const Eigen::Vector3d> pixel_sums = {};
 };
 
 // moments.segments and the label image cover the same segment_count segments.
