@@ -347,15 +347,29 @@ struct ScoredPlane {
   float offset;
 };
 
+// plane_score's rule without its divisions: a pixel's score against a plane is
+// distance / (base facing) with distance = |n . p + offset|, facing = max(|n . p| / |p|, min)
+// and base = distance_base + distance_per_z2 z^2; so score = distance |p| / (base max(|n . p|,
+// min |p|)), whose parts are compared by cross-multiplying.
 struct ScoreRule {
   float distance_base, distance_per_z2, min_facing;
 
-  // plane_score: the distance to the plane over the allowance there (< 1: within it).
-  float operator()(const ScoredPlane& plane, const Eigen::Vector3f& p, float inverse_range) const {
-    const float along = plane.normal.dot(p);
-    const float facing = std::max(std::fabs(along) * inverse_range, min_facing);
-    return std::fabs(along + plane.offset) /
-           ((distance_base + distance_per_z2 * p.z() * p.z()) * facing);
+  // The index of the candidate with the lowest score below 1, or -1.
+  int best(const ScoredPlane* const* planes, int count, const Eigen::Vector3f& p) const {
+    const float range = p.norm();
+    const float floor = min_facing * range;
+    float best_distance = 1.0f, best_scale = 0.0f;  // no candidate yet: 1 / 0
+    int choice = -1;
+    for (int k = 0; k < count; ++k) {
+      const float along = planes[k]->normal.dot(p);
+      const float distance = std::fabs(along + planes[k]->offset);
+      const float scale = std::max(std::fabs(along), floor);
+      if (distance * best_scale < best_distance * scale) {
+        best_distance = distance, best_scale = scale, choice = k;
+      }
+    }
+    const float base = distance_base + distance_per_z2 * p.z() * p.z();
+    return choice >= 0 && best_distance * range < base * best_scale ? choice : -1;
   }
 };
 
@@ -416,21 +430,15 @@ std::uint32_t assign_cell(const AssignInputs& in, std::size_t cell,
   const int x1 = std::min(points.width(), x0 + in.cells.cell_size);
   const int y1 = std::min(points.height(), y0 + in.cells.cell_size);
   std::array<std::uint32_t, 36> taken{};
+  std::array<const ScoredPlane*, 36> scored;
+  for (int k = 0; k < candidates.count; ++k) scored[k] = &in.scored[candidates.planes[k]];
   for (int y = y0; y < y1; ++y) {
     for (int x = x0; x < x1; ++x) {
       const std::size_t i = static_cast<std::size_t>(y) * points.width() + x;
       const Point4f& point = points.data()[i];
       if (!is_valid(point)) continue;
-      int choice = candidates.whole ? 0 : -1;
-      if (!candidates.whole) {
-        const Eigen::Vector3f p = point.head<3>();
-        const float inverse_range = 1.0f / p.norm();
-        float best = 1.0f;
-        for (int k = 0; k < candidates.count; ++k) {
-          const float score = in.rule(in.scored[candidates.planes[k]], p, inverse_range);
-          if (score < best) best = score, choice = k;
-        }
-      }
+      const int choice =
+          candidates.whole ? 0 : in.rule.best(scored.data(), candidates.count, point.head<3>());
       if (choice < 0) continue;
       const std::uint32_t plane = candidates.planes[choice];
       pixel_plane[i] = plane;
