@@ -161,6 +161,43 @@ TEST(PlaneMerge, JoinsCoplanarNeighboursAndKeepsOffsetAndTiltedOnesApart) {
   EXPECT_NE(tilted[2], tilted[3]);
 }
 
+// What a caller may hand merging instead of having it recomputed (the cells mode does): the
+// segments' graph, fits and pixel sums give the same planes as merging finds them itself; inputs
+// of the wrong size are refused.
+TEST(PlaneMerge, GivenGraphFitsAndPixelSumsChangeNothing) {
+  segmentation::PlaneMergeParams params;
+  params.min_seed_pixels = 50;
+  params.min_pixels_for_angle = 50;
+  const StripScene scene = strips({2, 2, 2.1, 2}, {0, 0, 0, 0.2});
+  const compute::Context context = compute::Context::cpu();
+  const std::vector<std::uint32_t> labels(scene.labels.pixels().begin(),
+                                          scene.labels.pixels().end());
+  const geometry::SegmentMomentSet moments = moments_of(context, scene.points, labels, 4);
+  const segmentation::MergedPlanes own =
+      segmentation::merge_segments(scene.labels, moments, params, {{}, &scene.points});
+  std::vector<segmentation::SegmentPlane> fits;
+  std::vector<Eigen::Vector3d> pixel_sums(4, Eigen::Vector3d::Zero());
+  for (const geometry::SegmentMoments& m : moments.segments)
+    fits.push_back(segmentation::fit_plane(m, moments.origin, params.fit));
+  for (int y = 0; y < scene.labels.height(); ++y) {
+    for (int x = 0; x < scene.labels.width(); ++x)
+      pixel_sums[scene.labels(x, y)] += Eigen::Vector3d(x, y, 1.0);
+  }
+  const segmentation::SegmentGraph graph = segmentation::pixel_adjacency_graph(scene.labels, 4);
+  const segmentation::MergedPlanes given = segmentation::merge_segments(
+      scene.labels, moments, params, {{}, &scene.points, &graph, fits, pixel_sums});
+  EXPECT_EQ(given.segment_plane, own.segment_plane);
+  ASSERT_EQ(given.planes.size(), own.planes.size());
+  for (std::size_t p = 0; p < own.planes.size(); ++p) {
+    EXPECT_EQ(given.planes[p].normal, own.planes[p].normal);
+    EXPECT_EQ(given.planes[p].offset, own.planes[p].offset);
+  }
+  const std::vector<segmentation::SegmentPlane> three(fits.begin(), fits.begin() + 3);
+  EXPECT_ERROR_MENTIONS(
+      segmentation::merge_segments(scene.labels, moments, params, {{}, nullptr, nullptr, three}),
+      "not one per segment");
+}
+
 TEST(PlaneMerge, AdjacencyGraphsKnownAnswers) {
   // 0 0 1
   // 2 . 1      (. = no label)
