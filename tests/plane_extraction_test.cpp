@@ -318,18 +318,29 @@ TEST(PlaneExtraction, CellsModeDetectsTheLargeGroundTruthPlanesOfSyntheticKinect
   expect_detected(score_synthetic_tour(100, segmentation::PlaneExtractionMode::cells), 0.95);
 }
 
-segmentation::PlaneSet extract_synthetic(const compute::Context& context,
-                                         const PinholeIntrinsics& camera, int frame_index) {
+// Frame `frame_index` of the robot tour through synthetic world 1 (Kinect noise), back-projected
+// on the CPU: its points and colours.
+struct SyntheticView {
+  PointImage points;
+  RgbImage color;
+};
+
+SyntheticView synthetic_view(const PinholeIntrinsics& camera, int frame_index) {
   static const synth::World world = synth::make_building(1);
   const Trajectory tour = synth::robot_tour(world, 300);
-  const synth::SyntheticFrame frame =
+  synth::SyntheticFrame frame =
       synth::render(world, camera, tour[frame_index].pose, synth::NoiseModel::kinect(), 77);
   geometry::DepthRange range;
   range.units_per_metre = synth::kTumDepthUnitsPerMetre;
-  const PointImage points =
-      geometry::backproject(compute::Context::cpu(), frame.depth, camera, range);
+  return {geometry::backproject(compute::Context::cpu(), frame.depth, camera, range),
+          std::move(frame.color)};
+}
+
+segmentation::PlaneSet extract_synthetic(const compute::Context& context,
+                                         const PinholeIntrinsics& camera, int frame_index) {
+  const SyntheticView view = synthetic_view(camera, frame_index);
   segmentation::PlaneExtractor extractor(context, camera);
-  return extractor.extract(points, frame.color);
+  return extractor.extract(view.points, view.color);
 }
 
 void expect_same_planes(const segmentation::PlaneSet& a, const segmentation::PlaneSet& b,
@@ -375,19 +386,14 @@ KARTOGRAF_INSTANTIATE_BACKEND_TESTS(PlaneExtractionBackendTest);
 TEST(PlaneExtraction, CellsModeGivesConsistentPlanes) {
   const compute::Context context = compute::Context::cpu();
   const PinholeIntrinsics camera{320, 240, 262.5, 262.5, 159.5, 119.5};
-  static const synth::World world = synth::make_building(1);
-  const Trajectory tour = synth::robot_tour(world, 300);
-  const synth::SyntheticFrame frame =
-      synth::render(world, camera, tour[40].pose, synth::NoiseModel::kinect(), 77);
-  geometry::DepthRange range;
-  range.units_per_metre = synth::kTumDepthUnitsPerMetre;
-  const PointImage points = geometry::backproject(context, frame.depth, camera, range);
+  const SyntheticView view = synthetic_view(camera, 40);
+  const PointImage& points = view.points;
   segmentation::PlaneExtractionParams params;
   params.mode = segmentation::PlaneExtractionMode::cells;
   segmentation::PlaneExtractor extractor(context, camera, params);
-  const segmentation::PlaneSet set = extractor.extract(points, frame.color);
+  const segmentation::PlaneSet set = extractor.extract(points, view.color);
   ASSERT_GE(set.planes.size(), 2u);
-  expect_same_planes(set, extractor.extract(points, frame.color), 0.0);
+  expect_same_planes(set, extractor.extract(points, view.color), 0.0);
   std::vector<std::uint64_t> counted(set.planes.size() + 1, 0);
   std::uint64_t labelled = 0, beyond = 0;
   for (std::size_t i = 0; i < set.labels.size(); ++i) {
@@ -415,7 +421,7 @@ TEST(PlaneExtraction, CellsModeGivesConsistentPlanes) {
       EXPECT_LE(plane.inlier_count, set.planes[plane.id - 2].inlier_count);
     }
   }
-  EXPECT_TRUE(extractor.extract(PointImage(320, 240, invalid_point()), frame.color).planes.empty());
+  EXPECT_TRUE(extractor.extract(PointImage(320, 240, invalid_point()), view.color).planes.empty());
   const PinholeIntrinsics tiny{6, 4, 5, 5, 3, 2};
   PointImage flat(6, 4);
   for (int y = 0; y < 4; ++y)
@@ -424,26 +430,19 @@ TEST(PlaneExtraction, CellsModeGivesConsistentPlanes) {
   EXPECT_TRUE(small.extract(flat, RgbImage(6, 4)).planes.empty());  // fewer than 300 pixels
 }
 
-// A frame whose size is no multiple of the cells' (the last row and column of cells cut by the
-// border, some of their blocks empty) gives the planes of the same view at a multiple.
 // The share of a synthetic view's valid pixels that the extraction puts on planes, and its plane
 // count (frame 40 of the robot tour, fx = 210 at any size).
 std::pair<double, std::size_t> view_coverage(int width, int height,
                                              segmentation::PlaneExtractionMode mode) {
   const compute::Context context = compute::Context::cpu();
-  static const synth::World world = synth::make_building(1);
-  const Trajectory tour = synth::robot_tour(world, 300);
   const PinholeIntrinsics camera{
       width, height, 210.0, 210.0, (width - 1) / 2.0, (height - 1) / 2.0};
-  const synth::SyntheticFrame frame =
-      synth::render(world, camera, tour[40].pose, synth::NoiseModel::kinect(), 77);
-  geometry::DepthRange range;
-  range.units_per_metre = synth::kTumDepthUnitsPerMetre;
-  const PointImage points = geometry::backproject(context, frame.depth, camera, range);
+  const SyntheticView view = synthetic_view(camera, 40);
+  const PointImage& points = view.points;
   segmentation::PlaneExtractionParams params;
   params.mode = mode;
   segmentation::PlaneExtractor extractor(context, camera, params);
-  const segmentation::PlaneSet set = extractor.extract(points, frame.color);
+  const segmentation::PlaneSet set = extractor.extract(points, view.color);
   std::uint64_t valid = 0, labelled = 0;
   for (std::size_t i = 0; i < points.size(); ++i) {
     valid += is_valid(points.data()[i]);

@@ -174,6 +174,12 @@ def _camera(msg) -> _kartograf.PinholeIntrinsics:
     return _kartograf.PinholeIntrinsics(int(msg.width), int(msg.height), k[0], k[4], k[2], k[5])
 
 
+def _transform_matrix(stamped) -> np.ndarray:
+    """parent_T_child of a geometry_msgs/TransformStamped."""
+    transform = stamped.transform
+    return bag_poses.message_matrix(transform.translation, transform.rotation)
+
+
 class _PoseRecords:
     """What the pose prior is made of, gathered while the bag is read."""
 
@@ -199,13 +205,10 @@ class _PoseRecords:
         for stamped in self.changing:
             parent, child = stamped.header.frame_id, stamped.child_frame_id
             if not (self.odometry and tree.has_edge(parent, child)):
-                transform = stamped.transform
-                tree.add_sample(parent, child, _stamp(stamped),
-                                bag_poses.message_matrix(transform.translation, transform.rotation))
+                tree.add_sample(parent, child, _stamp(stamped), _transform_matrix(stamped))
         for stamped in self.fixed:
-            transform = stamped.transform
             tree.add_fixed(stamped.header.frame_id, stamped.child_frame_id,
-                           bag_poses.message_matrix(transform.translation, transform.rotation))
+                           _transform_matrix(stamped))
         tree.finish()
         return tree
 

@@ -496,9 +496,15 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
       const bool earlier = assigned_in[c] >= 0 && assigned_in[c] < pass;
       return Planes{earlier ? carried[c] : kNone, kNone, kNone, kNone};
     };
+    // The cells this pass reaches, with their candidates (found once).
     std::vector<std::size_t> now;
+    std::vector<CellCandidates> now_candidates;
     for (std::size_t c = 0; c < cells.size(); ++c) {
-      if (assigned_in[c] < 0 && candidates_of(cells, c, planes_of).count > 0) now.push_back(c);
+      if (assigned_in[c] >= 0) continue;
+      const CellCandidates candidates = candidates_of(cells, c, planes_of);
+      if (candidates.count == 0) continue;
+      now.push_back(c);
+      now_candidates.push_back(candidates);
     }
     if (now.empty()) break;
     compute::detail::for_each_chunk(
@@ -507,8 +513,7 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
           chunk_sums[chunk].assign(planes.size(), PlanePixelSums{});
           for (std::size_t k = begin; k < end; ++k) {
             const std::size_t c = now[k];
-            carried[c] = assign_cell(in, c, candidates_of(cells, c, planes_of), chunk_sums[chunk],
-                                     pixel_plane);
+            carried[c] = assign_cell(in, c, now_candidates[k], chunk_sums[chunk], pixel_plane);
           }
         });
     for (const std::vector<PlanePixelSums>& sums : chunk_sums) {  // in chunk order

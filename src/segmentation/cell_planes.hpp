@@ -31,8 +31,8 @@ struct CellGrid {
   std::vector<std::uint8_t> block_continuous;
   std::vector<Eigen::Vector3d> block_colours;  // sum of the block's valid pixels' RGB
   std::vector<std::uint8_t> valid;             // per pixel: 1 where it has a point
-  // Per cell: its segment if the whole cell is planar, else those of its planar blocks
-  // (kNoLabel where none).
+  // Per cell: its segment in all four entries if the whole cell is planar, else those of its
+  // planar blocks (kNoLabel where none).
   std::vector<std::array<std::uint32_t, 4>> segments;
 
   std::size_t size() const { return moments.size(); }
@@ -41,10 +41,10 @@ struct CellGrid {
 };
 
 // One pass over the frame: which pixels have a point, every block's moments about `origin` and
-// colour sum, and every
-// block's and cell's depth continuity: neighbouring valid pixels in a row or column of it jump
-// (by more than max_depth_jump of their depth z and more than jump_per_z2 z^2) at most half its
-// side's times (an edge across it jumps on each row or column it crosses). Cells sum their blocks.
+// colour sum, and every block's and cell's depth continuity: neighbouring valid pixels in a row
+// or column of it jump (by more than max_depth_jump of their depth z and more than jump_per_z2
+// z^2) at most half its side's times (an edge across it jumps on each row or column it
+// crosses). Cells sum their blocks.
 void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
                    float max_depth_jump, float jump_per_z2, const Eigen::Vector3d& origin,
                    CellGrid& cells);
