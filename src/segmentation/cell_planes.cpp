@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
+#include <limits>
 #include <optional>
 
 #include "compute/cpu_parallel.hpp"
@@ -60,6 +62,25 @@ struct BlockRect {
   int cell_x0, cell_y0;
 };
 
+// Four floats that the compiler keeps in one SIMD register (GCC and Clang vector extension).
+using Lanes = float __attribute__((vector_size(16)));
+// Four int lanes, for comparisons and choices between Lanes.
+using Mask = std::int32_t __attribute__((vector_size(16)));
+
+Lanes splat(float value) {
+  return Lanes{value, value, value, value};
+}
+Mask splat(std::int32_t value) {
+  return Mask{value, value, value, value};
+}
+
+// Per lane: a where the mask is set, else b.
+template <class Vector>
+Vector select(Mask mask, Vector a, Vector b) {
+  return reinterpret_cast<Vector>((mask & reinterpret_cast<Mask>(a)) |
+                                  (~mask & reinterpret_cast<Mask>(b)));
+}
+
 struct BlockSums {
   CellSums sums;
   std::uint32_t inside_jumps = 0, edge_jumps = 0;
@@ -95,11 +116,12 @@ BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRe
   }
   CellSums& sums = out.sums;
   sums.reference = reference->head<3>();
-  const float rx = sums.reference.x(), ry = sums.reference.y(), rz = sums.reference.z();
-  // Local accumulators: the validity mask's byte stores may alias anything, so sums kept in the
-  // struct would be stored and reloaded for every pixel.
-  float sx = 0, sy = 0, sz = 0, xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  std::uint32_t count = 0, red = 0, green = 0, blue = 0;
+  const Lanes origin{sums.reference.x(), sums.reference.y(), sums.reference.z(), 0.0f};
+  // Local accumulators (the validity mask's byte stores may alias anything, so sums kept in the
+  // struct would be stored and reloaded for every pixel), four lanes each: with d = (dx, dy, dz,
+  // 1), `first` sums d (the count in its last lane) and `by_x` .. `by_z` sum d dx .. d dz.
+  Lanes first{}, by_x{}, by_y{}, by_z{};
+  std::uint32_t red = 0, green = 0, blue = 0;
   for (int y = r.y0; y < r.y1; ++y) {
     const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
     const Rgb8* colours = rgb.data() + static_cast<std::size_t>(y) * rgb.width();
@@ -109,11 +131,12 @@ BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRe
       const bool is = is_valid(p);
       valid_row[x] = is;
       if (!is) continue;
-      const float dx = p.x() - rx, dy = p.y() - ry, dz = p.z() - rz;
-      ++count;
-      sx += dx, sy += dy, sz += dz;
-      xx += dx * dx, xy += dx * dy, xz += dx * dz;
-      yy += dy * dy, yz += dy * dz, zz += dz * dz;
+      Lanes d;
+      std::memcpy(&d, p.data(), sizeof d);
+      d = d - origin;
+      d[3] = 1.0f;
+      first += d;
+      by_x += d * d[0], by_y += d * d[1], by_z += d * d[2];
       red += colours[x][0], green += colours[x][1], blue += colours[x][2];
     }
     // Jumps within the block, and with the neighbouring blocks of the same cell (left, above).
@@ -125,9 +148,10 @@ BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRe
     for (int x = r.x0; x < r.x1; ++x) vertical += jumps(row[x].z(), above[x].z());
     (y > r.y0 ? out.inside_jumps : out.edge_jumps) += vertical;
   }
-  sums.sum = Eigen::Vector3f(sx, sy, sz);
-  sums.count = count;
-  sums.xx = xx, sums.xy = xy, sums.xz = xz, sums.yy = yy, sums.yz = yz, sums.zz = zz;
+  sums.sum = Eigen::Vector3f(first[0], first[1], first[2]);
+  sums.count = static_cast<std::uint32_t>(first[3]);  // at most 2^24 pixels: exact in float
+  sums.xx = by_x[0], sums.xy = by_x[1], sums.xz = by_x[2];
+  sums.yy = by_y[1], sums.yz = by_y[2], sums.zz = by_z[2];
   sums.red = red, sums.green = green, sums.blue = blue;
   return out;
 }
@@ -304,11 +328,12 @@ SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_cou
 namespace {
 
 // The distinct planes of a cell and its 8 neighbours (kNoLabel left out), the cell's own first;
-// `whole`: the cell and all its neighbours inside the image lie in one plane.
+// `own`: the cell lies in one plane; `whole`: so do all its neighbours inside the image, in the
+// same one.
 struct CellCandidates {
   std::array<std::uint32_t, 36> planes;
   int count = 0;
-  bool whole = false;
+  bool own = false, whole = false;
 
   void add(std::uint32_t plane) {
     if (plane != geometry::kNoLabel &&
@@ -327,7 +352,7 @@ CellCandidates candidates_of(const CellGrid& cells, std::size_t cell, PlanesOf&&
   };
   const std::array<std::uint32_t, 4> own = planes_of(cell);
   for (const std::uint32_t p : own) out.add(p);
-  out.whole = in_one(own);
+  out.own = out.whole = in_one(own);
   const int cx = static_cast<int>(cell % cells.columns),
             cy = static_cast<int>(cell / cells.columns);
   for (int y = std::max(0, cy - 1); y <= std::min(cells.rows - 1, cy + 1); ++y) {
@@ -347,29 +372,45 @@ struct ScoredPlane {
   float offset;
 };
 
-// plane_score's rule without its divisions: a pixel's score against a plane is
-// distance / (base facing) with distance = |n . p + offset|, facing = max(|n . p| / |p|, min)
-// and base = distance_base + distance_per_z2 z^2; so score = distance |p| / (base max(|n . p|,
-// min |p|)), whose parts are compared by cross-multiplying.
+// Four pixels of a row (a lane without a point holds NaN, which compares false: it takes none).
+struct PixelLanes {
+  Lanes x, y, z;
+};
+
+// A cell's candidate planes, each coefficient in all four lanes.
+struct CandidateLanes {
+  std::array<Lanes, 36> nx, ny, nz, offset;
+  int count = 0;
+};
+
+// plane_score's rule without divisions or roots, four pixels at once: a pixel's score against a
+// plane is distance / (base facing) with distance = |n . p + offset|, facing = max(|n . p| /
+// |p|, min) and base = distance_base + distance_per_z2 z^2; so score^2 = distance^2 |p|^2 /
+// (base^2 max((n . p)^2, min^2 |p|^2)), whose parts (none negative) are compared by
+// cross-multiplying.
 struct ScoreRule {
   float distance_base, distance_per_z2, min_facing;
 
-  // The index of the candidate with the lowest score below 1, or -1.
-  int best(const ScoredPlane* const* planes, int count, const Eigen::Vector3f& p) const {
-    const float range = p.norm();
-    const float floor = min_facing * range;
-    float best_distance = 1.0f, best_scale = 0.0f;  // no candidate yet: 1 / 0
-    int choice = -1;
-    for (int k = 0; k < count; ++k) {
-      const float along = planes[k]->normal.dot(p);
-      const float distance = std::fabs(along + planes[k]->offset);
-      const float scale = std::max(std::fabs(along), floor);
-      if (distance * best_scale < best_distance * scale) {
-        best_distance = distance, best_scale = scale, choice = k;
-      }
+  // Per lane: the index of the candidate with the lowest score below 1, or -1; `distance2`: the
+  // point's squared distance to that candidate.
+  Mask best(const CandidateLanes& planes, const PixelLanes& p, Lanes& distance2) const {
+    const Lanes range2 = p.x * p.x + p.y * p.y + p.z * p.z;
+    const Lanes floor2 = splat(min_facing * min_facing) * range2;
+    Lanes best_d2 = splat(1.0f), best_s2 = splat(0.0f);  // no candidate yet: 1 / 0
+    Mask choice = splat(-1);
+    for (int k = 0; k < planes.count; ++k) {
+      const Lanes along = planes.nx[k] * p.x + planes.ny[k] * p.y + planes.nz[k] * p.z;
+      const Lanes d = along + planes.offset[k];
+      const Lanes d2 = d * d, a2 = along * along;
+      const Lanes s2 = select(a2 > floor2, a2, floor2);
+      const Mask better = d2 * best_s2 < best_d2 * s2;
+      best_d2 = select(better, d2, best_d2);
+      best_s2 = select(better, s2, best_s2);
+      choice = select(better, splat(k), choice);
     }
-    const float base = distance_base + distance_per_z2 * p.z() * p.z();
-    return choice >= 0 && best_distance * range < base * best_scale ? choice : -1;
+    const Lanes base = splat(distance_base) + splat(distance_per_z2) * p.z * p.z;
+    distance2 = best_d2;
+    return select(best_d2 * range2 < base * base * best_s2, choice, splat(-1));
   }
 };
 
@@ -384,27 +425,39 @@ struct AssignInputs {
   ScoreRule rule;
 };
 
-// A cell inside one plane, away from the image's edge: its valid pixels take the plane, its
-// moments give the plane's count and squared distances, and it adds nothing to the extent. A
-// plane's image and its in-plane coordinates are related by a homography, which keeps convex
-// hulls: the extreme points lie on the plane's outline in the image, in cells at its border or at
-// the image's edge, never inside.
-void assign_interior_cell(const AssignInputs& in, std::size_t cell, std::uint32_t plane,
-                          std::vector<PlanePixelSums>& sums,
-                          std::vector<std::uint32_t>& pixel_plane) {
+// A planar cell whose neighbours hold no other plane: its valid pixels take its plane (its
+// planarity test and the merge have judged them), and its moments give the plane's count and
+// squared distances. A plane's image and its in-plane coordinates are related by a homography,
+// which keeps convex hulls: a plane's extreme points lie on its outline in the image, never
+// inside. So the cell adds to the extent only the first and last valid pixel of each row (the
+// corners of its pixels' hull are among them), and a cell whose neighbours all lie in the plane
+// (`inside`, away from the image's edge) adds nothing.
+void assign_planar_cell(const AssignInputs& in, std::size_t cell, std::uint32_t plane, bool inside,
+                        std::vector<PlanePixelSums>& sums,
+                        std::vector<std::uint32_t>& pixel_plane) {
   const int width = in.points.width();
   const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
-  for (int y = y0; y < y0 + in.cells.cell_size; ++y) {
+  const int x1 = std::min(width, x0 + in.cells.cell_size);
+  const int y1 = std::min(in.points.height(), y0 + in.cells.cell_size);
+  const PlaneFrame& frame = in.frames[plane];
+  PlanePixelSums& sum = sums[plane];
+  for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * width;
-    for (int x = x0; x < x0 + in.cells.cell_size; ++x) {
-      if (in.cells.valid[row + x]) pixel_plane[row + x] = plane;
+    int first = -1, last = -1;
+    for (int x = x0; x < x1; ++x) {
+      if (!in.cells.valid[row + x]) continue;
+      pixel_plane[row + x] = plane;
+      if (first < 0) first = x;
+      last = x;
     }
+    if (inside || first < 0) continue;
+    sum.extend(frame, in.points.data()[row + first]);
+    sum.extend(frame, in.points.data()[row + last]);
   }
   const geometry::SegmentMoments& m = in.cells.moments[cell];
   const Eigen::Vector3d& n = in.planes[plane].normal;
   // sum (n . p + offset)^2 with p = origin + q: n^T (sum q q^T) n + 2 e n . (sum q) + count e^2.
   const double e = n.dot(in.origin) + in.planes[plane].offset;
-  PlanePixelSums& sum = sums[plane];
   sum.squared_error += n.dot(m.sum_outer * n) + 2 * e * n.dot(m.sum) + double(m.count) * e * e;
   sum.count += m.count;
 }
@@ -415,37 +468,86 @@ bool at_image_edge(const CellGrid& cells, std::size_t cell) {
          cy + 1 == std::size_t(cells.rows);
 }
 
+// The candidates' coefficients, each in all four lanes.
+CandidateLanes candidate_lanes(const AssignInputs& in, const CellCandidates& candidates) {
+  CandidateLanes lanes;
+  lanes.count = candidates.count;
+  for (int k = 0; k < candidates.count; ++k) {
+    const ScoredPlane& plane = in.scored[candidates.planes[k]];
+    lanes.nx[k] = splat(plane.normal.x()), lanes.ny[k] = splat(plane.normal.y());
+    lanes.nz[k] = splat(plane.normal.z()), lanes.offset[k] = splat(plane.offset);
+  }
+  return lanes;
+}
+
+// Each valid pixel of the cell takes the candidate it scores best against (none if none is
+// within its allowance), and is added to that plane's sums: its count and squared distance, and
+// its extent from the first and last pixel of each row that took the plane (the corners of the
+// hull of a plane's pixels in the cell are among them; see assign_planar_cell). Four pixels are
+// scored at once; the sums stay in locals until the cell is done. Returns how many pixels took
+// each candidate.
+std::array<std::uint32_t, 36> score_cell_pixels(const AssignInputs& in, std::size_t cell,
+                                                const CellCandidates& candidates,
+                                                std::vector<PlanePixelSums>& sums,
+                                                std::vector<std::uint32_t>& pixel_plane) {
+  const Point4f* points = in.points.data();
+  const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
+  const int x1 = std::min(in.points.width(), x0 + in.cells.cell_size);
+  const int y1 = std::min(in.points.height(), y0 + in.cells.cell_size);
+  const int count = candidates.count;
+  const CandidateLanes lanes = candidate_lanes(in, candidates);
+  std::array<std::uint32_t, 36> taken{};
+  std::array<double, 36> squared{};
+  const Lanes none = splat(std::numeric_limits<float>::quiet_NaN());
+  for (int y = y0; y < y1; ++y) {
+    const std::size_t row = static_cast<std::size_t>(y) * in.points.width();
+    std::array<int, 36> first, last;
+    std::fill_n(first.begin(), count, -1);
+    for (int x = x0; x < x1; x += 4) {
+      PixelLanes p{none, none, none};
+      for (int j = 0; j < 4 && x + j < x1; ++j) {
+        const Point4f& point = points[row + x + j];
+        p.x[j] = point.x(), p.y[j] = point.y(), p.z[j] = point.z();
+      }
+      Lanes distance2;
+      const Mask choices = in.rule.best(lanes, p, distance2);
+      for (int j = 0; j < 4; ++j) {
+        const int choice = choices[j];
+        if (choice < 0) continue;
+        pixel_plane[row + x + j] = candidates.planes[choice];
+        ++taken[choice];
+        squared[choice] += distance2[j];
+        if (first[choice] < 0) first[choice] = x + j;
+        last[choice] = x + j;
+      }
+    }
+    for (int k = 0; k < count; ++k) {
+      if (first[k] < 0) continue;
+      const std::uint32_t plane = candidates.planes[k];
+      sums[plane].extend(in.frames[plane], points[row + first[k]]);
+      sums[plane].extend(in.frames[plane], points[row + last[k]]);
+    }
+  }
+  for (int k = 0; k < count; ++k) {
+    sums[candidates.planes[k]].count += taken[k];
+    sums[candidates.planes[k]].squared_error += squared[k];
+  }
+  return taken;
+}
+
 // Assigns the cell's valid pixels among the candidates, adding them to their planes' sums;
 // returns the plane that took the most of them when that is at least a quarter of the cell's
 // valid pixels (kNoLabel otherwise).
 std::uint32_t assign_cell(const AssignInputs& in, std::size_t cell,
                           const CellCandidates& candidates, std::vector<PlanePixelSums>& sums,
                           std::vector<std::uint32_t>& pixel_plane) {
-  if (candidates.whole && !at_image_edge(in.cells, cell)) {
-    assign_interior_cell(in, cell, candidates.planes[0], sums, pixel_plane);
+  if (candidates.own && candidates.count == 1) {
+    const bool inside = candidates.whole && !at_image_edge(in.cells, cell);
+    assign_planar_cell(in, cell, candidates.planes[0], inside, sums, pixel_plane);
     return candidates.planes[0];
   }
-  const PointImage& points = in.points;
-  const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
-  const int x1 = std::min(points.width(), x0 + in.cells.cell_size);
-  const int y1 = std::min(points.height(), y0 + in.cells.cell_size);
-  std::array<std::uint32_t, 36> taken{};
-  std::array<const ScoredPlane*, 36> scored;
-  for (int k = 0; k < candidates.count; ++k) scored[k] = &in.scored[candidates.planes[k]];
-  for (int y = y0; y < y1; ++y) {
-    for (int x = x0; x < x1; ++x) {
-      const std::size_t i = static_cast<std::size_t>(y) * points.width() + x;
-      const Point4f& point = points.data()[i];
-      if (!is_valid(point)) continue;
-      const int choice =
-          candidates.whole ? 0 : in.rule.best(scored.data(), candidates.count, point.head<3>());
-      if (choice < 0) continue;
-      const std::uint32_t plane = candidates.planes[choice];
-      pixel_plane[i] = plane;
-      sums[plane].add(in.frames[plane], point);
-      ++taken[choice];
-    }
-  }
+  const std::array<std::uint32_t, 36> taken =
+      score_cell_pixels(in, cell, candidates, sums, pixel_plane);
   const auto most =
       std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
   const bool enough = candidates.count > 0 && 4 * taken[most] >= in.cells.moments[cell].count;

@@ -68,16 +68,15 @@ std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMer
 SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count);
 
 // Every valid pixel's plane (index into `planes`, or kNoLabel), in passes over the cells:
-// - first, cells inside one plane (their 8 neighbours in it too) take it whole; pixels of cells
-//   at a plane's border or next to one take, among the planes of their cell and its neighbours
-//   (those of their segments), the one whose distance allowance they are deepest within (merge's
-//   plane score);
+// - first, planar cells whose neighbours hold no other plane take their plane whole; pixels of
+//   the other cells take, among the planes of their cell and its neighbours (those of their
+//   segments), the one whose distance allowance they are deepest within (merge's plane score);
 // - then (passes - 1 times) cells not yet reached do the same with the planes their reached
 //   neighbours carry: the plane most of a cell's pixels took.
 // Planes thus reach past the cells next to them, around objects and across gaps of no depth.
 // segment_plane: each segment's plane (kNoLabel: none); origin: the cells' moments'. Returns the
-// sums of each plane's pixels (cells inside a plane add their moments' count and squared
-// distances, but not to the extent: their pixels cannot be extreme, see assign_interior_cell).
+// sums of each plane's pixels (cells taken whole add their moments' count and squared distances,
+// and only their outline's pixels to the extent: see assign_planar_cell).
 std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const CellGrid& cells,
                                                const std::vector<std::uint32_t>& segment_plane,
                                                const std::vector<SegmentPlane>& planes,

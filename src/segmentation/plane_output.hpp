@@ -55,11 +55,19 @@ struct PlanePixelSums {
 
   void add(const PlaneFrame& frame, const Point4f& point) {
     const Eigen::Vector3f d = point.head<3>() - frame.centroid;
-    const float u = d.dot(frame.major), v = d.dot(frame.minor), w = d.dot(frame.normal);
-    lo_u = std::min(lo_u, u), hi_u = std::max(hi_u, u);
-    lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
+    extend(d.dot(frame.major), d.dot(frame.minor));
+    const float w = d.dot(frame.normal);
     squared_error += double{w} * w;
     ++count;
+  }
+  // The extent alone (the point's count and error added otherwise).
+  void extend(const PlaneFrame& frame, const Point4f& point) {
+    const Eigen::Vector3f d = point.head<3>() - frame.centroid;
+    extend(d.dot(frame.major), d.dot(frame.minor));
+  }
+  void extend(float u, float v) {
+    lo_u = std::min(lo_u, u), hi_u = std::max(hi_u, u);
+    lo_v = std::min(lo_v, v), hi_v = std::max(hi_v, v);
   }
   void add(const PlanePixelSums& other) {
     lo_u = std::min(lo_u, other.lo_u), hi_u = std::max(hi_u, other.hi_u);
