@@ -377,6 +377,25 @@ TEST_P(PlaneExtractionBackendTest, IsDeterministicAndAgreesWithTheCpuBackend) {
   expect_same_planes(first, extract_synthetic(compute::Context::cpu(), camera, 40), 1e-9);
 }
 
+// The cells mode's pass over the frame runs on the context (kernels/cell_blocks), the rest on the
+// host: the same planes as on the CPU backend (the block sums are floats summed in the same
+// order; a device may fuse multiply-adds, hence the tolerance).
+TEST_P(PlaneExtractionBackendTest, CellsModeAgreesWithTheCpuBackend) {
+  const PinholeIntrinsics camera{320, 240, 262.5, 262.5, 159.5, 119.5};
+  segmentation::PlaneExtractionParams params;
+  params.mode = segmentation::PlaneExtractionMode::cells;
+  const compute::Context cpu_context = compute::Context::cpu();
+  for (const int frame : {40, 130}) {
+    const SyntheticView view = synthetic_view(camera, frame);
+    segmentation::PlaneExtractor mine(context(), camera, params);
+    segmentation::PlaneExtractor cpu(cpu_context, camera, params);
+    const segmentation::PlaneSet set = mine.extract(view.points, view.color);
+    EXPECT_GE(set.planes.size(), 2u) << frame;
+    expect_same_planes(set, cpu.extract(view.points, view.color), 1e-6);
+    expect_same_planes(set, mine.extract(view.points, view.color), 0.0);
+  }
+}
+
 KARTOGRAF_INSTANTIATE_BACKEND_TESTS(PlaneExtractionBackendTest);
 
 // The cells mode on the CPU: deterministic, planes by decreasing size with their records filled,

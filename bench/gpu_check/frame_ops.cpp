@@ -17,6 +17,7 @@
 #include "kartograf/registration/projective_association.hpp"
 #include "kartograf/registration/voxel_hash_correspondences.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
+#include "kartograf/segmentation/plane_extraction.hpp"
 #include "kartograf/segmentation/region_growing.hpp"
 
 namespace kartograf::gpu_check {
@@ -39,9 +40,16 @@ struct Workspace {
         gate(context),
         hash(context),
         grower(context),
+        cell_planes(context, frames.camera, cells_mode()),
         tsdf_fine(context, tsdf_params(0.01)),
         tsdf_coarse(context, tsdf_params(0.05)),
         esdf_fine(context, tsdf_params(0.01)) {}
+
+  static segmentation::PlaneExtractionParams cells_mode() {
+    segmentation::PlaneExtractionParams params;
+    params.mode = segmentation::PlaneExtractionMode::cells;
+    return params;
+  }
 
   static mapping::TsdfVolumeParams tsdf_params(double voxel) {
     mapping::TsdfVolumeParams params;
@@ -81,6 +89,8 @@ struct Workspace {
   segmentation::RegionGrower grower;
   segmentation::LabCodeImage lab;          // of frame 1
   compute::Buffer<Point4f> frame1_points;  // frame 1 back-projected, for the region growing
+  PointImage frame1_host_points;           // the same on the host, for the plane extraction
+  segmentation::PlaneExtractor cell_planes;
   // TSDFs of 1 and 5 cm voxels. The poses are unknown here: the first frame is fused again and
   // again at the identity, so the block set stays that of one frame (the steady state of a
   // camera at rest).
@@ -217,6 +227,7 @@ std::shared_ptr<Workspace> make_workspace(const compute::Context& context, const
   w->lab = segmentation::to_lab_codes(frames.frames[1 % frames.frames.size()].color);
   w->frame1_points = compute::Buffer<Point4f>(context, w->points.size());
   w->frame1_points.raw().copy_from(w->points.buffer().raw(), w->points.buffer().raw().size_bytes());
+  w->frame1_host_points = w->points.to_image();
   context.finish();
   return w;
 }
@@ -270,6 +281,12 @@ const std::vector<Operation>& frame_operations() {
       {"region growing (Lab)", 0,
        [](Workspace& w) {
          w.grower.grow(w.lab, w.frame1_points, segmentation::RegionGrowingParams{});
+       }},
+      // The whole extraction from host images: upload, the block pass here, the rest on the host.
+      {"plane extraction, cells mode", 0,
+       [](Workspace& w) {
+         w.cell_planes.extract(w.frame1_host_points,
+                               w.frames.frames[1 % w.frames.frames.size()].color);
        }},
   };
   return list;

@@ -92,6 +92,9 @@ std::vector<PlaneMethod> kartograf_plane_methods(bool device_backends) {
       methods.push_back(extractor_method("kartograf PlaneExtractor (" + device.label + ")",
                                          "driver's own", device.context,
                                          PlaneExtractionMode::regions));
+      methods.push_back(extractor_method("kartograf PlaneExtractor cells (" + device.label + ")",
+                                         "driver's own", device.context,
+                                         PlaneExtractionMode::cells));
     }
   }
   return methods;

@@ -1,159 +1,50 @@
 #include "cell_planes.hpp"
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
 #include <cstring>
 #include <limits>
 #include <optional>
 
+#include "compute/cpu/lanes.hpp"
 #include "compute/cpu_parallel.hpp"
+#include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/segmentation/lab_color.hpp"
 #include "kartograf/segmentation/plane_fit.hpp"
+#include "kernels/cell_blocks/cell_blocks.h"
 #include "plane_output.hpp"
 
 namespace kartograf::segmentation::detail {
 
 namespace {
 
-// Sums of one block in float about a point of it (its first valid one): the offsets are
-// centimetres, so float keeps the covariance to far below the depth noise.
-struct CellSums {
-  Eigen::Vector3f reference = Eigen::Vector3f::Zero();
-  std::uint32_t count = 0;
-  Eigen::Vector3f sum = Eigen::Vector3f::Zero();
-  float xx = 0, xy = 0, xz = 0, yy = 0, yz = 0, zz = 0;
-  std::uint32_t red = 0, green = 0, blue = 0;
+using compute::detail::LaneMask;
+using compute::detail::Lanes;
+using compute::detail::select;
+using compute::detail::splat;
 
-  Eigen::Vector3d colour() const { return Eigen::Vector3d(red, green, blue); }
+constexpr compute::KernelSpec kCellBlocksKernel{"cell_blocks", KG_CELL_BLOCKS_LOCAL_X};
 
-  // The moments about `origin` in double (the shift of sums of outer products is exact algebra).
-  geometry::SegmentMoments moments(const Eigen::Vector3d& origin) const {
-    geometry::SegmentMoments m;
-    m.count = count;
-    if (count == 0) return m;
-    const Eigen::Vector3d s = sum.cast<double>();
-    const Eigen::Vector3d shift = reference.cast<double>() - origin;
-    Eigen::Matrix3d outer;
-    outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
-    const double n = count;
-    m.sum = s + n * shift;
-    m.sum_outer =
-        outer + s * shift.transpose() + shift * s.transpose() + n * shift * shift.transpose();
-    return m;
-  }
-};
-
-// What a jump between neighbouring depths is: more than `relative` of the depth and more than
-// `per_z2` z^2 (far away, noise and quantization alone exceed the relative part).
-struct JumpRule {
-  float relative = 0;
-  float per_z2 = 0;
-  bool operator()(float a, float b) const {  // false when either is NaN (no depth)
-    const float z = std::min(a, b);
-    return std::fabs(a - b) > z * std::max(relative, per_z2 * z);
-  }
-};
-
-// A block of a cell: its pixel rectangle, and where its cell starts (jumps are counted between
-// pixels of one cell: `inside` those of this block only, `edge` those with the neighbouring block).
-struct BlockRect {
-  int x0, y0, x1, y1;
-  int cell_x0, cell_y0;
-};
-
-// Four floats that the compiler keeps in one SIMD register (GCC and Clang vector extension).
-using Lanes = float __attribute__((vector_size(16)));
-// Four int lanes, for comparisons and choices between Lanes.
-using Mask = std::int32_t __attribute__((vector_size(16)));
-
-Lanes splat(float value) {
-  return Lanes{value, value, value, value};
-}
-Mask splat(std::int32_t value) {
-  return Mask{value, value, value, value};
-}
-
-// Per lane: a where the mask is set, else b.
-template <class Vector>
-Vector select(Mask mask, Vector a, Vector b) {
-  return reinterpret_cast<Vector>((mask & reinterpret_cast<Mask>(a)) |
-                                  (~mask & reinterpret_cast<Mask>(b)));
-}
-
-struct BlockSums {
-  CellSums sums;
-  std::uint32_t inside_jumps = 0, edge_jumps = 0;
-};
-
-// The block's first valid point (the reference of its float sums), or nullptr when it has none.
-const Point4f* first_valid(const PointImage& points, const BlockRect& r) {
-  for (int y = r.y0; y < r.y1; ++y) {
-    const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
-    for (int x = r.x0; x < r.x1; ++x) {
-      if (is_valid(row[x])) return &row[x];
-    }
-  }
-  return nullptr;
-}
-
-// Jumps between the pixels of row `row` in [x0, x1) and their left neighbours from `left_from`
-// on (an invalid pixel's NaN depth compares as no jump).
-std::uint32_t row_jumps(const Point4f* row, int left_from, int x1, const JumpRule& jumps) {
-  std::uint32_t count = 0;
-  for (int x = left_from; x < x1; ++x) count += jumps(row[x].z(), row[x - 1].z());
-  return count;
-}
-
-BlockSums sum_block(const PointImage& points, const RgbImage& rgb, const BlockRect& r,
-                    const JumpRule& jumps, std::uint8_t* valid) {
-  BlockSums out;
-  const Point4f* reference = first_valid(points, r);
-  if (!reference) {
-    for (int y = r.y0; y < r.y1; ++y)
-      std::fill_n(valid + static_cast<std::size_t>(y) * points.width() + r.x0, r.x1 - r.x0, 0);
-    return out;
-  }
-  CellSums& sums = out.sums;
-  sums.reference = reference->head<3>();
-  const Lanes origin{sums.reference.x(), sums.reference.y(), sums.reference.z(), 0.0f};
-  // Local accumulators (the validity mask's byte stores may alias anything, so sums kept in the
-  // struct would be stored and reloaded for every pixel), four lanes each: with d = (dx, dy, dz,
-  // 1), `first` sums d (the count in its last lane) and `by_x` .. `by_z` sum d dx .. d dz.
-  Lanes first{}, by_x{}, by_y{}, by_z{};
-  std::uint32_t red = 0, green = 0, blue = 0;
-  for (int y = r.y0; y < r.y1; ++y) {
-    const Point4f* row = points.data() + static_cast<std::size_t>(y) * points.width();
-    const Rgb8* colours = rgb.data() + static_cast<std::size_t>(y) * rgb.width();
-    std::uint8_t* valid_row = valid + static_cast<std::size_t>(y) * points.width();
-    for (int x = r.x0; x < r.x1; ++x) {
-      const Point4f& p = row[x];
-      const bool is = is_valid(p);
-      valid_row[x] = is;
-      if (!is) continue;
-      Lanes d;
-      std::memcpy(&d, p.data(), sizeof d);
-      d = d - origin;
-      d[3] = 1.0f;
-      first += d;
-      by_x += d * d[0], by_y += d * d[1], by_z += d * d[2];
-      red += colours[x][0], green += colours[x][1], blue += colours[x][2];
-    }
-    // Jumps within the block, and with the neighbouring blocks of the same cell (left, above).
-    out.inside_jumps += row_jumps(row, r.x0 + 1, r.x1, jumps);
-    if (r.x0 > r.cell_x0) out.edge_jumps += jumps(row[r.x0].z(), row[r.x0 - 1].z());
-    if (y == r.y0 && y == r.cell_y0) continue;
-    const Point4f* above = row - points.width();
-    std::uint32_t vertical = 0;
-    for (int x = r.x0; x < r.x1; ++x) vertical += jumps(row[x].z(), above[x].z());
-    (y > r.y0 ? out.inside_jumps : out.edge_jumps) += vertical;
-  }
-  sums.sum = Eigen::Vector3f(first[0], first[1], first[2]);
-  sums.count = static_cast<std::uint32_t>(first[3]);  // at most 2^24 pixels: exact in float
-  sums.xx = by_x[0], sums.xy = by_x[1], sums.xz = by_x[2];
-  sums.yy = by_y[1], sums.yz = by_y[2], sums.zz = by_z[2];
-  sums.red = red, sums.green = green, sums.blue = blue;
-  return out;
+// A block's moments about `origin` in double, from its float sums about its reference point (the
+// shift of sums of outer products is exact algebra).
+geometry::SegmentMoments block_moments(const float* sums, std::uint32_t count,
+                                       const Eigen::Vector3d& origin) {
+  geometry::SegmentMoments m;
+  m.count = count;
+  if (count == 0) return m;
+  const Eigen::Vector3d reference(sums[0], sums[1], sums[2]);
+  const Eigen::Vector3d s(sums[3], sums[4], sums[5]);
+  const double xx = sums[6], xy = sums[7], xz = sums[8], yy = sums[9], yz = sums[10], zz = sums[11];
+  const Eigen::Vector3d shift = reference - origin;
+  Eigen::Matrix3d outer;
+  outer << xx, xy, xz, xy, yy, yz, xz, yz, zz;
+  const double n = count;
+  m.sum = s + n * shift;
+  m.sum_outer =
+      outer + s * shift.transpose() + shift * s.transpose() + n * shift * shift.transpose();
+  return m;
 }
 
 void add_moments(geometry::SegmentMoments& into, const geometry::SegmentMoments& m) {
@@ -162,49 +53,89 @@ void add_moments(geometry::SegmentMoments& into, const geometry::SegmentMoments&
   into.sum_outer += m.sum_outer;
 }
 
+// The colour image as the kernel reads it: bytes on the CPU (the image itself), 32-bit words on
+// a device (a copy padded to whole words).
+void colours_to_backend(const compute::Context& context, const RgbImage& rgb,
+                        compute::RawBuffer& colours) {
+  const std::size_t bytes = rgb.size() * sizeof(Rgb8);
+  if (context.is_cpu() || bytes % 4 == 0) {
+    colours.refer_or_upload(context, rgb.data(), bytes);
+    return;
+  }
+  std::vector<std::uint8_t> padded(bytes + 4 - bytes % 4, 0);
+  std::memcpy(padded.data(), rgb.data(), bytes);
+  colours.refer_or_upload(context, padded.data(), padded.size());
+}
+
+// Cells from the kernel's block records: each block's moments, colour and continuity, and each
+// cell's sums over its blocks.
+void cells_from_blocks(const compute::HostView<float>& sums,
+                       const compute::HostView<std::uint32_t>& counts,
+                       const Eigen::Vector3d& origin, CellGrid& cells) {
+  const int half = cells.cell_size / 2;
+  compute::detail::for_each_chunk(
+      cells.size(), cells.size() * 4, [&](std::size_t begin, std::size_t end, std::size_t) {
+        for (std::size_t c = begin; c < end; ++c) {
+          const std::size_t bx = 2 * (c % cells.columns), by = 2 * (c / cells.columns);
+          std::uint32_t cell_jumps = 0;
+          for (std::size_t b = 0; b < 4; ++b) {
+            const std::size_t block = (by + b / 2) * cells.blocks_x + bx + b % 2;
+            const std::uint32_t* n = counts.data() + block * KG_CELL_BLOCK_COUNTS;
+            const std::size_t k = 4 * c + b;
+            cells.block_moments[k] = block_moments(sums.data() + block * KG_CELL_BLOCK_SUMS,
+                                                   n[KG_CELL_BLOCK_COUNT], origin);
+            cells.block_colours[k] = Eigen::Vector3d(n[1], n[2], n[3]);
+            // An edge across a block jumps on every row or column it crosses; depth noise and
+            // quantization far away jump here and there.
+            const std::uint32_t inside = n[KG_CELL_BLOCK_INSIDE_JUMPS];
+            cells.block_continuous[k] = 2 * inside <= static_cast<std::uint32_t>(half);
+            cell_jumps += inside + n[KG_CELL_BLOCK_EDGE_JUMPS];
+            add_moments(cells.moments[c], cells.block_moments[k]);
+          }
+          cells.continuous[c] = 2 * cell_jumps <= static_cast<std::uint32_t>(cells.cell_size);
+        }
+      });
+}
+
 }  // namespace
 
-void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
-                   float max_depth_jump, float jump_per_z2, const Eigen::Vector3d& origin,
-                   CellGrid& cells) {
-  const JumpRule jumps{max_depth_jump, jump_per_z2};
+void measure_cells(const compute::Context& context, const compute::Buffer<Point4f>& points,
+                   const RgbImage& rgb, int cell_size, float max_depth_jump, float jump_per_z2,
+                   const Eigen::Vector3d& origin, CellBuffers& buffers, CellGrid& cells) {
   const int half = cell_size / 2;
   cells.cell_size = cell_size;
-  cells.columns = (points.width() + cell_size - 1) / cell_size;
-  cells.rows = (points.height() + cell_size - 1) / cell_size;
+  cells.columns = (rgb.width() + cell_size - 1) / cell_size;
+  cells.rows = (rgb.height() + cell_size - 1) / cell_size;
+  cells.blocks_x = 2 * cells.columns;
+  cells.mask_words = (half * half + 31) / 32;
   const std::size_t count = static_cast<std::size_t>(cells.columns) * cells.rows;
+  const kernels::CellBlocksParams params{static_cast<std::uint32_t>(rgb.width()),
+                                         static_cast<std::uint32_t>(rgb.height()),
+                                         static_cast<std::uint32_t>(half),
+                                         static_cast<std::uint32_t>(cells.blocks_x),
+                                         static_cast<std::uint32_t>(4 * count),
+                                         static_cast<std::uint32_t>(cells.mask_words),
+                                         max_depth_jump,
+                                         jump_per_z2};
+  if (buffers.counts.size() != 4 * count * KG_CELL_BLOCK_COUNTS ||
+      buffers.masks.size() != 4 * count * cells.mask_words) {
+    buffers.sums = compute::Buffer<float>(context, 4 * count * KG_CELL_BLOCK_SUMS);
+    buffers.counts = compute::Buffer<std::uint32_t>(context, 4 * count * KG_CELL_BLOCK_COUNTS);
+    buffers.masks = compute::Buffer<std::uint32_t>(context, 4 * count * cells.mask_words);
+  }
+  colours_to_backend(context, rgb, buffers.colours);
+  compute::dispatch(context, kCellBlocksKernel,
+                    {points, buffers.colours, buffers.sums, buffers.counts, buffers.masks}, params,
+                    {compute::groups_for(4 * count, kCellBlocksKernel.local_x)});
   cells.moments.assign(count, {});
   cells.continuous.assign(count, 0);
   cells.block_moments.assign(4 * count, {});
   cells.block_continuous.assign(4 * count, 0);
   cells.block_colours.assign(4 * count, Eigen::Vector3d::Zero());
-  cells.valid.resize(points.size());
-  compute::detail::for_each_chunk(
-      count, points.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
-        for (std::size_t c = begin; c < end; ++c) {
-          const int x0 = cells.first_x(c), y0 = cells.first_y(c);
-          std::uint32_t cell_jumps = 0;
-          for (int b = 0; b < 4; ++b) {
-            const int bx = x0 + (b % 2) * half, by = y0 + (b / 2) * half;
-            const BlockRect rect{std::min(bx, points.width()),
-                                 std::min(by, points.height()),
-                                 std::min(bx + half, points.width()),
-                                 std::min(by + half, points.height()),
-                                 x0,
-                                 y0};
-            const BlockSums sums = sum_block(points, rgb, rect, jumps, cells.valid.data());
-            const std::size_t k = 4 * c + static_cast<std::size_t>(b);
-            cells.block_moments[k] = sums.sums.moments(origin);
-            cells.block_colours[k] = sums.sums.colour();
-            // An edge across a block jumps on every row or column it crosses; depth noise and
-            // quantization far away jump here and there.
-            cells.block_continuous[k] = 2 * sums.inside_jumps <= static_cast<std::uint32_t>(half);
-            cell_jumps += sums.inside_jumps + sums.edge_jumps;
-            add_moments(cells.moments[c], cells.block_moments[k]);
-          }
-          cells.continuous[c] = 2 * cell_jumps <= static_cast<std::uint32_t>(cell_size);
-        }
-      });
+  cells_from_blocks(compute::HostView<float>(buffers.sums),
+                    compute::HostView<std::uint32_t>(buffers.counts), origin, cells);
+  const compute::HostView<std::uint32_t> masks(buffers.masks);
+  cells.block_masks.assign(masks.begin(), masks.end());
   // After the loop: an Error thrown on a helper thread would end the process.
   for (const geometry::SegmentMoments& m : cells.moments) {
     require(m.sum.allFinite() && m.sum_outer.allFinite(),
@@ -393,17 +324,17 @@ struct ScoreRule {
 
   // Per lane: the index of the candidate with the lowest score below 1, or -1; `distance2`: the
   // point's squared distance to that candidate.
-  Mask best(const CandidateLanes& planes, const PixelLanes& p, Lanes& distance2) const {
+  LaneMask best(const CandidateLanes& planes, const PixelLanes& p, Lanes& distance2) const {
     const Lanes range2 = p.x * p.x + p.y * p.y + p.z * p.z;
     const Lanes floor2 = splat(min_facing * min_facing) * range2;
     Lanes best_d2 = splat(1.0f), best_s2 = splat(0.0f);  // no candidate yet: 1 / 0
-    Mask choice = splat(-1);
+    LaneMask choice = splat(-1);
     for (int k = 0; k < planes.count; ++k) {
       const Lanes along = planes.nx[k] * p.x + planes.ny[k] * p.y + planes.nz[k] * p.z;
       const Lanes d = along + planes.offset[k];
       const Lanes d2 = d * d, a2 = along * along;
       const Lanes s2 = select(a2 > floor2, a2, floor2);
-      const Mask better = d2 * best_s2 < best_d2 * s2;
+      const LaneMask better = d2 * best_s2 < best_d2 * s2;
       best_d2 = select(better, d2, best_d2);
       best_s2 = select(better, s2, best_s2);
       choice = select(better, splat(k), choice);
@@ -435,22 +366,23 @@ struct AssignInputs {
 void assign_planar_cell(const AssignInputs& in, std::size_t cell, std::uint32_t plane, bool inside,
                         std::vector<PlanePixelSums>& sums,
                         std::vector<std::uint32_t>& pixel_plane) {
-  const int width = in.points.width();
+  const int width = in.points.width(), half = in.cells.cell_size / 2;
   const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
-  const int x1 = std::min(width, x0 + in.cells.cell_size);
   const int y1 = std::min(in.points.height(), y0 + in.cells.cell_size);
+  const int block_x = x0 / half;
   const PlaneFrame& frame = in.frames[plane];
   PlanePixelSums& sum = sums[plane];
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * width;
-    int first = -1, last = -1;
-    for (int x = x0; x < x1; ++x) {
-      if (!in.cells.valid[row + x]) continue;
-      pixel_plane[row + x] = plane;
-      if (first < 0) first = x;
-      last = x;
+    // The row's validity bits over the cell (bits past the image's edge are never set).
+    const std::uint64_t bits = in.cells.valid_bits(block_x, y) |
+                               std::uint64_t{in.cells.valid_bits(block_x + 1, y)} << half;
+    if (bits == 0) continue;
+    for (std::uint64_t rest = bits; rest != 0; rest &= rest - 1) {
+      pixel_plane[row + x0 + std::countr_zero(rest)] = plane;
     }
-    if (inside || first < 0) continue;
+    if (inside) continue;
+    const int first = x0 + std::countr_zero(bits), last = x0 + 63 - std::countl_zero(bits);
     sum.extend(frame, in.points.data()[row + first]);
     sum.extend(frame, in.points.data()[row + last]);
   }
@@ -510,7 +442,7 @@ std::array<std::uint32_t, 36> score_cell_pixels(const AssignInputs& in, std::siz
         p.x[j] = point.x(), p.y[j] = point.y(), p.z[j] = point.z();
       }
       Lanes distance2;
-      const Mask choices = in.rule.best(lanes, p, distance2);
+      const LaneMask choices = in.rule.best(lanes, p, distance2);
       for (int j = 0; j < 4; ++j) {
         const int choice = choices[j];
         if (choice < 0) continue;

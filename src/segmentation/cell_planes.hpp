@@ -8,6 +8,8 @@
 
 #include <Eigen/Core>
 
+#include "kartograf/compute/buffer.hpp"
+#include "kartograf/compute/context.hpp"
 #include "kartograf/core/color.hpp"
 #include "kartograf/core/point_image.hpp"
 #include "kartograf/geometry/segment_moments.hpp"
@@ -30,7 +32,10 @@ struct CellGrid {
   std::vector<geometry::SegmentMoments> block_moments;
   std::vector<std::uint8_t> block_continuous;
   std::vector<Eigen::Vector3d> block_colours;  // sum of the block's valid pixels' RGB
-  std::vector<std::uint8_t> valid;             // per pixel: 1 where it has a point
+  // Which pixels have a point: per block of the image's block grid (blocks_x across), mask_words
+  // words of bits, row by row (bit (y - y0) half + x - x0).
+  std::vector<std::uint32_t> block_masks;
+  int blocks_x = 0, mask_words = 0;
   // Per cell: its segment in all four entries if the whole cell is planar, else those of its
   // planar blocks (kNoLabel where none).
   std::vector<std::array<std::uint32_t, 4>> segments;
@@ -38,16 +43,27 @@ struct CellGrid {
   std::size_t size() const { return moments.size(); }
   int first_x(std::size_t cell) const { return static_cast<int>(cell % columns) * cell_size; }
   int first_y(std::size_t cell) const { return static_cast<int>(cell / columns) * cell_size; }
+  // Bit k of the result: whether pixel (x0 + k, y) has a point, where x0 is the first column of
+  // image block `block_x` (half a cell wide; y any row of the image).
+  std::uint32_t valid_bits(int block_x, int y) const {
+    const int half = cell_size / 2;
+    const std::size_t block = static_cast<std::size_t>(y / half) * blocks_x + block_x;
+    const int bit = (y % half) * half;
+    const std::uint32_t* words = block_masks.data() + block * mask_words + bit / 32;
+    std::uint64_t v = words[0];
+    if (bit % 32 + half > 32) v |= std::uint64_t{words[1]} << 32;
+    return static_cast<std::uint32_t>((v >> (bit % 32)) & ((std::uint64_t{1} << half) - 1));
+  }
 };
 
-// One pass over the frame: which pixels have a point, every block's moments about `origin` and
-// colour sum, and every block's and cell's depth continuity: neighbouring valid pixels in a row
-// or column of it jump (by more than max_depth_jump of their depth z and more than jump_per_z2
-// z^2) at most half its side's times (an edge across it jumps on each row or column it
-// crosses). Cells sum their blocks.
-void measure_cells(const PointImage& points, const RgbImage& rgb, int cell_size,
-                   float max_depth_jump, float jump_per_z2, const Eigen::Vector3d& origin,
-                   CellGrid& cells);
+// One pass over the frame on the context's backend (kernels/cell_blocks): which pixels have a
+// point, every block's moments about `origin` and colour sum, and every block's and cell's depth
+// continuity: neighbouring valid pixels in a row or column of it jump (by more than
+// max_depth_jump of their depth z and more than jump_per_z2 z^2) at most half its side's times
+// (an edge across it jumps on each row or column it crosses). Cells sum their blocks.
+void measure_cells(const compute::Context& context, const compute::Buffer<Point4f>& points,
+                   const RgbImage& rgb, int cell_size, float max_depth_jump, float jump_per_z2,
+                   const Eigen::Vector3d& origin, CellBuffers& buffers, CellGrid& cells);
 
 // The segments of the cells mode, as merging takes them.
 struct CellSegments {

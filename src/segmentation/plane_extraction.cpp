@@ -219,8 +219,9 @@ void plane_leftover_regions(const PointImage& points, const PlaneExtractionParam
 }  // namespace
 
 void CellPlaneParams::validate() const {
-  require(cell_size >= 4 && cell_size <= 256 && cell_size % 2 == 0,
-          "plane extraction: cells.cell_size must be even, 4..256 pixels, got " +
+  // Up to 64: a block's row of validity bits fits in 32 bits (cell_planes.hpp, CellGrid).
+  require(cell_size >= 4 && cell_size <= 64 && cell_size % 2 == 0,
+          "plane extraction: cells.cell_size must be even, 4..64 pixels, got " +
               std::to_string(cell_size));
   require(
       reach_passes >= 1 && reach_passes <= 64,
@@ -315,8 +316,10 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
   cell_params.rms_per_z2 *= focal_scale;
   cell_params.jump_per_z2 *= focal_scale;
   detail::CellGrid cells;
-  detail::measure_cells(points, rgb, cell_params.cell_size, params_.growing.max_depth_jump,
-                        static_cast<float>(cell_params.jump_per_z2), origin.cast<double>(), cells);
+  points_.refer_or_upload(*context_, points.pixels());  // no copy on the CPU backend
+  detail::measure_cells(*context_, points_, rgb, cell_params.cell_size,
+                        params_.growing.max_depth_jump, static_cast<float>(cell_params.jump_per_z2),
+                        origin.cast<double>(), cell_buffers_, cells);
   if (segments_.width() != points.width() || segments_.height() != points.height())
     segments_ = SegmentLabelImage(points.width(), points.height());
   detail::CellSegments pieces;

@@ -29,7 +29,8 @@ enum class PlaneExtractionMode : std::uint8_t {
 
 // The cells mode's cells and their planarity test.
 struct CellPlaneParams {
-  int cell_size = 16;  // pixels a side (even: a cell is 2 x 2 blocks, tested when it is not planar)
+  int cell_size =
+      16;  // pixels a side, 4..64 (even: a cell is 2 x 2 blocks, tested when it is not planar)
   // A cell is planar when at least this share of its pixels is valid, ...
   double min_valid_fraction = 0.2;
   // ... its depth is continuous (neighbouring pixels jump by more than growing.max_depth_jump of
@@ -117,6 +118,14 @@ struct PlaneSet {
 PlaneSet fit_segment_planes(const PointImage& points, const SegmentLabelImage& segments,
                             std::uint32_t segment_count, std::uint64_t min_pixels = 3);
 
+// The cells mode's buffers on the context (src/segmentation/cell_planes.hpp, measure_cells): the
+// colour image, and per block its float sums, counts and validity bits.
+struct CellBuffers {
+  compute::RawBuffer colours;
+  compute::Buffer<float> sums;
+  compute::Buffer<std::uint32_t> counts, masks;
+};
+
 class PlaneExtractor {
  public:
   // Throws Error on invalid intrinsics or parameters.
@@ -149,6 +158,7 @@ class PlaneExtractor {
   std::vector<std::uint32_t> flood_queue_;   // scratch: pixels to grow planes from
   std::vector<std::uint8_t> flood_sources_;  // scratch: which pixels start the growth
   SegmentStatistics statistics_;             // scratch: colours and moments per segment
+  CellBuffers cell_buffers_;                 // the cells mode's pass on the context
 };
 
 }  // namespace kartograf::segmentation
