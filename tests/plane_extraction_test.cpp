@@ -496,6 +496,48 @@ std::pair<double, std::size_t> view_coverage(int width, int height,
 // what the regions mode covers. At this focal length (210 px) the synthetic sensor's disparity
 // steps are 2.5 times those at 525 px: without CellPlaneParams::reference_focal's scaling the
 // cells mode covered 40 % here against the regions mode's 95 %.
+// A board 6 pixels wide in front of a wall: no cell or block of it is planar (its edges jump on
+// every row), so only the leftover regions make it a plane.
+TEST(PlaneExtraction, CellsModeMakesPlanesOfStripsNarrowerThanACell) {
+  const compute::Context context = compute::Context::cpu();
+  const PinholeIntrinsics camera{320, 240, 262.5, 262.5, 159.5, 119.5};
+  PointImage points(camera.width, camera.height, invalid_point());
+  const RgbImage colours(camera.width, camera.height, Rgb8{128, 128, 128});
+  const auto on_board = [](int u) { return u >= 100 && u < 106; };
+  for (int v = 0; v < camera.height; ++v) {
+    for (int u = 0; u < camera.width; ++u) {
+      const float z = on_board(u) ? 2.0f : 3.0f;
+      points(u, v) = Point4f(float((u - camera.cx) / camera.fx) * z,
+                             float((v - camera.cy) / camera.fy) * z, z, 1.0f);
+    }
+  }
+  segmentation::PlaneExtractionParams params;
+  params.mode = segmentation::PlaneExtractionMode::cells;
+  for (const bool leftover : {true, false}) {
+    params.cells.leftover_planes = leftover;
+    const segmentation::PlaneSet set =
+        segmentation::PlaneExtractor(context, camera, params).extract(points, colours);
+    std::size_t board = 0, labelled = 0;
+    Label board_label = kUnlabeled;
+    for (int v = 0; v < camera.height; ++v) {
+      for (int u = 100; u < 106; ++u) {
+        ++board;
+        labelled += set.labels(u, v) != kUnlabeled;
+        board_label = set.labels(u, v) != kUnlabeled ? set.labels(u, v) : board_label;
+      }
+    }
+    if (leftover) {
+      EXPECT_GE(labelled * 10, board * 9);
+      ASSERT_NE(board_label, kUnlabeled);
+      const segmentation::Plane& plane = set.planes[board_label - 1];
+      EXPECT_NEAR(std::fabs(plane.normal.z()), 1.0, 1e-3);
+      EXPECT_NEAR(std::fabs(plane.offset), 2.0, 1e-3);
+    } else {
+      EXPECT_EQ(labelled, 0u);
+    }
+  }
+}
+
 TEST(PlaneExtraction, CellsModeTakesFramesOfAnySize) {
   using segmentation::PlaneExtractionMode;
   const auto [odd, odd_planes] = view_coverage(250, 187, PlaneExtractionMode::cells);

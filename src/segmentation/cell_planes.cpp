@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstring>
 #include <limits>
+#include <numeric>
 #include <optional>
 
 #include "compute/cpu/lanes.hpp"
@@ -467,23 +468,33 @@ std::array<std::uint32_t, 36> score_cell_pixels(const AssignInputs& in, std::siz
   return taken;
 }
 
+// What a cell's assignment leaves: the plane it carries on to the next passes (kNoLabel: none)
+// and how many of its valid pixels took no plane.
+struct CellOutcome {
+  std::uint32_t carried;
+  std::uint32_t left;
+};
+
 // Assigns the cell's valid pixels among the candidates, adding them to their planes' sums;
 // returns the plane that took the most of them when that is at least a quarter of the cell's
 // valid pixels (kNoLabel otherwise).
-std::uint32_t assign_cell(const AssignInputs& in, std::size_t cell,
-                          const CellCandidates& candidates, std::vector<PlanePixelSums>& sums,
-                          std::vector<std::uint32_t>& pixel_plane) {
+CellOutcome assign_cell(const AssignInputs& in, std::size_t cell, const CellCandidates& candidates,
+                        std::vector<PlanePixelSums>& sums,
+                        std::vector<std::uint32_t>& pixel_plane) {
   if (candidates.own && candidates.count == 1) {
     const bool inside = candidates.whole && !at_image_edge(in.cells, cell);
     assign_planar_cell(in, cell, candidates.planes[0], inside, sums, pixel_plane);
-    return candidates.planes[0];
+    return {candidates.planes[0], 0};
   }
   const std::array<std::uint32_t, 36> taken =
       score_cell_pixels(in, cell, candidates, sums, pixel_plane);
   const auto most =
       std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
-  const bool enough = candidates.count > 0 && 4 * taken[most] >= in.cells.moments[cell].count;
-  return enough ? candidates.planes[most] : geometry::kNoLabel;
+  const std::uint64_t valid = in.cells.moments[cell].count;
+  const bool enough = candidates.count > 0 && 4 * taken[most] >= valid;
+  const auto left = static_cast<std::uint32_t>(
+      valid - std::accumulate(taken.begin(), taken.begin() + candidates.count, std::uint64_t{0}));
+  return {enough ? candidates.planes[most] : geometry::kNoLabel, left};
 }
 
 AssignInputs assign_inputs(const PointImage& points, const CellGrid& cells,
@@ -506,7 +517,8 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
                                                const std::vector<SegmentPlane>& planes,
                                                const Eigen::Vector3d& origin,
                                                const PlaneMergeParams& params, int passes,
-                                               std::vector<std::uint32_t>& pixel_plane) {
+                                               std::vector<std::uint32_t>& pixel_plane,
+                                               std::vector<std::uint32_t>& open_cells) {
   constexpr std::uint32_t kNone = geometry::kNoLabel;
   using Planes = std::array<std::uint32_t, 4>;
   const AssignInputs in = assign_inputs(points, cells, planes, origin, params);
@@ -522,6 +534,7 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
   }
   std::vector<int> assigned_in(cells.size(), -1);
   std::vector<std::uint32_t> carried(cells.size(), kNone);
+  std::vector<std::uint32_t> left(cells.size());
   std::vector<PlanePixelSums> total(planes.size());
   std::array<std::vector<PlanePixelSums>, compute::detail::kCpuChunks> chunk_sums;
   for (int pass = 0; pass < std::max(1, passes); ++pass) {
@@ -547,13 +560,20 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
           chunk_sums[chunk].assign(planes.size(), PlanePixelSums{});
           for (std::size_t k = begin; k < end; ++k) {
             const std::size_t c = now[k];
-            carried[c] = assign_cell(in, c, now_candidates[k], chunk_sums[chunk], pixel_plane);
+            const CellOutcome outcome =
+                assign_cell(in, c, now_candidates[k], chunk_sums[chunk], pixel_plane);
+            carried[c] = outcome.carried, left[c] = outcome.left;
           }
         });
     for (const std::vector<PlanePixelSums>& sums : chunk_sums) {  // in chunk order
       for (std::size_t m = 0; m < sums.size(); ++m) total[m].add(sums[m]);
     }
     for (const std::size_t c : now) assigned_in[c] = pass;
+  }
+  open_cells.clear();
+  for (std::size_t c = 0; c < cells.size(); ++c) {
+    if (assigned_in[c] < 0 ? cells.moments[c].count > 0 : left[c] > 0)
+      open_cells.push_back(static_cast<std::uint32_t>(c));
   }
   return total;
 }

@@ -92,12 +92,14 @@ SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_cou
 // Planes thus reach past the cells next to them, around objects and across gaps of no depth.
 // segment_plane: each segment's plane (kNoLabel: none); origin: the cells' moments'. Returns the
 // sums of each plane's pixels (cells taken whole add their moments' count and squared distances,
-// and only their outline's pixels to the extent: see assign_planar_cell).
+// and only their outline's pixels to the extent: see assign_planar_cell); `open_cells`: the cells
+// (in order) with valid pixels that no plane took.
 std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const CellGrid& cells,
                                                const std::vector<std::uint32_t>& segment_plane,
                                                const std::vector<SegmentPlane>& planes,
                                                const Eigen::Vector3d& origin,
                                                const PlaneMergeParams& params, int passes,
-                                               std::vector<std::uint32_t>& pixel_plane);
+                                               std::vector<std::uint32_t>& pixel_plane,
+                                               std::vector<std::uint32_t>& open_cells);
 
 }  // namespace kartograf::segmentation::detail

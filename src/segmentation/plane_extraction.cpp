@@ -166,53 +166,70 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
   }
 }
 
-// Connected regions of valid pixels that no plane took (up to kFloodRadius pixels apart, with
-// continuous depth) that are planar become planes of their own: on dark surfaces most pixels have
-// no depth, so colour growing over 8-neighbours leaves only crumbs that never seed a plane.
-void plane_leftover_regions(const PointImage& points, const PlaneExtractionParams& params,
-                            std::vector<std::uint32_t>& pixel_plane,
-                            std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region) {
+constexpr std::uint32_t kVisited = geometry::kNoLabel - 1;  // in no plane, checked
+
+// The connected region of valid pixels that no plane took around `seed` (up to `radius` pixels
+// apart, with continuous depth), marked kVisited; if it is planar it becomes a plane of its own
+// (appended to `planes`), and its pixels within the plane's allowance take it.
+void leftover_region(const PointImage& points, const PlaneExtractionParams& params, int radius,
+                     std::uint32_t seed, std::vector<std::uint32_t>& pixel_plane,
+                     std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region) {
   const int width = points.width(), height = points.height();
   const Point4f* point = points.data();
   const float jump = params.growing.max_depth_jump;
-  const double min_facing = std::cos(params.merge.max_incidence_deg * M_PI / 180.0);
-  constexpr std::uint32_t kVisited = geometry::kNoLabel - 1;  // in no plane, checked
-  for (std::size_t seed = 0; seed < pixel_plane.size(); ++seed) {
-    if (pixel_plane[seed] != geometry::kNoLabel || !is_valid(point[seed])) continue;
-    region.assign(1, static_cast<std::uint32_t>(seed));
-    pixel_plane[seed] = kVisited;
-    geometry::SegmentMoments moments;
-    const Eigen::Vector3d origin = point[seed].head<3>().cast<double>();
-    for (std::size_t head = 0; head < region.size(); ++head) {
-      const std::uint32_t i = region[head];
-      const Eigen::Vector3d d = point[i].head<3>().cast<double>() - origin;
-      ++moments.count;
-      moments.sum += d;
-      moments.sum_outer += d * d.transpose();
-      const float depth = point[i].z();
-      for_each_pixel_near(i, width, height, kFloodRadius, [&](std::uint32_t j) {
-        if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) return;
-        if (jump > 0.0f && std::fabs(point[j].z() - depth) > jump * depth) return;
-        pixel_plane[j] = kVisited;
-        region.push_back(j);
-      });
-    }
-    if (moments.count < params.min_plane_pixels) continue;
-    const SegmentPlane plane = fit_plane(moments, origin, params.merge.fit);
-    if (!plane.valid ||
-        plane.rms_error > distance_allowance(params.merge, plane.centroid, plane.normal) ||
-        std::fabs(plane.normal.dot(plane.centroid)) < min_facing * plane.centroid.norm()) {
-      continue;
-    }
-    const auto index = static_cast<std::uint32_t>(planes.size());
-    planes.push_back(plane);
-    for (const std::uint32_t i : region) {
-      if (plane_score(plane, PixelPoint(point[i], params.merge), params.merge) < 1.0)
-        pixel_plane[i] = index;
-    }
+  region.assign(1, seed);
+  pixel_plane[seed] = kVisited;
+  geometry::SegmentMoments moments;
+  const Eigen::Vector3d origin = point[seed].head<3>().cast<double>();
+  for (std::size_t head = 0; head < region.size(); ++head) {
+    const std::uint32_t i = region[head];
+    const Eigen::Vector3d d = point[i].head<3>().cast<double>() - origin;
+    ++moments.count;
+    moments.sum += d;
+    moments.sum_outer += d * d.transpose();
+    const float depth = point[i].z();
+    for_each_pixel_near(i, width, height, radius, [&](std::uint32_t j) {
+      if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) return;
+      if (jump > 0.0f && std::fabs(point[j].z() - depth) > jump * depth) return;
+      pixel_plane[j] = kVisited;
+      region.push_back(j);
+    });
   }
-  for (std::uint32_t& p : pixel_plane) {
-    if (p == kVisited) p = geometry::kNoLabel;
+  if (moments.count < params.min_plane_pixels) return;
+  const SegmentPlane plane = fit_plane(moments, origin, params.merge.fit);
+  const double min_facing = std::cos(params.merge.max_incidence_deg * M_PI / 180.0);
+  if (!plane.valid ||
+      plane.rms_error > distance_allowance(params.merge, plane.centroid, plane.normal) ||
+      std::fabs(plane.normal.dot(plane.centroid)) < min_facing * plane.centroid.norm()) {
+    return;
+  }
+  const auto index = static_cast<std::uint32_t>(planes.size());
+  planes.push_back(plane);
+  for (const std::uint32_t i : region) {
+    if (plane_score(plane, PixelPoint(point[i], params.merge), params.merge) < 1.0)
+      pixel_plane[i] = index;
+  }
+}
+
+// Connected regions of valid pixels that no plane took that are planar become planes of their
+// own (leftover_region): on dark surfaces most pixels have no depth, so colour growing over
+// 8-neighbours leaves only crumbs that never seed a plane. for_each_seed(visit) calls visit(i)
+// for the candidate seeds in order (pixels no plane took, valid or not); `visited` collects the
+// regions' pixels so that only they are unmarked at the end.
+template <class ForEachSeed>
+void plane_leftover_regions(const PointImage& points, const PlaneExtractionParams& params,
+                            int radius, ForEachSeed&& for_each_seed,
+                            std::vector<std::uint32_t>& pixel_plane,
+                            std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region,
+                            std::vector<std::uint32_t>& visited) {
+  visited.clear();
+  for_each_seed([&](std::uint32_t seed) {
+    if (pixel_plane[seed] != geometry::kNoLabel || !is_valid(points.data()[seed])) return;
+    leftover_region(points, params, radius, seed, pixel_plane, planes, region);
+    visited.insert(visited.end(), region.begin(), region.end());
+  });
+  for (const std::uint32_t i : visited) {
+    if (pixel_plane[i] == kVisited) pixel_plane[i] = geometry::kNoLabel;
   }
 }
 
@@ -280,6 +297,27 @@ std::uint32_t PlaneExtractor::grow_segments(const PointImage& points,
   return count;
 }
 
+namespace {
+
+// The sums of the planes from `first` on (the leftover regions' planes) over their pixels (all
+// among `visited`).
+void add_leftover_sums(const PointImage& points, const std::vector<std::uint32_t>& pixel_plane,
+                       const std::vector<SegmentPlane>& planes, std::size_t first,
+                       const std::vector<std::uint32_t>& visited,
+                       std::vector<detail::PlanePixelSums>& sums) {
+  if (planes.size() == first) return;
+  std::vector<detail::PlaneFrame> frames;
+  for (std::size_t p = first; p < planes.size(); ++p)
+    frames.push_back(detail::PlaneFrame::of(planes[p]));
+  sums.resize(planes.size());
+  for (const std::uint32_t i : visited) {
+    const std::uint32_t p = pixel_plane[i];
+    if (p != geometry::kNoLabel && p >= first) sums[p].add(frames[p - first], points.data()[i]);
+  }
+}
+
+}  // namespace
+
 void PlaneExtractor::assign_pixels(const PointImage& points, MergedPlanes& merged) {
   const SegmentLabelImage& segments = segments_;
   std::vector<std::uint32_t>& pixel_plane = pixel_plane_;
@@ -292,13 +330,38 @@ void PlaneExtractor::assign_pixels(const PointImage& points, MergedPlanes& merge
   refine_border_pixels(segments, points, merged, params_.merge, pixel_plane);
   flood_unassigned_pixels(points, merged.planes, params_.merge, params_.growing.max_depth_jump,
                           pixel_plane, flood_queue_, flood_sources_);
-  plane_leftover_regions(points, params_, pixel_plane, merged.planes, flood_queue_);
+  const auto every_pixel = [&](auto&& visit) {
+    for (std::size_t i = 0; i < pixel_plane.size(); ++i) visit(static_cast<std::uint32_t>(i));
+  };
+  plane_leftover_regions(points, params_, kFloodRadius, every_pixel, pixel_plane, merged.planes,
+                         flood_queue_, leftover_pixels_);
 }
 
 PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) {
   check_frame(points, rgb, intrinsics_.width, intrinsics_.height);
   return params_.mode == PlaneExtractionMode::cells ? extract_cells(points, rgb)
                                                     : extract_regions(points, rgb);
+}
+
+// What no cell's plane reached (thin poles, strips narrower than a cell): planar leftovers in the
+// cells with pixels left become planes of their own (8-connected), as in the regions mode.
+void PlaneExtractor::add_leftover_planes(const PointImage& points, const detail::CellGrid& cells,
+                                         std::vector<SegmentPlane>& planes,
+                                         std::vector<detail::PlanePixelSums>& sums) {
+  const std::size_t cell_plane_count = planes.size();
+  const auto pixels_of_open_cells = [&](auto&& visit) {
+    for (const std::uint32_t c : open_cells_) {
+      const int x0 = cells.first_x(c), y0 = cells.first_y(c);
+      const int x1 = std::min(points.width(), x0 + cells.cell_size);
+      const int y1 = std::min(points.height(), y0 + cells.cell_size);
+      for (int y = y0; y < y1; ++y) {
+        for (int x = x0; x < x1; ++x) visit(static_cast<std::uint32_t>(y * points.width() + x));
+      }
+    }
+  };
+  plane_leftover_regions(points, params_, 1, pixels_of_open_cells, pixel_plane_, planes,
+                         flood_queue_, leftover_pixels_);
+  add_leftover_sums(points, pixel_plane_, planes, cell_plane_count, leftover_pixels_, sums);
 }
 
 PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage& rgb) {
@@ -337,9 +400,10 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
   result.timings.merging = elapsed_ms(clock);
 
   // The assignment sums each plane's pixels as it goes: no second pass over the points.
-  const std::vector<detail::PlanePixelSums> sums = detail::assign_cell_pixels(
+  std::vector<detail::PlanePixelSums> sums = detail::assign_cell_pixels(
       points, cells, merged.segment_plane, merged.planes, origin.cast<double>(), params_.merge,
-      params_.cells.reach_passes, pixel_plane_);
+      params_.cells.reach_passes, pixel_plane_, open_cells_);
+  if (params_.cells.leftover_planes) add_leftover_planes(points, cells, merged.planes, sums);
   result.timings.refinement = elapsed_ms(clock);
 
   detail::write_planes(merged.planes, sums, pixel_plane_, params_.min_plane_pixels, result);

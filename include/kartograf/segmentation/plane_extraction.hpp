@@ -29,8 +29,8 @@ enum class PlaneExtractionMode : std::uint8_t {
 
 // The cells mode's cells and their planarity test.
 struct CellPlaneParams {
-  int cell_size =
-      16;  // pixels a side, 4..64 (even: a cell is 2 x 2 blocks, tested when it is not planar)
+  // Pixels a side, 4..64 (even: a cell is 2 x 2 blocks, tested when it is not planar).
+  int cell_size = 16;
   // A cell is planar when at least this share of its pixels is valid, ...
   double min_valid_fraction = 0.2;
   // ... its depth is continuous (neighbouring pixels jump by more than growing.max_depth_jump of
@@ -49,6 +49,10 @@ struct CellPlaneParams {
   // Passes of the pixel assignment: the first reaches the cells next to a plane's cells, each
   // further one a ring of cells further (around objects, across gaps of no depth).
   int reach_passes = 4;
+  // Then connected regions of valid pixels that no plane reached (thin poles, strips narrower than
+  // a cell) become planes of their own when they are planar, as in the regions mode (8-connected
+  // here). Costs ~0.5 ms a 7-Scenes frame; off: faster, fewer pixels on planes.
+  bool leftover_planes = true;
 
   void validate() const;  // throws Error naming the first bad field
 };
@@ -118,6 +122,11 @@ struct PlaneSet {
 PlaneSet fit_segment_planes(const PointImage& points, const SegmentLabelImage& segments,
                             std::uint32_t segment_count, std::uint64_t min_pixels = 3);
 
+namespace detail {
+struct CellGrid;        // src/segmentation/cell_planes.hpp
+struct PlanePixelSums;  // src/segmentation/plane_output.hpp
+}  // namespace detail
+
 // The cells mode's buffers on the context (src/segmentation/cell_planes.hpp, measure_cells): the
 // colour image, and per block its float sums, counts and validity bits.
 struct CellBuffers {
@@ -149,16 +158,21 @@ class PlaneExtractor {
   void assign_pixels(const PointImage& points, MergedPlanes& merged);
   PlaneSet extract_regions(const PointImage& points, const RgbImage& rgb);
   PlaneSet extract_cells(const PointImage& points, const RgbImage& rgb);
+  void add_leftover_planes(const PointImage& points, const detail::CellGrid& cells,
+                           std::vector<SegmentPlane>& planes,
+                           std::vector<detail::PlanePixelSums>& sums);
 
   RegionGrower grower_;
-  compute::Buffer<Point4f> points_;          // the frame's points on the context
-  LabCodeImage lab_;                         // the frame's colours (host)
-  SegmentLabelImage segments_;               // the frame's segments (host)
-  std::vector<std::uint32_t> pixel_plane_;   // scratch: merged plane per pixel
-  std::vector<std::uint32_t> flood_queue_;   // scratch: pixels to grow planes from
-  std::vector<std::uint8_t> flood_sources_;  // scratch: which pixels start the growth
-  SegmentStatistics statistics_;             // scratch: colours and moments per segment
-  CellBuffers cell_buffers_;                 // the cells mode's pass on the context
+  compute::Buffer<Point4f> points_;             // the frame's points on the context
+  LabCodeImage lab_;                            // the frame's colours (host)
+  SegmentLabelImage segments_;                  // the frame's segments (host)
+  std::vector<std::uint32_t> pixel_plane_;      // scratch: merged plane per pixel
+  std::vector<std::uint32_t> flood_queue_;      // scratch: pixels to grow planes from
+  std::vector<std::uint8_t> flood_sources_;     // scratch: which pixels start the growth
+  std::vector<std::uint32_t> leftover_pixels_;  // scratch: pixels of the leftover regions
+  std::vector<std::uint32_t> open_cells_;       // scratch: cells with pixels no plane took
+  SegmentStatistics statistics_;                // scratch: colours and moments per segment
+  CellBuffers cell_buffers_;                    // the cells mode's pass on the context
 };
 
 }  // namespace kartograf::segmentation
