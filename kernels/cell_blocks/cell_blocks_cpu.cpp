@@ -1,6 +1,7 @@
 // CPU wrapper of kernels/cell_blocks/cell_blocks.h: the rule's block loop with the sums taken in
-// four lanes at once (the same float sums, in the same order, per lane) and the colour read as
-// bytes; the blocks in chunks over the threads.
+// four lanes at once (the same float sums, in the same order, per lane), the colour read as bytes
+// and the jumps counted on each row's depths gathered as the sums go (vector code); the blocks in
+// chunks over the threads.
 #include <cstring>
 
 #include "compute/cpu/cpu_kernel.hpp"
@@ -20,6 +21,13 @@ struct BlockOutputs {
   uint* masks;
 };
 
+// Jumps between `depths` and `others` (n each; NaN: no depth, no jump), vector code.
+uint count_jumps(const float* depths, const float* others, uint n, const CellBlocksParams& p) {
+  uint count = 0;
+  for (uint k = 0; k < n; ++k) count += cell_jump_count(depths[k], others[k], p);
+  return count;
+}
+
 void measure_block(const float4* points, const std::uint8_t* colours, uint block,
                    const CellBlocksParams& p, const BlockOutputs& out) {
   const CellBlockRect r = cell_block_rect(block, p);
@@ -31,11 +39,20 @@ void measure_block(const float4* points, const std::uint8_t* colours, uint block
   uint red = 0, green = 0, blue = 0, inside = 0, edge = 0;
   // The validity bits in a local array (stores through `out` could alias the points).
   uint mask[32] = {};  // p.mask_words <= 32: blocks of at most 32 x 32 pixels
+  // cell_row_jumps' counts from the rows' depths gathered as the sums go: depth[0] is the pixel
+  // left of the block in its cell (NaN where the block starts its cell), depth[1..n] the row's;
+  // `above` the row above's, where there is one in the cell.
+  const uint n = r.x1 - r.x0;
+  float depth[33], above[32];
+  bool has_above = r.y0 > r.cell_y0;
+  for (uint k = 0; has_above && k < n; ++k) above[k] = points[(r.y0 - 1) * p.width + r.x0 + k].z;
   for (uint y = r.y0; y < r.y1; ++y) {
     const std::size_t row = std::size_t{y} * p.width;
+    depth[0] = r.x0 > r.cell_x0 ? points[row + r.x0 - 1].z : KG_NAN;
     std::uint64_t row_bits = 0;  // at most 32
     for (uint x = r.x0; x < r.x1; ++x) {
       const float4& q = points[row + x];
+      depth[1 + x - r.x0] = q.z;
       if (kg_isnan(q.x)) continue;
       row_bits |= std::uint64_t{1} << (x - r.x0);
       Lanes d;
@@ -51,8 +68,11 @@ void measure_block(const float4* points, const std::uint8_t* colours, uint block
     mask[start / 32] |= static_cast<uint>(row_bits << (start % 32));
     if (start % 32 + p.block_size > 32)
       mask[start / 32 + 1] |= static_cast<uint>(row_bits >> (32 - start % 32));
-    const CellRowJumps jumps = cell_row_jumps(points, r, y, p);
-    inside += jumps.inside, edge += jumps.edge;
+    inside += count_jumps(depth + 2, depth + 1, n > 0 ? n - 1 : 0, p);
+    edge += cell_jump_count(depth[1], depth[0], p);
+    if (has_above) (y > r.y0 ? inside : edge) += count_jumps(depth + 1, above, n, p);
+    std::copy_n(depth + 1, n, above);
+    has_above = true;
   }
   const float values[KG_CELL_BLOCK_SUMS] = {reference.x, reference.y, reference.z, first[0],
                                             first[1],    first[2],    by_x[0],     by_x[1],
