@@ -23,7 +23,7 @@ namespace {
 
 using testing::BackendTest;
 
-constexpr int kCellSize = 16;
+constexpr int kCellSize = 16;  // the default; the random frames try others
 constexpr float kMaxDepthJump = 0.02f, kJumpPerZ2 = 0.008f;
 
 struct ReferenceBlock {
@@ -53,12 +53,12 @@ void count_jumps(const PointImage& points, int x0, int y0, int x1, int y1, int c
 }
 
 ReferenceBlock reference_block(const PointImage& points, const RgbImage& rgb, int bx, int by,
-                               const Eigen::Vector3d& origin) {
-  const int half = kCellSize / 2;
+                               const Eigen::Vector3d& origin, int cell_size) {
+  const int half = cell_size / 2;
   const int x0 = std::min(points.width(), bx * half), y0 = std::min(points.height(), by * half);
   const int x1 = std::min(points.width(), x0 + half), y1 = std::min(points.height(), y0 + half);
   ReferenceBlock block;
-  count_jumps(points, x0, y0, x1, y1, bx / 2 * kCellSize, by / 2 * kCellSize, block);
+  count_jumps(points, x0, y0, x1, y1, bx / 2 * cell_size, by / 2 * cell_size, block);
   bool first = true;
   Eigen::Vector3d reference = Eigen::Vector3d::Zero();
   for (int y = y0; y < y1; ++y) {
@@ -81,7 +81,7 @@ ReferenceBlock reference_block(const PointImage& points, const RgbImage& rgb, in
 // Compares every block of `cells` with the reference; returns the worst relative moment error.
 double check_blocks(const PointImage& points, const RgbImage& rgb, const Eigen::Vector3d& origin,
                     const segmentation::detail::CellGrid& cells, const std::string& what) {
-  const int half = kCellSize / 2;
+  const int half = cells.cell_size / 2;
   double worst = 0;
   std::size_t mismatches = 0;
   for (std::size_t c = 0; c < cells.size(); ++c) {
@@ -89,7 +89,7 @@ double check_blocks(const PointImage& points, const RgbImage& rgb, const Eigen::
     for (int b = 0; b < 4; ++b) {
       const int bx = 2 * static_cast<int>(c % cells.columns) + b % 2;
       const int by = 2 * static_cast<int>(c / cells.columns) + b / 2;
-      const ReferenceBlock e = reference_block(points, rgb, bx, by, origin);
+      const ReferenceBlock e = reference_block(points, rgb, bx, by, origin, cells.cell_size);
       cell_jumps += e.inside + e.edge;
       const std::size_t k = 4 * c + static_cast<std::size_t>(b);
       const geometry::SegmentMoments& m = cells.block_moments[k];
@@ -101,7 +101,7 @@ double check_blocks(const PointImage& points, const RgbImage& rgb, const Eigen::
       worst = std::max({worst, (m.sum - e.sum).norm() / sum_bound,
                         (m.sum_outer - e.outer).norm() / outer_bound});
     }
-    mismatches += cells.continuous[c] != (2 * cell_jumps <= std::uint32_t(kCellSize));
+    mismatches += cells.continuous[c] != (2 * cell_jumps <= std::uint32_t(cells.cell_size));
   }
   for (int y = 0; y < points.height(); ++y) {
     for (int bx = 0; bx < cells.blocks_x; ++bx) {
@@ -119,11 +119,12 @@ double check_blocks(const PointImage& points, const RgbImage& rgb, const Eigen::
 }
 
 segmentation::detail::CellGrid measure(const compute::Context& context, const PointImage& points,
-                                       const RgbImage& rgb, const Eigen::Vector3d& origin) {
+                                       const RgbImage& rgb, const Eigen::Vector3d& origin,
+                                       int cell_size = kCellSize) {
   const auto device_points = compute::Buffer<Point4f>::from_host(context, points.pixels());
   segmentation::CellBuffers buffers;
   segmentation::detail::CellGrid cells;
-  segmentation::detail::measure_cells(context, device_points, rgb, kCellSize, kMaxDepthJump,
+  segmentation::detail::measure_cells(context, device_points, rgb, cell_size, kMaxDepthJump,
                                       kJumpPerZ2, origin, buffers, cells);
   return cells;
 }
@@ -161,11 +162,17 @@ TEST_P(CellBlocksTest, MatchesReferenceOnRandomFrames) {
       }
     }
     const Eigen::Vector3d origin(0.1, -0.2, 2.5);
-    const std::string what = std::to_string(width) + "x" + std::to_string(height);
-    const segmentation::detail::CellGrid cells = measure(context(), points, rgb, origin);
-    const double worst = check_blocks(points, rgb, origin, cells, what);
-    RecordProperty("worst_over_bound_" + what, testing::scientific(worst));
-    expect_same_cells(cells, measure(compute::Context::cpu(), points, rgb, origin));
+    // 12: a block's rows of validity bits straddle 32-bit words; 4 and 64: the smallest and
+    // largest cells.
+    for (const int cell_size : {kCellSize, 4, 12, 64}) {
+      const std::string what = std::to_string(width) + "x" + std::to_string(height) + ", " +
+                               std::to_string(cell_size) + " px cells";
+      const segmentation::detail::CellGrid cells =
+          measure(context(), points, rgb, origin, cell_size);
+      const double worst = check_blocks(points, rgb, origin, cells, what);
+      RecordProperty("worst_over_bound_" + what, testing::scientific(worst));
+      expect_same_cells(cells, measure(compute::Context::cpu(), points, rgb, origin, cell_size));
+    }
   }
 }
 

@@ -565,6 +565,9 @@ TEST(PlaneExtraction, RejectsBadInput) {
   bad_cells.cells.cell_size = 15;  // not 2 x 2 blocks
   EXPECT_ERROR_MENTIONS(segmentation::PlaneExtractor(context, camera, bad_cells), "cell_size",
                         "even", "15");
+  bad_cells.cells.cell_size = 66;  // a block's row of validity bits would not fit in 32
+  EXPECT_ERROR_MENTIONS(segmentation::PlaneExtractor(context, camera, bad_cells), "cell_size",
+                        "4..64", "66");
   bad_cells = {};
   bad_cells.cells.reach_passes = 0;
   EXPECT_ERROR_MENTIONS(segmentation::PlaneExtractor(context, camera, bad_cells), "reach_passes");

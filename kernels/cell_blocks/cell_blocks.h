@@ -87,7 +87,7 @@ KG_INLINE CellRowJumps cell_row_jumps(KG_BUFFER_PARAM(const float4, points) Cell
   for (uint x = r.x0 + 1u; x < r.x1; ++x) {
     jumps.inside += cell_jump_count(points[row + x].z, points[row + x - 1u].z, p);
   }
-  if (r.x0 > r.cell_x0) {
+  if (r.x0 > r.cell_x0 && r.x0 < r.x1) {  // an empty block (past the image's edge) has no edge
     jumps.edge += cell_jump_count(points[row + r.x0].z, points[row + r.x0 - 1u].z, p);
   }
   if (y == r.y0 && y == r.cell_y0) return jumps;

@@ -48,7 +48,8 @@ void measure_block(const float4* points, const std::uint8_t* colours, uint block
   for (uint k = 0; has_above && k < n; ++k) above[k] = points[(r.y0 - 1) * p.width + r.x0 + k].z;
   for (uint y = r.y0; y < r.y1; ++y) {
     const std::size_t row = std::size_t{y} * p.width;
-    depth[0] = r.x0 > r.cell_x0 ? points[row + r.x0 - 1].z : KG_NAN;
+    // NaN also for an empty block (past the image's edge), whose depth[1] is never written.
+    depth[0] = r.x0 > r.cell_x0 && n > 0 ? points[row + r.x0 - 1].z : KG_NAN;
     std::uint64_t row_bits = 0;  // at most 32
     for (uint x = r.x0; x < r.x1; ++x) {
       const float4& q = points[row + x];
