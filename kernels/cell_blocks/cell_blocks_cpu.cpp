@@ -13,7 +13,6 @@ namespace kartograf::kernels {
 namespace {
 
 using compute::detail::Lanes;
-using compute::detail::splat;
 
 struct BlockOutputs {
   float* sums;
