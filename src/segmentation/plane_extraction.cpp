@@ -111,6 +111,8 @@ void refine_border_pixels(const SegmentLabelImage& segments, const PointImage& p
 // How far apart [pixels] the refinement's growth and left-over regions connect pixels: across a
 // one-pixel gap of missing depth.
 constexpr int kFloodRadius = 2;
+// The cells mode's leftover regions are 8-connected: its passes already reached across gaps.
+constexpr int kCellLeftoverRadius = 1;
 
 // Calls visit(j) for every pixel j within `radius` (Chebyshev) of pixel i, i itself included.
 template <class Visit>
@@ -359,8 +361,8 @@ void PlaneExtractor::add_leftover_planes(const PointImage& points, const detail:
       }
     }
   };
-  plane_leftover_regions(points, params_, 1, pixels_of_open_cells, pixel_plane_, planes,
-                         flood_queue_, leftover_pixels_);
+  plane_leftover_regions(points, params_, kCellLeftoverRadius, pixels_of_open_cells, pixel_plane_,
+                         planes, flood_queue_, leftover_pixels_);
   add_leftover_sums(points, pixel_plane_, planes, cell_plane_count, leftover_pixels_, sums);
 }
 
