@@ -355,39 +355,78 @@ struct AssignInputs {
   std::vector<ScoredPlane> scored;
   std::vector<PlaneFrame> frames;
   ScoreRule rule;
+  const std::vector<std::array<std::uint32_t, 4>>* block_planes = nullptr;  // per cell's blocks
 };
 
-// A planar cell whose neighbours hold no other plane: its valid pixels take its plane (its
-// planarity test and the merge have judged them), and its moments give the plane's count and
-// squared distances. A plane's image and its in-plane coordinates are related by a homography,
-// which keeps convex hulls: a plane's extreme points lie on its outline in the image, never
-// inside. So the cell adds to the extent only the first and last valid pixel of each row (the
-// corners of its pixels' hull are among them), and a cell whose neighbours all lie in the plane
-// (`inside`, away from the image's edge) adds nothing.
-void assign_planar_cell(const AssignInputs& in, std::size_t cell, std::uint32_t plane, bool inside,
-                        std::vector<PlanePixelSums>& sums,
-                        std::vector<std::uint32_t>& pixel_plane) {
-  const int width = in.points.width(), half = in.cells.cell_size / 2;
+// A rectangle of pixels: a cell, or one of its blocks; x0 and x1 on block columns.
+struct PixelRect {
+  int x0, y0, x1, y1;
+};
+
+PixelRect cell_rect(const AssignInputs& in, std::size_t cell) {
   const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
-  const int y1 = std::min(in.points.height(), y0 + in.cells.cell_size);
-  const int block_x = x0 / half;
+  return {x0, y0, std::min(in.points.width(), x0 + in.cells.cell_size),
+          std::min(in.points.height(), y0 + in.cells.cell_size)};
+}
+
+// Block b (0..3, row by row) of a cell.
+PixelRect block_rect(const AssignInputs& in, std::size_t cell, int b) {
+  const int half = in.cells.cell_size / 2;
+  const int x0 = in.cells.first_x(cell) + (b % 2) * half,
+            y0 = in.cells.first_y(cell) + (b / 2) * half;
+  return {x0, y0, std::min(in.points.width(), x0 + half), std::min(in.points.height(), y0 + half)};
+}
+
+// f(y, bits) for each row y of the rectangle, bit k of `bits`: whether pixel (rect.x0 + k, y) has
+// a point (bits past the image's edge are never set).
+template <class RowBits>
+void for_each_row_bits(const CellGrid& cells, const PixelRect& rect, RowBits&& f) {
+  const int half = cells.cell_size / 2;
+  const std::size_t block_x = static_cast<std::size_t>(rect.x0 / half);
+  const bool two = rect.x1 - rect.x0 > half;  // a cell's two blocks across, or one
+  for (int y0 = rect.y0; y0 < rect.y1; y0 += half) {
+    const std::size_t block = static_cast<std::size_t>(y0 / half) * cells.blocks_x + block_x;
+    for (int row = 0; row < half && y0 + row < rect.y1; ++row) {
+      std::uint64_t bits = cells.block_row_bits(block, row);
+      if (two) bits |= std::uint64_t{cells.block_row_bits(block + 1, row)} << half;
+      f(y0 + row, bits);
+    }
+  }
+}
+
+// out[k] = plane for every set bit k, run by run.
+void label_bits(std::uint32_t* out, std::uint64_t bits, std::uint32_t plane) {
+  while (bits != 0) {
+    const int start = std::countr_zero(bits);
+    const int run = std::countr_one(bits >> start);
+    std::fill_n(out + start, run, plane);
+    bits = run + start >= 64 ? 0 : bits & (~std::uint64_t{0} << (start + run));
+  }
+}
+
+// A planar cell (or block) whose neighbours hold no other plane: its valid pixels take its plane
+// (its planarity test and the merge have judged them), and its moments give the plane's count
+// and squared distances. A plane's image and its in-plane coordinates are related by a
+// homography, which keeps convex hulls: a plane's extreme points lie on its outline in the image,
+// never inside. So the rectangle adds to the extent only the first and last valid pixel of each
+// row (the corners of its pixels' hull are among them), and one whose neighbours all lie in the
+// plane (`inside`, away from the image's edge) adds nothing.
+void assign_whole(const AssignInputs& in, const PixelRect& rect, const geometry::SegmentMoments& m,
+                  std::uint32_t plane, bool inside, std::vector<PlanePixelSums>& sums,
+                  std::vector<std::uint32_t>& pixel_plane) {
+  const int width = in.points.width();
   const PlaneFrame& frame = in.frames[plane];
   PlanePixelSums& sum = sums[plane];
-  for (int y = y0; y < y1; ++y) {
+  for_each_row_bits(in.cells, rect, [&](int y, std::uint64_t bits) {
+    if (bits == 0) return;
     const std::size_t row = static_cast<std::size_t>(y) * width;
-    // The row's validity bits over the cell (bits past the image's edge are never set).
-    const std::uint64_t bits = in.cells.valid_bits(block_x, y) |
-                               std::uint64_t{in.cells.valid_bits(block_x + 1, y)} << half;
-    if (bits == 0) continue;
-    for (std::uint64_t rest = bits; rest != 0; rest &= rest - 1) {
-      pixel_plane[row + x0 + std::countr_zero(rest)] = plane;
-    }
-    if (inside) continue;
-    const int first = x0 + std::countr_zero(bits), last = x0 + 63 - std::countl_zero(bits);
+    label_bits(pixel_plane.data() + row + rect.x0, bits, plane);
+    if (inside) return;
+    const int first = rect.x0 + std::countr_zero(bits),
+              last = rect.x0 + 63 - std::countl_zero(bits);
     sum.extend(frame, in.points.data()[row + first]);
     sum.extend(frame, in.points.data()[row + last]);
-  }
-  const geometry::SegmentMoments& m = in.cells.moments[cell];
+  });
   const Eigen::Vector3d& n = in.planes[plane].normal;
   // sum (n . p + offset)^2 with p = origin + q: n^T (sum q q^T) n + 2 e n . (sum q) + count e^2.
   const double e = n.dot(in.origin) + in.planes[plane].offset;
@@ -413,59 +452,90 @@ CandidateLanes candidate_lanes(const AssignInputs& in, const CellCandidates& can
   return lanes;
 }
 
+// The points at x .. x + 3 of a row as lanes (NaN past `end`, and where there is no point).
+PixelLanes pixel_lanes(const Point4f* row, int x, int end) {
+  if (x + 4 <= end) {
+    Lanes a, b, c, d;
+    std::memcpy(&a, row + x, sizeof a), std::memcpy(&b, row + x + 1, sizeof b);
+    std::memcpy(&c, row + x + 2, sizeof c), std::memcpy(&d, row + x + 3, sizeof d);
+    const compute::detail::XyzLanes t = compute::detail::transpose_xyz(a, b, c, d);
+    return {t.x, t.y, t.z};
+  }
+  const Lanes none = splat(std::numeric_limits<float>::quiet_NaN());
+  PixelLanes p{none, none, none};
+  for (int j = 0; j < 4 && x + j < end; ++j) {
+    p.x[j] = row[x + j].x(), p.y[j] = row[x + j].y(), p.z[j] = row[x + j].z();
+  }
+  return p;
+}
+
+// A cell's pixels taken per candidate while it is scored: counts and squared distances for the
+// cell, and per row the first and last pixel (x) that took each candidate.
+struct CellTally {
+  std::array<std::uint32_t, 36> taken{};
+  std::array<double, 36> squared{};
+  std::array<int, 36> first, last;
+
+  // Four pixels from x whose lanes chose `choices` (-1: none).
+  void add(const LaneMask& choices, const Lanes& distance2, int x) {
+    const int c = choices[0];
+    const LaneMask differ = choices ^ splat(c);
+    if (c >= 0 && (differ[0] | differ[1] | differ[2] | differ[3]) == 0) {  // the usual case
+      taken[c] += 4;
+      for (int j = 0; j < 4; ++j) squared[c] += distance2[j];
+      if (first[c] < 0) first[c] = x;
+      last[c] = x + 3;
+      return;
+    }
+    for (int j = 0; j < 4; ++j) {
+      const int choice = choices[j];
+      if (choice < 0) continue;
+      ++taken[choice];
+      squared[choice] += distance2[j];
+      if (first[choice] < 0) first[choice] = x + j;
+      last[choice] = x + j;
+    }
+  }
+};
+
 // Each valid pixel of the cell takes the candidate it scores best against (none if none is
 // within its allowance), and is added to that plane's sums: its count and squared distance, and
 // its extent from the first and last pixel of each row that took the plane (the corners of the
 // hull of a plane's pixels in the cell are among them; see assign_planar_cell). Four pixels are
 // scored at once; the sums stay in locals until the cell is done. Returns how many pixels took
 // each candidate.
-std::array<std::uint32_t, 36> score_cell_pixels(const AssignInputs& in, std::size_t cell,
-                                                const CellCandidates& candidates,
-                                                std::vector<PlanePixelSums>& sums,
-                                                std::vector<std::uint32_t>& pixel_plane) {
+std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRect& rect,
+                                           const CellCandidates& candidates,
+                                           std::vector<PlanePixelSums>& sums,
+                                           std::vector<std::uint32_t>& pixel_plane) {
   const Point4f* points = in.points.data();
-  const int x0 = in.cells.first_x(cell), y0 = in.cells.first_y(cell);
-  const int x1 = std::min(in.points.width(), x0 + in.cells.cell_size);
-  const int y1 = std::min(in.points.height(), y0 + in.cells.cell_size);
+  const auto [x0, y0, x1, y1] = rect;
   const int count = candidates.count;
   const CandidateLanes lanes = candidate_lanes(in, candidates);
-  std::array<std::uint32_t, 36> taken{};
-  std::array<double, 36> squared{};
-  const Lanes none = splat(std::numeric_limits<float>::quiet_NaN());
+  CellTally tally;
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * in.points.width();
-    std::array<int, 36> first, last;
-    std::fill_n(first.begin(), count, -1);
+    std::fill_n(tally.first.begin(), count, -1);
     for (int x = x0; x < x1; x += 4) {
-      PixelLanes p{none, none, none};
-      for (int j = 0; j < 4 && x + j < x1; ++j) {
-        const Point4f& point = points[row + x + j];
-        p.x[j] = point.x(), p.y[j] = point.y(), p.z[j] = point.z();
-      }
       Lanes distance2;
-      const LaneMask choices = in.rule.best(lanes, p, distance2);
+      const LaneMask choices = in.rule.best(lanes, pixel_lanes(points + row, x, x1), distance2);
       for (int j = 0; j < 4; ++j) {
-        const int choice = choices[j];
-        if (choice < 0) continue;
-        pixel_plane[row + x + j] = candidates.planes[choice];
-        ++taken[choice];
-        squared[choice] += distance2[j];
-        if (first[choice] < 0) first[choice] = x + j;
-        last[choice] = x + j;
+        if (choices[j] >= 0) pixel_plane[row + x + j] = candidates.planes[choices[j]];
       }
+      tally.add(choices, distance2, x);
     }
     for (int k = 0; k < count; ++k) {
-      if (first[k] < 0) continue;
+      if (tally.first[k] < 0) continue;
       const std::uint32_t plane = candidates.planes[k];
-      sums[plane].extend(in.frames[plane], points[row + first[k]]);
-      sums[plane].extend(in.frames[plane], points[row + last[k]]);
+      sums[plane].extend(in.frames[plane], points[row + tally.first[k]]);
+      sums[plane].extend(in.frames[plane], points[row + tally.last[k]]);
     }
   }
   for (int k = 0; k < count; ++k) {
-    sums[candidates.planes[k]].count += taken[k];
-    sums[candidates.planes[k]].squared_error += squared[k];
+    sums[candidates.planes[k]].count += tally.taken[k];
+    sums[candidates.planes[k]].squared_error += tally.squared[k];
   }
-  return taken;
+  return tally.taken;
 }
 
 // What a cell's assignment leaves: the plane it carries on to the next passes (kNoLabel: none)
@@ -475,6 +545,64 @@ struct CellOutcome {
   std::uint32_t left;
 };
 
+// The candidates of block b of a planar cell in plane `own`: its plane and the planes of the
+// eight blocks around it (pass 0's); `whole` when they are all its plane and none lies past the
+// image's edge.
+CellCandidates block_candidates(const AssignInputs& in, std::size_t cell, int b,
+                                std::uint32_t own) {
+  const CellGrid& cells = in.cells;
+  const int bx = static_cast<int>(cell % cells.columns) * 2 + b % 2;
+  const int by = static_cast<int>(cell / cells.columns) * 2 + b / 2;
+  CellCandidates out;
+  out.add(own);
+  out.own = out.whole = true;
+  for (int y = by - 1; y <= by + 1; ++y) {
+    for (int x = bx - 1; x <= bx + 1; ++x) {
+      if (x < 0 || y < 0 || x >= 2 * cells.columns || y >= 2 * cells.rows) {
+        out.whole = false;
+        continue;
+      }
+      const std::size_t c = static_cast<std::size_t>(y / 2) * cells.columns + x / 2;
+      const std::uint32_t plane = (*in.block_planes)[c][(y % 2) * 2 + x % 2];
+      out.whole = out.whole && plane == own;
+      out.add(plane);
+    }
+  }
+  return out;
+}
+
+// A planar cell beside other planes, block by block: a block takes its plane whole when the
+// blocks around it hold no other plane; else its pixels are scored among those blocks' planes.
+// A pixel thus takes another plane only from a block next to its own (not from anywhere in the
+// next cells): the cell's own fit and planarity test have judged all its pixels but a border's.
+// Returns how many pixels took each of the cell's candidates.
+std::array<std::uint32_t, 36> assign_cell_by_blocks(const AssignInputs& in, std::size_t cell,
+                                                    const CellCandidates& candidates,
+                                                    std::vector<PlanePixelSums>& sums,
+                                                    std::vector<std::uint32_t>& pixel_plane) {
+  std::array<std::uint32_t, 36> taken{};
+  const std::uint32_t own = candidates.planes[0];
+  for (int b = 0; b < 4; ++b) {
+    const PixelRect rect = block_rect(in, cell, b);
+    if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) continue;
+    const CellCandidates block = block_candidates(in, cell, b, own);
+    if (block.count == 1) {
+      const geometry::SegmentMoments& m = in.cells.block_moments[4 * cell + b];
+      assign_whole(in, rect, m, own, block.whole, sums, pixel_plane);
+      taken[0] += static_cast<std::uint32_t>(m.count);
+      continue;
+    }
+    const std::array<std::uint32_t, 36> block_taken =
+        score_pixels(in, rect, block, sums, pixel_plane);
+    for (int k = 0; k < block.count; ++k) {
+      const auto* at = std::find(candidates.planes.begin(),
+                                 candidates.planes.begin() + candidates.count, block.planes[k]);
+      taken[static_cast<std::size_t>(at - candidates.planes.begin())] += block_taken[k];
+    }
+  }
+  return taken;
+}
+
 // Assigns the cell's valid pixels among the candidates, adding them to their planes' sums;
 // returns the plane that took the most of them when that is at least a quarter of the cell's
 // valid pixels (kNoLabel otherwise).
@@ -483,11 +611,13 @@ CellOutcome assign_cell(const AssignInputs& in, std::size_t cell, const CellCand
                         std::vector<std::uint32_t>& pixel_plane) {
   if (candidates.own && candidates.count == 1) {
     const bool inside = candidates.whole && !at_image_edge(in.cells, cell);
-    assign_planar_cell(in, cell, candidates.planes[0], inside, sums, pixel_plane);
+    assign_whole(in, cell_rect(in, cell), in.cells.moments[cell], candidates.planes[0], inside,
+                 sums, pixel_plane);
     return {candidates.planes[0], 0};
   }
   const std::array<std::uint32_t, 36> taken =
-      score_cell_pixels(in, cell, candidates, sums, pixel_plane);
+      candidates.own ? assign_cell_by_blocks(in, cell, candidates, sums, pixel_plane)
+                     : score_pixels(in, cell_rect(in, cell), candidates, sums, pixel_plane);
   const auto most =
       std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
   const std::uint64_t valid = in.cells.moments[cell].count;
@@ -521,7 +651,7 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
                                                std::vector<std::uint32_t>& open_cells) {
   constexpr std::uint32_t kNone = geometry::kNoLabel;
   using Planes = std::array<std::uint32_t, 4>;
-  const AssignInputs in = assign_inputs(points, cells, planes, origin, params);
+  AssignInputs in = assign_inputs(points, cells, planes, origin, params);
   pixel_plane.assign(points.size(), kNone);
   // Per cell: its segments' planes; the pass that assigned it (-1: none yet); the plane it
   // carries on to the next passes' cells (the one most of its pixels took).
@@ -532,6 +662,7 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
       if (s != kNone) cell_planes[c][b] = segment_plane[s];
     }
   }
+  in.block_planes = &cell_planes;
   std::vector<int> assigned_in(cells.size(), -1);
   std::vector<std::uint32_t> carried(cells.size(), kNone);
   std::vector<std::uint32_t> left(cells.size());

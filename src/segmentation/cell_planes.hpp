@@ -43,16 +43,20 @@ struct CellGrid {
   std::size_t size() const { return moments.size(); }
   int first_x(std::size_t cell) const { return static_cast<int>(cell % columns) * cell_size; }
   int first_y(std::size_t cell) const { return static_cast<int>(cell / columns) * cell_size; }
-  // Bit k of the result: whether pixel (x0 + k, y) has a point, where x0 is the first column of
-  // image block `block_x` (half a cell wide; y any row of the image).
-  std::uint32_t valid_bits(int block_x, int y) const {
+  // Bit k of the result: whether pixel (x0 + k, y0 + row) has a point, where (x0, y0) is the
+  // first pixel of image block `block` (half a cell a side; row < half).
+  std::uint32_t block_row_bits(std::size_t block, int row) const {
     const int half = cell_size / 2;
-    const std::size_t block = static_cast<std::size_t>(y / half) * blocks_x + block_x;
-    const int bit = (y % half) * half;
+    const int bit = row * half;
     const std::uint32_t* words = block_masks.data() + block * mask_words + bit / 32;
     std::uint64_t v = words[0];
     if (bit % 32 + half > 32) v |= std::uint64_t{words[1]} << 32;
     return static_cast<std::uint32_t>((v >> (bit % 32)) & ((std::uint64_t{1} << half) - 1));
+  }
+  // The same for pixel (x0 + k, y) of image block column `block_x` (y any row of the image).
+  std::uint32_t valid_bits(int block_x, int y) const {
+    const int half = cell_size / 2;
+    return block_row_bits(static_cast<std::size_t>(y / half) * blocks_x + block_x, y % half);
   }
 };
 

@@ -23,4 +23,30 @@ Vector select(LaneMask mask, Vector a, Vector b) {
                                   (~mask & reinterpret_cast<LaneMask>(b)));
 }
 
+// Four points of four floats each (x, y, z, w), as read from memory, turned into their x, y and z
+// lanes (w dropped): a 4 x 4 transpose in six shuffles instead of twelve lane inserts.
+struct XyzLanes {
+  Lanes x, y, z;
+};
+inline XyzLanes transpose_xyz(Lanes a, Lanes b, Lanes c, Lanes d) {
+#if defined(__clang__)
+  const Lanes ab_low = __builtin_shufflevector(a, b, 0, 4, 1, 5);   // ax bx ay by
+  const Lanes cd_low = __builtin_shufflevector(c, d, 0, 4, 1, 5);   // cx dx cy dy
+  const Lanes ab_high = __builtin_shufflevector(a, b, 2, 6, 3, 7);  // az bz aw bw
+  const Lanes cd_high = __builtin_shufflevector(c, d, 2, 6, 3, 7);  // cz dz cw dw
+  return {__builtin_shufflevector(ab_low, cd_low, 0, 1, 4, 5),
+          __builtin_shufflevector(ab_low, cd_low, 2, 3, 6, 7),
+          __builtin_shufflevector(ab_high, cd_high, 0, 1, 4, 5)};
+#else
+  using Index = LaneMask;
+  const Lanes ab_low = __builtin_shuffle(a, b, Index{0, 4, 1, 5});
+  const Lanes cd_low = __builtin_shuffle(c, d, Index{0, 4, 1, 5});
+  const Lanes ab_high = __builtin_shuffle(a, b, Index{2, 6, 3, 7});
+  const Lanes cd_high = __builtin_shuffle(c, d, Index{2, 6, 3, 7});
+  return {__builtin_shuffle(ab_low, cd_low, Index{0, 1, 4, 5}),
+          __builtin_shuffle(ab_low, cd_low, Index{2, 3, 6, 7}),
+          __builtin_shuffle(ab_high, cd_high, Index{0, 1, 4, 5})};
+#endif
+}
+
 }  // namespace kartograf::compute::detail
