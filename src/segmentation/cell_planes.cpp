@@ -454,19 +454,8 @@ CandidateLanes candidate_lanes(const AssignInputs& in, const CellCandidates& can
 
 // The points at x .. x + 3 of a row as lanes (NaN past `end`, and where there is no point).
 PixelLanes pixel_lanes(const Point4f* row, int x, int end) {
-  if (x + 4 <= end) {
-    Lanes a, b, c, d;
-    std::memcpy(&a, row + x, sizeof a), std::memcpy(&b, row + x + 1, sizeof b);
-    std::memcpy(&c, row + x + 2, sizeof c), std::memcpy(&d, row + x + 3, sizeof d);
-    const compute::detail::XyzLanes t = compute::detail::transpose_xyz(a, b, c, d);
-    return {t.x, t.y, t.z};
-  }
-  const Lanes none = splat(std::numeric_limits<float>::quiet_NaN());
-  PixelLanes p{none, none, none};
-  for (int j = 0; j < 4 && x + j < end; ++j) {
-    p.x[j] = row[x + j].x(), p.y[j] = row[x + j].y(), p.z[j] = row[x + j].z();
-  }
-  return p;
+  const compute::detail::XyzLanes t = compute::detail::load_xyz(row[x].data(), end - x);
+  return {t.x, t.y, t.z};
 }
 
 // A cell's pixels taken per candidate while it is scored: counts and squared distances for the

@@ -3,6 +3,8 @@
 // extension: SSE on x86-64, NEON on ARM, without target-specific code), for CPU loops whose
 // sums or choices the auto-vectorizer does not find.
 #include <cstdint>
+#include <cstring>
+#include <limits>
 
 namespace kartograf::compute::detail {
 
@@ -47,6 +49,23 @@ inline XyzLanes transpose_xyz(Lanes a, Lanes b, Lanes c, Lanes d) {
           __builtin_shuffle(ab_low, cd_low, Index{2, 3, 6, 7}),
           __builtin_shuffle(ab_high, cd_high, Index{0, 1, 4, 5})};
 #endif
+}
+
+// The x, y and z lanes of `count` (<= 4) consecutive points of four floats each from `first`
+// (NaN in the lanes past count); four points by the transpose, fewer one by one.
+inline XyzLanes load_xyz(const float* first, int count) {
+  if (count >= 4) {
+    Lanes a, b, c, d;
+    std::memcpy(&a, first, sizeof a), std::memcpy(&b, first + 4, sizeof b);
+    std::memcpy(&c, first + 8, sizeof c), std::memcpy(&d, first + 12, sizeof d);
+    return transpose_xyz(a, b, c, d);
+  }
+  const Lanes none = splat(std::numeric_limits<float>::quiet_NaN());
+  XyzLanes p{none, none, none};
+  for (int j = 0; j < count; ++j) {
+    p.x[j] = first[4 * j], p.y[j] = first[4 * j + 1], p.z[j] = first[4 * j + 2];
+  }
+  return p;
 }
 
 }  // namespace kartograf::compute::detail
