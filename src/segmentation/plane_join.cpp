@@ -85,6 +85,7 @@ class PlaneJoiner {
   void sum_pixels();
   double see_through(std::uint32_t p, std::uint32_t q, const SegmentPlane& plane);
   void update_uncertainty(std::uint32_t p);
+  void update_mean_colour(std::uint32_t p);
   bool pair_within(std::uint32_t p, std::uint32_t q, bool adjacent_pair) const;
   bool each_near_other_plane(std::uint32_t p, std::uint32_t q) const;
   double side_cost(std::uint32_t r, const SegmentPlane& own, const SegmentPlane& joint,
@@ -111,6 +112,7 @@ class PlaneJoiner {
   std::vector<Eigen::Vector3d> pixel_sums_;
   std::vector<std::uint8_t> relation_;  // Relation per pair, row-major
   std::vector<double> uncertainty_;
+  std::vector<Eigen::Vector3d> mean_colour_;      // per plane, when the planes have colours
   std::vector<std::array<AngleShare, 2>> share_;  // [0] touching/near, [1] apart
   std::vector<double> pair_cost_;                 // upper triangle, row-major
   // The cheapest pair of each row (q > p; the first of equal costs), so that finding the next
@@ -136,7 +138,8 @@ PlaneJoiner::PlaneJoiner(const SegmentLabelImage& labels, const PointImage* poin
       pair_cost_(plane_count_ * plane_count_, kNoJoin),
       row_best_(plane_count_, kNoLabel) {
   std::iota(alias_.begin(), alias_.end(), 0u);
-  for (std::uint32_t p = 0; p < plane_count_; ++p) update_uncertainty(p);
+  if (!merged_.colour_sums.empty()) mean_colour_.resize(plane_count_);
+  for (std::uint32_t p = 0; p < plane_count_; ++p) update_uncertainty(p), update_mean_colour(p);
   for (std::uint32_t p = 0; p < plane_count_; ++p) {
     for (std::uint32_t q = p + 1; q < plane_count_; ++q) evaluate(p, q);
   }
@@ -204,6 +207,12 @@ void PlaneJoiner::update_uncertainty(std::uint32_t p) {
   }
 }
 
+// Each pair's colour test reads the means: kept per plane, not divided out for every pair.
+void PlaneJoiner::update_mean_colour(std::uint32_t p) {
+  if (!mean_colour_.empty())
+    mean_colour_[p] = merged_.colour_sums[p] / static_cast<double>(merged_.planes[p].count);
+}
+
 bool PlaneJoiner::pair_within(std::uint32_t p, std::uint32_t q, bool adjacent_pair) const {
   const AngleShare& a = share_[p][adjacent_pair ? 0 : 1];
   const AngleShare& b = share_[q][adjacent_pair ? 0 : 1];
@@ -263,12 +272,9 @@ double PlaneJoiner::cost(std::uint32_t p, std::uint32_t q, Relation relation) {
   const SegmentPlane& b = merged_.planes[q];
   if (!a.valid || !b.valid) return kNoJoin;
   // The cheap tests first (most pairs are apart and fail one of them).
-  const bool coloured = !merged_.colour_sums.empty();
-  const double colour_distance_sq = coloured
-                                        ? (merged_.colour_sums[p] / static_cast<double>(a.count) -
-                                           merged_.colour_sums[q] / static_cast<double>(b.count))
-                                              .squaredNorm()
-                                        : 0.0;
+  const bool coloured = !mean_colour_.empty();
+  const double colour_distance_sq =
+      coloured ? (mean_colour_[p] - mean_colour_[q]).squaredNorm() : 0.0;
   if (!adjacent_pair &&
       colour_distance_sq > params_.max_apart_colour_distance * params_.max_apart_colour_distance) {
     return kNoJoin;
@@ -326,6 +332,7 @@ void PlaneJoiner::absorb(std::uint32_t p, std::uint32_t q) {
   merged_.planes[q] = {};
   if (!pixel_sums_.empty()) pixel_sums_[p] += pixel_sums_[q];
   update_uncertainty(p);
+  update_mean_colour(p);
   alias_[q] = p;
 }
 
