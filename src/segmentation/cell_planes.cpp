@@ -15,6 +15,7 @@
 #include "kartograf/segmentation/lab_color.hpp"
 #include "kartograf/segmentation/plane_fit.hpp"
 #include "kernels/cell_blocks/cell_blocks.h"
+#include "kernels/cell_scores/cell_scores.h"
 #include "plane_output.hpp"
 
 namespace kartograf::segmentation::detail {
@@ -27,6 +28,7 @@ using compute::detail::select;
 using compute::detail::splat;
 
 constexpr compute::KernelSpec kCellBlocksKernel{"cell_blocks", KG_CELL_BLOCKS_LOCAL_X};
+constexpr compute::KernelSpec kCellScoresKernel{"cell_scores", KG_CELL_SCORES_LOCAL_X};
 
 // A block's moments about `origin` in double, from its float sums about its reference point (the
 // shift of sums of outer products is exact algebra).
@@ -346,6 +348,19 @@ struct ScoreRule {
   }
 };
 
+// The scoring jobs of a pass (a cell's or block's rectangle with its candidates, in the order the
+// assignment meets them) and, off the CPU backend, the device's choices for their pixels
+// (kernels/cell_scores), each job's pixels row by row from its slot.
+struct ScoringJobs {
+  std::vector<std::uint32_t> words;       // KG_CELL_JOB_WORDS per job
+  std::vector<std::uint32_t> candidates;  // the jobs' candidate planes, one after the other
+  std::size_t pixels = 0;
+  std::vector<std::uint32_t> choices;  // per job pixel: candidate index or KG_CELL_NO_CHOICE
+  std::vector<float> distances;        // per job pixel: squared distance to it
+
+  std::size_t slot(std::size_t job) const { return words[job * KG_CELL_JOB_WORDS + 6]; }
+};
+
 // What every cell's assignment reads.
 struct AssignInputs {
   const PointImage& points;
@@ -356,6 +371,7 @@ struct AssignInputs {
   std::vector<PlaneFrame> frames;
   ScoreRule rule;
   const std::vector<std::array<std::uint32_t, 4>>* block_planes = nullptr;  // per cell's blocks
+  const ScoringJobs* device = nullptr;  // the device's choices, off the CPU backend
 };
 
 // A rectangle of pixels: a cell, or one of its blocks; x0 and x1 on block columns.
@@ -458,6 +474,23 @@ PixelLanes pixel_lanes(const Point4f* row, int x, int end) {
   return {t.x, t.y, t.z};
 }
 
+// The device's choices for the pixels at x .. x + 3 of row y of job `job` (rectangle `rect`), as
+// ScoreRule::best gives them (-1: none, also past the rectangle).
+LaneMask device_choices(const ScoringJobs& scores, std::size_t job, const PixelRect& rect, int x,
+                        int y, Lanes& distance2) {
+  const std::size_t first = scores.slot(job) +
+                            static_cast<std::size_t>(y - rect.y0) * (rect.x1 - rect.x0) +
+                            static_cast<std::size_t>(x - rect.x0);
+  LaneMask choices = splat(-1);
+  distance2 = splat(1.0f);
+  for (int j = 0; j < 4 && x + j < rect.x1; ++j) {
+    // KG_CELL_NO_CHOICE is -1 as a signed lane.
+    choices[j] = static_cast<std::int32_t>(scores.choices[first + j]);
+    distance2[j] = scores.distances[first + j];
+  }
+  return choices;
+}
+
 // A cell's pixels taken per candidate while it is scored: counts and squared distances for the
 // cell, and per row the first and last pixel (x) that took each candidate.
 struct CellTally {
@@ -494,20 +527,22 @@ struct CellTally {
 // scored at once; the sums stay in locals until the cell is done. Returns how many pixels took
 // each candidate.
 std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRect& rect,
-                                           const CellCandidates& candidates,
+                                           const CellCandidates& candidates, std::size_t job,
                                            std::vector<PlanePixelSums>& sums,
                                            std::vector<std::uint32_t>& pixel_plane) {
   const Point4f* points = in.points.data();
   const auto [x0, y0, x1, y1] = rect;
   const int count = candidates.count;
-  const CandidateLanes lanes = candidate_lanes(in, candidates);
+  const CandidateLanes lanes = in.device ? CandidateLanes{} : candidate_lanes(in, candidates);
   CellTally tally;
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * in.points.width();
     std::fill_n(tally.first.begin(), count, -1);
     for (int x = x0; x < x1; x += 4) {
       Lanes distance2;
-      const LaneMask choices = in.rule.best(lanes, pixel_lanes(points + row, x, x1), distance2);
+      const LaneMask choices =
+          in.device ? device_choices(*in.device, job, rect, x, y, distance2)
+                    : in.rule.best(lanes, pixel_lanes(points + row, x, x1), distance2);
       for (int j = 0; j < 4; ++j) {
         if (choices[j] >= 0) pixel_plane[row + x + j] = candidates.planes[choices[j]];
       }
@@ -567,6 +602,7 @@ CellCandidates block_candidates(const AssignInputs& in, std::size_t cell, int b,
 // Returns how many pixels took each of the cell's candidates.
 std::array<std::uint32_t, 36> assign_cell_by_blocks(const AssignInputs& in, std::size_t cell,
                                                     const CellCandidates& candidates,
+                                                    std::size_t job,
                                                     std::vector<PlanePixelSums>& sums,
                                                     std::vector<std::uint32_t>& pixel_plane) {
   std::array<std::uint32_t, 36> taken{};
@@ -582,7 +618,7 @@ std::array<std::uint32_t, 36> assign_cell_by_blocks(const AssignInputs& in, std:
       continue;
     }
     const std::array<std::uint32_t, 36> block_taken =
-        score_pixels(in, rect, block, sums, pixel_plane);
+        score_pixels(in, rect, block, job++, sums, pixel_plane);
     for (int k = 0; k < block.count; ++k) {
       const auto* at = std::find(candidates.planes.begin(),
                                  candidates.planes.begin() + candidates.count, block.planes[k]);
@@ -595,8 +631,9 @@ std::array<std::uint32_t, 36> assign_cell_by_blocks(const AssignInputs& in, std:
 // Assigns the cell's valid pixels among the candidates, adding them to their planes' sums;
 // returns the plane that took the most of them when that is at least a quarter of the cell's
 // valid pixels (kNoLabel otherwise).
+// `job`: the cell's first scoring job (add_scoring_jobs' order).
 CellOutcome assign_cell(const AssignInputs& in, std::size_t cell, const CellCandidates& candidates,
-                        std::vector<PlanePixelSums>& sums,
+                        std::size_t job, std::vector<PlanePixelSums>& sums,
                         std::vector<std::uint32_t>& pixel_plane) {
   if (candidates.own && candidates.count == 1) {
     const bool inside = candidates.whole && !at_image_edge(in.cells, cell);
@@ -605,8 +642,8 @@ CellOutcome assign_cell(const AssignInputs& in, std::size_t cell, const CellCand
     return {candidates.planes[0], 0};
   }
   const std::array<std::uint32_t, 36> taken =
-      candidates.own ? assign_cell_by_blocks(in, cell, candidates, sums, pixel_plane)
-                     : score_pixels(in, cell_rect(in, cell), candidates, sums, pixel_plane);
+      candidates.own ? assign_cell_by_blocks(in, cell, candidates, job, sums, pixel_plane)
+                     : score_pixels(in, cell_rect(in, cell), candidates, job, sums, pixel_plane);
   const auto most =
       std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
   const std::uint64_t valid = in.cells.moments[cell].count;
@@ -615,6 +652,110 @@ CellOutcome assign_cell(const AssignInputs& in, std::size_t cell, const CellCand
       valid - std::accumulate(taken.begin(), taken.begin() + candidates.count, std::uint64_t{0}));
   return {enough ? candidates.planes[most] : geometry::kNoLabel, left};
 }
+
+void add_job(const PixelRect& rect, const CellCandidates& candidates, ScoringJobs& jobs) {
+  const auto area = static_cast<std::size_t>(rect.x1 - rect.x0) * (rect.y1 - rect.y0);
+  const std::uint32_t words[KG_CELL_JOB_WORDS] = {
+      static_cast<std::uint32_t>(rect.x0),
+      static_cast<std::uint32_t>(rect.y0),
+      static_cast<std::uint32_t>(rect.x1),
+      static_cast<std::uint32_t>(rect.y1),
+      static_cast<std::uint32_t>(jobs.candidates.size()),
+      static_cast<std::uint32_t>(candidates.count),
+      static_cast<std::uint32_t>(jobs.pixels)};
+  jobs.words.insert(jobs.words.end(), words, words + KG_CELL_JOB_WORDS);
+  jobs.candidates.insert(jobs.candidates.end(), candidates.planes.begin(),
+                         candidates.planes.begin() + candidates.count);
+  jobs.pixels += area;
+}
+
+// The cell's scoring jobs, in the order assign_cell meets them; how many.
+std::size_t add_scoring_jobs(const AssignInputs& in, std::size_t cell,
+                             const CellCandidates& candidates, ScoringJobs& jobs) {
+  if (candidates.own && candidates.count == 1) return 0;
+  if (!candidates.own) {
+    add_job(cell_rect(in, cell), candidates, jobs);
+    return 1;
+  }
+  std::size_t added = 0;
+  for (int b = 0; b < 4; ++b) {
+    const PixelRect rect = block_rect(in, cell, b);
+    if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) continue;
+    const CellCandidates block = block_candidates(in, cell, b, candidates.planes[0]);
+    if (block.count == 1) continue;
+    add_job(rect, block, jobs);
+    ++added;
+  }
+  return added;
+}
+
+// `buffer` holding at least `count` values (grown by half again or more, so rarely).
+template <class T>
+compute::Buffer<T>& at_least(compute::Buffer<T>& buffer, const compute::Context& context,
+                             std::size_t count) {
+  if (buffer.size() < count)
+    buffer = compute::Buffer<T>(context, std::max(count, buffer.size() * 3 / 2));
+  return buffer;
+}
+
+// The jobs' pixels scored on the context's backend (kernels/cell_scores); buffers.score_planes
+// holds the planes (n, offset).
+void score_on_device(const compute::Context& context, const compute::Buffer<Point4f>& points,
+                     CellBuffers& buffers, const AssignInputs& in, ScoringJobs& jobs) {
+  jobs.choices.resize(jobs.pixels);
+  jobs.distances.resize(jobs.pixels);
+  if (jobs.pixels == 0) return;
+  at_least(buffers.score_jobs, context, jobs.words.size()).upload(jobs.words);
+  at_least(buffers.score_candidates, context, jobs.candidates.size()).upload(jobs.candidates);
+  at_least(buffers.score_choices, context, jobs.pixels);
+  at_least(buffers.score_distances, context, jobs.pixels);
+  const auto job_count = static_cast<std::uint32_t>(jobs.words.size() / KG_CELL_JOB_WORDS);
+  const kernels::CellScoresParams params{static_cast<std::uint32_t>(in.points.width()), job_count,
+                                         in.rule.distance_base, in.rule.distance_per_z2,
+                                         in.rule.min_facing};
+  compute::dispatch(context, kCellScoresKernel,
+                    {points, buffers.score_jobs, buffers.score_candidates, buffers.score_planes,
+                     buffers.score_choices, buffers.score_distances},
+                    params, {compute::groups_for(job_count, kCellScoresKernel.local_x)});
+  buffers.score_choices.download(jobs.choices);
+  buffers.score_distances.download(jobs.distances);
+}
+
+// Off the CPU backend, each pass's pixels are scored by the device (the CPU backend scores them
+// four at a time as the cells are assigned): the planes go up once, each pass's jobs go up and
+// their choices come back.
+class DeviceScoring {
+ public:
+  DeviceScoring(const compute::Context& context, const compute::Buffer<Point4f>& points,
+                CellBuffers& buffers, const AssignInputs& in)
+      : context_(&context), points_(&points), buffers_(&buffers) {
+    std::vector<Eigen::Vector4f> planes;
+    for (const ScoredPlane& plane : in.scored) {
+      planes.emplace_back(plane.normal.x(), plane.normal.y(), plane.normal.z(), plane.offset);
+    }
+    if (!planes.empty()) at_least(buffers.score_planes, context, planes.size()).upload(planes);
+  }
+
+  // The pass's cells' jobs scored (in.device then points to them); each cell's first job.
+  std::vector<std::size_t> score(AssignInputs& in, const std::vector<std::size_t>& cells,
+                                 const std::vector<CellCandidates>& candidates) {
+    jobs_ = ScoringJobs{};
+    std::vector<std::size_t> first_job(cells.size());
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      first_job[k] = jobs_.words.size() / KG_CELL_JOB_WORDS;
+      add_scoring_jobs(in, cells[k], candidates[k], jobs_);
+    }
+    score_on_device(*context_, *points_, *buffers_, in, jobs_);
+    in.device = &jobs_;
+    return first_job;
+  }
+
+ private:
+  const compute::Context* context_;
+  const compute::Buffer<Point4f>* points_;
+  CellBuffers* buffers_;
+  ScoringJobs jobs_;
+};
 
 AssignInputs assign_inputs(const PointImage& points, const CellGrid& cells,
                            const std::vector<SegmentPlane>& planes, const Eigen::Vector3d& origin,
@@ -631,13 +772,12 @@ AssignInputs assign_inputs(const PointImage& points, const CellGrid& cells,
 
 }  // namespace
 
-std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const CellGrid& cells,
-                                               const std::vector<std::uint32_t>& segment_plane,
-                                               const std::vector<SegmentPlane>& planes,
-                                               const Eigen::Vector3d& origin,
-                                               const PlaneMergeParams& params, int passes,
-                                               std::vector<std::uint32_t>& pixel_plane,
-                                               std::vector<std::uint32_t>& open_cells) {
+std::vector<PlanePixelSums> assign_cell_pixels(
+    const compute::Context& context, const compute::Buffer<Point4f>& device_points,
+    CellBuffers& buffers, const PointImage& points, const CellGrid& cells,
+    const std::vector<std::uint32_t>& segment_plane, const std::vector<SegmentPlane>& planes,
+    const Eigen::Vector3d& origin, const PlaneMergeParams& params, int passes,
+    std::vector<std::uint32_t>& pixel_plane, std::vector<std::uint32_t>& open_cells) {
   constexpr std::uint32_t kNone = geometry::kNoLabel;
   using Planes = std::array<std::uint32_t, 4>;
   AssignInputs in = assign_inputs(points, cells, planes, origin, params);
@@ -652,6 +792,8 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
     }
   }
   in.block_planes = &cell_planes;
+  std::optional<DeviceScoring> device;
+  if (!context.is_cpu()) device.emplace(context, device_points, buffers, in);
   std::vector<int> assigned_in(cells.size(), -1);
   std::vector<std::uint32_t> carried(cells.size(), kNone);
   std::vector<std::uint32_t> left(cells.size());
@@ -674,6 +816,8 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
       now_candidates.push_back(candidates);
     }
     if (now.empty()) break;
+    const std::vector<std::size_t> first_job =
+        device ? device->score(in, now, now_candidates) : std::vector<std::size_t>{};
     compute::detail::for_each_chunk(
         now.size(), now.size() * static_cast<std::size_t>(cells.cell_size * cells.cell_size),
         [&](std::size_t begin, std::size_t end, std::size_t chunk) {
@@ -681,7 +825,8 @@ std::vector<PlanePixelSums> assign_cell_pixels(const PointImage& points, const C
           for (std::size_t k = begin; k < end; ++k) {
             const std::size_t c = now[k];
             const CellOutcome outcome =
-                assign_cell(in, c, now_candidates[k], chunk_sums[chunk], pixel_plane);
+                assign_cell(in, c, now_candidates[k], device ? first_job[k] : 0, chunk_sums[chunk],
+                            pixel_plane);
             carried[c] = outcome.carried, left[c] = outcome.left;
           }
         });

@@ -403,8 +403,8 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
 
   // The assignment sums each plane's pixels as it goes: no second pass over the points.
   std::vector<detail::PlanePixelSums> sums = detail::assign_cell_pixels(
-      points, cells, merged.segment_plane, merged.planes, origin.cast<double>(), params_.merge,
-      params_.cells.reach_passes, pixel_plane_, open_cells_);
+      *context_, points_, cell_buffers_, points, cells, merged.segment_plane, merged.planes,
+      origin.cast<double>(), params_.merge, params_.cells.reach_passes, pixel_plane_, open_cells_);
   if (params_.cells.leftover_planes) add_leftover_planes(points, cells, merged.planes, sums);
   result.timings.refinement = elapsed_ms(clock);
 

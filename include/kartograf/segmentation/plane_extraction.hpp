@@ -127,12 +127,17 @@ struct CellGrid;        // src/segmentation/cell_planes.hpp
 struct PlanePixelSums;  // src/segmentation/plane_output.hpp
 }  // namespace detail
 
-// The cells mode's buffers on the context (src/segmentation/cell_planes.hpp, measure_cells): the
-// colour image, and per block its float sums, counts and validity bits.
+// The cells mode's buffers on the context (src/segmentation/cell_planes.hpp, measure_cells and
+// assign_cell_pixels): the colour image, and per block its float sums, counts and validity bits;
+// off the CPU backend, the pixel scores' planes, jobs, candidates and results (grown as needed,
+// kept from frame to frame).
 struct CellBuffers {
   compute::RawBuffer colours;
   compute::Buffer<float> sums;
   compute::Buffer<std::uint32_t> counts, masks;
+  compute::Buffer<Eigen::Vector4f> score_planes;
+  compute::Buffer<std::uint32_t> score_jobs, score_candidates, score_choices;
+  compute::Buffer<float> score_distances;
 };
 
 class PlaneExtractor {
