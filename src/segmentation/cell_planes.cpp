@@ -816,8 +816,12 @@ std::vector<PlanePixelSums> assign_cell_pixels(
       now_candidates.push_back(candidates);
     }
     if (now.empty()) break;
+    // The device scores the first pass, which holds nearly all the scored pixels; the few cells
+    // the later passes reach are scored on the host (the same rule, bit for bit).
+    const bool on_device = device && pass == 0;
+    in.device = nullptr;
     const std::vector<std::size_t> first_job =
-        device ? device->score(in, now, now_candidates) : std::vector<std::size_t>{};
+        on_device ? device->score(in, now, now_candidates) : std::vector<std::size_t>{};
     compute::detail::for_each_chunk(
         now.size(), now.size() * static_cast<std::size_t>(cells.cell_size * cells.cell_size),
         [&](std::size_t begin, std::size_t end, std::size_t chunk) {
@@ -825,8 +829,8 @@ std::vector<PlanePixelSums> assign_cell_pixels(
           for (std::size_t k = begin; k < end; ++k) {
             const std::size_t c = now[k];
             const CellOutcome outcome =
-                assign_cell(in, c, now_candidates[k], device ? first_job[k] : 0, chunk_sums[chunk],
-                            pixel_plane);
+                assign_cell(in, c, now_candidates[k], on_device ? first_job[k] : 0,
+                            chunk_sums[chunk], pixel_plane);
             carried[c] = outcome.carried, left[c] = outcome.left;
           }
         });

@@ -98,10 +98,11 @@ SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_cou
 // sums of each plane's pixels (cells taken whole add their moments' count and squared distances,
 // and only their outline's pixels to the extent: see assign_planar_cell); `open_cells`: the cells
 // (in order) with valid pixels that no plane took.
-// Off the CPU backend the pixels are scored on the context's device (kernels/cell_scores), from
-// device_points (the frame's points there), with `buffers`' score buffers; on the CPU backend on
-// the host, four at a time. The tallies (counts, squared distances, extents) and the passes'
-// decisions stay on the host either way.
+// Off the CPU backend the first pass's pixels are scored on the context's device
+// (kernels/cell_scores), from device_points (the frame's points there), with `buffers`' score
+// buffers; the later passes' (few) and, on the CPU backend, all on the host, four at a time. The
+// tallies (counts, squared distances, extents) and the passes' decisions stay on the host either
+// way.
 std::vector<PlanePixelSums> assign_cell_pixels(
     const compute::Context& context, const compute::Buffer<Point4f>& device_points,
     CellBuffers& buffers, const PointImage& points, const CellGrid& cells,
