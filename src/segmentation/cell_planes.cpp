@@ -520,12 +520,13 @@ struct CellTally {
   }
 };
 
-// Each valid pixel of the cell takes the candidate it scores best against (none if none is
-// within its allowance), and is added to that plane's sums: its count and squared distance, and
-// its extent from the first and last pixel of each row that took the plane (the corners of the
-// hull of a plane's pixels in the cell are among them; see assign_planar_cell). Four pixels are
-// scored at once; the sums stay in locals until the cell is done. Returns how many pixels took
-// each candidate.
+// Each valid pixel of the rectangle (a cell or a block) takes the candidate it scores best
+// against (none if none is within its allowance), and is added to that plane's sums: its count
+// and squared distance, and its extent from the first and last pixel of each row that took the
+// plane (the corners of the hull of a plane's pixels in the rectangle are among them; see
+// assign_whole). Four pixels are scored at once on the host, or their scores read from the
+// device's (`job`: the rectangle's scoring job); the sums stay in locals until the rectangle is
+// done. Returns how many pixels took each candidate.
 std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRect& rect,
                                            const CellCandidates& candidates, std::size_t job,
                                            std::vector<PlanePixelSums>& sums,

@@ -88,21 +88,22 @@ std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMer
 SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count);
 
 // Every valid pixel's plane (index into `planes`, or kNoLabel), in passes over the cells:
-// - first, planar cells whose neighbours hold no other plane take their plane whole; pixels of
-//   the other cells take, among the planes of their cell and its neighbours (those of their
-//   segments), the one whose distance allowance they are deepest within (merge's plane score);
+// - first, planar cells whose neighbours hold no other plane take their plane whole, and the
+//   other planar cells do the same block by block (a block beside another plane's block has its
+//   pixels scored among its and its 8 neighbouring blocks' planes); pixels of the other cells
+//   take, among the planes of their cell and its neighbours (those of their segments), the one
+//   whose distance allowance they are deepest within (merge's plane score);
 // - then (passes - 1 times) cells not yet reached do the same with the planes their reached
 //   neighbours carry: the plane most of a cell's pixels took.
 // Planes thus reach past the cells next to them, around objects and across gaps of no depth.
 // segment_plane: each segment's plane (kNoLabel: none); origin: the cells' moments'. Returns the
-// sums of each plane's pixels (cells taken whole add their moments' count and squared distances,
-// and only their outline's pixels to the extent: see assign_planar_cell); `open_cells`: the cells
-// (in order) with valid pixels that no plane took.
-// Off the CPU backend the first pass's pixels are scored on the context's device
-// (kernels/cell_scores), from device_points (the frame's points there), with `buffers`' score
-// buffers; the later passes' (few) and, on the CPU backend, all on the host, four at a time. The
-// tallies (counts, squared distances, extents) and the passes' decisions stay on the host either
-// way.
+// sums of each plane's pixels (cells and blocks taken whole add their moments' count and squared
+// distances, and only their outline's pixels to the extent: see assign_whole); `open_cells`: the
+// cells (in order) with valid pixels that no plane took. Off the CPU backend the first pass's
+// pixels are scored on the context's device (kernels/cell_scores), from device_points (the frame's
+// points there), with `buffers`' score buffers; the later passes' (few) and, on the CPU backend,
+// all on the host, four at a time. The tallies (counts, squared distances, extents) and the passes'
+// decisions stay on the host either way.
 std::vector<PlanePixelSums> assign_cell_pixels(
     const compute::Context& context, const compute::Buffer<Point4f>& device_points,
     CellBuffers& buffers, const PointImage& points, const CellGrid& cells,
