@@ -322,7 +322,8 @@ struct CandidateLanes {
 // |p|, min) and base = distance_base + distance_per_z2 z^2; so score^2 = distance^2 |p|^2 /
 // (base^2 max((n . p)^2, min^2 |p|^2)), whose parts (none negative) are compared by
 // cross-multiplying. The device's rule (kernels/cell_scores, cell_choice) does the same float
-// operations in the same order, so both choose alike bit for bit (CellScoresTest).
+// operations in the same order, so both choose alike (the cells mode's labels on every backend
+// equal the CPU's: PlaneExtractionBackendTest.CellsModeAgreesWithTheCpuBackend).
 struct ScoreRule {
   float distance_base, distance_per_z2, min_facing;
 
