@@ -181,14 +181,8 @@ void leftover_region(const PointImage& points, const PlaneExtractionParams& para
   const float jump = params.growing.max_depth_jump;
   region.assign(1, seed);
   pixel_plane[seed] = kVisited;
-  geometry::SegmentMoments moments;
-  const Eigen::Vector3d origin = point[seed].head<3>().cast<double>();
   for (std::size_t head = 0; head < region.size(); ++head) {
     const std::uint32_t i = region[head];
-    const Eigen::Vector3d d = point[i].head<3>().cast<double>() - origin;
-    ++moments.count;
-    moments.sum += d;
-    moments.sum_outer += d * d.transpose();
     const float depth = point[i].z();
     for_each_pixel_near(i, width, height, radius, [&](std::uint32_t j) {
       if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) return;
@@ -197,7 +191,16 @@ void leftover_region(const PointImage& points, const PlaneExtractionParams& para
       region.push_back(j);
     });
   }
-  if (moments.count < params.min_plane_pixels) return;
+  // Most regions are crumbs: their moments are summed only when they are large enough.
+  if (region.size() < params.min_plane_pixels) return;
+  geometry::SegmentMoments moments;
+  const Eigen::Vector3d origin = point[seed].head<3>().cast<double>();
+  for (const std::uint32_t i : region) {
+    const Eigen::Vector3d d = point[i].head<3>().cast<double>() - origin;
+    ++moments.count;
+    moments.sum += d;
+    moments.sum_outer += d * d.transpose();
+  }
   const SegmentPlane plane = fit_plane(moments, origin, params.merge.fit);
   const double min_facing = std::cos(params.merge.max_incidence_deg * M_PI / 180.0);
   if (!plane.valid ||
