@@ -598,55 +598,58 @@ CellCandidates block_candidates(const AssignInputs& in, std::size_t cell, int b,
   return out;
 }
 
-// A planar cell beside other planes, block by block: a block takes its plane whole when the
-// blocks around it hold no other plane; else its pixels are scored among those blocks' planes.
-// A pixel thus takes another plane only from a block next to its own (not from anywhere in the
-// next cells): the cell's own fit and planarity test have judged all its pixels but a border's.
-// Returns how many pixels took each of the cell's candidates.
-std::array<std::uint32_t, 36> assign_cell_by_blocks(const AssignInputs& in, std::size_t cell,
-                                                    const CellCandidates& candidates,
-                                                    std::size_t job,
-                                                    std::vector<PlanePixelSums>& sums,
-                                                    std::vector<std::uint32_t>& pixel_plane) {
-  std::array<std::uint32_t, 36> taken{};
-  const std::uint32_t own = candidates.planes[0];
+// The parts of a cell's assignment, in the order it meets them: whole(rect, moments, inside) for
+// a rectangle whose valid pixels take the cell's own plane, scored(rect, candidates) for one whose
+// pixels are scored among candidates. A planar cell with no other plane around is one whole part;
+// a planar cell beside other planes goes block by block (a block with no other plane among its 8
+// neighbouring blocks is whole; the others are scored among those blocks' planes, so a pixel of a
+// planar cell takes another plane only from a block next to its own: the cell's fit and
+// planarity test have judged all its pixels but a border's); any other cell is scored whole.
+template <class Whole, class Scored>
+void for_each_part(const AssignInputs& in, std::size_t cell, const CellCandidates& candidates,
+                   Whole&& whole, Scored&& scored) {
+  if (!candidates.own) {
+    scored(cell_rect(in, cell), candidates);
+    return;
+  }
+  if (candidates.count == 1) {
+    whole(cell_rect(in, cell), in.cells.moments[cell],
+          candidates.whole && !at_image_edge(in.cells, cell));
+    return;
+  }
   for (int b = 0; b < 4; ++b) {
     const PixelRect rect = block_rect(in, cell, b);
     if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) continue;
-    const CellCandidates block = block_candidates(in, cell, b, own);
+    const CellCandidates block = block_candidates(in, cell, b, candidates.planes[0]);
     if (block.count == 1) {
-      const geometry::SegmentMoments& m = in.cells.block_moments[4 * cell + b];
-      assign_whole(in, rect, m, own, block.whole, sums, pixel_plane);
-      taken[0] += static_cast<std::uint32_t>(m.count);
-      continue;
-    }
-    const std::array<std::uint32_t, 36> block_taken =
-        score_pixels(in, rect, block, job++, sums, pixel_plane);
-    for (int k = 0; k < block.count; ++k) {
-      const auto* at = std::find(candidates.planes.begin(),
-                                 candidates.planes.begin() + candidates.count, block.planes[k]);
-      taken[static_cast<std::size_t>(at - candidates.planes.begin())] += block_taken[k];
+      whole(rect, in.cells.block_moments[4 * cell + b], block.whole);
+    } else {
+      scored(rect, block);
     }
   }
-  return taken;
 }
 
 // Assigns the cell's valid pixels among the candidates, adding them to their planes' sums;
 // returns the plane that took the most of them when that is at least a quarter of the cell's
-// valid pixels (kNoLabel otherwise).
-// `job`: the cell's first scoring job (add_scoring_jobs' order).
+// valid pixels (kNoLabel otherwise). `job`: the cell's first scoring job (add_scoring_jobs').
 CellOutcome assign_cell(const AssignInputs& in, std::size_t cell, const CellCandidates& candidates,
                         std::size_t job, std::vector<PlanePixelSums>& sums,
                         std::vector<std::uint32_t>& pixel_plane) {
-  if (candidates.own && candidates.count == 1) {
-    const bool inside = candidates.whole && !at_image_edge(in.cells, cell);
-    assign_whole(in, cell_rect(in, cell), in.cells.moments[cell], candidates.planes[0], inside,
-                 sums, pixel_plane);
-    return {candidates.planes[0], 0};
-  }
-  const std::array<std::uint32_t, 36> taken =
-      candidates.own ? assign_cell_by_blocks(in, cell, candidates, job, sums, pixel_plane)
-                     : score_pixels(in, cell_rect(in, cell), candidates, job, sums, pixel_plane);
+  std::array<std::uint32_t, 36> taken{};  // per candidate of the cell
+  const auto whole = [&](const PixelRect& rect, const geometry::SegmentMoments& m, bool inside) {
+    assign_whole(in, rect, m, candidates.planes[0], inside, sums, pixel_plane);
+    taken[0] += static_cast<std::uint32_t>(m.count);
+  };
+  const auto scored = [&](const PixelRect& rect, const CellCandidates& part) {
+    const std::array<std::uint32_t, 36> part_taken =
+        score_pixels(in, rect, part, job++, sums, pixel_plane);
+    for (int k = 0; k < part.count; ++k) {
+      const auto* at = std::find(candidates.planes.begin(),
+                                 candidates.planes.begin() + candidates.count, part.planes[k]);
+      taken[static_cast<std::size_t>(at - candidates.planes.begin())] += part_taken[k];
+    }
+  };
+  for_each_part(in, cell, candidates, whole, scored);
   const auto most =
       std::max_element(taken.begin(), taken.begin() + candidates.count) - taken.begin();
   const std::uint64_t valid = in.cells.moments[cell].count;
@@ -672,24 +675,12 @@ void add_job(const PixelRect& rect, const CellCandidates& candidates, ScoringJob
   jobs.pixels += area;
 }
 
-// The cell's scoring jobs, in the order assign_cell meets them; how many.
-std::size_t add_scoring_jobs(const AssignInputs& in, std::size_t cell,
-                             const CellCandidates& candidates, ScoringJobs& jobs) {
-  if (candidates.own && candidates.count == 1) return 0;
-  if (!candidates.own) {
-    add_job(cell_rect(in, cell), candidates, jobs);
-    return 1;
-  }
-  std::size_t added = 0;
-  for (int b = 0; b < 4; ++b) {
-    const PixelRect rect = block_rect(in, cell, b);
-    if (rect.x0 >= rect.x1 || rect.y0 >= rect.y1) continue;
-    const CellCandidates block = block_candidates(in, cell, b, candidates.planes[0]);
-    if (block.count == 1) continue;
-    add_job(rect, block, jobs);
-    ++added;
-  }
-  return added;
+// The cell's scoring jobs, in the order assign_cell meets them.
+void add_scoring_jobs(const AssignInputs& in, std::size_t cell, const CellCandidates& candidates,
+                      ScoringJobs& jobs) {
+  for_each_part(
+      in, cell, candidates, [](const PixelRect&, const geometry::SegmentMoments&, bool) {},
+      [&](const PixelRect& rect, const CellCandidates& part) { add_job(rect, part, jobs); });
 }
 
 // `buffer` holding at least `count` values (grown by half again or more, so rarely).
