@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <map>
 #include <utility>
@@ -162,40 +163,85 @@ TEST(PlaneMerge, JoinsCoplanarNeighboursAndKeepsOffsetAndTiltedOnesApart) {
 }
 
 // What a caller may hand merging instead of having it recomputed (the cells mode does): the
-// segments' graph, fits and pixel sums give the same planes as merging finds them itself; inputs
+// segments' graph, fits and pixel sums.
+struct GivenMergeInputs {
+  std::vector<segmentation::SegmentPlane> fits;
+  std::vector<Eigen::Vector3d> pixel_sums;
+  segmentation::SegmentGraph graph;
+};
+
+GivenMergeInputs given_merge_inputs(const StripScene& scene,
+                                    const geometry::SegmentMomentSet& moments,
+                                    const segmentation::PlaneMergeParams& params) {
+  GivenMergeInputs given;
+  given.pixel_sums.assign(moments.segments.size(), Eigen::Vector3d::Zero());
+  for (const geometry::SegmentMoments& m : moments.segments)
+    given.fits.push_back(segmentation::fit_plane(m, moments.origin, params.fit));
+  for (int y = 0; y < scene.labels.height(); ++y) {
+    for (int x = 0; x < scene.labels.width(); ++x)
+      given.pixel_sums[scene.labels(x, y)] += Eigen::Vector3d(x, y, 1.0);
+  }
+  given.graph = segmentation::pixel_adjacency_graph(
+      scene.labels, static_cast<std::uint32_t>(moments.segments.size()));
+  return given;
+}
+
+geometry::SegmentMomentSet strip_moments(const StripScene& scene) {
+  const compute::Context context = compute::Context::cpu();
+  const std::vector<std::uint32_t> labels(scene.labels.pixels().begin(),
+                                          scene.labels.pixels().end());
+  return moments_of(context, scene.points, labels, 4);
+}
+
+// The given graph, fits and pixel sums give the same planes as merging finds them itself; inputs
 // of the wrong size are refused.
 TEST(PlaneMerge, GivenGraphFitsAndPixelSumsChangeNothing) {
   segmentation::PlaneMergeParams params;
   params.min_seed_pixels = 50;
   params.min_pixels_for_angle = 50;
   const StripScene scene = strips({2, 2, 2.1, 2}, {0, 0, 0, 0.2});
-  const compute::Context context = compute::Context::cpu();
-  const std::vector<std::uint32_t> labels(scene.labels.pixels().begin(),
-                                          scene.labels.pixels().end());
-  const geometry::SegmentMomentSet moments = moments_of(context, scene.points, labels, 4);
+  const geometry::SegmentMomentSet moments = strip_moments(scene);
   const segmentation::MergedPlanes own =
       segmentation::merge_segments(scene.labels, moments, params, {{}, &scene.points});
-  std::vector<segmentation::SegmentPlane> fits;
-  std::vector<Eigen::Vector3d> pixel_sums(4, Eigen::Vector3d::Zero());
-  for (const geometry::SegmentMoments& m : moments.segments)
-    fits.push_back(segmentation::fit_plane(m, moments.origin, params.fit));
-  for (int y = 0; y < scene.labels.height(); ++y) {
-    for (int x = 0; x < scene.labels.width(); ++x)
-      pixel_sums[scene.labels(x, y)] += Eigen::Vector3d(x, y, 1.0);
-  }
-  const segmentation::SegmentGraph graph = segmentation::pixel_adjacency_graph(scene.labels, 4);
+  const GivenMergeInputs in = given_merge_inputs(scene, moments, params);
   const segmentation::MergedPlanes given = segmentation::merge_segments(
-      scene.labels, moments, params, {{}, &scene.points, &graph, fits, pixel_sums});
+      scene.labels, moments, params, {{}, &scene.points, &in.graph, in.fits, in.pixel_sums});
   EXPECT_EQ(given.segment_plane, own.segment_plane);
   ASSERT_EQ(given.planes.size(), own.planes.size());
   for (std::size_t p = 0; p < own.planes.size(); ++p) {
     EXPECT_EQ(given.planes[p].normal, own.planes[p].normal);
     EXPECT_EQ(given.planes[p].offset, own.planes[p].offset);
   }
-  const std::vector<segmentation::SegmentPlane> three(fits.begin(), fits.begin() + 3);
+  const std::vector<segmentation::SegmentPlane> three(in.fits.begin(), in.fits.begin() + 3);
   EXPECT_ERROR_MENTIONS(
       segmentation::merge_segments(scene.labels, moments, params, {{}, nullptr, nullptr, three}),
       "not one per segment");
+}
+
+// A caller that knows each pixel's segment without a label image (the cells mode) hands merging a
+// lookup and an empty image: the same planes. The see-through test reads the lookup: strip 2,
+// 10 cm behind the others, is seen through between strips 1 and 3, so they stay apart, unless
+// the lookup gives its pixels to strip 0.
+TEST(PlaneMerge, ASegmentLookupStandsInForTheLabelImage) {
+  segmentation::PlaneMergeParams params;
+  params.min_seed_pixels = 50;
+  params.min_pixels_for_angle = 50;
+  params.join_apart = true;
+  const StripScene scene = strips({2, 2, 2.1, 2}, {0, 0, 0, 0});
+  const geometry::SegmentMomentSet moments = strip_moments(scene);
+  const GivenMergeInputs in = given_merge_inputs(scene, moments, params);
+  const auto merge = [&](const segmentation::SegmentLabelImage& labels,
+                         std::function<std::uint32_t(int, int)> segment_at) {
+    return segmentation::merge_segments(
+               labels, moments, params,
+               {{}, &scene.points, &in.graph, in.fits, in.pixel_sums, std::move(segment_at)})
+        .segment_plane;
+  };
+  EXPECT_EQ(merge(scene.labels, {}), (std::vector<std::uint32_t>{0, 0, 1, 2}));
+  EXPECT_EQ(merge({}, [&](int x, int y) { return scene.labels(x, y); }),
+            (std::vector<std::uint32_t>{0, 0, 1, 2}));
+  EXPECT_EQ(merge({}, [](int, int) { return 0u; }), (std::vector<std::uint32_t>{0, 0, 1, 0}));
+  EXPECT_ERROR_MENTIONS(merge({}, {}), "without a label image");
 }
 
 TEST(PlaneMerge, AdjacencyGraphsKnownAnswers) {

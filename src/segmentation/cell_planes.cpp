@@ -107,6 +107,7 @@ void measure_cells(const compute::Context& context, const compute::Buffer<Point4
                    const Eigen::Vector3d& origin, CellBuffers& buffers, CellGrid& cells) {
   const int half = cell_size / 2;
   cells.cell_size = cell_size;
+  cells.width = rgb.width(), cells.height = rgb.height();
   cells.columns = (rgb.width() + cell_size - 1) / cell_size;
   cells.rows = (rgb.height() + cell_size - 1) / cell_size;
   cells.blocks_x = 2 * cells.columns;
@@ -178,19 +179,16 @@ Eigen::Vector3f mean_lab(const Eigen::Vector3d& colour_sum, std::uint64_t count)
   return rgb_to_lab(rgb);
 }
 
-// Labels the square of `size` pixels at (x0, y0), cut by the image; returns its pixel sums.
-Eigen::Vector3d fill_labels(SegmentLabelImage& labels, int x0, int y0, int size,
-                            std::uint32_t label) {
-  const int x1 = std::min(labels.width(), x0 + size), y1 = std::min(labels.height(), y0 + size);
-  for (int y = y0; y < y1; ++y) std::fill(&labels(x0, y), &labels(x0, y) + (x1 - x0), label);
-  return rectangle_pixel_sums(x0, y0, x1, y1);
+// The pixel sums of the square of `size` pixels at (x0, y0), cut by the image.
+Eigen::Vector3d square_pixel_sums(int width, int height, int x0, int y0, int size) {
+  return rectangle_pixel_sums(x0, y0, std::min(width, x0 + size), std::min(height, y0 + size));
 }
 
 }  // namespace
 
 std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
                                    const Eigen::Vector3d& origin, CellGrid& cells,
-                                   SegmentLabelImage& labels, CellSegments& segments) {
+                                   CellSegments& segments) {
   const int size = cells.cell_size, half = size / 2;
   const auto min_count = [&](int side) {
     return static_cast<std::uint64_t>(std::ceil(params.min_valid_fraction * side * side));
@@ -199,14 +197,13 @@ std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMer
   cells.segments.assign(cells.size(), {kNone, kNone, kNone, kNone});
   segments = {};
   segments.moments.origin = origin;
-  std::fill(labels.pixels().begin(), labels.pixels().end(), kNone);
   const auto add_segment = [&](const geometry::SegmentMoments& m, const SegmentPlane& fit,
                                const Eigen::Vector3d& colour, int x0, int y0, int side) {
     const auto segment = static_cast<std::uint32_t>(segments.fits.size());
     segments.moments.segments.push_back(m);
     segments.fits.push_back(fit);
     segments.lab_colours.push_back(mean_lab(colour, m.count));
-    segments.pixel_sums.push_back(fill_labels(labels, x0, y0, side, segment));
+    segments.pixel_sums.push_back(square_pixel_sums(cells.width, cells.height, x0, y0, side));
     return segment;
   };
   for (std::size_t c = 0; c < cells.size(); ++c) {

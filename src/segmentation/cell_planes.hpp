@@ -25,6 +25,7 @@ namespace kartograf::segmentation::detail {
 // that is not planar as a whole may still hold planar blocks (a strip of table between objects).
 struct CellGrid {
   int cell_size = 0;
+  int width = 0, height = 0;  // the image's, in pixels
   int columns = 0, rows = 0;  // cells across and down (the last ones may be cut by the border)
   std::vector<geometry::SegmentMoments> moments;  // per cell, about the moment origin
   std::vector<std::uint8_t> continuous;           // per cell: no edge's depth jump across it
@@ -53,6 +54,11 @@ struct CellGrid {
     if (bit % 32 + half > 32) v |= std::uint64_t{words[1]} << 32;
     return static_cast<std::uint32_t>((v >> (bit % 32)) & ((std::uint64_t{1} << half) - 1));
   }
+  // The segment pixel (x, y) lies in (kNoLabel: none).
+  std::uint32_t segment_at(int x, int y) const {
+    const int half = cell_size / 2, bx = x / half, by = y / half;
+    return segments[static_cast<std::size_t>(by / 2) * columns + bx / 2][(by % 2) * 2 + bx % 2];
+  }
   // The same for pixel (x0 + k, y) of image block column `block_x` (y any row of the image).
   std::uint32_t valid_bits(int block_x, int y) const {
     const int half = cell_size / 2;
@@ -78,11 +84,11 @@ struct CellSegments {
 };
 
 // Planar cells, and the planar blocks of the other cells, become segments 0..n-1 (grid.segments;
-// their pixels labelled in `labels`, the rest kNoLabel). A cell or block is planar when enough of
-// it is valid, its depth is continuous and its plane fit's RMS is within the noise allowance.
+// CellGrid::segment_at gives a pixel's). A cell or block is planar when enough of it is valid, its
+// depth is continuous and its plane fit's RMS is within the noise allowance.
 std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
                                    const Eigen::Vector3d& origin, CellGrid& cells,
-                                   SegmentLabelImage& labels, CellSegments& segments);
+                                   CellSegments& segments);
 
 // The segments' neighbours (8-adjacent blocks of different segments), as merging takes them.
 SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count);

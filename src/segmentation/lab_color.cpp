@@ -63,10 +63,21 @@ const LabTables& lab_tables() {
   return tables;
 }
 
+// srgb_to_linear of every 8-bit value, kept (the same doubles, without three pow calls a colour).
+const std::array<double, 256>& linear_table() {
+  static const std::array<double, 256> table = [] {
+    std::array<double, 256> values{};
+    for (int v = 0; v < 256; ++v) values[v] = srgb_to_linear(static_cast<std::uint8_t>(v));
+    return values;
+  }();
+  return table;
+}
+
 }  // namespace
 
 Eigen::Vector3f rgb_to_lab(const Rgb8& rgb) {
-  const double linear[3] = {srgb_to_linear(rgb[0]), srgb_to_linear(rgb[1]), srgb_to_linear(rgb[2])};
+  const std::array<double, 256>& table = linear_table();
+  const double linear[3] = {table[rgb[0]], table[rgb[1]], table[rgb[2]]};
   double f[3];
   for (int r = 0; r < 3; ++r) {
     double t = 0.0;

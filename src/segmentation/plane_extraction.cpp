@@ -388,19 +388,19 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
   detail::measure_cells(*context_, points_, rgb, cell_params.cell_size,
                         params_.growing.max_depth_jump, static_cast<float>(cell_params.jump_per_z2),
                         origin.cast<double>(), cell_buffers_, cells);
-  if (segments_.width() != points.width() || segments_.height() != points.height())
-    segments_ = SegmentLabelImage(points.width(), points.height());
   detail::CellSegments pieces;
-  result.segment_count = detail::planar_cell_segments(
-      cell_params, params_.merge, origin.cast<double>(), cells, segments_, pieces);
+  result.segment_count = detail::planar_cell_segments(cell_params, params_.merge,
+                                                      origin.cast<double>(), cells, pieces);
   result.timings.moments = elapsed_ms(clock);
   if (result.segment_count == 0) return result;
 
   // Merging takes what the cells know: adjacency, fits and pixel sums (no pass over the pixels).
   const SegmentGraph graph = detail::cell_segment_graph(cells, result.segment_count);
+  // No label image: a pixel's segment is its cell's or block's.
   MergedPlanes merged =
-      merge_segments(segments_, pieces.moments, params_.merge,
-                     {pieces.lab_colours, &points, &graph, pieces.fits, pieces.pixel_sums});
+      merge_segments(SegmentLabelImage(), pieces.moments, params_.merge,
+                     {pieces.lab_colours, &points, &graph, pieces.fits, pieces.pixel_sums,
+                      [&cells](int x, int y) { return cells.segment_at(x, y); }});
   result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
   result.timings.merging = elapsed_ms(clock);
 

@@ -74,9 +74,8 @@ struct AngleShare {
 // left with count 0 (and alias the plane they joined) until compact().
 class PlaneJoiner {
  public:
-  PlaneJoiner(const SegmentLabelImage& labels, const PointImage* points,
-              std::span<const Eigen::Vector3d> segment_pixel_sums, const PlaneMergeParams& params,
-              const Eigen::Vector3d& origin, MergedPlanes& merged);
+  PlaneJoiner(const SegmentLabelImage& labels, const MergeInputs& inputs,
+              const PlaneMergeParams& params, const Eigen::Vector3d& origin, MergedPlanes& merged);
   void join_cheapest_pairs();  // while some pair costs below 1
   void compact();              // drops absorbed planes, renumbers in order
 
@@ -100,6 +99,7 @@ class PlaneJoiner {
   void rejoin_pairs(std::uint32_t p, std::uint32_t q);
 
   const SegmentLabelImage& labels_;
+  std::function<std::uint32_t(int, int)> segment_at_;  // the caller's, or the labels'
   const PointImage* points_;
   std::span<const Eigen::Vector3d> segment_pixel_sums_;  // per segment, or empty
   const PlaneMergeParams& params_;
@@ -120,13 +120,14 @@ class PlaneJoiner {
   std::vector<std::uint32_t> row_best_;
 };
 
-PlaneJoiner::PlaneJoiner(const SegmentLabelImage& labels, const PointImage* points,
-                         std::span<const Eigen::Vector3d> segment_pixel_sums,
+PlaneJoiner::PlaneJoiner(const SegmentLabelImage& labels, const MergeInputs& inputs,
                          const PlaneMergeParams& params, const Eigen::Vector3d& origin,
                          MergedPlanes& merged)
     : labels_(labels),
-      points_(points),
-      segment_pixel_sums_(segment_pixel_sums),
+      segment_at_(inputs.segment_at ? inputs.segment_at
+                                    : [&labels](int x, int y) { return labels(x, y); }),
+      points_(inputs.points),
+      segment_pixel_sums_(inputs.pixel_sums),
       params_(params),
       origin_(origin),
       merged_(merged),
@@ -183,7 +184,7 @@ double PlaneJoiner::see_through(std::uint32_t p, std::uint32_t q, const SegmentP
   for (int k = 0; k <= steps; ++k) {
     const Eigen::Vector2d at = from + (to - from) * (steps > 0 ? double(k) / steps : 0.0);
     const int x = static_cast<int>(std::lround(at.x())), y = static_cast<int>(std::lround(at.y()));
-    const std::uint32_t s = labels_(x, y);
+    const std::uint32_t s = segment_at_(x, y);
     const std::uint32_t owner = s == kNoLabel ? kNoLabel : plane_of_segment(s);
     const Point4f& point = (*points_)(x, y);
     if (owner == p || owner == q || !is_valid(point)) continue;
@@ -399,11 +400,10 @@ void PlaneJoiner::compact() {
 
 }  // namespace
 
-void join_adjacent_planes(const SegmentLabelImage& labels, const PointImage* points,
-                          std::span<const Eigen::Vector3d> segment_pixel_sums,
+void join_adjacent_planes(const SegmentLabelImage& labels, const MergeInputs& inputs,
                           const PlaneMergeParams& params, const Eigen::Vector3d& origin,
                           MergedPlanes& merged) {
-  PlaneJoiner joiner(labels, points, segment_pixel_sums, params, origin, merged);
+  PlaneJoiner joiner(labels, inputs, params, origin, merged);
   joiner.join_cheapest_pairs();
   joiner.compact();
 }

@@ -25,11 +25,10 @@ inline void add_moments(geometry::SegmentMoments& into, const geometry::SegmentM
 
 // Second pass: joins adjacent merged planes, lowest cost first (cost: RMS of the joint fit over the
 // allowance at its depth; joins only below 1 and within the angle), then drops the absorbed planes
-// and renumbers the rest in order. `points` (may be null) enables the see-through test;
-// `segment_pixel_sums` (may be empty: summed over the labels then) are each segment's pixel x and
-// y sums and count.
-void join_adjacent_planes(const SegmentLabelImage& labels, const PointImage* points,
-                          std::span<const Eigen::Vector3d> segment_pixel_sums,
+// and renumbers the rest in order. From `inputs`: `points` (may be null) enables the see-through
+// test; `pixel_sums` (may be empty: summed over the labels then) are each segment's pixel x and
+// y sums and count; `segment_at` (may be empty: the labels are read then) each pixel's segment.
+void join_adjacent_planes(const SegmentLabelImage& labels, const MergeInputs& inputs,
                           const PlaneMergeParams& params, const Eigen::Vector3d& origin,
                           MergedPlanes& merged);
 

@@ -26,9 +26,15 @@ void check_inputs(const SegmentLabelImage& labels, std::uint32_t segment_count,
                   const MergeInputs& inputs) {
   const PointImage* points = inputs.points;
   const std::span<const Eigen::Vector3f> segment_colours = inputs.colours;
-  require(points == nullptr ||
-              (points->width() == labels.width() && points->height() == labels.height()),
-          "plane merge: the point image's size differs from the label image's");
+  if (labels.size() == 0) {
+    require(inputs.segment_at && inputs.graph != nullptr && !inputs.pixel_sums.empty(),
+            "plane merge: without a label image the segments' lookup, neighbour graph and pixel "
+            "sums must be given");
+  } else {
+    require(points == nullptr ||
+                (points->width() == labels.width() && points->height() == labels.height()),
+            "plane merge: the point image's size differs from the label image's");
+  }
   require(segment_colours.empty() || segment_colours.size() == segment_count,
           "plane merge: " + std::to_string(segment_colours.size()) + " segment colours for " +
               std::to_string(segment_count) + " segments");
@@ -291,8 +297,7 @@ MergedPlanes merge_segments(const SegmentLabelImage& labels,
   if (!inputs.colours.empty()) sum_colours(inputs.colours, moments.segments, result);
   result.graph = graph;
   if (params.join_planes)
-    detail::join_adjacent_planes(labels, inputs.points, inputs.pixel_sums, params, moments.origin,
-                                 result);
+    detail::join_adjacent_planes(labels, inputs, params, moments.origin, result);
   return result;
 }
 

@@ -25,6 +25,7 @@
 // (default) or, as in the paper, overlapping bounding rectangles. Deterministic: the order is fixed
 // by size, then label.
 #include <cstdint>
+#include <functional>
 #include <span>
 #include <vector>
 
@@ -135,9 +136,14 @@ struct MergeInputs {
   // Each segment's labelled pixels: sum of x, sum of y, count (where the see-through test draws
   // its lines from) when the caller knows them; otherwise summed over the labels.
   std::span<const Eigen::Vector3d> pixel_sums = {};
+  // The segment at pixel (x, y) (kNoLabel: none) when the caller knows it without a label image
+  // (the cells mode: each cell's or block's segment). With it, and with the graph and the pixel
+  // sums, the labels are not read and may be an empty image.
+  std::function<std::uint32_t(int x, int y)> segment_at = {};
 };
 
-// moments.segments and the label image cover the same segment_count segments.
+// moments.segments and the label image (unless empty: see MergeInputs::segment_at) cover the same
+// segment_count segments.
 MergedPlanes merge_segments(const SegmentLabelImage& labels,
                             const geometry::SegmentMomentSet& moments,
                             const PlaneMergeParams& params, const MergeInputs& inputs = {});
