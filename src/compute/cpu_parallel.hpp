@@ -1,18 +1,21 @@
 #pragma once
 // The CPU backend's data parallelism for the hot loops of the operations: a fixed number of
-// contiguous chunks, run on KARTOGRAF_CPU_THREADS threads (default 1). Per-chunk results combined in chunk order do
-// not depend on the thread count or on scheduling, so sums are identical for any setting.
+// contiguous chunks, run on KARTOGRAF_CPU_THREADS threads (default 1). Per-chunk results combined
+// in chunk order do not depend on the thread count or on scheduling, so sums are identical for any
+// setting.
 //
-// Why one thread by default: on a machine shared with other work (this project's 2-core build
-// hosts), a helper thread descheduled while holding a chunk stalls every join for a time slice;
-// 640x480 odometry measured 27 ms per frame on one thread and 35 ms on two there. On a dedicated
-// multi-core machine, KARTOGRAF_CPU_THREADS=<cores> shortens the ICP part accordingly.
+// The helper threads are started once and sleep between calls (cpu_parallel.cpp); starting a
+// thread per call, as before 2026-11-29, cost more than the second thread saved: 7-Scenes
+// odometry (`kartograf odometry`, 600 frames, this project's 2-core build host) ran at 63 fps on
+// two threads against 69 on one; with the kept helpers it runs at 73-76 fps on two.
+//
+// Why one thread by default: on a machine shared with other work (such as those build hosts), a
+// helper thread descheduled while holding a chunk stalls every join for a time slice. On a
+// dedicated multi-core machine, KARTOGRAF_CPU_THREADS=<cores> shortens the parallel parts.
 #include <algorithm>
-#include <atomic>
 #include <cstddef>
 #include <cstdlib>
 #include <string>
-#include <thread>
 #include <vector>
 
 #include "kartograf/core/error.hpp"
@@ -32,9 +35,18 @@ inline std::size_t configured_cpu_threads() {
   return std::min<std::size_t>(static_cast<std::size_t>(value), kCpuChunks);
 }
 
+// Runs run_chunk(chunk) for every chunk in [0, kCpuChunks) on `threads` threads: the caller's
+// and threads - 1 helpers kept waiting between calls (cpu_parallel.cpp), so that a call costs a
+// wake-up instead of starting threads. A call made while the helpers are busy (from a helper, or
+// from another thread of the process) runs its chunks on the caller's thread alone; the results
+// are the same, as the chunks are. A chunk that throws ends the process on a helper, as on a
+// thread of its own; on the caller the exception is thrown on once the helpers are done.
+void run_chunks(std::size_t threads, void (*run_chunk)(const void* context, std::size_t chunk),
+                const void* context);
+
 // Calls body(begin, end, chunk) for the kCpuChunks contiguous chunks of [0, count); `work` is
-// the number of points behind them (e.g. count rows of an image): below ~32k points starting a
-// thread (~50 us) costs more than it saves.
+// the number of points behind them (e.g. count rows of an image): below ~32k points waking a
+// helper costs more than it saves.
 template <class Body>
 void for_each_chunk(std::size_t count, std::size_t work, Body&& body) {
   const auto run_chunk = [&](std::size_t chunk) {
@@ -45,13 +57,13 @@ void for_each_chunk(std::size_t count, std::size_t work, Body&& body) {
     for (std::size_t chunk = 0; chunk < kCpuChunks; ++chunk) run_chunk(chunk);
     return;
   }
-  std::atomic<std::size_t> next{0};
-  const auto worker = [&] {
-    for (std::size_t chunk = next++; chunk < kCpuChunks; chunk = next++) run_chunk(chunk);
-  };
-  std::vector<std::jthread> helpers;
-  for (std::size_t t = 1; t < threads; ++t) helpers.emplace_back(worker);
-  worker();
+  using RunChunk = decltype(run_chunk);
+  run_chunks(
+      threads,
+      [](const void* context, std::size_t chunk) {
+        (*static_cast<const RunChunk*>(context))(chunk);
+      },
+      &run_chunk);
 }
 
 }  // namespace kartograf::compute::detail
