@@ -186,28 +186,26 @@ Eigen::Vector3d square_pixel_sums(int width, int height, int x0, int y0, int siz
 
 }  // namespace
 
-std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
-                                   const Eigen::Vector3d& origin, CellGrid& cells,
-                                   CellSegments& segments) {
+namespace {
+
+// A planar cell (block -1) or block of a cell, with its fit and mean colour.
+struct PlanarPiece {
+  std::size_t cell;
+  int block;
+  SegmentPlane fit;
+  Eigen::Vector3f lab;
+};
+
+// The planar pieces of cells [begin, end), in order: the cell when it is planar as a whole, else
+// its planar blocks.
+void planar_pieces(const CellPlaneParams& params, const PlaneMergeParams& merge,
+                   const Eigen::Vector3d& origin, const CellGrid& cells, std::size_t begin,
+                   std::size_t end, std::vector<PlanarPiece>& out) {
   const int size = cells.cell_size, half = size / 2;
   const auto min_count = [&](int side) {
     return static_cast<std::uint64_t>(std::ceil(params.min_valid_fraction * side * side));
   };
-  constexpr std::uint32_t kNone = geometry::kNoLabel;
-  cells.segments.assign(cells.size(), {kNone, kNone, kNone, kNone});
-  segments = {};
-  segments.moments.origin = origin;
-  const auto add_segment = [&](const geometry::SegmentMoments& m, const SegmentPlane& fit,
-                               const Eigen::Vector3d& colour, int x0, int y0, int side) {
-    const auto segment = static_cast<std::uint32_t>(segments.fits.size());
-    segments.moments.segments.push_back(m);
-    segments.fits.push_back(fit);
-    segments.lab_colours.push_back(mean_lab(colour, m.count));
-    segments.pixel_sums.push_back(square_pixel_sums(cells.width, cells.height, x0, y0, side));
-    return segment;
-  };
-  for (std::size_t c = 0; c < cells.size(); ++c) {
-    const int x0 = cells.first_x(c), y0 = cells.first_y(c);
+  for (std::size_t c = begin; c < end; ++c) {
     const std::optional<SegmentPlane> cell_fit =
         cells.continuous[c] ? planar_piece(params, merge, cells.moments[c], origin, min_count(size))
                             : std::nullopt;
@@ -215,18 +213,55 @@ std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMer
       const std::size_t k = 4 * c;
       const Eigen::Vector3d colour = cells.block_colours[k] + cells.block_colours[k + 1] +
                                      cells.block_colours[k + 2] + cells.block_colours[k + 3];
-      cells.segments[c].fill(add_segment(cells.moments[c], *cell_fit, colour, x0, y0, size));
+      out.push_back({c, -1, *cell_fit, mean_lab(colour, cells.moments[c].count)});
       continue;
     }
-    for (std::size_t b = 0; b < 4; ++b) {
-      const std::size_t k = 4 * c + b;
+    for (int b = 0; b < 4; ++b) {
+      const std::size_t k = 4 * c + static_cast<std::size_t>(b);
       if (!cells.block_continuous[k]) continue;
       const std::optional<SegmentPlane> fit =
           planar_piece(params, merge, cells.block_moments[k], origin, min_count(half));
-      if (!fit) continue;
-      cells.segments[c][b] = add_segment(cells.block_moments[k], *fit, cells.block_colours[k],
-                                         x0 + static_cast<int>(b % 2) * half,
-                                         y0 + static_cast<int>(b / 2) * half, half);
+      if (fit)
+        out.push_back({c, b, *fit, mean_lab(cells.block_colours[k], cells.block_moments[k].count)});
+    }
+  }
+}
+
+}  // namespace
+
+std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMergeParams& merge,
+                                   const Eigen::Vector3d& origin, CellGrid& cells,
+                                   CellSegments& segments) {
+  constexpr std::uint32_t kNone = geometry::kNoLabel;
+  cells.segments.assign(cells.size(), {kNone, kNone, kNone, kNone});
+  segments = {};
+  segments.moments.origin = origin;
+  // The fits over the threads; the segments numbered in cell order after (chunks in order).
+  std::array<std::vector<PlanarPiece>, compute::detail::kCpuChunks> pieces;
+  compute::detail::for_each_chunk(
+      cells.size(), cells.size() * static_cast<std::size_t>(cells.cell_size * cells.cell_size),
+      [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+        planar_pieces(params, merge, origin, cells, begin, end, pieces[chunk]);
+      });
+  const int half = cells.cell_size / 2;
+  for (const std::vector<PlanarPiece>& chunk : pieces) {
+    for (const PlanarPiece& piece : chunk) {
+      const auto segment = static_cast<std::uint32_t>(segments.fits.size());
+      const bool whole = piece.block < 0;
+      const std::size_t k = 4 * piece.cell + static_cast<std::size_t>(std::max(piece.block, 0));
+      const int x0 = cells.first_x(piece.cell) + (whole ? 0 : piece.block % 2 * half);
+      const int y0 = cells.first_y(piece.cell) + (whole ? 0 : piece.block / 2 * half);
+      segments.moments.segments.push_back(whole ? cells.moments[piece.cell]
+                                                : cells.block_moments[k]);
+      segments.fits.push_back(piece.fit);
+      segments.lab_colours.push_back(piece.lab);
+      segments.pixel_sums.push_back(
+          square_pixel_sums(cells.width, cells.height, x0, y0, whole ? cells.cell_size : half));
+      if (whole) {
+        cells.segments[piece.cell].fill(segment);
+      } else {
+        cells.segments[piece.cell][static_cast<std::size_t>(piece.block)] = segment;
+      }
     }
   }
   return static_cast<std::uint32_t>(segments.fits.size());
