@@ -8,6 +8,8 @@
 #include <numeric>
 #include <vector>
 
+#include "compute/cpu_parallel.hpp"
+
 namespace kartograf::segmentation::detail {
 
 namespace {
@@ -91,8 +93,12 @@ class PlaneJoiner {
                    Relation relation) const;
   double fit_cost(std::uint32_t p, std::uint32_t q, const SegmentPlane& joint,
                   Relation relation) const;
+  double cost_before_see_through(std::uint32_t p, std::uint32_t q, Relation relation,
+                                 SegmentPlane& joint, bool& look) const;
   double cost(std::uint32_t p, std::uint32_t q, Relation relation);
+  bool may_join(std::uint32_t lo, std::uint32_t hi, Relation relation) const;
   void evaluate(std::uint32_t p, std::uint32_t q);
+  void evaluate_all_pairs();
   double cost_of(std::uint32_t p, std::uint32_t q) const;
   void update_row(std::uint32_t p);
   void absorb(std::uint32_t p, std::uint32_t q);
@@ -141,9 +147,7 @@ PlaneJoiner::PlaneJoiner(const SegmentLabelImage& labels, const MergeInputs& inp
   std::iota(alias_.begin(), alias_.end(), 0u);
   if (!merged_.colour_sums.empty()) mean_colour_.resize(plane_count_);
   for (std::uint32_t p = 0; p < plane_count_; ++p) update_uncertainty(p), update_mean_colour(p);
-  for (std::uint32_t p = 0; p < plane_count_; ++p) {
-    for (std::uint32_t q = p + 1; q < plane_count_; ++q) evaluate(p, q);
-  }
+  evaluate_all_pairs();
   for (std::uint32_t p = 0; p < plane_count_; ++p) update_row(p);
 }
 
@@ -154,21 +158,40 @@ std::uint32_t PlaneJoiner::plane_of_segment(std::uint32_t s) const {
   return p;
 }
 
+// Each segment's pixels in the labels (sum of x, sum of y, count), run by run along the rows.
+std::vector<Eigen::Vector3d> label_pixel_sums(const SegmentLabelImage& labels,
+                                              std::size_t segment_count) {
+  std::vector<Eigen::Vector3d> sums(segment_count, Eigen::Vector3d::Zero());
+  const int width = labels.width();
+  for (int y = 0; y < labels.height(); ++y) {
+    const std::uint32_t* row = &labels(0, y);
+    for (int x = 0; x < width;) {
+      const std::uint32_t s = row[x];
+      int end = x + 1;
+      while (end < width && row[end] == s) ++end;
+      if (s != kNoLabel) {
+        const std::int64_t n = end - x;
+        sums[s] += Eigen::Vector3d(static_cast<double>(n * (x + end - 1) / 2),
+                                   static_cast<double>(n * y), static_cast<double>(n));
+      }
+      x = end;
+    }
+  }
+  return sums;
+}
+
+// Integers in double: the sums are exact in any order.
 void PlaneJoiner::sum_pixels() {
   pixel_sums_.assign(plane_count_, Eigen::Vector3d::Zero());
-  if (!segment_pixel_sums_.empty()) {  // the caller's; integers in double: exact in any order
-    for (std::uint32_t s = 0; s < segment_pixel_sums_.size(); ++s) {
-      if (plane_of_segment(s) != kNoLabel)
-        pixel_sums_[plane_of_segment(s)] += segment_pixel_sums_[s];
-    }
-    return;
+  std::vector<Eigen::Vector3d> from_labels;
+  std::span<const Eigen::Vector3d> segment_sums = segment_pixel_sums_;  // the caller's, if given
+  if (segment_sums.empty()) {
+    from_labels = label_pixel_sums(labels_, merged_.segment_plane.size());
+    segment_sums = from_labels;
   }
-  for (int y = 0; y < labels_.height(); ++y) {
-    for (int x = 0; x < labels_.width(); ++x) {
-      const std::uint32_t s = labels_(x, y);
-      if (s != kNoLabel && plane_of_segment(s) != kNoLabel)
-        pixel_sums_[plane_of_segment(s)] += Eigen::Vector3d(x, y, 1.0);
-    }
+  for (std::uint32_t s = 0; s < segment_sums.size(); ++s) {
+    const std::uint32_t p = plane_of_segment(s);
+    if (p != kNoLabel) pixel_sums_[p] += segment_sums[s];
   }
 }
 
@@ -266,8 +289,10 @@ double PlaneJoiner::fit_cost(std::uint32_t p, std::uint32_t q, const SegmentPlan
 
 // Cost of joining p and q (>= 1: no). Each side must lie within the allowance at its own depth
 // of the joint plane. Pairs that are not near (a plane cut in two by an occluder or a doorway)
-// must also be nearly parallel.
-double PlaneJoiner::cost(std::uint32_t p, std::uint32_t q, Relation relation) {
+// must also be nearly parallel. `look`: whether the see-through test must still pass, on `joint`.
+double PlaneJoiner::cost_before_see_through(std::uint32_t p, std::uint32_t q, Relation relation,
+                                            SegmentPlane& joint, bool& look) const {
+  look = false;
   const bool adjacent_pair = relation != apart;
   const SegmentPlane& a = merged_.planes[p];
   const SegmentPlane& b = merged_.planes[q];
@@ -284,7 +309,7 @@ double PlaneJoiner::cost(std::uint32_t p, std::uint32_t q, Relation relation) {
   if (!adjacent_pair && !each_near_other_plane(p, q)) return kNoJoin;
   geometry::SegmentMoments both = merged_.moments[p];
   add_moments(both, merged_.moments[q]);
-  const SegmentPlane joint = fit_plane(both, origin_, params_.fit);
+  joint = fit_plane(both, origin_, params_.fit);
   // Two parallel pieces with a step between them fit a plane tilted to both: the joint plane
   // itself must keep within the angle of each.
   if (!joint.valid ||
@@ -294,23 +319,68 @@ double PlaneJoiner::cost(std::uint32_t p, std::uint32_t q, Relation relation) {
   }
   const double result = fit_cost(p, q, joint, relation);
   // Seen through the gap: one wall on both sides of a doorway, or two coplanar objects.
-  if (result < 1.0 && !adjacent_pair && points_ != nullptr &&
-      (!coloured || colour_distance_sq > params_.max_see_through_colour_distance *
-                                             params_.max_see_through_colour_distance) &&
-      see_through(p, q, joint) > params_.max_see_through_fraction) {
-    return kNoJoin;
-  }
+  look = result < 1.0 && !adjacent_pair && points_ != nullptr &&
+         (!coloured || colour_distance_sq > params_.max_see_through_colour_distance *
+                                                params_.max_see_through_colour_distance);
   return result;
+}
+
+double PlaneJoiner::cost(std::uint32_t p, std::uint32_t q, Relation relation) {
+  SegmentPlane joint;
+  bool look = false;
+  const double result = cost_before_see_through(p, q, relation, joint, look);
+  if (look && see_through(p, q, joint) > params_.max_see_through_fraction) return kNoJoin;
+  return result;
+}
+
+bool PlaneJoiner::may_join(std::uint32_t lo, std::uint32_t hi, Relation relation) const {
+  return relation != apart ||
+         (params_.join_apart && merged_.moments[lo].count >= params_.min_apart_pixels &&
+          merged_.moments[hi].count >= params_.min_apart_pixels);
 }
 
 void PlaneJoiner::evaluate(std::uint32_t p, std::uint32_t q) {
   const std::uint32_t lo = std::min(p, q), hi = std::max(p, q);
   const auto relation = static_cast<Relation>(relation_[lo * plane_count_ + hi]);
-  const bool may_join =
-      relation != apart ||
-      (params_.join_apart && merged_.moments[lo].count >= params_.min_apart_pixels &&
-       merged_.moments[hi].count >= params_.min_apart_pixels);
-  pair_cost_[lo * plane_count_ + hi] = may_join ? cost(lo, hi, relation) : kNoJoin;
+  pair_cost_[lo * plane_count_ + hi] =
+      may_join(lo, hi, relation) ? cost(lo, hi, relation) : kNoJoin;
+}
+
+// Every pair's cost, the pairs over the CPU threads (cost_before_see_through reads only what the
+// pass has not changed yet), then the see-through tests on this thread (the first one sums
+// the planes' pixels). The same costs as evaluate() pair by pair.
+void PlaneJoiner::evaluate_all_pairs() {
+  struct Deferred {
+    std::uint32_t p, q;
+    SegmentPlane joint;
+  };
+  const std::size_t n = plane_count_;
+  std::array<std::vector<Deferred>, compute::detail::kCpuChunks> deferred;
+  // Rows in the order 0, n - 1, 1, n - 2, ...: neighbouring rows hold n - 1 pairs together, so
+  // that contiguous chunks of rows hold alike numbers of pairs. A pair's tests cost about what
+  // kPairWork points do.
+  constexpr std::size_t kPairWork = 8;
+  compute::detail::for_each_chunk(
+      n, n * n / 2 * kPairWork, [&](std::size_t begin, std::size_t end, std::size_t chunk) {
+        for (std::size_t k = begin; k < end; ++k) {
+          const auto p = static_cast<std::uint32_t>(k % 2 == 0 ? k / 2 : n - 1 - k / 2);
+          for (std::uint32_t q = p + 1; q < n; ++q) {
+            const auto relation = static_cast<Relation>(relation_[p * n + q]);
+            SegmentPlane joint;
+            bool look = false;
+            pair_cost_[p * n + q] = may_join(p, q, relation)
+                                        ? cost_before_see_through(p, q, relation, joint, look)
+                                        : kNoJoin;
+            if (look) deferred[chunk].push_back({p, q, joint});
+          }
+        }
+      });
+  for (const std::vector<Deferred>& chunk : deferred) {
+    for (const Deferred& pair : chunk) {
+      if (see_through(pair.p, pair.q, pair.joint) > params_.max_see_through_fraction)
+        pair_cost_[pair.p * n + pair.q] = kNoJoin;
+    }
+  }
 }
 
 double PlaneJoiner::cost_of(std::uint32_t p, std::uint32_t q) const {
