@@ -4,11 +4,17 @@
 #include <array>
 #include <cmath>
 
+#include "compute/cpu/lanes.hpp"
 #include "compute/cpu_parallel.hpp"
 
 namespace kartograf::segmentation {
 
 namespace {
+
+using compute::detail::LaneMask;
+using compute::detail::Lanes;
+using compute::detail::select;
+using compute::detail::splat;
 
 // sRGB -> XYZ (D65) and the D65 reference white, from IEC 61966-2-1.
 constexpr double kRgbToXyz[3][3] = {{0.4124564, 0.3575761, 0.1804375},
@@ -56,6 +62,18 @@ struct LabTables {
     const float w = x - static_cast<float>(i);
     return f[i] + w * (f[i + 1] - f[i]);
   }
+
+  // interpolated_f of four values, lane by lane the same float operations.
+  Lanes interpolated_f(Lanes t) const {
+    t = select(t < splat(0.0f), splat(0.0f), t);  // std::max(t, 0)
+    const Lanes x = select(splat(kFMax) < t, splat(kFMax), t) * splat(kFSamples / kFMax);
+    LaneMask i = __builtin_convertvector(x, LaneMask);  // truncation, as static_cast<int>
+    i = select(splat(kFSamples) < i, splat(kFSamples), i);
+    const Lanes w = x - __builtin_convertvector(i, Lanes);
+    Lanes at, next;
+    for (int k = 0; k < 4; ++k) at[k] = f[i[k]], next[k] = f[i[k] + 1];
+    return at + w * (next - at);
+  }
 };
 
 const LabTables& lab_tables() {
@@ -99,23 +117,47 @@ std::int16_t to_code(float value) {
   return static_cast<std::int16_t>((scaled + kShift) - kShift);
 }
 
-// Converts every pixel with the tables (on the CPU backend's threads); `store` receives the index
-// and (L*, a*, b*).
+// to_code of four values, lane by lane the same float operations.
+LaneMask to_codes(Lanes value) {
+  constexpr float kShift = 12582912.0f;  // 1.5 * 2^23
+  constexpr float kClamp = 255.0f;
+  value = select(value < splat(-kClamp), splat(-kClamp), value);  // std::max(value, -kClamp)
+  const Lanes scaled = select(splat(kClamp) < value, splat(kClamp), value) * splat(kLabCodeScale);
+  return __builtin_convertvector((scaled + splat(kShift)) - splat(kShift), LaneMask);
+}
+
+// L*, a* and b* of `count` (<= 4) pixels from `in`, lane by lane (the lanes past count hold the
+// last pixel's).
+struct LabLanes {
+  Lanes l, a, b;
+};
+LabLanes lab_lanes(const LabTables& tables, const Rgb8* in, int count) {
+  Lanes rgb[3];
+  for (int k = 0; k < 4; ++k) {
+    const Rgb8& pixel = in[std::min(k, count - 1)];
+    for (int c = 0; c < 3; ++c) rgb[c][k] = tables.linear[pixel[c]];
+  }
+  Lanes f[3];
+  for (int row = 0; row < 3; ++row) {
+    const float* m = tables.matrix[row];
+    f[row] =
+        tables.interpolated_f(splat(m[0]) * rgb[0] + splat(m[1]) * rgb[1] + splat(m[2]) * rgb[2]);
+  }
+  return {splat(116.0f) * f[1] - splat(16.0f), splat(500.0f) * (f[0] - f[1]),
+          splat(200.0f) * (f[1] - f[2])};
+}
+
+// Converts every pixel with the tables, four at a time (on the CPU backend's threads); `store`
+// receives the first pixel's index, how many of the four lanes are pixels, and their lanes.
 template <class Store>
 void convert_pixels(const RgbImage& rgb, Store&& store) {
   const LabTables& tables = lab_tables();
   const Rgb8* in = rgb.data();
   compute::detail::for_each_chunk(
       rgb.size(), rgb.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
-        for (std::size_t i = begin; i < end; ++i) {
-          const float r = tables.linear[in[i][0]], g = tables.linear[in[i][1]],
-                      b = tables.linear[in[i][2]];
-          float f[3];
-          for (int row = 0; row < 3; ++row) {
-            const float* m = tables.matrix[row];
-            f[row] = tables.interpolated_f(m[0] * r + m[1] * g + m[2] * b);
-          }
-          store(i, 116.0f * f[1] - 16.0f, 500.0f * (f[0] - f[1]), 200.0f * (f[1] - f[2]));
+        for (std::size_t i = begin; i < end; i += 4) {
+          const int count = static_cast<int>(std::min<std::size_t>(4, end - i));
+          store(i, count, lab_lanes(tables, in + i, count));
         }
       });
 }
@@ -125,8 +167,9 @@ void convert_pixels(const RgbImage& rgb, Store&& store) {
 LabImage to_lab(const RgbImage& rgb) {
   LabImage lab(rgb.width(), rgb.height());
   Eigen::Vector4f* out = lab.data();
-  convert_pixels(rgb, [out](std::size_t i, float l, float a, float b) {
-    out[i] = Eigen::Vector4f(l, a, b, 0.0f);
+  convert_pixels(rgb, [out](std::size_t i, int count, const LabLanes& lab) {
+    for (int k = 0; k < count; ++k)
+      out[i + k] = Eigen::Vector4f(lab.l[k], lab.a[k], lab.b[k], 0.0f);
   });
   return lab;
 }
@@ -141,8 +184,12 @@ void to_lab_codes(const RgbImage& rgb, LabCodeImage& codes) {
   if (codes.width() != rgb.width() || codes.height() != rgb.height())
     codes = LabCodeImage(rgb.width(), rgb.height());
   LabCode* out = codes.data();
-  convert_pixels(rgb, [out](std::size_t i, float l, float a, float b) {
-    out[i] = {to_code(l), to_code(a), to_code(b), 1};
+  convert_pixels(rgb, [out](std::size_t i, int count, const LabLanes& lab) {
+    const LaneMask l = to_codes(lab.l), a = to_codes(lab.a), b = to_codes(lab.b);
+    for (int k = 0; k < count; ++k) {
+      out[i + k] = {static_cast<std::int16_t>(l[k]), static_cast<std::int16_t>(a[k]),
+                    static_cast<std::int16_t>(b[k]), 1};
+    }
   });
 }
 
