@@ -77,6 +77,26 @@ TEST(LabColor, ImageConversionMatchesPerPixelConversion) {
   EXPECT_LT(worst, 2e-3);
 }
 
+// The image is converted four pixels at a time: a colour gets the same code (and Lab) wherever
+// it sits, in any lane, in a group cut short by the image's end or a chunk's, as alone.
+TEST(LabColor, AColourGetsTheSameCodeWhereverItSits) {
+  std::mt19937 random(7);
+  for (const int width : {1, 3, 5, 7, 641}) {
+    RgbImage rgb(width, 3);
+    for (Rgb8& pixel : rgb.pixels()) {
+      pixel = {static_cast<std::uint8_t>(random()), static_cast<std::uint8_t>(random()),
+               static_cast<std::uint8_t>(random())};
+    }
+    const LabCodeImage codes = segmentation::to_lab_codes(rgb);
+    const LabImage lab = segmentation::to_lab(rgb);
+    for (std::size_t i = 0; i < rgb.size(); ++i) {
+      const RgbImage alone(1, 1, rgb.data()[i]);
+      ASSERT_EQ(codes.data()[i], segmentation::to_lab_codes(alone).data()[0]) << width << " " << i;
+      ASSERT_EQ(lab.data()[i], segmentation::to_lab(alone).data()[0]) << width << " " << i;
+    }
+  }
+}
+
 TEST(LabColor, CodesAreTheRoundedLabInSixtyFourthsAndMarkInvalidColours) {
   RgbImage rgb(16, 16);
   for (int y = 0; y < 16; ++y) {
