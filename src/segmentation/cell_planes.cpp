@@ -184,10 +184,6 @@ Eigen::Vector3d square_pixel_sums(int width, int height, int x0, int y0, int siz
   return rectangle_pixel_sums(x0, y0, std::min(width, x0 + size), std::min(height, y0 + size));
 }
 
-}  // namespace
-
-namespace {
-
 // A planar cell (block -1) or block of a cell, with its fit and mean colour.
 struct PlanarPiece {
   std::size_t cell;
