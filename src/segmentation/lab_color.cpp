@@ -56,14 +56,7 @@ struct LabTables {
       for (int c = 0; c < 3; ++c) matrix[r][c] = static_cast<float>(normalised_matrix(r, c));
   }
 
-  float interpolated_f(float t) const {
-    const float x = std::min(std::max(t, 0.0f), kFMax) * (kFSamples / kFMax);
-    const int i = std::min(static_cast<int>(x), kFSamples);
-    const float w = x - static_cast<float>(i);
-    return f[i] + w * (f[i + 1] - f[i]);
-  }
-
-  // interpolated_f of four values, lane by lane the same float operations.
+  // lab_f of four values: t clamped to [0, kFMax], the two samples around it interpolated.
   Lanes interpolated_f(Lanes t) const {
     t = select(t < splat(0.0f), splat(0.0f), t);  // std::max(t, 0)
     const Lanes x = select(splat(kFMax) < t, splat(kFMax), t) * splat(kFSamples / kFMax);
