@@ -242,6 +242,13 @@ TEST(PlaneMerge, ASegmentLookupStandsInForTheLabelImage) {
             (std::vector<std::uint32_t>{0, 0, 1, 2}));
   EXPECT_EQ(merge({}, [](int, int) { return 0u; }), (std::vector<std::uint32_t>{0, 0, 1, 0}));
   EXPECT_ERROR_MENTIONS(merge({}, {}), "without a label image");
+  // No segments: no pixel sums to give, and no planes.
+  segmentation::SegmentGraph no_graph;
+  no_graph.offsets = {0};
+  const segmentation::MergedPlanes none = segmentation::merge_segments(
+      {}, geometry::SegmentMomentSet{}, params,
+      {{}, &scene.points, &no_graph, {}, {}, [](int, int) { return geometry::kNoLabel; }});
+  EXPECT_TRUE(none.planes.empty());
 }
 
 TEST(PlaneMerge, AdjacencyGraphsKnownAnswers) {

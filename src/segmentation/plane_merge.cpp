@@ -27,7 +27,8 @@ void check_inputs(const SegmentLabelImage& labels, std::uint32_t segment_count,
   const PointImage* points = inputs.points;
   const std::span<const Eigen::Vector3f> segment_colours = inputs.colours;
   if (labels.size() == 0) {
-    require(inputs.segment_at && inputs.graph != nullptr && !inputs.pixel_sums.empty(),
+    require(inputs.segment_at && inputs.graph != nullptr &&
+                (segment_count == 0 || !inputs.pixel_sums.empty()),
             "plane merge: without a label image the segments' lookup, neighbour graph and pixel "
             "sums must be given");
   } else {
