@@ -265,21 +265,17 @@ std::uint32_t planar_cell_segments(const CellPlaneParams& params, const PlaneMer
 
 SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_count) {
   const int columns = 2 * cells.columns, rows = 2 * cells.rows;  // blocks
-  const auto segment_at = [&](int x, int y) {
-    const std::size_t cell = static_cast<std::size_t>(y / 2) * cells.columns + x / 2;
-    return cells.segments[cell][static_cast<std::size_t>((y % 2) * 2 + x % 2)];
-  };
   std::vector<std::uint64_t> edges;
   for (int y = 0; y < rows; ++y) {
     for (int x = 0; x < columns; ++x) {
-      const std::uint32_t a = segment_at(x, y);
+      const std::uint32_t a = cells.block_segment(x, y);
       if (a == geometry::kNoLabel) continue;
       // Right, down-left, down, down-right: each neighbouring pair once.
       const int steps[4][2] = {{1, 0}, {-1, 1}, {0, 1}, {1, 1}};
       for (const auto& step : steps) {
         const int nx = x + step[0], ny = y + step[1];
         if (nx < 0 || nx >= columns || ny >= rows) continue;
-        const std::uint32_t b = segment_at(nx, ny);
+        const std::uint32_t b = cells.block_segment(nx, ny);
         if (b != geometry::kNoLabel && b != a) edges.push_back(segment_edge(a, b));
       }
     }

@@ -54,10 +54,13 @@ struct CellGrid {
     if (bit % 32 + half > 32) v |= std::uint64_t{words[1]} << 32;
     return static_cast<std::uint32_t>((v >> (bit % 32)) & ((std::uint64_t{1} << half) - 1));
   }
+  // The segment of block (bx, by) of the image's block grid (kNoLabel: none).
+  std::uint32_t block_segment(int bx, int by) const {
+    return segments[static_cast<std::size_t>(by / 2) * columns + bx / 2][(by % 2) * 2 + bx % 2];
+  }
   // The segment pixel (x, y) lies in (kNoLabel: none).
   std::uint32_t segment_at(int x, int y) const {
-    const int half = cell_size / 2, bx = x / half, by = y / half;
-    return segments[static_cast<std::size_t>(by / 2) * columns + bx / 2][(by % 2) * 2 + bx % 2];
+    return block_segment(x / (cell_size / 2), y / (cell_size / 2));
   }
   // The same for pixel (x0 + k, y) of image block column `block_x` (y any row of the image).
   std::uint32_t valid_bits(int block_x, int y) const {
