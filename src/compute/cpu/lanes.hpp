@@ -68,4 +68,14 @@ inline XyzLanes load_xyz(const float* first, int count) {
   return p;
 }
 
+// Asks for the cache lines of [begin, end) before they are read: the next row of a rectangle in
+// an image lies a whole image row away, where the hardware has not fetched yet. A hint only.
+inline void prefetch_lines(const void* begin, const void* end) {
+  constexpr std::uintptr_t kLine = 64;
+  const std::uintptr_t last = reinterpret_cast<std::uintptr_t>(end);
+  for (std::uintptr_t line = reinterpret_cast<std::uintptr_t>(begin) & ~(kLine - 1); line < last;
+       line += kLine)
+    __builtin_prefetch(reinterpret_cast<const void*>(line));
+}
+
 }  // namespace kartograf::compute::detail
