@@ -50,7 +50,8 @@ void blocks_on_segment(const Eigen::Vector3d& a, const Eigen::Vector3d& b,
 }
 
 // The plain reference of one frame fused into an empty volume: the blocks each pixel's ray crosses
-// within +-truncation of its depth, and each of their voxels fused once (in double precision).
+// within +-truncation of its depth, and each of their voxels fused once (in double precision),
+// with weight 1 or (fusion_weight_depth / z)^4 beyond fusion_weight_depth.
 std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> reference_frame(
     const DepthImage& depth, const Eigen::Isometry3d& pose, const TsdfVolumeParams& p) {
   std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> blocks;
@@ -80,7 +81,10 @@ std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> reference_frame(
       if (d == 0) continue;
       const double distance = d / kUnits - c.z();
       if (distance < -p.truncation) continue;
-      voxels[i] = {static_cast<float>(std::min(1.0, distance / p.truncation)), 1.0f, 0};
+      const double ratio =
+          p.fusion_weight_depth > 0 ? std::min(1.0, p.fusion_weight_depth / c.z()) : 1.0;
+      voxels[i] = {static_cast<float>(std::min(1.0, distance / p.truncation)),
+                   static_cast<float>(ratio * ratio * ratio * ratio), 0};
     }
   }
   return blocks;
@@ -88,18 +92,20 @@ std::map<std::tuple<int, int, int>, std::vector<TsdfVoxel>> reference_frame(
 
 class TsdfVolumeTest : public testing::BackendTest {};
 
-TEST_P(TsdfVolumeTest, OneFrameMatchesThePlainReference) {
+// One frame of the scene fused with `params` against the plain reference: the same blocks, and
+// each voxel's value within 1e-4 and weight within 1e-6 of it (rounding may move a voxel centre
+// across a pixel's edge: a few voxels may differ).
+void expect_one_frame_matches_reference(const compute::Context& context,
+                                        const TsdfVolumeParams& params) {
   const Scene scene;
   const Eigen::Isometry3d pose = pose_at(0.05, 0.02, 8);
   const DepthImage depth = render(scene, pose);
-  const TsdfVolumeParams params = volume_params(0.02, 0.06);
-  TsdfVolume volume(context(), params);
+  TsdfVolume volume(context, params);
   const mapping::TsdfIntegration done = volume.integrate(depth, {}, kCamera, depth_range(), pose);
   const TsdfBlocks blocks = volume.download();
   const auto expected = reference_frame(depth, pose, params);
   EXPECT_EQ(done.active_blocks, expected.size());
   ASSERT_EQ(blocks.size(), expected.size());
-  // Rounding may move a voxel centre across a pixel's edge: a few voxels may differ.
   std::size_t compared = 0, differing = 0;
   double worst = 0;
   for (std::size_t b = 0; b < blocks.size(); ++b) {
@@ -111,7 +117,8 @@ TEST_P(TsdfVolumeTest, OneFrameMatchesThePlainReference) {
       const TsdfVoxel& want = it->second[i];
       ++compared;
       if (want.weight == 0 && got.weight == 0) continue;  // never observed: no value
-      if (got.weight != want.weight || std::abs(got.tsdf - want.tsdf) > 1e-4f) {
+      if (std::abs(got.weight - want.weight) > 1e-6f * want.weight ||
+          std::abs(got.tsdf - want.tsdf) > 1e-4f) {
         ++differing;
         continue;
       }
@@ -119,9 +126,46 @@ TEST_P(TsdfVolumeTest, OneFrameMatchesThePlainReference) {
     }
   }
   EXPECT_LE(differing, compared / 2000) << differing << " of " << compared;
-  RecordProperty("voxels_compared", std::to_string(compared));
-  RecordProperty("voxels_differing", std::to_string(differing));
-  RecordProperty("max_tsdf_error", testing::scientific(worst));
+  ::testing::Test::RecordProperty("voxels_compared", std::to_string(compared));
+  ::testing::Test::RecordProperty("voxels_differing", std::to_string(differing));
+  ::testing::Test::RecordProperty("max_tsdf_error", testing::scientific(worst));
+}
+
+TEST_P(TsdfVolumeTest, OneFrameMatchesThePlainReference) {
+  expect_one_frame_matches_reference(context(), volume_params(0.02, 0.06));
+}
+
+// The scene lies 1.2-2.4 m away: beyond 1.5 m its voxels weigh (1.5 / z)^4, down to 0.15.
+TEST_P(TsdfVolumeTest, DepthWeightedFrameMatchesThePlainReference) {
+  TsdfVolumeParams params = volume_params(0.02, 0.06);
+  params.fusion_weight_depth = 1.5;
+  expect_one_frame_matches_reference(context(), params);
+}
+
+// A wall seen 2 cm too far from 2.4 m away, then right from 0.4 m: with fusion_weight_depth 1 m the
+// far view weighs (1 / 2.4)^4 = 0.03 against the near one's 1, so the surface lies 0.6 mm behind
+// the wall; with every view weighing 1, halfway (1 cm).
+TEST_P(TsdfVolumeTest, NearViewsOutweighFarOnes) {
+  for (const double weight_depth : {1.0, 0.0}) {
+    TsdfVolumeParams params = volume_params(0.02, 0.06);
+    params.fusion_weight_depth = weight_depth;
+    TsdfVolume volume(context(), params);
+    Scene far_wall;
+    far_wall.wall_z += 0.02;
+    const Eigen::Isometry3d origin = Eigen::Isometry3d::Identity();
+    volume.integrate(render(far_wall, origin), {}, kCamera, depth_range(), origin);
+    Eigen::Isometry3d near = Eigen::Isometry3d::Identity();
+    near.translation() = Eigen::Vector3d(1.0, 0.5, 2.0);  // clear of the sphere's shadow
+    const Scene scene;
+    volume.integrate(render(scene, near), {}, kCamera, depth_range(), near);
+    const PointImage points = volume.raycast(kCamera, depth_range(), near);
+    const Point4f& centre = points(kCamera.width / 2, kCamera.height / 2);
+    ASSERT_TRUE(is_valid(centre)) << weight_depth;
+    const double far_weight = std::pow(std::min(1.0, weight_depth / 2.4), 4);
+    const double expected = weight_depth > 0 ? 0.02 * far_weight / (1 + far_weight) : 0.01;
+    EXPECT_NEAR(centre.z() + near.translation().z(), scene.wall_z + expected, 0.002)
+        << "fusion_weight_depth " << weight_depth;
+  }
 }
 
 // The distances to the scene of the points a ray cast from `view` finds, and in `surface` the
@@ -422,6 +466,8 @@ TEST_P(TsdfVolumeTest, FullVolumeAndBadInputsAreErrors) {
            [](TsdfVolumeParams& p) { p.truncation = 0.5; },
            [](TsdfVolumeParams& p) { p.truncation = 0.001; },
            [](TsdfVolumeParams& p) { p.max_weight = 0.5; },
+           [](TsdfVolumeParams& p) { p.fusion_weight_depth = -1; },
+           [](TsdfVolumeParams& p) { p.fusion_weight_depth = std::nan(""); },
            [](TsdfVolumeParams& p) { p.max_blocks = 0; },
            [](TsdfVolumeParams& p) { p.touch_step = -1; }}) {
     TsdfVolumeParams p;

@@ -7,7 +7,8 @@
 //                stamped slot appends its block to the frame's active list
 //   3 integrate  every voxel of the active blocks: projected into the depth image, the
 //                projective distance d - z, truncated and divided by the truncation, joins the
-//                voxel's weighted mean (as its colour does), where d - z >= -truncation
+//                voxel's weighted mean (as its colour does), where d - z >= -truncation, with
+//                weight 1 or, with weight_depth, less for far observations
 // Ray casting reads the field: every pixel's ray marches through the blocks to the first change
 // from + to -, refined on the trilinear field, and returns the point in the camera's frame.
 // Voxel v of a block at block coordinates b is at world (8 b + v + 0.5) x voxel_size (its centre).
@@ -63,8 +64,9 @@ KG_PARAM(float, cy)
 KG_PARAM(float, voxel_size)
 KG_PARAM(float, truncation)
 KG_PARAM(float, max_weight)
-KG_PARAM(float, inverse_voxel)  // 1 / voxel_size and 1 / (8 voxel_size), rounded once on the host:
-KG_PARAM(float, inverse_block)  // a device's division may round otherwise
+KG_PARAM(float, inverse_voxel)  // 1 / voxel_size, rounded once on the host (a device's division
+                                // may round otherwise); a block's is an eighth of it, exactly
+KG_PARAM(float, weight_depth)   // an observation beyond it weighs (weight_depth / z)^4; 0: all 1
 KG_TSDF_RIGID_PARAMS
 KG_PARAM(uint, capacity_log2)   // the table has 2^capacity_log2 slots
 KG_PARAM(uint, block_capacity)  // the pool's blocks
@@ -73,6 +75,12 @@ KG_PARAM(uint, count)           // items of the pass: slots, active voxels
 KG_PARAM(uint, step)            // touch: every step-th pixel each way; ray cast: the most steps
 KG_PARAM(uint, has_color)
 KG_PARAMS_END(TsdfParams)
+
+// 1 / (8 voxel_size): the host's rounded 1 / voxel_size scaled by a power of two, so the same
+// float as rounding 1 / (8 voxel_size) itself.
+KG_INLINE float tsdf_inverse_block(TsdfParams p) {
+  return p.inverse_voxel * 0.125f;
+}
 
 KG_INLINE bool tsdf_depth_valid(uint d, TsdfParams p) {
   return KG_BOTH(d != 0u, KG_BOTH(d >= p.min_units, d <= p.max_units));
@@ -206,8 +214,8 @@ KG_FORCE_INLINE TsdfSegmentWalk tsdf_touch_walk(KG_BUFFER_PARAM(uint, status) ui
                                                 uint d, TsdfParams p) {
   const float z = tsdf_metres(d, p);
   const float3 ray = KG_FLOAT3((KG_FLOAT(x) - p.cx) / p.fx, (KG_FLOAT(y) - p.cy) / p.fy, 1.0f);
-  const float3 a = tsdf_to_world(ray * (z - p.truncation), p) * p.inverse_block;
-  const float3 b = tsdf_to_world(ray * (z + p.truncation), p) * p.inverse_block;
+  const float3 a = tsdf_to_world(ray * (z - p.truncation), p) * tsdf_inverse_block(p);
+  const float3 b = tsdf_to_world(ray * (z + p.truncation), p) * tsdf_inverse_block(p);
   const bool in_range = tsdf_axis_in_range(a.x) && tsdf_axis_in_range(a.y) &&
                         tsdf_axis_in_range(a.z) && tsdf_axis_in_range(b.x) &&
                         tsdf_axis_in_range(b.y) && tsdf_axis_in_range(b.z);
@@ -315,10 +323,10 @@ KG_INLINE TsdfVoxelView tsdf_voxel_view(KG_BUFFER_PARAM(const uint, active_block
 
 // One channel's weighted mean, rounded to the nearest level.
 KG_INLINE uint tsdf_mean_channel(uint old_color, uint new_color, uint shift, float old_weight,
-                                 float share) {
+                                 float new_weight, float share) {
   const float a = KG_FLOAT((old_color >> shift) & 0xffu);
   const float b = KG_FLOAT((new_color >> shift) & 0xffu);
-  const float mean = (a * old_weight + b) * share;
+  const float mean = (a * old_weight + b * new_weight) * share;
   return KG_UINT(min(KG_INT(mean + 0.5f), 255)) << shift;  // int: a vector conversion
 }
 
@@ -328,19 +336,29 @@ KG_INLINE bool tsdf_fuses(uint d, float z, TsdfParams p) {
   return KG_BOTH(tsdf_depth_valid(d, p), tsdf_metres(d, p) - z >= -p.truncation);
 }
 
+// An observation's weight at depth z: 1, or with weight_depth > 0 the inverse variance of a
+// structured-light sensor's depth noise (which grows as z^2) relative to weight_depth's,
+// (weight_depth / z)^4, at most 1.
+KG_INLINE float tsdf_observation_weight(float z, TsdfParams p) {
+  const float ratio = min(1.0f, p.weight_depth / max(z, 1e-6f));
+  const float squared = ratio * ratio;
+  return p.weight_depth > 0.0f ? squared * squared : 1.0f;
+}
+
 // The voxel after fusing depth value d (and colour) seen at depth z of the voxel's centre.
 // Selections instead of branches: the CPU wrapper runs it over a block as vector code.
 KG_INLINE TsdfVoxel tsdf_fuse(TsdfVoxel voxel, uint d, float z, uint color, TsdfParams p) {
   const bool fuses = tsdf_fuses(d, z, p);
   const float distance = tsdf_metres(d, p) - z;
   const float value = min(1.0f, distance / p.truncation);
-  const float share = 1.0f / (voxel.weight + 1.0f);  // the new measurement's share of the mean
-  const uint mean = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight, share) |
-                    tsdf_mean_channel(voxel.color, color, 8u, voxel.weight, share) |
-                    tsdf_mean_channel(voxel.color, color, 16u, voxel.weight, share);
+  const float weight = tsdf_observation_weight(z, p);
+  const float share = 1.0f / (voxel.weight + weight);  // the mean's divisor, as a factor
+  const uint mean = tsdf_mean_channel(voxel.color, color, 0u, voxel.weight, weight, share) |
+                    tsdf_mean_channel(voxel.color, color, 8u, voxel.weight, weight, share) |
+                    tsdf_mean_channel(voxel.color, color, 16u, voxel.weight, weight, share);
   TsdfVoxel fused;
-  fused.tsdf = fuses ? (voxel.tsdf * voxel.weight + value) * share : voxel.tsdf;
-  fused.weight = fuses ? min(voxel.weight + 1.0f, p.max_weight) : voxel.weight;
+  fused.tsdf = fuses ? (voxel.tsdf * voxel.weight + value * weight) * share : voxel.tsdf;
+  fused.weight = fuses ? min(voxel.weight + weight, p.max_weight) : voxel.weight;
   fused.color = KG_BOTH(fuses, p.has_color != 0u) ? mean : voxel.color;
   return fused;
 }
@@ -463,8 +481,9 @@ KG_INLINE TsdfVoxel tsdf_voxel_at(KG_BUFFER_PARAM(const uint64_t, keys)
 KG_INLINE float tsdf_block_exit(float3 w, float3 direction, float t, TsdfParams p) {
   const float side = p.voxel_size * KG_FLOAT(KG_TSDF_BLOCK_SIDE);
   float exit = 1e30f;
-  const float bx = floor(w.x * p.inverse_block), by = floor(w.y * p.inverse_block),
-              bz = floor(w.z * p.inverse_block);
+  const float inverse_block = tsdf_inverse_block(p);
+  const float bx = floor(w.x * inverse_block), by = floor(w.y * inverse_block),
+              bz = floor(w.z * inverse_block);
   if (direction.x != 0.0f)
     exit = min(exit, ((direction.x > 0.0f ? bx + 1.0f : bx) * side - w.x) / direction.x);
   if (direction.y != 0.0f)
@@ -478,7 +497,7 @@ KG_INLINE float tsdf_block_exit(float3 w, float3 direction, float t, TsdfParams 
 
 // Whether world point w lies in the range of keys.
 KG_INLINE bool tsdf_point_in_range(float3 w, TsdfParams p) {
-  const float inverse_block = p.inverse_block;
+  const float inverse_block = tsdf_inverse_block(p);
   return tsdf_axis_in_range(w.x * inverse_block - 1.0f) &&
          tsdf_axis_in_range(w.y * inverse_block - 1.0f) &&
          tsdf_axis_in_range(w.z * inverse_block - 1.0f) &&
@@ -543,20 +562,21 @@ KG_INLINE float tsdf_field_on_ray(KG_BUFFER_PARAM(const uint64_t, keys)
 // the trilinear field, else in the voxels' values. The voxels' signs change up to half a voxel
 // away from the field's: where the field at t1 is still > 0, the crossing lies beyond, and where
 // it is <= 0 at t0 already, before; the bracket moves by half a voxel (at most
-// KG_TSDF_CROSSING_MOVES times) to catch it. Taking the voxels' values there instead biased the surface by up to half
-// a voxel, and frame-to-model tracking drifted with it (synthetic, noise-free: 4.8 mm at 2 cm).
+// KG_TSDF_CROSSING_MOVES times) to catch it. Taking the voxels' values there instead biased the
+// surface by up to half a voxel, and frame-to-model tracking drifted with it (synthetic,
+// noise-free: 4.8 mm at 2 cm).
 #define KG_TSDF_CROSSING_MOVES 4u
 KG_INLINE float tsdf_crossing(KG_BUFFER_PARAM(const uint64_t, keys)
                                   KG_BUFFER_PARAM(const uint, slot_blocks)
                                       KG_BUFFER_PARAM(const TsdfVoxel, voxels) float3 origin,
                               float3 direction, float t0, float f0, float t1, float f1,
                               float half_voxel, TsdfParams p) {
-  float s0 = tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks)
-                                   KG_BUFFER_ARG(voxels) origin,
-                               direction, t0, p);
-  float s1 = tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks)
-                                   KG_BUFFER_ARG(voxels) origin,
-                               direction, t1, p);
+  float s0 =
+      tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin,
+                        direction, t0, p);
+  float s1 =
+      tsdf_field_on_ray(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin,
+                        direction, t1, p);
   float u0 = t0, u1 = t1;  // the bracket in the field
   for (uint i = 0u; i < KG_TSDF_CROSSING_MOVES; ++i) {
     const bool beyond = s1 > 0.0f;  // NaN compares false: no move
@@ -611,10 +631,9 @@ KG_FORCE_INLINE float4 tsdf_cast_ray(KG_BUFFER_PARAM(const uint64_t, keys)
     const bool known = v.weight > 0.0f;
     if (known && v.tsdf <= 0.0f) {
       if (kg_isnan(previous)) break;  // the back of a surface, or inside it from the start
-      const float hit =
-          tsdf_crossing(KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin,
-                        direction, previous_t, previous, t, v.tsdf, 0.5f * p.voxel_size / per_depth,
-                        p);
+      const float hit = tsdf_crossing(
+          KG_BUFFER_ARG(keys) KG_BUFFER_ARG(slot_blocks) KG_BUFFER_ARG(voxels) origin, direction,
+          previous_t, previous, t, v.tsdf, 0.5f * p.voxel_size / per_depth, p);
       return KG_FLOAT4(ray_c.x * hit, ray_c.y * hit, hit, 1.0f);
     }
     previous = known ? v.tsdf : KG_NAN;

@@ -42,6 +42,7 @@ TsdfVolumeParams ModelTrackingParams::default_volume() {
   v.voxel_size = 0.02;
   v.truncation = 0.08;
   v.max_blocks = 1 << 16;
+  v.fusion_weight_depth = 1.5;  // the frame-to-frame odometry's reach of flat pair weights
   return v;
 }
 

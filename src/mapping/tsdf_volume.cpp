@@ -50,7 +50,7 @@ kernels::TsdfParams frame_params(const TsdfVolumeParams& volume, const PinholeIn
   p.truncation = static_cast<float>(volume.truncation);
   p.max_weight = static_cast<float>(volume.max_weight);
   p.inverse_voxel = static_cast<float>(1.0 / volume.voxel_size);
-  p.inverse_block = static_cast<float>(1.0 / (volume.voxel_size * kTsdfBlockSide));
+  p.weight_depth = static_cast<float>(volume.fusion_weight_depth);
   const Eigen::Matrix3f r = camera_to_world.linear().cast<float>();
   const Eigen::Vector3f t = camera_to_world.translation().cast<float>();
   p.r00 = r(0, 0), p.r01 = r(0, 1), p.r02 = r(0, 2);
@@ -107,6 +107,9 @@ void TsdfVolumeParams::validate() const {
               std::to_string(truncation) + " m for voxels of " + std::to_string(voxel_size) + " m");
   require(std::isfinite(max_weight) && max_weight >= 1,
           "TSDF volume: max_weight must be >= 1, got " + std::to_string(max_weight));
+  require(std::isfinite(fusion_weight_depth) && fusion_weight_depth >= 0,
+          "TSDF volume: fusion_weight_depth must be >= 0 m (0: every observation weighs 1), got " +
+              std::to_string(fusion_weight_depth));
   require(max_blocks >= 1 && max_blocks <= kMaxBlocks,
           "TSDF volume: max_blocks must be in [1, 2^23], got " + std::to_string(max_blocks));
   require(touch_step >= 0, "TSDF volume: touch_step must be >= 0 (0: automatic)");

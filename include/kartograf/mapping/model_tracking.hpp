@@ -56,7 +56,8 @@ struct ModelTrackingParams {
   double evict_fill = 0.75;
 
   // 2 cm voxels, 8 cm truncation, 2^16 blocks (fewer where the device's largest buffer holds
-  // fewer: the tracker lowers max_blocks to fit).
+  // fewer: the tracker lowers max_blocks to fit); observations beyond 1.5 m weigh (1.5 / z)^4,
+  // the pairs' noise model (7-Scenes 0-599 2.31 -> 2.26 cm).
   static TsdfVolumeParams default_volume();
   // The odometry's point-to-plane levels with pairs whose normals agree within 20 degrees (PCL's
   // KinFu's gate), not 45: the model's normals are smooth, and pairs across its rounded edges

@@ -10,7 +10,8 @@
 //   - every voxel of those blocks in front of the camera is projected into the depth image, and
 //     where the measured depth d is at most `truncation` in front of it (d - z >= -truncation,
 //     z the voxel centre's depth) the value min(1, (d - z) / truncation) joins the voxel's running
-//     mean with weight 1 (the weight stops growing at max_weight, so the field can follow change);
+//     mean with weight 1, or less for far views with fusion_weight_depth (the weight stops
+//     growing at max_weight, so the field can follow change);
 //     the pixel's colour joins the colour's mean the same way.
 // Ray casting marches each pixel's ray through the field (steps bounded by the field's value) to
 // the first change from + to -, placed by linear interpolation of the trilinear field.
@@ -46,6 +47,11 @@ struct TsdfVolumeParams {
   // (8 voxels) and at least one voxel. 4 voxels by default.
   double truncation = 0.04;
   double max_weight = 64;
+  // Metres; 0: every observation joins a voxel's mean with weight 1. Otherwise an observation
+  // of a voxel at depth z beyond it weighs (fusion_weight_depth / z)^4: the inverse variance of
+  // a structured-light sensor's depth noise, which grows as z^2. Far, noisy views then cannot
+  // drag a surface that near views have measured (the frame-to-model tracker's model uses 1.5 m).
+  double fusion_weight_depth = 0;
   // The pool: 12 bytes a voxel, 6 KiB a block; 16384 blocks (96 MiB) fit every device's largest
   // buffer (Vulkan guarantees 128 MiB) and hold about 170 m^2 of surface at 1 cm voxels.
   std::size_t max_blocks = 1 << 14;
