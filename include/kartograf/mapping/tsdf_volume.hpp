@@ -51,6 +51,8 @@ struct TsdfVolumeParams {
   // of a voxel at depth z beyond it weighs (fusion_weight_depth / z)^4: the inverse variance of
   // a structured-light sensor's depth noise, which grows as z^2. Far, noisy views then cannot
   // drag a surface that near views have measured (the frame-to-model tracker's model uses 1.5 m).
+  // A mesh's or band's min_weight then counts near-view equivalents: a wall seen once from 3 m
+  // weighs 1/16.
   double fusion_weight_depth = 0;
   // The pool: 12 bytes a voxel, 6 KiB a block; 16384 blocks (96 MiB) fit every device's largest
   // buffer (Vulkan guarantees 128 MiB) and hold about 170 m^2 of surface at 1 cm voxels.
