@@ -214,8 +214,9 @@ KG_FORCE_INLINE TsdfSegmentWalk tsdf_touch_walk(KG_BUFFER_PARAM(uint, status) ui
                                                 uint d, TsdfParams p) {
   const float z = tsdf_metres(d, p);
   const float3 ray = KG_FLOAT3((KG_FLOAT(x) - p.cx) / p.fx, (KG_FLOAT(y) - p.cy) / p.fy, 1.0f);
-  const float3 a = tsdf_to_world(ray * (z - p.truncation), p) * tsdf_inverse_block(p);
-  const float3 b = tsdf_to_world(ray * (z + p.truncation), p) * tsdf_inverse_block(p);
+  const float inverse_block = tsdf_inverse_block(p);
+  const float3 a = tsdf_to_world(ray * (z - p.truncation), p) * inverse_block;
+  const float3 b = tsdf_to_world(ray * (z + p.truncation), p) * inverse_block;
   const bool in_range = tsdf_axis_in_range(a.x) && tsdf_axis_in_range(a.y) &&
                         tsdf_axis_in_range(a.z) && tsdf_axis_in_range(b.x) &&
                         tsdf_axis_in_range(b.y) && tsdf_axis_in_range(b.z);

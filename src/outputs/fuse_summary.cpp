@@ -16,6 +16,7 @@ std::string fuse_summary_json(const FuseRun& run, const mapping::TsdfVolume& vol
   json["voxel_m"] = p.voxel_size;
   json["truncation_m"] = p.truncation;
   json["max_weight"] = p.max_weight;
+  json["fusion_weight_depth_m"] = p.fusion_weight_depth;  // 0: every observation weighs 1
   json["blocks"] = volume.block_count();
   json["max_blocks"] = p.max_blocks;
   json["mesh"] = {{"file", "mesh.ply"},
