@@ -130,23 +130,37 @@ TEST(FeatureTracking, ALargeMotionFollowsTheFeaturesOnlyWhereThePairAgreesBetter
   EXPECT_GT(misled.worst_m, 0.05);  // measured 13 cm, 4.4 degrees
 }
 
-TEST(FeatureTracking, LoopClosureFindsByAppearanceWhatTheDriftHides) {
-  // Two views of one room 80 frames apart on the tour, the second seen again from nearby.
-  const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
-  const testing::RenderedSequence views =
-      testing::render_sequence({tour[400].pose, tour[404].pose}, kKinect);
+// Two views of one room 80 frames apart on the tour, the second seen again from nearby; the
+// estimate of the second drifted 40 cm and 70 degrees (8 m of path: 0.4 m allowance).
+struct RevisitedRoom {
+  testing::RenderedSequence views;
+  std::vector<Eigen::Isometry3d> drifted;
   geometry::DepthRange range;
-  range.units_per_metre = testing::kSynthUnitsPerMetre;
+};
+
+const RevisitedRoom& revisited_room() {
+  static const RevisitedRoom room = [] {
+    const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
+    RevisitedRoom r{testing::render_sequence({tour[400].pose, tour[404].pose}, kKinect), {}, {}};
+    r.drifted = r.views.truth;
+    r.drifted[1] = r.drifted[1] * Eigen::Translation3d(0.3, 0, 0.25) *
+                   Eigen::AngleAxisd(70 * kDegree, Eigen::Vector3d::UnitY());
+    r.range.units_per_metre = testing::kSynthUnitsPerMetre;
+    return r;
+  }();
+  return room;
+}
+
+TEST(FeatureTracking, LoopClosureFindsByAppearanceWhatTheDriftHides) {
+  const testing::RenderedSequence& views = revisited_room().views;
+  const geometry::DepthRange& range = revisited_room().range;
   mapping::LoopClosureParams params;
   params.min_frame_gap = 1;
   const compute::Context context = compute::Context::cpu();
   mapping::LoopClosureDetector detector(context, kKinect, range, params, orb());
   detector.add_keyframe(0, views.frames[0].depth, 0.0, &views.frames[0].color);
   detector.add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
-  // The estimate of frame 1 drifted: 40 cm and 70 degrees off (8 m of path: 0.4 m allowance).
-  std::vector<Eigen::Isometry3d> poses = views.truth;
-  poses[1] = poses[1] * Eigen::Translation3d(0.3, 0, 0.25) *
-             Eigen::AngleAxisd(70 * kDegree, Eigen::Vector3d::UnitY());
+  const std::vector<Eigen::Isometry3d>& poses = revisited_room().drifted;
   EXPECT_TRUE(detector.find_candidates(1, poses).empty());
   const std::vector<mapping::LoopCandidate> found = detector.find_appearance_candidates(1, poses);
   ASSERT_EQ(found.size(), 1u);
@@ -173,6 +187,43 @@ TEST(FeatureTracking, LoopClosureFindsByAppearanceWhatTheDriftHides) {
   blind.add_keyframe(0, views.frames[0].depth, 0.0, &views.frames[0].color);
   blind.add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
   EXPECT_TRUE(blind.find_appearance_candidates(1, poses).empty());
+}
+
+// Keyframes whose depth, samples and features all went to the temporary files (no memory for
+// them) give the same candidates and the same loop as keyframes kept in memory.
+TEST(FeatureTracking, KeyframesReadBackFromDiskFindTheSameLoops) {
+  const testing::RenderedSequence& views = revisited_room().views;
+  const geometry::DepthRange& range = revisited_room().range;
+  mapping::LoopClosureParams in_memory;
+  in_memory.min_frame_gap = 1;
+  mapping::LoopClosureParams on_disk = in_memory;
+  on_disk.keyframe_depth_memory = 0;
+  on_disk.keyframe_feature_memory = 0;
+  const compute::Context context = compute::Context::cpu();
+  mapping::LoopClosureDetector kept(context, kKinect, range, in_memory, orb());
+  mapping::LoopClosureDetector spilled(context, kKinect, range, on_disk, orb());
+  for (mapping::LoopClosureDetector* detector : {&kept, &spilled}) {
+    detector->add_keyframe(0, views.frames[0].depth, 0.0, &views.frames[0].color);
+    detector->add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
+  }
+  EXPECT_EQ(kept.keyframe_bytes_on_disk(), 0u);
+  EXPECT_GT(kept.keyframe_bytes_in_memory(), 2 * 640 * 480u);
+  EXPECT_EQ(spilled.keyframe_bytes_in_memory(), 0u);
+  EXPECT_GT(spilled.keyframe_bytes_on_disk(), 2 * 640 * 480u);
+  const std::vector<Eigen::Isometry3d>& poses = revisited_room().drifted;
+  const auto expected = kept.find_appearance_candidates(1, poses);
+  const auto found = spilled.find_appearance_candidates(1, poses);
+  ASSERT_EQ(expected.size(), 1u);
+  ASSERT_EQ(found.size(), 1u);
+  EXPECT_EQ(found[0].feature_inliers, expected[0].feature_inliers);
+  EXPECT_EQ(found[0].overlap, expected[0].overlap);
+  EXPECT_TRUE(found[0].feature_motion.matrix() == expected[0].feature_motion.matrix());
+  EXPECT_EQ(spilled.view_overlap(1, 0, found[0].feature_motion, 0.1),
+            kept.view_overlap(1, 0, found[0].feature_motion, 0.1));
+  const mapping::LoopClosure a = kept.verify(expected[0], poses);
+  const mapping::LoopClosure b = spilled.verify(found[0], poses);
+  ASSERT_TRUE(b.report.accepted());
+  EXPECT_TRUE(b.constraint.motion.matrix() == a.constraint.motion.matrix());
 }
 
 // A loop found by pose whose ICP corrects the estimate by more than a loop may move without drift

@@ -71,6 +71,33 @@ TEST(Mapper, GivesTheBatchSlamPosesFrameByFrame) {
   EXPECT_GE(result.volume.refusions, 1u);  // the final poses were fused again
   EXPECT_FALSE(result.mesh.triangles.empty());
   EXPECT_EQ(result.mesh.vertices.size(), result.map.size());
+  EXPECT_GT(result.volume.keyframe_memory_bytes, 0u);
+  EXPECT_EQ(result.volume.keyframe_disk_bytes, 0u);
+}
+
+// With no memory for the keyframes (their depth, samples and features all in temporary files)
+// the mapper finds the same loops and gives the same poses.
+TEST(Mapper, KeyframesKeptOnDiskGiveTheSamePoses) {
+  const compute::Context cpu = compute::Context::cpu();
+  pipeline::MapperParams params = loop_params();
+  params.pipeline.features = true;
+  pipeline::MapperParams on_disk = params;
+  on_disk.pipeline.slam.loops.keyframe_depth_memory = 0;
+  on_disk.pipeline.slam.loops.keyframe_feature_memory = 0;
+  const testing::MemoryFrameSource source(testing::out_and_back());
+  pipeline::Mapper kept(cpu, source.camera(), source.depth_units_per_metre(), params);
+  pipeline::Mapper spilled(cpu, source.camera(), source.depth_units_per_metre(), on_disk);
+  feed(kept, testing::out_and_back(), false);
+  feed(spilled, testing::out_and_back(), false);
+  const pipeline::VolumeStats stats = spilled.volume_stats();
+  EXPECT_EQ(stats.keyframe_memory_bytes, 0u);
+  EXPECT_GT(stats.keyframe_disk_bytes, 0u);
+  const mapping::SlamResult a = kept.finish().slam, b = spilled.finish().slam;
+  ASSERT_FALSE(a.loop_closures.empty());
+  EXPECT_EQ(b.loop_closures.size(), a.loop_closures.size());
+  ASSERT_EQ(b.poses.size(), a.poses.size());
+  for (std::size_t i = 0; i < a.poses.size(); ++i)
+    EXPECT_TRUE(b.poses[i].matrix() == a.poses[i].matrix()) << "frame " << i;
 }
 
 // With frame-to-model tracking the mapper still gives the batch SLAM's poses (and so its

@@ -155,6 +155,16 @@ std::optional<registration::FeatureAlignment> OrbFrontEnd::align(
   return alignment;
 }
 
+std::vector<std::uint8_t> OrbFrontEnd::serialize(
+    const registration::FeatureDescription& description) const {
+  return features::serialize(as_orb(description, "ORB serialisation"));
+}
+
+std::shared_ptr<const registration::FeatureDescription> OrbFrontEnd::deserialize(
+    std::span<const std::uint8_t> bytes) const {
+  return deserialize_orb(bytes);
+}
+
 std::unique_ptr<registration::PlaceIndex> OrbFrontEnd::make_place_index() const {
   return std::make_unique<OrbPlaceIndex>(params_.places);
 }

@@ -14,7 +14,6 @@ namespace kartograf::features {
 // Places in the order added (ids increasing), so the places below an id hold a prefix of the rows.
 struct OrbPlaceIndex::Store {
   std::vector<std::size_t> ids;
-  std::vector<std::shared_ptr<const registration::FeatureDescription>> descriptions;
   std::vector<int> end_row;    // per place: one past its last row in `descriptors`
   std::vector<int> row_place;  // per row: the position of its place in `ids`
   cv::Mat descriptors;         // every place's rows, one after the other
@@ -88,11 +87,8 @@ OrbPlaceIndex::OrbPlaceIndex(const OrbPlaceParams& params)
 
 OrbPlaceIndex::~OrbPlaceIndex() = default;
 
-void OrbPlaceIndex::add(std::size_t place,
-                        std::shared_ptr<const registration::FeatureDescription> features) {
-  require(features != nullptr,
-          "ORB place index: place " + std::to_string(place) + " has no features");
-  const OrbDescription& orb = as_orb(*features, "ORB place index");
+void OrbPlaceIndex::add(std::size_t place, const registration::FeatureDescription& features) {
+  const OrbDescription& orb = as_orb(features, "ORB place index");
   Store& s = *store_;
   require(s.ids.empty() || place > s.ids.back(),
           "ORB place index: place " + std::to_string(place) + " added after place " +
@@ -104,7 +100,6 @@ void OrbPlaceIndex::add(std::size_t place,
                      static_cast<int>(s.ids.size()));
   s.end_row.push_back(s.descriptors.rows);
   s.ids.push_back(place);
-  s.descriptions.push_back(std::move(features));
 }
 
 std::vector<registration::PlaceMatch> OrbPlaceIndex::query(
@@ -126,15 +121,6 @@ std::vector<registration::PlaceMatch> OrbPlaceIndex::query(
                    [](const auto& a, const auto& b) { return a.score > b.score; });
   if (result.size() > max_results) result.resize(max_results);
   return result;
-}
-
-std::shared_ptr<const registration::FeatureDescription> OrbPlaceIndex::features_of(
-    std::size_t place) const {
-  const Store& s = *store_;
-  const std::size_t k = s.places_below(place);
-  require(k < s.ids.size() && s.ids[k] == place,
-          "ORB place index: no place " + std::to_string(place));
-  return s.descriptions[k];
 }
 
 std::size_t OrbPlaceIndex::places() const {

@@ -1,6 +1,7 @@
 #include "kartograf/mapping/frame_store.hpp"
 
 #include <algorithm>
+#include <span>
 #include <string>
 
 #include "kartograf/core/error.hpp"
@@ -12,6 +13,16 @@ namespace {
 template <typename Pixel>
 std::size_t byte_size(const Image<Pixel>& image) {
   return static_cast<std::size_t>(image.width()) * image.height() * sizeof(Pixel);
+}
+
+template <typename Pixel>
+std::span<const std::uint8_t> bytes_of(const Image<Pixel>& image) {
+  return {reinterpret_cast<const std::uint8_t*>(image.data()), byte_size(image)};
+}
+
+template <typename Pixel>
+std::span<std::uint8_t> bytes_of(Image<Pixel>& image) {
+  return {reinterpret_cast<std::uint8_t*>(image.data()), byte_size(image)};
 }
 
 }  // namespace
@@ -62,44 +73,32 @@ registration::RgbdImages FrameStore::add(const registration::RgbdImages& frame) 
 }
 
 void FrameStore::write(const registration::RgbdImages& small, Record& record) {
-  const std::size_t depth_bytes = byte_size(small.depth), color_bytes = byte_size(small.color);
-  const auto* depth = reinterpret_cast<const std::uint8_t*>(small.depth.data());
-  const auto* color = reinterpret_cast<const std::uint8_t*>(small.color.data());
-  if (!file_ && memory_bytes_ + depth_bytes + color_bytes <= memory_budget_) {  // memory first
-    std::vector<std::uint8_t>& bytes = memory_.emplace_back(depth, depth + depth_bytes);
-    bytes.insert(bytes.end(), color, color + color_bytes);
+  const std::span<const std::uint8_t> depth = bytes_of(small.depth), color = bytes_of(small.color);
+  // Memory first, while the file is unused: the in-memory records are the first ones.
+  if (file_.size() == 0 && memory_bytes_ + depth.size() + color.size() <= memory_budget_) {
+    std::vector<std::uint8_t>& bytes = memory_.emplace_back(depth.begin(), depth.end());
+    bytes.insert(bytes.end(), color.begin(), color.end());
     memory_bytes_ += bytes.size();
     record.in_memory = true;
     return;
   }
-  if (!file_) {
-    file_.reset(std::tmpfile());
-    require(file_ != nullptr, "frame store: cannot create a temporary file for the frames");
-  }
-  record.offset = end_;
-  const bool written = std::fseek(file_.get(), static_cast<long>(end_), SEEK_SET) == 0 &&
-                       std::fwrite(depth, 1, depth_bytes, file_.get()) == depth_bytes &&
-                       std::fwrite(color, 1, color_bytes, file_.get()) == color_bytes;
-  require(written, "frame store: writing frame " + std::to_string(records_.size()) +
-                       " to the temporary file failed (disk full?)");
-  end_ += depth_bytes + color_bytes;
+  const std::span<const std::uint8_t> pieces[] = {depth, color};
+  record.offset = file_.append(std::span<const std::span<const std::uint8_t>>(pieces));
 }
 
 void FrameStore::read(const Record& record, registration::RgbdImages& out) const {
-  auto* depth = reinterpret_cast<std::uint8_t*>(out.depth.data());
-  auto* color = reinterpret_cast<std::uint8_t*>(out.color.data());
-  const std::size_t depth_bytes = byte_size(out.depth), color_bytes = byte_size(out.color);
+  const std::span<std::uint8_t> depth = bytes_of(out.depth), color = bytes_of(out.color);
   if (record.in_memory) {
     const std::size_t k = static_cast<std::size_t>(&record - records_.data());
     const std::vector<std::uint8_t>& bytes = memory_[k];  // in-memory records come first
-    std::copy(bytes.begin(), bytes.begin() + depth_bytes, depth);
-    std::copy(bytes.begin() + depth_bytes, bytes.end(), color);
+    std::copy(bytes.begin(), bytes.begin() + static_cast<std::ptrdiff_t>(depth.size()),
+              depth.begin());
+    std::copy(bytes.begin() + static_cast<std::ptrdiff_t>(depth.size()), bytes.end(),
+              color.begin());
     return;
   }
-  const bool read = std::fseek(file_.get(), static_cast<long>(record.offset), SEEK_SET) == 0 &&
-                    std::fread(depth, 1, depth_bytes, file_.get()) == depth_bytes &&
-                    std::fread(color, 1, color_bytes, file_.get()) == color_bytes;
-  require(read, "frame store: reading a frame back from the temporary file failed");
+  file_.read(record.offset, depth);
+  file_.read(record.offset + depth.size(), color);
 }
 
 registration::RgbdImages FrameStore::frame(std::size_t i) const {

@@ -11,6 +11,7 @@
 #include "kartograf/registration/depth_weighted_finder.hpp"
 #include "kartograf/registration/geometric_information.hpp"
 #include "kartograf/registration/projective_association.hpp"
+#include "mapping/keyframe_archive.hpp"
 
 namespace kartograf::mapping {
 
@@ -88,6 +89,17 @@ LoopClosureDetector::LoopClosureDetector(
   validate(params_);
   depths_ =
       std::make_unique<FrameStore>(camera, range.units_per_metre, 1, params_.keyframe_depth_memory);
+  archive_ = std::make_unique<KeyframeArchive>(features_, params_.keyframe_feature_memory);
+}
+
+LoopClosureDetector::~LoopClosureDetector() = default;
+
+std::size_t LoopClosureDetector::keyframe_bytes_in_memory() const {
+  return depths_->bytes_in_memory() + archive_->bytes_in_memory();
+}
+
+std::size_t LoopClosureDetector::keyframe_bytes_on_disk() const {
+  return depths_->bytes_on_disk() + archive_->bytes_on_disk();
 }
 
 void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& depth,
@@ -98,10 +110,10 @@ void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& dept
   require(
       depth.width() == camera_.width && depth.height() == camera_.height,
       "loop closure: keyframe " + std::to_string(frame) + " depth size differs from the camera");
-  Keyframe keyframe{frame, path_length, {}, nullptr};
+  KeyframeArchive::Entry entry;
   if (features_ && color && !color->empty()) {
-    keyframe.features = features_->describe(depth, *color, camera_, range_.units_per_metre);
-    places_->add(frame, keyframe.features);
+    entry.features = features_->describe(depth, *color, camera_, range_.units_per_metre);
+    places_->add(frame, *entry.features);
   }
   const int step = params_.sample_step;
   const double metres_per_unit = 1.0 / range_.units_per_metre;
@@ -109,13 +121,14 @@ void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& dept
     for (int u = step / 2; u < depth.width(); u += step) {
       const double z = depth(u, v) * metres_per_unit;
       if (depth(u, v) == 0 || z < range_.min_metres || z > range_.max_metres) continue;
-      keyframe.samples.emplace_back(static_cast<float>((u - camera_.cx) * z / camera_.fx),
-                                    static_cast<float>((v - camera_.cy) * z / camera_.fy),
-                                    static_cast<float>(z));
+      entry.samples.emplace_back(static_cast<float>((u - camera_.cx) * z / camera_.fx),
+                                 static_cast<float>((v - camera_.cy) * z / camera_.fy),
+                                 static_cast<float>(z));
     }
   }
   depths_->add({depth, RgbImage(), 0.0, std::nullopt});
-  keyframes_.push_back(std::move(keyframe));
+  keyframes_.push_back({frame, path_length, entry.features != nullptr});
+  archive_->add(std::move(entry));
 }
 
 void LoopClosureDetector::require_pose(std::span<const Eigen::Isometry3d> poses,
@@ -127,12 +140,13 @@ void LoopClosureDetector::require_pose(std::span<const Eigen::Isometry3d> poses,
 double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
                                          const Eigen::Isometry3d& from_to_to,
                                          double tolerance) const {
-  const Keyframe& source = keyframes_.at(from);
-  if (source.samples.empty()) return 0;
+  require(from < keyframes_.size(), "loop closure: no keyframe " + std::to_string(from));
+  const std::shared_ptr<const KeyframeArchive::Entry> source = archive_->at(from);
+  if (source->samples.empty()) return 0;
   const DepthImage target = depth_of(to);
   const double metres_per_unit = 1.0 / range_.units_per_metre;
   std::size_t seen = 0;
-  for (const Eigen::Vector3f& sample : source.samples) {
+  for (const Eigen::Vector3f& sample : source->samples) {
     const Eigen::Vector3d p = from_to_to * sample.cast<double>();
     if (p.z() <= 0) continue;
     const double u = std::floor(camera_.fx * p.x() / p.z() + camera_.cx + 0.5);
@@ -141,7 +155,7 @@ double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
     const std::uint16_t d = target(static_cast<int>(u), static_cast<int>(v));
     if (d != 0 && std::abs(d * metres_per_unit - p.z()) <= tolerance) ++seen;
   }
-  return static_cast<double>(seen) / static_cast<double>(source.samples.size());
+  return static_cast<double>(seen) / static_cast<double>(source->samples.size());
 }
 
 LoopCandidate LoopClosureDetector::candidate_between(
@@ -189,21 +203,23 @@ std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
   std::vector<LoopCandidate> candidates;
   const Keyframe& j = keyframes_.at(query);
   const std::size_t gap = relocalise ? 1 : params_.min_frame_gap;
-  if (!places_ || !j.features || j.frame < gap) return candidates;
+  if (!places_ || !j.has_features || j.frame < gap) return candidates;
+  const std::shared_ptr<const registration::FeatureDescription> features =
+      archive_->at(query)->features;
   const std::vector<registration::PlaceMatch> similar =
-      places_->query(*j.features, j.frame - gap + 1, params_.max_appearance_candidates);
+      places_->query(*features, j.frame - gap + 1, params_.max_appearance_candidates);
   for (const registration::PlaceMatch& place : similar) {
     // Places are keyframes' frame indices, in increasing order.
     const auto earlier = keyframes_.begin() + static_cast<std::ptrdiff_t>(query);
     const auto found =
         std::lower_bound(keyframes_.begin(), earlier, place.place,
                          [](const Keyframe& k, std::size_t frame) { return k.frame < frame; });
-    if (found == earlier || found->frame != place.place || !found->features) continue;
+    if (found == earlier || found->frame != place.place || !found->has_features) continue;
+    const auto match = static_cast<std::size_t>(found - keyframes_.begin());
     const std::optional<registration::FeatureAlignment> aligned =
-        features_->align(*j.features, *found->features);
+        features_->align(*features, *archive_->at(match)->features);
     if (!aligned) continue;
-    LoopCandidate c =
-        candidate_between(query, static_cast<std::size_t>(found - keyframes_.begin()), poses);
+    LoopCandidate c = candidate_between(query, match, poses);
     // Buildings repeat their materials and furniture: a look-alike elsewhere is only believed
     // where the estimate, with its drift allowance, could still be that wrong.
     const Eigen::Isometry3d estimated = poses[c.match_frame].inverse() * poses[c.query_frame];
@@ -245,7 +261,7 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   closure.report = registration::judge_registration(result, expected, limits, geometry.degeneracy);
   if (closure.report.accepted() && !candidate.by_appearance &&
       closure.report.correction_m > params_.min_correction_m &&
-      !features_agree(query, match, result.source_to_target)) {
+      !features_agree(candidate.query, candidate.match, result.source_to_target)) {
     closure.report.verdict = registration::RegistrationVerdict::unconfirmed;
   }
   // Where the query's geometry barely constrains a direction (along a corridor, along the line
@@ -270,11 +286,12 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   return closure;
 }
 
-bool LoopClosureDetector::features_agree(const Keyframe& query, const Keyframe& match,
+bool LoopClosureDetector::features_agree(std::size_t query, std::size_t match,
                                          const Eigen::Isometry3d& motion) const {
-  if (!features_ || !query.features || !match.features) return true;
+  if (!features_ || !keyframes_.at(query).has_features || !keyframes_.at(match).has_features)
+    return true;
   const std::optional<registration::FeatureAlignment> aligned =
-      features_->align(*query.features, *match.features);
+      features_->align(*archive_->at(query)->features, *archive_->at(match)->features);
   return aligned && (aligned->source_to_target.translation() - motion.translation()).norm() <=
                         params_.feature_agreement_m;
 }

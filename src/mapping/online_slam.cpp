@@ -368,6 +368,14 @@ const std::vector<Eigen::Isometry3d>& OnlineSlam::poses() const {
   return state_->graph.estimate();
 }
 
+std::size_t OnlineSlam::keyframe_bytes_in_memory() const {
+  return state_->detector ? state_->detector->keyframe_bytes_in_memory() : 0;
+}
+
+std::size_t OnlineSlam::keyframe_bytes_on_disk() const {
+  return state_->detector ? state_->detector->keyframe_bytes_on_disk() : 0;
+}
+
 SlamResult OnlineSlam::finish() {
   State& s = *state_;
   require(!s.finished, "online SLAM: finish() was called twice");

@@ -166,6 +166,8 @@ Json report_json(const pipeline::MapPipelineResult& r,
                     {"covers_all_frames", v.covers_all_frames},
                     {"frame_store_memory_bytes", v.store_memory_bytes},
                     {"frame_store_disk_bytes", v.store_disk_bytes},
+                    {"keyframe_memory_bytes", v.keyframe_memory_bytes},
+                    {"keyframe_disk_bytes", v.keyframe_disk_bytes},
                     {"mesh_vertices", r.mesh.vertices.size()},
                     {"mesh_triangles", r.mesh.triangles.size()}};
   json["views"] = {{"labelled", r.labelled_views},

@@ -226,6 +226,15 @@ struct Mapper::State {
 
   const std::vector<Eigen::Isometry3d>& poses() const { return slam ? slam->poses() : given; }
 
+  VolumeStats stats() const {
+    VolumeStats stats = volume.stats();
+    if (slam) {
+      stats.keyframe_memory_bytes = slam->keyframe_bytes_in_memory();
+      stats.keyframe_disk_bytes = slam->keyframe_bytes_on_disk();
+    }
+    return stats;
+  }
+
   // The pose of the next frame: tracked, or given (relative to the first given one).
   Eigen::Isometry3d locate(const registration::RgbdImages& frame,
                            const std::optional<Eigen::Isometry3d>& pose, MapperStep& step);
@@ -298,7 +307,7 @@ MapPipelineResult Mapper::State::complete(mapping::SlamResult slam_result) {
   mapping::TsdfBandMaps band = mapping::tsdf_band_maps(volume.volume(), slice);  // on the device
   result.band_occupancy = std::move(band.occupancy);
   result.esdf = std::move(band.esdf);
-  result.volume = volume.stats();
+  result.volume = stats();
   result.slam.timing.map_seconds = result.volume.fusion_seconds;
   result.timings.push_back({"volume", seconds_since(start)});
   return result;
@@ -344,7 +353,7 @@ const std::vector<Eigen::Isometry3d>& Mapper::poses() const {
 }
 
 VolumeStats Mapper::volume_stats() const {
-  return state_->volume.stats();
+  return state_->stats();
 }
 
 TriangleMesh Mapper::mesh() {

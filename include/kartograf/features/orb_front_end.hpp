@@ -51,6 +51,12 @@ class OrbFrontEnd final : public registration::FeatureFrontEnd {
       const registration::FeatureDescription& source,
       const registration::FeatureDescription& target) const override;
 
+  // Throws Error when a description was not made by an OrbFrontEnd, or the bytes are not one.
+  std::vector<std::uint8_t> serialize(
+      const registration::FeatureDescription& description) const override;
+  std::shared_ptr<const registration::FeatureDescription> deserialize(
+      std::span<const std::uint8_t> bytes) const override;
+
   // An OrbPlaceIndex with params().places.
   std::unique_ptr<registration::PlaceIndex> make_place_index() const override;
 

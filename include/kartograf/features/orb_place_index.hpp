@@ -20,8 +20,9 @@ struct OrbPlaceParams {
   int descriptors_per_place = 300;
 };
 
-// Holds descriptions made by OrbFrontEnd. query() and features_of() may run on several threads at
-// once, but not while add() runs (the caller serialises adding).
+// Over descriptions made by OrbFrontEnd; keeps each place's strongest descriptors (about 10 KB a
+// place), not the descriptions. query() may run on several threads at once, but not while add()
+// runs (the caller serialises adding).
 class OrbPlaceIndex final : public registration::PlaceIndex {
  public:
   explicit OrbPlaceIndex(const OrbPlaceParams& params = {});
@@ -30,16 +31,11 @@ class OrbPlaceIndex final : public registration::PlaceIndex {
   OrbPlaceIndex& operator=(const OrbPlaceIndex&) = delete;
 
   // Throws Error when place is not above every id added before, or the features are not ORB's.
-  void add(std::size_t place,
-           std::shared_ptr<const registration::FeatureDescription> features) override;
+  void add(std::size_t place, const registration::FeatureDescription& features) override;
   // Scores are the votes (a count), best first; ties: the lower id first.
   std::vector<registration::PlaceMatch> query(const registration::FeatureDescription& features,
                                               std::size_t before,
                                               std::size_t max_results) const override;
-  // Throws Error when no place has this id.
-  std::shared_ptr<const registration::FeatureDescription> features_of(
-      std::size_t place) const override;
-
   std::size_t places() const;
 
  private:

@@ -6,7 +6,6 @@
 // with the decimated camera.
 #include <cstddef>
 #include <cstdint>
-#include <cstdio>
 #include <memory>
 #include <mutex>
 #include <optional>
@@ -14,6 +13,7 @@
 
 #include "kartograf/core/image.hpp"
 #include "kartograf/mapping/frame_source.hpp"
+#include "kartograf/mapping/spill_file.hpp"
 
 namespace kartograf::mapping {
 
@@ -51,7 +51,7 @@ class FrameStore final : public FrameSource {
   registration::RgbdImages frame(std::size_t i) const override;
   int factor() const { return factor_; }
   std::size_t bytes_in_memory() const { return memory_bytes_; }
-  std::size_t bytes_on_disk() const { return end_; }
+  std::size_t bytes_on_disk() const { return file_.size(); }
 
  private:
   struct Record {
@@ -66,11 +66,10 @@ class FrameStore final : public FrameSource {
   double units_;
   int factor_;
   std::size_t memory_budget_;
-  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_{nullptr, &std::fclose};
+  SpillFile file_{"frame store"};
   std::vector<Record> records_;
   std::vector<std::vector<std::uint8_t>> memory_;  // per record in memory, in order
   std::size_t memory_bytes_ = 0;
-  std::size_t end_ = 0;
   mutable std::mutex mutex_;  // frame() may run on a prefetch thread
 };
 

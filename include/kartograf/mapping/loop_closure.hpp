@@ -88,9 +88,12 @@ struct LoopClosureParams {
   // the drift allowance (5 % of a 40 m path is 2 m): with a feature front end, the features of
   // the two keyframes must then find the same motion within this (else: unconfirmed).
   double feature_agreement_m = 0.1;
-  // Keyframe depth kept in memory, in bytes; beyond it the depth goes to a temporary file, so
-  // that a long run's keyframes grow by their samples and features only (about 0.1 MB each).
+  // Keyframe depth kept in memory, in bytes; beyond it the depth goes to a temporary file.
   std::size_t keyframe_depth_memory = std::size_t{32} << 20;
+  // The newest keyframes' overlap samples and features kept in memory, in bytes (35-65 KB a
+  // keyframe measured); older ones go to a temporary file. What still grows in memory with the
+  // keyframes is the place index's strongest descriptors (about 10 KB each) and a few numbers.
+  std::size_t keyframe_feature_memory = std::size_t{16} << 20;
 };
 
 struct LoopCandidate {
@@ -119,6 +122,8 @@ struct LoopClosure {
   std::size_t free_directions = 0;
 };
 
+class KeyframeArchive;
+
 class LoopClosureDetector {
  public:
   // Throws Error on invalid intrinsics, range or parameters.
@@ -126,10 +131,12 @@ class LoopClosureDetector {
   LoopClosureDetector(const compute::Context& context, const PinholeIntrinsics& camera,
                       const geometry::DepthRange& range, LoopClosureParams params = {},
                       std::shared_ptr<const registration::FeatureFrontEnd> features = nullptr);
+  ~LoopClosureDetector();
 
   // Keeps the keyframe's depth (for verification; the first keyframe_depth_memory bytes of
-  // keyframes in memory, the rest in a temporary file) and its overlap samples, and with a
-  // feature front end and a colour image its features. path_length: metres travelled from the first
+  // keyframes in memory, the rest in a temporary file), its overlap samples, and with a feature
+  // front end and a colour image its features (the newest keyframe_feature_memory bytes of
+  // them in memory, older ones in a temporary file). path_length: metres travelled from the first
   // frame to this one. Frames must come in increasing order.
   void add_keyframe(std::size_t frame, const DepthImage& depth, double path_length,
                     const RgbImage* color = nullptr);
@@ -154,13 +161,15 @@ class LoopClosureDetector {
   LoopClosure verify(const LoopCandidate& candidate, std::span<const Eigen::Isometry3d> poses);
 
   const LoopClosureParams& params() const { return params_; }
+  // The keyframes' depth, samples and features: bytes in memory and in the temporary files.
+  std::size_t keyframe_bytes_in_memory() const;
+  std::size_t keyframe_bytes_on_disk() const;
 
  private:
   struct Keyframe {
     std::size_t frame = 0;
     double path_length = 0;
-    std::vector<Eigen::Vector3f> samples;                              // camera frame
-    std::shared_ptr<const registration::FeatureDescription> features;  // or null
+    bool has_features = false;  // the archive holds them
   };
   LoopCandidate candidate_between(std::size_t query, std::size_t match,
                                   std::span<const Eigen::Isometry3d> poses) const;
@@ -169,8 +178,7 @@ class LoopClosureDetector {
   registration::IcpResult align(const Eigen::Isometry3d& initial);
   // Whether the keyframes' features agree with `motion` (match <- query) within
   // feature_agreement_m; true when either keyframe has none.
-  bool features_agree(const Keyframe& query, const Keyframe& match,
-                      const Eigen::Isometry3d& motion) const;
+  bool features_agree(std::size_t query, std::size_t match, const Eigen::Isometry3d& motion) const;
 
   PinholeIntrinsics camera_;
   geometry::DepthRange range_;
@@ -178,7 +186,8 @@ class LoopClosureDetector {
   int finest_level_;
   int information_level_;
   std::vector<Keyframe> keyframes_;
-  std::unique_ptr<FrameStore> depths_;  // keyframe k's depth is frame k
+  std::unique_ptr<FrameStore> depths_;        // keyframe k's depth is frame k
+  std::unique_ptr<KeyframeArchive> archive_;  // keyframe k's samples and features
   DepthImage depth_of(std::size_t keyframe) const { return depths_->frame(keyframe).depth; }
   std::shared_ptr<const registration::FeatureFrontEnd> features_;
   std::unique_ptr<registration::PlaceIndex> places_;

@@ -44,6 +44,10 @@ class OnlineSlam {
   std::size_t frame_count() const;
   // The current estimate of every frame so far (camera-to-world, frame 0 = identity).
   const std::vector<Eigen::Isometry3d>& poses() const;
+  // The loop closure's keyframes (depth, samples, features): bytes in memory, bytes in its
+  // temporary files (0 without loop closure).
+  std::size_t keyframe_bytes_in_memory() const;
+  std::size_t keyframe_bytes_on_disk() const;
 
   // The final optimisation; the result's map is empty and its timing holds the compute times
   // (load times are the caller's). Once only: later calls to add() or finish() throw Error.

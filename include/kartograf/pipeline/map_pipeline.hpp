@@ -90,7 +90,7 @@ struct StageTiming {
   double seconds = 0;
 };
 
-// What the TSDF of the online mapper (mapper.hpp) did.
+// What the TSDF of the online mapper (mapper.hpp) did, and what the mapper keeps for later passes.
 struct VolumeStats {
   std::size_t blocks = 0;       // in the live volume now
   std::size_t peak_blocks = 0;  // the most it held
@@ -102,6 +102,10 @@ struct VolumeStats {
   bool covers_all_frames = true;       // false after an eviction: the volume holds the nearby part
   std::size_t store_memory_bytes = 0;  // the kept frames in memory (up to 64 MiB)
   std::size_t store_disk_bytes = 0;    // and in a temporary file
+  // The loop closure's keyframes (depth, samples, features) in memory (up to 32 + 16 MiB by
+  // default) and in temporary files.
+  std::size_t keyframe_memory_bytes = 0;
+  std::size_t keyframe_disk_bytes = 0;
 };
 
 struct MapPipelineResult {

@@ -23,6 +23,12 @@
 // is evicted; it comes back when the camera returns), halving the radius until they fit. A
 // mesh of a map larger than the budget therefore covers the camera's surroundings only; the
 // step's and the result's volume statistics say when that happened.
+// What else is held, each with its own bound: the kept frames' first 64 MiB (the rest in a
+// temporary file); the loop closure's keyframe depth (32 MiB) and its newest keyframes' samples
+// and features (16 MiB; both LoopClosureParams, the rest in temporary files); a snapshot's pooled
+// views (at most pipeline.max_views of them, about 2.7 MB each at 320x240, freed when the grid is
+// built). What grows with the run: per frame its pose and tracking record, per keyframe the place
+// index's descriptors (about 10 KB). docs/volumetric.md has the measured figures.
 #include <cstddef>
 #include <memory>
 #include <optional>

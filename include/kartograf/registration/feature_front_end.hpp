@@ -5,8 +5,10 @@
 // uses OpenCV's ORB is the features layer's (features/orb_front_end.hpp), handed in by the
 // pipeline, so the odometry and the SLAM stay free of OpenCV.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -24,6 +26,8 @@ class FeatureDescription {
   virtual ~FeatureDescription() = default;
   // Keypoints with a valid depth (the ones that can be matched in 3-D).
   virtual std::size_t size() const = 0;
+  // What it holds in memory, in bytes (for the keyframes' memory budget).
+  virtual std::size_t memory_bytes() const = 0;
 };
 
 // A rigid motion from matched features: the RANSAC consensus of 3-D point pairs, refined on its
@@ -52,6 +56,11 @@ class FeatureFrontEnd {
   // The motion that maps source's points onto target's, or nothing when too few matches agree.
   virtual std::optional<FeatureAlignment> align(const FeatureDescription& source,
                                                 const FeatureDescription& target) const = 0;
+  // A description as bytes and back, for keyframes kept on disk. Throws Error when the description
+  // was made by another front end, or the bytes are not one of this front end's descriptions.
+  virtual std::vector<std::uint8_t> serialize(const FeatureDescription& description) const = 0;
+  virtual std::shared_ptr<const FeatureDescription> deserialize(
+      std::span<const std::uint8_t> bytes) const = 0;
 };
 
 // A place-recognition index over keyframes' features.
@@ -63,13 +72,12 @@ struct PlaceMatch {
 class PlaceIndex {
  public:
   virtual ~PlaceIndex() = default;
-  // Adds a place; ids must increase.
-  virtual void add(std::size_t place, std::shared_ptr<const FeatureDescription> features) = 0;
+  // Adds a place; ids must increase. The index keeps what it searches, not the description.
+  virtual void add(std::size_t place, const FeatureDescription& features) = 0;
   // The places most similar to `features` among those with id < before, best first, at most
   // max_results, only those above the index's own similarity floor.
   virtual std::vector<PlaceMatch> query(const FeatureDescription& features, std::size_t before,
                                         std::size_t max_results) const = 0;
-  virtual std::shared_ptr<const FeatureDescription> features_of(std::size_t place) const = 0;
 };
 
 }  // namespace kartograf::registration
