@@ -113,8 +113,14 @@ j = json.load(open(sys.argv[1]))
 ms = statistics.median(f["seconds"] for f in j["per_frame"][1:]) * 1000
 print("| %s | kartograf | %.1f | %.2f |" % (sys.argv[2], ms, 100 * j["ate_rmse_m"]))
 PY
-  "$peers_python" "$data/../tools/peers/odometry_peers.py" "$sequence" "$dir" 2>/dev/null |
-    awk -v n="$name" '/ms\/frame/ {printf "| %s | %s | %.1f | %.2f |\n", n, $1, $5, 100 * $8}'
+  # A peer that fails (Open3D's hybrid odometry refuses SUN3D's one-channel colour) stops the
+  # script after the methods it finished: their rows stay, and the failure is a row of its own.
+  local rows status=0
+  rows="$("$peers_python" "$data/../tools/peers/odometry_peers.py" "$sequence" "$dir" \
+    2>"$dir/peers.log")" || status=$?
+  awk -v n="$name" '/ms\/frame/ {printf "| %s | %s | %.1f | %.2f |\n", n, $1, $5, 100 * $8}' \
+    <<<"$rows"
+  [ "$status" -eq 0 ] || echo "| $name | (a peer failed, exit $status: $dir/peers.log) | - | - |"
 }
 if [ -n "$peers_python" ]; then
   {
