@@ -11,18 +11,8 @@ namespace kartograf::mapping {
 namespace {
 
 template <typename Pixel>
-std::size_t byte_size(const Image<Pixel>& image) {
-  return static_cast<std::size_t>(image.width()) * image.height() * sizeof(Pixel);
-}
-
-template <typename Pixel>
-std::span<const std::uint8_t> bytes_of(const Image<Pixel>& image) {
-  return {reinterpret_cast<const std::uint8_t*>(image.data()), byte_size(image)};
-}
-
-template <typename Pixel>
-std::span<std::uint8_t> bytes_of(Image<Pixel>& image) {
-  return {reinterpret_cast<std::uint8_t*>(image.data()), byte_size(image)};
+std::size_t pixel_count(const Image<Pixel>& image) {
+  return static_cast<std::size_t>(image.width()) * image.height();
 }
 
 }  // namespace
@@ -73,7 +63,10 @@ registration::RgbdImages FrameStore::add(const registration::RgbdImages& frame) 
 }
 
 void FrameStore::write(const registration::RgbdImages& small, Record& record) {
-  const std::span<const std::uint8_t> depth = bytes_of(small.depth), color = bytes_of(small.color);
+  const std::span<const std::uint8_t> depth =
+      bytes_of(small.depth.data(), pixel_count(small.depth));
+  const std::span<const std::uint8_t> color =
+      bytes_of(small.color.data(), pixel_count(small.color));
   // Memory first, while the file is unused: the in-memory records are the first ones.
   if (file_.size() == 0 && memory_bytes_ + depth.size() + color.size() <= memory_budget_) {
     std::vector<std::uint8_t>& bytes = memory_.emplace_back(depth.begin(), depth.end());
@@ -87,7 +80,8 @@ void FrameStore::write(const registration::RgbdImages& small, Record& record) {
 }
 
 void FrameStore::read(const Record& record, registration::RgbdImages& out) const {
-  const std::span<std::uint8_t> depth = bytes_of(out.depth), color = bytes_of(out.color);
+  const std::span<std::uint8_t> depth = bytes_of(out.depth.data(), pixel_count(out.depth));
+  const std::span<std::uint8_t> color = bytes_of(out.color.data(), pixel_count(out.color));
   if (record.in_memory) {
     const std::size_t k = static_cast<std::size_t>(&record - records_.data());
     const std::vector<std::uint8_t>& bytes = memory_[k];  // in-memory records come first

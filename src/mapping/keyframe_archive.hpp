@@ -28,18 +28,21 @@ class KeyframeArchive {
   void add(Entry entry);
   // Keyframe k's data, from memory or from the file; Error when there is no keyframe k.
   std::shared_ptr<const Entry> at(std::size_t k) const;
+  // Whether keyframe k has features, without reading it back; Error when there is no keyframe k.
+  bool has_features(std::size_t k) const;
   std::size_t size() const { return records_.size(); }
   std::size_t bytes_in_memory() const { return memory_bytes_; }
   std::size_t bytes_on_disk() const { return file_.size(); }
 
  private:
   struct Record {
-    std::shared_ptr<const Entry> entry;  // null once on disk
-    std::size_t bytes = 0;               // in memory
-    std::size_t offset = 0, samples = 0, feature_bytes = 0;
+    std::shared_ptr<const Entry> entry;                      // null once on disk
+    std::size_t bytes = 0;                                   // in memory
+    std::size_t offset = 0, samples = 0, feature_bytes = 0;  // in the file
     bool has_features = false;
   };
   void spill(Record& record);
+  const Record& record(std::size_t k) const;
 
   std::shared_ptr<const registration::FeatureFrontEnd> front_end_;
   std::size_t memory_budget_;

@@ -127,7 +127,7 @@ void LoopClosureDetector::add_keyframe(std::size_t frame, const DepthImage& dept
     }
   }
   depths_->add({depth, RgbImage(), 0.0, std::nullopt});
-  keyframes_.push_back({frame, path_length, entry.features != nullptr});
+  keyframes_.push_back({frame, path_length});
   archive_->add(std::move(entry));
 }
 
@@ -140,7 +140,6 @@ void LoopClosureDetector::require_pose(std::span<const Eigen::Isometry3d> poses,
 double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
                                          const Eigen::Isometry3d& from_to_to,
                                          double tolerance) const {
-  require(from < keyframes_.size(), "loop closure: no keyframe " + std::to_string(from));
   const std::shared_ptr<const KeyframeArchive::Entry> source = archive_->at(from);
   if (source->samples.empty()) return 0;
   const DepthImage target = depth_of(to);
@@ -203,7 +202,7 @@ std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
   std::vector<LoopCandidate> candidates;
   const Keyframe& j = keyframes_.at(query);
   const std::size_t gap = relocalise ? 1 : params_.min_frame_gap;
-  if (!places_ || !j.has_features || j.frame < gap) return candidates;
+  if (!places_ || !archive_->has_features(query) || j.frame < gap) return candidates;
   const std::shared_ptr<const registration::FeatureDescription> features =
       archive_->at(query)->features;
   const std::vector<registration::PlaceMatch> similar =
@@ -214,8 +213,9 @@ std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
     const auto found =
         std::lower_bound(keyframes_.begin(), earlier, place.place,
                          [](const Keyframe& k, std::size_t frame) { return k.frame < frame; });
-    if (found == earlier || found->frame != place.place || !found->has_features) continue;
+    if (found == earlier || found->frame != place.place) continue;
     const auto match = static_cast<std::size_t>(found - keyframes_.begin());
+    if (!archive_->has_features(match)) continue;
     const std::optional<registration::FeatureAlignment> aligned =
         features_->align(*features, *archive_->at(match)->features);
     if (!aligned) continue;
@@ -288,8 +288,7 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
 
 bool LoopClosureDetector::features_agree(std::size_t query, std::size_t match,
                                          const Eigen::Isometry3d& motion) const {
-  if (!features_ || !keyframes_.at(query).has_features || !keyframes_.at(match).has_features)
-    return true;
+  if (!features_ || !archive_->has_features(query) || !archive_->has_features(match)) return true;
   const std::optional<registration::FeatureAlignment> aligned =
       features_->align(*archive_->at(query)->features, *archive_->at(match)->features);
   return aligned && (aligned->source_to_target.translation() - motion.translation()).norm() <=

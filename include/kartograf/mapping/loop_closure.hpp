@@ -169,7 +169,6 @@ class LoopClosureDetector {
   struct Keyframe {
     std::size_t frame = 0;
     double path_length = 0;
-    bool has_features = false;  // the archive holds them
   };
   LoopCandidate candidate_between(std::size_t query, std::size_t match,
                                   std::span<const Eigen::Isometry3d> poses) const;

@@ -13,6 +13,16 @@
 
 namespace kartograf::mapping {
 
+// The bytes of `count` contiguous values, as append() and read() take them.
+template <typename T>
+std::span<const std::uint8_t> bytes_of(const T* values, std::size_t count) {
+  return {reinterpret_cast<const std::uint8_t*>(values), count * sizeof(T)};
+}
+template <typename T>
+std::span<std::uint8_t> bytes_of(T* values, std::size_t count) {
+  return {reinterpret_cast<std::uint8_t*>(values), count * sizeof(T)};
+}
+
 class SpillFile {
  public:
   // what: names the owner in errors ("frame store").
