@@ -86,3 +86,13 @@ test -s "$1/p/planes.json" || { echo "FAIL: KARTOGRAF_DEVICE=0 planes wrote noth
 set_tests_properties(Cli.limits_maps_too_large_for_memory_are_refused
   Cli.limits_invalid_option_values_are_errors Cli.limits_kartograf_device_on_every_command
   PROPERTIES ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
+
+# The defaults the help prints are the ones the run uses: --anchor-bounds once listed 17 numbers,
+# memory between two temporaries' arrays, after its three.
+add_test(NAME Cli.help_shows_the_anchor_bounds_default
+  COMMAND sh -c [=[
+for command in odometry slam map; do
+  "$0" "$command" --help | grep -F -- "=[0.4,25,100] x 3" ||
+    { echo "FAIL: $command --help: $("$0" "$command" --help | grep -F -- --anchor-bounds)"; exit 1; }
+done
+]=] $<TARGET_FILE:kartograf>)

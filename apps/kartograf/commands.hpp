@@ -89,8 +89,11 @@ struct SequenceRunOptions {
   std::string backend = "auto";
   std::string backend_source = "--backend";  // names the setting in errors
   int reestimate_interval = pipeline::TrackingChoices{}.reestimate_interval;
-  std::vector<double> anchor_bounds{std::begin(pipeline::TrackingChoices{}.anchor_bounds),
-                                    std::end(pipeline::TrackingChoices{}.anchor_bounds)};
+  // One TrackingChoices for both ends: begin and end of two temporaries would be no range.
+  std::vector<double> anchor_bounds = [] {
+    const auto bounds = pipeline::TrackingChoices{}.anchor_bounds;
+    return std::vector<double>(bounds.begin(), bounds.end());
+  }();
   std::string tracking = pipeline::TrackingChoices{}.tracking;
   double model_voxel = pipeline::TrackingChoices{}.model_voxel;
   bool progress = true;
