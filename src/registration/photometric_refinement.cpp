@@ -229,7 +229,31 @@ Sums descend(const std::vector<Sample>& samples, const Textured& target, const P
   return sums;
 }
 
+void require_camera_sized(const DepthImage& source_depth, const RgbImage& source_color,
+                          const RgbImage& target_color, const PinholeIntrinsics& camera) {
+  const auto same_size = [&](int w, int h) { return w == camera.width && h == camera.height; };
+  require(same_size(source_depth.width(), source_depth.height()) &&
+              same_size(source_color.width(), source_color.height()) &&
+              same_size(target_color.width(), target_color.height()),
+          "photometric refinement: depth and colour images must have the camera's size " +
+              std::to_string(camera.width) + "x" + std::to_string(camera.height));
+}
+
 }  // namespace
+
+double intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
+                      const RgbImage& target_color, const PinholeIntrinsics& camera,
+                      double units_per_metre, const Eigen::Isometry3d& source_to_target,
+                      const PhotometricParams& params) {
+  require_camera_sized(source_depth, source_color, target_color, camera);
+  const Textured source(blurred(grey_of(source_color), 1));
+  const Textured target(blurred(grey_of(target_color), 1));
+  const std::vector<Sample> samples =
+      samples_of(source_depth, source, camera, units_per_metre, params);
+  if (samples.size() < params.min_pixels) return 0;
+  const Sums sums = evaluate(samples, target, camera, source_to_target, {}, params.huber_levels);
+  return sums.count >= params.min_pixels ? std::sqrt(sums.squared / sums.count) : 0.0;
+}
 
 PhotometricResult refine_photometrically(const DepthImage& source_depth,
                                          const RgbImage& source_color, const RgbImage& target_color,
@@ -239,12 +263,7 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
                                          const PhotometricParams& params,
                                          const se3::Matrix6d& start_information,
                                          std::size_t measured_directions) {
-  const auto same_size = [&](int w, int h) { return w == camera.width && h == camera.height; };
-  require(same_size(source_depth.width(), source_depth.height()) &&
-              same_size(source_color.width(), source_color.height()) &&
-              same_size(target_color.width(), target_color.height()),
-          "photometric refinement: depth and colour images must have the camera's size " +
-              std::to_string(camera.width) + "x" + std::to_string(camera.height));
+  require_camera_sized(source_depth, source_color, target_color, camera);
   require(params.pixel_step >= 1 && params.iterations >= 0 && params.blur_passes >= 1 &&
               units_per_metre > 0,
           "photometric refinement: pixel_step, blur_passes >= 1, iterations >= 0 and "

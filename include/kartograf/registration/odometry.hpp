@@ -81,10 +81,13 @@ enum class MotionModel { still, velocity, acceleration };
 
 // The frame in which the motion model keeps the camera centre's step. world: a camera that pans
 // while its carrier walks straight (hand-held); camera: a camera fixed to a robot that drives
-// arcs, whose step turns with it; adaptive: whichever predicted the recent well-constrained
-// frames better (decides the free directions of degenerate frames, so a wrong choice drifts
-// sideways by the step times the turn per frame).
-enum class StepFrame { world, camera, adaptive };
+// arcs, whose step turns with it; arc: the last step's length along the direction of travel
+// learnt on well-constrained frames (camera frame), turned by half the predicted turn (a wheeled
+// robot's chord, the camera over the turning axis), so that a wrong sideways step is not
+// repeated; adaptive: whichever of the three predicted the recent well-constrained frames better
+// (decides the free directions of degenerate frames, so a wrong choice drifts sideways by the
+// step times the turn per frame).
+enum class StepFrame { world, camera, arc, adaptive };
 std::string_view to_string(StepFrame frame);
 
 struct KeyframePolicy {
@@ -156,7 +159,11 @@ struct OdometryParams {
   StepFrame step_frame = StepFrame::adaptive;
   // Frame-to-frame acceptance; the correction is relative to the initial guess.
   RegistrationLimits frame_limits{200, 0.1, 0.02, false, 0.3, 20};
-  // Re-estimation acceptance; the correction is relative to the chained estimate.
+  // Re-estimation acceptance; the correction is relative to the chained estimate. After a
+  // fallback, and after degenerate frames since the anchor when the re-estimate's own view is not
+  // degenerate, corrections up to frame_limits' are allowed; in the second case one beyond these
+  // limits must be confirmed by the images: a grey-level RMSE at the re-estimate below
+  // feature_arbitration_ratio times that at the chained estimate (else `unconfirmed`).
   RegistrationLimits reestimate_limits{200, 0.1, 0.02, false, 0.03, 2};
   InformationModel information;
   // The prior of an unmeasured step (fallbacks) and the floor of every edge's information.
@@ -293,6 +300,13 @@ class RgbdOdometry {
   std::optional<Attempt> register_from_features();
   void keep_images_for_features(const DepthImage& depth, const RgbImage* color);
   void reestimate(OdometryFrame& frame);
+  struct ReestimateLimits {
+    RegistrationLimits limits;
+    bool only_where_measured = false;  // the widened limits hold where the view measures well
+  };
+  ReestimateLimits reestimate_limits(const OdometryFrame& frame, std::size_t anchor) const;
+  bool images_confirm(std::size_t anchor, const Eigen::Isometry3d& motion,
+                      const Eigen::Isometry3d& chained) const;
   // Whether frame n, just re-estimated, becomes the next anchor (AnchorPolicy).
   bool moves_anchor(std::size_t n) const;
   bool is_keyframe(const OdometryFrame& frame) const;
@@ -328,14 +342,19 @@ class RgbdOdometry {
   std::size_t anchor_ = 0;  // the next re-estimate's anchor (AnchorPolicy)
   std::unique_ptr<PlanarFrames> planar_;
   // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses, with the step
-  // kept in the world or the camera frame.
+  // kept in the world or the camera frame, or on an arc (StepFrame).
   Eigen::Isometry3d predict(StepFrame frame) const;
   StepFrame step_frame_in_use() const;
-  // StepFrame::adaptive: each frame's mean squared step error (metres^2, decaying) of the two
+  // StepFrame::adaptive: each frame's mean squared step error (metres^2, decaying) of the three
   // predictions on frames whose geometry measured every direction.
   void score_step_frames(const Eigen::Isometry3d& measured);
   double world_step_error_ = 0;
   double camera_step_error_ = 0;
+  double arc_step_error_ = 0;
+  // StepFrame::arc: the camera's direction of travel with no turn (camera frame; its length is a
+  // decaying weighted mean, only its direction is used).
+  Eigen::Vector3d heading_ = Eigen::Vector3d::Zero();
+  void learn_heading(const Eigen::Isometry3d& measured);
 };
 
 }  // namespace kartograf::registration

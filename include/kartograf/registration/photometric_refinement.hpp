@@ -71,4 +71,12 @@ PhotometricResult refine_photometrically(
     const se3::Matrix6d& start_information = se3::Matrix6d::Zero(),
     std::size_t measured_directions = 6);
 
+// The grey-level RMSE at `source_to_target` over the pixels the refinement would use, after one
+// smoothing pass (PhotometricResult::rmse_before); 0 when fewer than params.min_pixels are
+// textured. Compares two candidate motions of the same pair.
+double intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
+                      const RgbImage& target_color, const PinholeIntrinsics& camera,
+                      double units_per_metre, const Eigen::Isometry3d& source_to_target,
+                      const PhotometricParams& params = {});
+
 }  // namespace kartograf::registration
