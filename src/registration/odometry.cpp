@@ -549,13 +549,12 @@ RgbdOdometry::ReestimateLimits RgbdOdometry::reestimate_limits(const OdometryFra
   // A fallback since the last re-estimate leaves the chained estimate less certain, and so do
   // degenerate frames since the anchor when this view is not degenerate: their free directions
   // came from the motion model, and this view measures them. Allow what a single frame-to-frame
-  // registration may correct; after degenerate frames, only where this view measures well.
+  // registration may correct; after degenerate frames, only when the images confirm it.
   const bool after_fallback =
       since(frame.index - k + 1, [](const OdometryFrame& f) { return f.fallback; });
-  limits.only_where_measured =
-      !after_fallback && !geometry_.degeneracy.degenerate &&
-      since(anchor + 1, [](const OdometryFrame& f) { return f.degenerate; });
-  if (after_fallback || limits.only_where_measured) {
+  limits.needs_images = !after_fallback && !geometry_.degeneracy.degenerate &&
+                        since(anchor + 1, [](const OdometryFrame& f) { return f.degenerate; });
+  if (after_fallback || limits.needs_images) {
     limits.limits.max_correction_m =
         std::max(limits.limits.max_correction_m, params_.frame_limits.max_correction_m);
     limits.limits.max_correction_deg =
@@ -592,7 +591,7 @@ void RgbdOdometry::reestimate(OdometryFrame& frame) {
   const ReestimateLimits limits = reestimate_limits(frame, anchor);
   Attempt attempt = register_frames(anchor, chained, limits.limits);
   const RegistrationLimits& usual = params_.reestimate_limits;
-  if (limits.only_where_measured && attempt.report.accepted() &&
+  if (limits.needs_images && attempt.report.accepted() &&
       (attempt.report.correction_m > usual.max_correction_m ||
        attempt.report.correction_deg > usual.max_correction_deg) &&
       !images_confirm(anchor, attempt.motion, chained)) {

@@ -302,7 +302,9 @@ class RgbdOdometry {
   void reestimate(OdometryFrame& frame);
   struct ReestimateLimits {
     RegistrationLimits limits;
-    bool only_where_measured = false;  // the widened limits hold where the view measures well
+    // After degenerate frames: a correction beyond reestimate_limits must be confirmed by the
+    // images (images_confirm).
+    bool needs_images = false;
   };
   ReestimateLimits reestimate_limits(const OdometryFrame& frame, std::size_t anchor) const;
   bool images_confirm(std::size_t anchor, const Eigen::Isometry3d& motion,
