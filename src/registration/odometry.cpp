@@ -571,12 +571,11 @@ bool RgbdOdometry::images_confirm(std::size_t anchor, const Eigen::Isometry3d& m
                                   const Eigen::Isometry3d& chained) const {
   const RgbImage& anchor_color = colors_[slot_of(anchor)];
   if (!color_ || color_->empty() || anchor_color.empty()) return false;
-  const auto rmse_at = [&](const Eigen::Isometry3d& candidate) {
-    return intensity_rmse(*depth_, *color_, anchor_color, builder_.camera(),
-                          params_.depth_range.units_per_metre, candidate, params_.photometric);
-  };
-  const double at_reestimate = rmse_at(motion);
-  const double at_chain = rmse_at(chained);
+  const Eigen::Isometry3d candidates[] = {motion, chained};
+  const std::vector<double> rmse =
+      intensity_rmse(*depth_, *color_, anchor_color, builder_.camera(),
+                     params_.depth_range.units_per_metre, candidates, params_.photometric);
+  const double at_reestimate = rmse[0], at_chain = rmse[1];
   return at_reestimate > 0 && at_chain > 0 &&
          at_reestimate < params_.feature_arbitration_ratio * at_chain;
 }

@@ -241,18 +241,24 @@ void require_camera_sized(const DepthImage& source_depth, const RgbImage& source
 
 }  // namespace
 
-double intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
-                      const RgbImage& target_color, const PinholeIntrinsics& camera,
-                      double units_per_metre, const Eigen::Isometry3d& source_to_target,
-                      const PhotometricParams& params) {
+std::vector<double> intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
+                                   const RgbImage& target_color, const PinholeIntrinsics& camera,
+                                   double units_per_metre,
+                                   std::span<const Eigen::Isometry3d> source_to_target,
+                                   const PhotometricParams& params) {
   require_camera_sized(source_depth, source_color, target_color, camera);
+  std::vector<double> rmse(source_to_target.size(), 0.0);
   const Textured source(blurred(grey_of(source_color), 1));
   const Textured target(blurred(grey_of(target_color), 1));
   const std::vector<Sample> samples =
       samples_of(source_depth, source, camera, units_per_metre, params);
-  if (samples.size() < params.min_pixels) return 0;
-  const Sums sums = evaluate(samples, target, camera, source_to_target, {}, params.huber_levels);
-  return sums.count >= params.min_pixels ? std::sqrt(sums.squared / sums.count) : 0.0;
+  if (samples.size() < params.min_pixels) return rmse;
+  for (std::size_t m = 0; m < source_to_target.size(); ++m) {
+    const Sums sums =
+        evaluate(samples, target, camera, source_to_target[m], {}, params.huber_levels);
+    if (sums.count >= params.min_pixels) rmse[m] = std::sqrt(sums.squared / sums.count);
+  }
+  return rmse;
 }
 
 PhotometricResult refine_photometrically(const DepthImage& source_depth,

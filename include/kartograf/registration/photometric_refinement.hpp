@@ -21,6 +21,7 @@
 // the start knows (the geometry's weak but not free ones) need not be measured by the images.
 #include <cstddef>
 #include <span>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -71,12 +72,13 @@ PhotometricResult refine_photometrically(
     const se3::Matrix6d& start_information = se3::Matrix6d::Zero(),
     std::size_t measured_directions = 6);
 
-// The grey-level RMSE at `source_to_target` over the pixels the refinement would use, after one
-// smoothing pass (PhotometricResult::rmse_before); 0 when fewer than params.min_pixels are
-// textured. Compares two candidate motions of the same pair.
-double intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
-                      const RgbImage& target_color, const PinholeIntrinsics& camera,
-                      double units_per_metre, const Eigen::Isometry3d& source_to_target,
-                      const PhotometricParams& params = {});
+// The grey-level RMSE at each of `source_to_target` over the pixels the refinement would use,
+// after one smoothing pass (PhotometricResult::rmse_before); 0 where fewer than params.min_pixels
+// are textured. Compares candidate motions of the same pair, whose images are prepared once.
+std::vector<double> intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
+                                   const RgbImage& target_color, const PinholeIntrinsics& camera,
+                                   double units_per_metre,
+                                   std::span<const Eigen::Isometry3d> source_to_target,
+                                   const PhotometricParams& params = {});
 
 }  // namespace kartograf::registration
