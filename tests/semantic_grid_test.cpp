@@ -250,9 +250,16 @@ TEST(SemanticGrid, FurnitureInARowIsJudgedPieceByPiece) {
   }
 }
 
+// A cell's class, and whether no view saw it.
+std::pair<SemanticClass, bool> class_at(const SemanticGrid& grid, double x, double y) {
+  const Eigen::Vector2i c = grid.cell_of({x, y});
+  return std::pair{grid.classes(c.x(), c.y()), std::isnan(grid.weight(c.x(), c.y()))};
+}
+
 // A cabinet 1 m wide standing 0.45 m in front of a wall, its front taken for a wall by the views
-// (and its sides too with `sides_seen`), the space behind it unseen.
-LabelledPoints cabinet_scene(bool sides_seen) {
+// (and its sides too with `sides_seen`; `front` names what the views took the front for), the
+// space behind it unseen.
+LabelledPoints cabinet_scene(bool sides_seen, SemanticClass front = SemanticClass::wall) {
   LabelledPoints s;
   for (double x = 0.012; x <= 4.012; x += 0.02) {
     for (double y = 0.012; y <= 3.012; y += 0.02) {
@@ -260,7 +267,7 @@ LabelledPoints cabinet_scene(bool sides_seen) {
     }
   }
   s.box_face({0.012, 3.012, 0.02}, {4.012, 3.012, 1.4}, SemanticClass::wall);  // the wall
-  s.box_face({1.012, 2.562, 0.02}, {2.012, 2.562, 1.2}, SemanticClass::wall);  // the front
+  s.box_face({1.012, 2.562, 0.02}, {2.012, 2.562, 1.2}, front);
   if (sides_seen) {
     s.box_face({1.012, 2.562, 0.02}, {1.012, 3.012, 1.2}, SemanticClass::wall);
     s.box_face({2.012, 2.562, 0.02}, {2.012, 3.012, 1.2}, SemanticClass::wall);
@@ -301,6 +308,46 @@ TEST(SemanticGrid, ACabinetWhoseSidesJoinTheWallBehindIsFurniture) {
   expect_cabinet_found(cabinet_scene(true), Eigen::Vector2d(1.02, 2.8));
 }
 
+// The views named the cabinet's front: its top and back, unseen between the front and the wall,
+// are furniture; the wall stays a wall. Off with the fronts (furniture_max_depth 0).
+TEST(SemanticGrid, TheUnseenPocketBehindAFurnitureFaceIsFurniture) {
+  using C = SemanticClass;
+  const LabelledPoints s = cabinet_scene(false, C::furniture);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.5, 2.57), std::pair(C::furniture, false));  // the front
+  for (const double y : {2.65, 2.8, 2.95})
+    EXPECT_EQ(class_at(grid, 1.5, y), std::pair(C::furniture, false)) << "behind it, y " << y;
+  EXPECT_EQ(class_at(grid, 1.5, 3.02).first, C::wall);
+  EXPECT_EQ(grid.furniture_pockets, 1);
+  SemanticGridParams off;
+  off.furniture_max_depth = 0;
+  const SemanticGrid without = build_semantic_grid(s.points, s.labels, off);
+  EXPECT_EQ(class_at(without, 1.5, 2.8), std::pair(C::unknown, true));
+  EXPECT_EQ(without.furniture_pockets, 0);
+}
+
+// A cabinet 0.45 m in front of the wall between two rooms hides that wall's near face: the first
+// wall cell behind it is the far face, seen from the next room with its floor just beyond. The
+// unseen cells up to it hold the wall's inside, so none of them becomes furniture.
+TEST(SemanticGrid, NoPocketReachesAcrossAWallToItsFarFace) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 0.012; y <= 1.962; y += 0.02) {
+      if (!(x > 1.0 && x < 2.0 && y > 1.5)) s.add({x, y, 0}, C::floor);  // south room
+    }
+  }
+  s.box_face({0.012, 2.162, 0}, {4.012, 4.012, 0}, C::floor);           // north room
+  s.box_face({0.012, 1.962, 0.02}, {0.992, 1.962, 1.4}, C::wall);       // the near face
+  s.box_face({2.032, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);       //   but behind it
+  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);       // the far face
+  s.box_face({1.012, 1.512, 0.02}, {2.012, 1.512, 0.8}, C::furniture);  // the cabinet
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double y : {1.6, 1.8, 2.06})
+    EXPECT_NE(class_at(grid, 1.5, y).first, C::furniture) << "y " << y;
+  EXPECT_EQ(grid.furniture_pockets, 0);
+}
+
 // A wall 0.2 m thick seen from both rooms: its inside, which no view sees, is wall; two walls
 // 1 m apart with nothing seen between (a closed shaft) are not joined.
 TEST(SemanticGrid, AWallsInsideBetweenItsTwoFacesIsWall) {
@@ -339,12 +386,6 @@ LabelledPoints two_rooms_with_a_wall_between() {
   s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
   s.box_face({0.012, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the outer north wall
   return s;
-}
-
-// A cell's class, and whether no view saw it.
-std::pair<SemanticClass, bool> class_at(const SemanticGrid& grid, double x, double y) {
-  const Eigen::Vector2i c = grid.cell_of({x, y});
-  return std::pair{grid.classes(c.x(), c.y()), std::isnan(grid.weight(c.x(), c.y()))};
 }
 
 TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {

@@ -68,7 +68,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
   cells["unobserved"] = d.unobserved_cells;
   json["cells"] = std::move(cells);
   json["inferred"] = {{"wall_thickness_m", d.wall_thickness ? Json(*d.wall_thickness) : Json()},
-                      {"furniture_fronts", d.furniture_fronts}};
+                      {"furniture_fronts", d.furniture_fronts},
+                      {"furniture_pockets", d.furniture_pockets}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

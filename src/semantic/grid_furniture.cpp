@@ -72,26 +72,44 @@ bool faces_floor(const SemanticGrid& grid, const std::vector<cv::Point>& cells) 
   return 2 * facing >= cells.size();
 }
 
-// What a pocket touches (4-neighbours): the wall pieces (labels of `wall_labels`), and whether a
-// door.
-struct Surroundings {
-  std::set<int> walls;
-  bool door = false;
-};
-
-Surroundings surroundings(const SemanticGrid& grid, const cv::Mat& wall_labels,
-                          const std::vector<cv::Point>& cells) {
-  Surroundings around;
+// The 4-neighbours of cells that lie in the grid.
+template <typename Visit>
+void for_each_neighbour(const SemanticGrid& grid, const std::vector<cv::Point>& cells,
+                        Visit&& visit) {
   for (const cv::Point& c : cells) {
     for (const cv::Point d :
          {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
-      const cv::Point n = c + d;
-      if (!grid.contains({n.x, n.y})) continue;
-      if (const int w = wall_labels.at<int>(n.y, n.x); w > 0) around.walls.insert(w);
-      around.door |= grid.classes(n.x, n.y) == SemanticClass::door;
+      if (grid.contains({(c + d).x, (c + d).y})) visit(c + d);
     }
   }
-  return around;
+}
+
+// The wall pieces (labels of `wall_labels`) a pocket touches.
+std::set<int> walls_around(const SemanticGrid& grid, const cv::Mat& wall_labels,
+                           const std::vector<cv::Point>& cells) {
+  std::set<int> walls;
+  for_each_neighbour(grid, cells, [&](const cv::Point& n) {
+    if (const int w = wall_labels.at<int>(n.y, n.x); w > 0) walls.insert(w);
+  });
+  return walls;
+}
+
+// Whether a door cell touches the cells: beside a door, an unseen pocket is a wall's inside behind
+// its leaf, not what furniture hid.
+bool beside_door(const SemanticGrid& grid, const std::vector<cv::Point>& cells) {
+  bool door = false;
+  for_each_neighbour(grid, cells, [&](const cv::Point& n) {
+    door |= grid.classes(n.x, n.y) == SemanticClass::door;
+  });
+  return door;
+}
+
+// Whether a seen floor cell lies within `cells` steps of `out` beyond c.
+bool floor_within(const SemanticGrid& grid, const Eigen::Vector2i& c, const Eigen::Vector2i& out,
+                  int cells) {
+  for (int k = 1; k <= cells; ++k)
+    if (seen_as(grid, c + k * out, SemanticClass::floor)) return true;
+  return false;
 }
 
 // Cells of a joined front's pocket, each way (0.15 m at 5 cm cells).
@@ -191,15 +209,15 @@ WallPieces wall_pieces(const SemanticGrid& grid, double max_extent, double max_a
   return w;
 }
 
-// A furniture-sized pocket beside a longer wall and no door (beside a door, a pocket is a wall's
-// inside behind its leaf, not behind furniture); `around` gets what it touches.
+// A furniture-sized pocket beside a longer wall and no door; `beside` gets the wall pieces it
+// touches.
 bool backed_pocket(const SemanticGrid& grid, const WallPieces& walls,
                    const std::vector<cv::Point>& pocket, double max_extent, double max_area,
-                   Surroundings& around) {
+                   std::set<int>& beside) {
   if (!furniture_sized(pocket, grid.resolution, max_extent, max_area)) return false;
-  around = surroundings(grid, walls.pieces.labels, pocket);
-  return !around.door && std::any_of(around.walls.begin(), around.walls.end(),
-                                     [&](int w) { return walls.long_wall[w]; });
+  if (beside_door(grid, pocket)) return false;
+  beside = walls_around(grid, walls.pieces.labels, pocket);
+  return std::any_of(beside.begin(), beside.end(), [&](int w) { return walls.long_wall[w]; });
 }
 
 void mark_furniture(SemanticGrid& grid, const std::vector<cv::Point>& cells, float weight,
@@ -221,9 +239,8 @@ int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
   int fronts = 0;
   std::vector<cv::Point> to_furniture;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
-    Surroundings around;
-    if (!backed_pocket(grid, walls, pockets.cells[p], max_extent, max_area, around)) continue;
-    const std::set<int>& beside = around.walls;
+    std::set<int> beside;
+    if (!backed_pocket(grid, walls, pockets.cells[p], max_extent, max_area, beside)) continue;
     if (std::none_of(beside.begin(), beside.end(), [&](int w) { return walls.front_like[w]; }))
       continue;
     ++fronts;
@@ -245,9 +262,9 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
   int fronts = 0;
   std::vector<cv::Point> to_furniture;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
-    Surroundings around;
+    std::set<int> beside;
     const std::vector<cv::Point>& pocket = pockets.cells[p];
-    if (!backed_pocket(grid, walls, pocket, max_extent, max_area, around)) continue;
+    if (!backed_pocket(grid, walls, pocket, max_extent, max_area, beside)) continue;
     const std::vector<cv::Point> joined = front_and_sides(grid, pocket);
     if (joined.empty()) continue;
     ++fronts;
@@ -256,6 +273,45 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
   }
   mark_furniture(grid, to_furniture, weight, furniture);
   return fronts;
+}
+
+int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_area,
+                             int max_depth_cells, float weight, Image<std::uint8_t>& furniture) {
+  const auto furniture_cell = [&](const Eigen::Vector2i& c) {
+    return seen_as(grid, c, SemanticClass::furniture);
+  };
+  const auto end = [&](const Eigen::Vector2i& c) {
+    return furniture_cell(c) || is_wall(grid, c.x(), c.y());
+  };
+  // A wall end with floor just behind it is the far face of a wall whose near face the furniture
+  // hid: the run crossed the wall's inside, which is no pocket.
+  const auto far_face = [&](const Eigen::Vector2i& c, const Eigen::Vector2i& out) {
+    return !furniture_cell(c) && floor_within(grid, c, out, 2);
+  };
+  // A furniture end whose face the room saw: floor within 3 cells in front of it.
+  const auto front = [&](const Eigen::Vector2i& c, const Eigen::Vector2i& out) {
+    return furniture_cell(c) && floor_within(grid, c, out, 3);
+  };
+  const auto from_furniture = [&](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    const Eigen::Vector2i step = (b - a).cwiseSign();
+    return (front(a, -step) || front(b, step)) && !far_face(a, -step) && !far_face(b, step);
+  };
+  cv::Mat hidden = cv::Mat::zeros(grid.height(), grid.width(), CV_8U);
+  for (const Eigen::Vector2i& k :
+       unobserved_runs_between(grid, end, 0, max_depth_cells, from_furniture))
+    hidden.at<std::uint8_t>(k.y(), k.x()) = 255;
+  const Pieces pockets = pieces_of(hidden);
+  std::vector<cv::Point> to_furniture;
+  int filled = 0;
+  for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
+    const std::vector<cv::Point>& pocket = pockets.cells[p];
+    if (!furniture_sized(pocket, grid.resolution, max_extent, max_area)) continue;
+    if (beside_door(grid, pocket)) continue;
+    ++filled;
+    to_furniture.insert(to_furniture.end(), pocket.begin(), pocket.end());
+  }
+  mark_furniture(grid, to_furniture, weight, furniture);
+  return filled;
 }
 
 Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, double max_area,

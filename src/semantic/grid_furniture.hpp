@@ -27,6 +27,12 @@ int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
 int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
                                 int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
 
+// The unseen cells behind furniture: row and column runs of at most `max_depth_cells` unseen cells
+// from a furniture cell to a wall or furniture cell (a cabinet's top and back that its front hid),
+// in furniture-sized pieces with no door beside them, become furniture. Returns the pieces filled.
+int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_area,
+                             int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
+
 // The unseen cells on row and column runs of more than `min_cells` and at most `max_cells` unseen
 // cells between two wall cells of which one belongs to a piece that may be a cabinet's front
 // (furniture sized, most of it facing floor): what the walls' insides fill must leave to

@@ -937,6 +937,11 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
         cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
         masks.furniture);
+    // Last: the fronts above are among the faces whose hidden backs it fills.
+    grid.furniture_pockets = detail::pockets_behind_furniture(
+        grid, options.furniture_max_extent, options.max_furniture_fill_area,
+        cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
+        masks.furniture);
   }
   if (options.max_floor_shadow > 0) {
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
@@ -1042,6 +1047,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.ceiling_z = grid.ceiling_z;
   d.wall_thickness = grid.wall_thickness;
   d.furniture_fronts = grid.furniture_fronts;
+  d.furniture_pockets = grid.furniture_pockets;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

@@ -103,7 +103,8 @@ struct SemanticGridParams {
   double furniture_max_height = 2.1;  // m
   // A face of furniture size standing at most this far in front of a longer wall, with only
   // unseen cells between (a cabinet's front that the views took for a wall, its top and sides
-  // hidden), is furniture, and so is the pocket behind it. 0: off.
+  // hidden), is furniture, and so is the pocket behind it. So are the unseen cells at most this far
+  // behind a furniture face the room saw, up to a wall or furniture (its top and back). 0: off.
   double furniture_max_depth = 1.0;  // m
   // Unobserved cells between the two faces of a wall (wall cells at most this far apart along a
   // row or a column, nothing seen between) are wall: its inside, which no view can see. 0: off.
@@ -191,9 +192,11 @@ struct SemanticGrid {
   TraversabilityWeights weights;  // the table the cells were weighted with
   // What the grid inferred beyond the views: the wall thickness measured on walls seen from both
   // sides and given to walls seen from one side (none: too few two-sided walls, none backed), and
-  // the cabinet fronts the views had taken for walls.
+  // the cabinet fronts the views had taken for walls, and the unseen pockets behind furniture faces
+  // filled as furniture.
   std::optional<double> wall_thickness;  // m
   int furniture_fronts = 0;
+  int furniture_pockets = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -248,6 +251,7 @@ struct MapDescription {
   int unobserved_cells = 0;
   std::optional<double> wall_thickness;  // as SemanticGrid's
   int furniture_fronts = 0;
+  int furniture_pockets = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
