@@ -411,6 +411,36 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   EXPECT_FALSE(alone.wall_thickness.has_value());
 }
 
+// The outer north wall is seen but for 1 m behind a cabinet standing 0.1 m in front of it (its
+// front seen as furniture): the wall line runs on through the hidden stretch, as thick as on
+// either side of it. Without the backs (back_one_sided_walls off) the stretch stays unseen.
+TEST(SemanticGrid, AnOuterWallHiddenBehindACabinetRunsOnBehindIt) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);      // south room
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);  // the wall between
+  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 2.162; y <= 4.012; y += 0.02) {
+      if (!(x > 1.5 && x < 2.5 && y > 3.9)) s.add({x, y, 0}, C::floor);  // north room
+    }
+  }
+  s.box_face({0.012, 4.012, 0.02}, {1.492, 4.012, 1.4}, C::wall);  // the outer north wall
+  s.box_face({2.532, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  //   but behind the cabinet
+  s.box_face({1.512, 3.912, 0.02}, {2.512, 3.912, 0.9}, C::furniture);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.0, 4.012 + 0.12), std::pair(C::wall, false));  // a back, beside it
+  for (const double x : {1.7, 2.0, 2.3}) {
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.02), std::pair(C::wall, false)) << "x " << x;
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.12), std::pair(C::wall, false)) << "x " << x;
+  }
+  EXPECT_EQ(class_at(grid, 2.0, 4.012 + 0.22), std::pair(C::unknown, true));  // beyond the wall
+  SemanticGridParams off;
+  off.back_one_sided_walls = false;
+  EXPECT_EQ(class_at(build_semantic_grid(s.points, s.labels, off), 2.0, 4.012 + 0.12),
+            std::pair(C::unknown, true));
+}
+
 // With an outer east wall too, the block where the two outer walls meet, which no view sees, is
 // wall as thick as their backs; without the backs it stays unseen.
 TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {

@@ -219,4 +219,39 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
   }
 }
 
+void wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                                 float weight) {
+  const auto hidden = [&](const Eigen::Vector2i& c) {
+    return unobserved(grid, c) || seen_as(grid, c, SemanticClass::furniture);
+  };
+  std::vector<Eigen::Vector2i> bridged;
+  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
+    const Eigen::Vector2i across(step.y(), step.x());
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const Eigen::Vector2i start(col, row);
+        if (!seen_as(grid, start, SemanticClass::wall) || !hidden(start + step) ||
+            wall_run(grid, start, -step, beyond_cells) < beyond_cells)
+          continue;
+        Eigen::Vector2i c = start + step;
+        int gap = 0;
+        bool furniture = false;
+        for (; hidden(c) && gap <= max_gap_cells; c += step, ++gap) {
+          for (int k = -beyond_cells; k <= beyond_cells; ++k)
+            furniture |= seen_as(grid, c + k * across, SemanticClass::furniture);
+        }
+        if (gap > max_gap_cells || !furniture || !seen_as(grid, c, SemanticClass::wall) ||
+            wall_run(grid, c, step, beyond_cells) < beyond_cells)
+          continue;
+        for (Eigen::Vector2i k = start + step; k != c; k += step)
+          if (unobserved(grid, k)) bridged.push_back(k);
+      }
+    }
+  }
+  for (const Eigen::Vector2i& c : bridged) {
+    grid.classes(c.x(), c.y()) = SemanticClass::wall;
+    grid.weight(c.x(), c.y()) = weight;
+  }
+}
+
 }  // namespace kartograf::semantic::detail

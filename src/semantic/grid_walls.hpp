@@ -43,4 +43,12 @@ void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, floa
 // repeated until a block `thickness` cells square is filled (nothing changes for 0).
 void fill_wall_corners(SemanticGrid& grid, int thickness, float weight);
 
+// A wall line hidden behind furniture: along a row or a column, a gap of at most `max_gap_cells`
+// unseen or furniture cells, with furniture within `beyond_cells` across it, between two wall
+// cells from which the wall runs on for at least `beyond_cells` each way (more than a wall is
+// thick, so that the line is a wall's length, not another wall's thickness); its unseen cells are
+// wall.
+void wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                                 float weight);
+
 }  // namespace kartograf::semantic::detail

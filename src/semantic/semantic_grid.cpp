@@ -964,6 +964,10 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
   if (options.back_one_sided_walls)
     detail::fill_wall_corners(grid, thickness, options.weights.of(SemanticClass::wall));
+  // Last: the backs and corners above make the wall lines whose hidden stretches it joins.
+  if (options.back_one_sided_walls && max_wall > 0 && options.furniture_max_extent > 0)
+    detail::wall_lines_behind_furniture(grid, cells(options.furniture_max_extent), max_wall + 1,
+                                        options.weights.of(SemanticClass::wall));
   if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
 }
 
