@@ -667,18 +667,42 @@ TEST(SemanticGrid, ThinShadowsInTheFloorAreFloor) {
       if (!strip && !patch) s.add({x, y, 0}, C::floor);
     }
   }
-  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  SemanticGridParams shadows;
+  shadows.max_floor_hole = 0;  // the patch is a hole in the floor (below)
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels, shadows);
   const auto at = [&](double x, double y) {
     const Eigen::Vector2i c = grid.cell_of({x, y});
     return std::pair{grid.classes(c.x(), c.y()), std::isnan(grid.weight(c.x(), c.y()))};
   };
   EXPECT_EQ(at(1.52, 1.52), std::pair(C::floor, false));
   EXPECT_EQ(at(3.27, 0.77), std::pair(C::unknown, true));
-  SemanticGridParams off;
+  SemanticGridParams off = shadows;
   off.max_floor_shadow = 0;
   const SemanticGrid unfilled = build_semantic_grid(s.points, s.labels, off);
   const Eigen::Vector2i c = unfilled.cell_of({1.52, 1.52});
   EXPECT_TRUE(std::isnan(unfilled.weight(c.x(), c.y())));
+}
+
+// An unseen patch 0.5 m square with seen floor all around it (where a robot turned in place) is
+// floor; the same patch with a cabinet's face on its edge, or larger than max_floor_hole, is not.
+TEST(SemanticGrid, AnUnseenHoleInTheFloorIsFloor) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 0.012; y <= 3.012; y += 0.02) {
+      const bool hole = x > 1.0 && x < 1.5 && y > 1.0 && y < 1.5;
+      const bool beside_face = x > 3.0 && x < 3.5 && y > 1.0 && y < 1.5;
+      if (!hole && !beside_face) s.add({x, y, 0}, C::floor);
+    }
+  }
+  s.box_face({3.0, 1.512, 0.02}, {3.5, 1.512, 0.8}, C::furniture);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.25, 1.25), std::pair(C::floor, false));
+  EXPECT_EQ(class_at(grid, 3.25, 1.25).second, true);
+  SemanticGridParams small;
+  small.max_floor_hole = 0.2;  // m^2, under the hole's 0.25
+  EXPECT_EQ(class_at(build_semantic_grid(s.points, s.labels, small), 1.25, 1.25),
+            std::pair(C::unknown, true));
 }
 
 // A streak of wall points in open floor from one view (edge artefacts along its rays) is no

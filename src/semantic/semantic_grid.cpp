@@ -135,9 +135,10 @@ void describe_cells(const SemanticGrid& grid, const Image<CellEvidence>& evidenc
   }
 }
 
-// The cells of each connected component of `mask` (8-connected), in raster order.
-std::vector<std::vector<Eigen::Vector2i>> components(const Image<std::uint8_t>& mask) {
-  const LabelImage labels = label_connected_components(mask, {Connectivity::eight, 1});
+// The cells of each connected component of `mask` (8-connected unless told), in raster order.
+std::vector<std::vector<Eigen::Vector2i>> components(
+    const Image<std::uint8_t>& mask, Connectivity connectivity = Connectivity::eight) {
+  const LabelImage labels = label_connected_components(mask, {connectivity, 1});
   std::vector<std::vector<Eigen::Vector2i>> out;
   for (int row = 0; row < mask.height(); ++row) {
     for (int col = 0; col < mask.width(); ++col) {
@@ -398,6 +399,33 @@ void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells,
     if (keep && (*keep)(c.x(), c.y())) continue;
     grid.classes(c.x(), c.y()) = ends;
     grid.weight(c.x(), c.y()) = weight;
+  }
+}
+
+// Holes of unseen cells (4-neighbours) whose every neighbour is seen floor, up to max_area [m^2],
+// are floor (SemanticGridParams::max_floor_hole).
+void fill_floor_holes(SemanticGrid& grid, double max_area, float weight) {
+  Image<std::uint8_t> unseen(grid.width(), grid.height(), 0);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      unseen(col, row) = detail::unobserved(grid, {col, row});
+  const auto max_cells = static_cast<std::size_t>(max_area / (grid.resolution * grid.resolution));
+  for (const std::vector<Eigen::Vector2i>& hole : components(unseen, Connectivity::four)) {
+    if (hole.size() > max_cells) continue;
+    bool enclosed = true;
+    for (const Eigen::Vector2i& c : hole) {
+      for (const Eigen::Vector2i& d : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
+                                       Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
+        const Eigen::Vector2i n = c + d;
+        enclosed &= grid.contains(n) &&
+                    (detail::unobserved(grid, n) || detail::seen_as(grid, n, SemanticClass::floor));
+      }
+    }
+    if (!enclosed) continue;
+    for (const Eigen::Vector2i& c : hole) {
+      grid.classes(c.x(), c.y()) = SemanticClass::floor;
+      grid.weight(c.x(), c.y()) = weight;
+    }
   }
 }
 
@@ -842,8 +870,10 @@ void SemanticGridParams::validate() const {
   require(std::isfinite(furniture_max_depth) && furniture_max_depth >= 0,
           "SemanticGridParams: furniture_max_depth must be >= 0");
   require(std::isfinite(max_wall_thickness) && max_wall_thickness >= 0 &&
-              std::isfinite(max_floor_shadow) && max_floor_shadow >= 0,
-          "SemanticGridParams: max_wall_thickness and max_floor_shadow must be >= 0");
+              std::isfinite(max_floor_shadow) && max_floor_shadow >= 0 &&
+              std::isfinite(max_floor_hole) && max_floor_hole >= 0,
+          "SemanticGridParams: max_wall_thickness, max_floor_shadow and max_floor_hole must be "
+          ">= 0");
   require(free_space_ray_stride >= 0, "SemanticGridParams: free_space_ray_stride must be >= 0");
   positive(free_space_slab, "free_space_slab");
   positive(furniture_join_gap, "furniture_join_gap");
@@ -947,6 +977,8 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
                          options.weights.of(SemanticClass::floor));
   }
+  if (options.max_floor_hole > 0)
+    fill_floor_holes(grid, options.max_floor_hole, options.weights.of(SemanticClass::floor));
   // The walls' thickness is measured before their faces are placed: a wall's two faces, seen
   // from views whose poses differ by a centimetre or two, lose a row to the placement often
   // enough to move the median (0.15 -> 0.10 m on a survey with the SLAM's poses).
