@@ -28,8 +28,11 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
                                 int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
 
 // The unseen cells behind furniture: row and column runs of at most `max_depth_cells` unseen cells
-// from a furniture cell to a wall or furniture cell (a cabinet's top and back that its front hid),
-// in furniture-sized pieces with no door beside them, become furniture. Returns the pieces filled.
+// from a furniture cell with seen floor within 3 cells in front of it (a face the room saw) to a
+// wall or furniture cell (a cabinet's top and back that its front hid), in furniture-sized pieces
+// with no door beside them, become furniture. A wall end with floor within 2 cells behind it ends
+// no run: it is the far face of a wall whose near face the furniture hid. Returns the pieces
+// filled.
 int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_area,
                              int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
 
