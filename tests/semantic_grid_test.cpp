@@ -308,24 +308,6 @@ TEST(SemanticGrid, ACabinetWhoseSidesJoinTheWallBehindIsFurniture) {
   expect_cabinet_found(cabinet_scene(true), Eigen::Vector2d(1.02, 2.8));
 }
 
-// The views took the cabinet's front for a wall but saw its inside as furniture behind it, and no
-// wall behind that (an outer wall the cabinet hides): the front is furniture. A wall of the same
-// size with floor behind it stays a wall.
-TEST(SemanticGrid, AFrontWithFurnitureBehindItIsFurniture) {
-  using C = SemanticClass;
-  LabelledPoints s;
-  for (double x = 0.012; x <= 4.012; x += 0.02) {
-    for (double y = 0.012; y <= 2.552; y += 0.02) s.add({x, y, 0}, C::floor);
-  }
-  s.box_face({1.012, 2.562, 0.02}, {2.012, 2.562, 1.2}, C::wall);      // the front
-  s.box_face({1.012, 2.662, 0.5}, {2.012, 2.812, 0.5}, C::furniture);  // a shelf inside it
-  s.box_face({2.512, 1.012, 0.02}, {2.512, 1.912, 1.2}, C::wall);      // a stub in the room
-  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
-  EXPECT_EQ(class_at(grid, 1.5, 2.57), std::pair(C::furniture, false));
-  EXPECT_EQ(class_at(grid, 2.52, 1.5).first, C::wall);
-  EXPECT_GE(grid.furniture_fronts, 1);
-}
-
 // The views named the cabinet's front: its top and back, unseen between the front and the wall,
 // are furniture; the wall stays a wall. Off with the fronts (furniture_max_depth 0).
 TEST(SemanticGrid, TheUnseenPocketBehindAFurnitureFaceIsFurniture) {

@@ -314,37 +314,6 @@ int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_a
   return filled;
 }
 
-int fronts_before_furniture(SemanticGrid& grid, double max_extent, double max_area, float weight,
-                            Image<std::uint8_t>& furniture) {
-  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
-  std::vector<cv::Point> to_furniture;
-  int fronts = 0;
-  for (std::size_t k = 1; k < walls.pieces.cells.size(); ++k) {
-    if (!walls.front_like[k]) continue;
-    // Each cell that faces floor: whether furniture lies behind it, away from the floor.
-    std::size_t facing = 0, backed = 0;
-    for (const cv::Point& p : walls.pieces.cells[k]) {
-      const Eigen::Vector2i c(p.x, p.y);
-      for (const Eigen::Vector2i& d : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
-                                       Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
-        if (!seen_as(grid, c + d, SemanticClass::floor)) continue;
-        ++facing;
-        bool behind = false;
-        for (int step = 1; step <= 3; ++step)
-          behind |= seen_as(grid, c - step * d, SemanticClass::furniture);
-        backed += behind;
-        break;
-      }
-    }
-    if (facing == 0 || 2 * backed < facing) continue;
-    ++fronts;
-    to_furniture.insert(to_furniture.end(), walls.pieces.cells[k].begin(),
-                        walls.pieces.cells[k].end());
-  }
-  mark_furniture(grid, to_furniture, weight, furniture);
-  return fronts;
-}
-
 Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, double max_area,
                                   int min_cells, int max_cells) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);

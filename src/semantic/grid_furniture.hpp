@@ -36,13 +36,6 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
 int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_area,
                              int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
 
-// A cabinet whose front the views took for a wall and whose top or inside they saw as furniture,
-// with no wall seen behind it (an outer wall it hides): a wall piece of furniture size facing
-// floor, with furniture within 3 cells behind at least half of its cells that face floor, is
-// furniture. Returns the number of such fronts.
-int fronts_before_furniture(SemanticGrid& grid, double max_extent, double max_area, float weight,
-                            Image<std::uint8_t>& furniture);
-
 // The unseen cells on row and column runs of more than `min_cells` and at most `max_cells` unseen
 // cells between two wall cells of which one belongs to a piece that may be a cabinet's front
 // (furniture sized, most of it facing floor): what the walls' insides fill must leave to

@@ -967,9 +967,6 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
         cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
         masks.furniture);
-    grid.furniture_fronts += detail::fronts_before_furniture(
-        grid, options.furniture_max_extent, options.max_furniture_fill_area,
-        options.weights.of(SemanticClass::furniture), masks.furniture);
     // Last: the fronts above are among the faces whose hidden backs it fills.
     grid.furniture_pockets = detail::pockets_behind_furniture(
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
