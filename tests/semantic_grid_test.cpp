@@ -411,6 +411,25 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   EXPECT_FALSE(alone.wall_thickness.has_value());
 }
 
+// Points the views took for an object inside the wall between the rooms (across its inside) and
+// in a thin layer on the outer wall's hidden back: no floor was seen beside either, so neither is
+// furniture. Both are wall, and the outer wall's back fills across the layer to its thickness.
+TEST(SemanticGrid, FurnitureSpecksInsideAWallAreWall) {
+  using C = SemanticClass;
+  LabelledPoints s = two_rooms_with_a_wall_between();
+  s.box_face({1.112, 1.982, 0.02}, {1.112, 2.142, 1.4}, C::furniture);  // across the inside
+  s.box_face({1.012, 4.062, 0.02}, {2.012, 4.062, 1.4}, C::furniture);  // on the hidden back
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.112, 2.062), std::pair(C::wall, false));
+  EXPECT_EQ(class_at(grid, 1.5, 4.062), std::pair(C::wall, false));
+  EXPECT_EQ(class_at(grid, 1.5, 4.012 + 0.12), std::pair(C::wall, false));
+  // Where floor was seen beside them, such points are furniture against the wall.
+  LabelledPoints against = two_rooms_with_a_wall_between();
+  against.box_face({1.012, 3.912, 0.02}, {2.012, 3.912, 0.9}, C::furniture);
+  EXPECT_EQ(class_at(build_semantic_grid(against.points, against.labels), 1.5, 3.912).first,
+            C::furniture);
+}
+
 // The outer north wall is seen but for 1 m behind a cabinet standing 0.1 m in front of it (its
 // front seen as furniture): the wall line runs on through the hidden stretch, as thick as on
 // either side of it. Without the backs (back_one_sided_walls off) the stretch stays unseen.

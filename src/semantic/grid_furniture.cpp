@@ -314,6 +314,83 @@ int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_a
   return filled;
 }
 
+namespace {
+
+// How thick a layer of a face's points the depth noise spreads behind it, in cells (two cells of
+// 5 cm: a few centimetres of noise at the surveys' 3-5 m ranges, and the cell it straddles).
+constexpr int kNoiseLayerCells = 2;
+
+// Whether wall closes every row of the piece at both ends (`step` (1, 0)), or every column
+// (`step` (0, 1)): the piece lies inside a wall's line.
+bool walled_in(const SemanticGrid& grid, const std::vector<cv::Point>& piece,
+               const Eigen::Vector2i& step) {
+  std::set<std::pair<int, int>> cells;
+  for (const cv::Point& c : piece) cells.insert({c.x, c.y});
+  for (const cv::Point& c : piece) {
+    const Eigen::Vector2i cell(c.x, c.y);
+    for (const int sign : {-1, 1}) {
+      const Eigen::Vector2i n = cell + sign * step;
+      if (cells.count({n.x(), n.y()})) continue;
+      if (!is_wall(grid, n.x(), n.y())) return false;
+    }
+  }
+  return true;
+}
+
+// Whether the piece is a layer on a wall's face: no thicker than `reach` cells (what the depth
+// noise spreads a face's points over), running along the face (at least twice as long as thick,
+// or a cell or two), every cell within `reach` cells (8-neighbour steps) of a wall cell. A
+// cabinet's corner behind a front the views took for wall is as near its walls, but as thick as
+// long.
+bool hugs_wall(const SemanticGrid& grid, const std::vector<cv::Point>& piece, int reach) {
+  const cv::Rect box = cv::boundingRect(piece);
+  const int thick = std::min(box.width, box.height), length = std::max(box.width, box.height);
+  if (thick > reach || (length < 2 * thick && piece.size() > 2)) return false;
+  for (const cv::Point& c : piece) {
+    bool near = false;
+    for (int dy = -reach; dy <= reach && !near; ++dy)
+      for (int dx = -reach; dx <= reach && !near; ++dx) near = is_wall(grid, c.x + dx, c.y + dy);
+    if (!near) return false;
+  }
+  return true;
+}
+
+// Whether seen floor lies among the 8 neighbours of any of the cells.
+bool floor_around(const SemanticGrid& grid, const std::vector<cv::Point>& cells) {
+  for (const cv::Point& c : cells)
+    for (int dy = -1; dy <= 1; ++dy)
+      for (int dx = -1; dx <= 1; ++dx)
+        if (seen_as(grid, {c.x + dx, c.y + dy}, SemanticClass::floor)) return true;
+  return false;
+}
+
+}  // namespace
+
+int furniture_specks_in_walls(SemanticGrid& grid, int max_cells, float weight,
+                              Image<std::uint8_t>& furniture) {
+  cv::Mat seen = cv::Mat::zeros(grid.height(), grid.width(), CV_8U);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      if (seen_as(grid, {col, row}, SemanticClass::furniture))
+        seen.at<std::uint8_t>(row, col) = 255;
+  const Pieces pieces = pieces_of(seen);
+  int specks = 0;
+  for (std::size_t p = 1; p < pieces.cells.size(); ++p) {
+    const std::vector<cv::Point>& piece = pieces.cells[p];
+    if (floor_around(grid, piece)) continue;
+    const bool small_in_line = piece.size() <= static_cast<std::size_t>(max_cells) &&
+                               (walled_in(grid, piece, {1, 0}) || walled_in(grid, piece, {0, 1}));
+    if (!small_in_line && !hugs_wall(grid, piece, kNoiseLayerCells)) continue;
+    ++specks;
+    for (const cv::Point& c : piece) {
+      grid.classes(c.x, c.y) = SemanticClass::wall;
+      grid.weight(c.x, c.y) = weight;
+      furniture(c.x, c.y) = 0;
+    }
+  }
+  return specks;
+}
+
 Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, double max_area,
                                   int min_cells, int max_cells) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);

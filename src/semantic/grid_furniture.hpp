@@ -36,6 +36,16 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
 int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_area,
                              int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
 
+// Furniture specks in walls: pieces (8-neighbours) of seen furniture cells with no seen floor
+// around them that lie inside a wall's line (at most `max_cells` cells, closed by wall at both ends
+// of every row or of every column) or on a wall's face as a thin layer along it (at most two cells
+// thick, twice as long as thick). Furniture stands in a room, where the views that saw it saw the
+// floor in front of it; such specks are wall points the views took for an object, or the depth
+// noise behind a face, and they would stop the walls' insides and hidden backs from filling across
+// them. They become wall (weight `weight`; `furniture` unmarks them). Returns the specks.
+int furniture_specks_in_walls(SemanticGrid& grid, int max_cells, float weight,
+                              Image<std::uint8_t>& furniture);
+
 // The unseen cells on row and column runs of more than `min_cells` and at most `max_cells` unseen
 // cells between two wall cells of which one belongs to a piece that may be a cabinet's front
 // (furniture sized, most of it facing floor): what the walls' insides fill must leave to

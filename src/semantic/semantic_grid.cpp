@@ -943,6 +943,11 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   // and a wall, deeper than a wall's inside (by a cell, for noise), is what a cabinet hid, and the
   // insides' fill leaves it to the fronts.
   const int max_wall = cells(options.max_wall_thickness);
+  // First: a speck inside a wall would stop every fill across the wall below.
+  if (max_wall > 0) {
+    detail::furniture_specks_in_walls(grid, max_wall, options.weights.of(SemanticClass::wall),
+                                      masks.furniture);
+  }
   const int across =
       max_wall > 0 ? detail::two_sided_wall_thickness(grid, max_wall, kMinTwoSidedWallCells, true)
                    : 0;
