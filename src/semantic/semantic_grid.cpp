@@ -253,14 +253,12 @@ std::vector<cv::Point> rectangle_around(const std::vector<cv::Point>& outline) {
   return corners;
 }
 
-// Fills one piece of furniture (its outline `piece`): without free space its hull; with it, the
-// rectangle around it, but for the cells that the views saw through just under the piece's tops
-// (open floor in the hull of an L or of two pieces, the shadow behind a table).
+// Fills one piece of furniture within `hull` (fill_furniture's shape of it), but for the cells
+// that the views saw through just under the piece's tops when the free space is known (open floor
+// in the hull of an L or of two pieces, the shadow behind a table).
 void fill_piece(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                 const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
-                const std::vector<cv::Point>& piece, std::vector<cv::Point> hull,
-                float furniture_weight) {
-  if (free_space) hull = rectangle_around(piece);
+                std::vector<cv::Point> hull, float furniture_weight) {
   const cv::Rect box = cv::boundingRect(hull) & cv::Rect(0, 0, grid.width(), grid.height());
   cv::Mat fill = cv::Mat::zeros(box.height, box.width, CV_8U);
   for (cv::Point& p : hull) p -= box.tl();
@@ -318,7 +316,14 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
         cv::drawContours(too_large, pieces, static_cast<int>(k), 255, cv::FILLED);
         continue;
       }
-      fill_piece(grid, evidence, free_space, furniture, pieces[k], hull, furniture_weight);
+      // What the piece fills: with the free space, the rectangle around it, where that is
+      // furniture sized too; pieces joined in an L (a table and a cabinet beside it) have a hull
+      // of furniture size and a rectangle over the open floor between them.
+      if (free_space) {
+        std::vector<cv::Point> rectangle = rectangle_around(pieces[k]);
+        if (cv::contourArea(rectangle) * cell_area <= max_area) hull = std::move(rectangle);
+      }
+      fill_piece(grid, evidence, free_space, furniture, hull, furniture_weight);
     }
     cv::bitwise_and(left, too_large, left);
   }
