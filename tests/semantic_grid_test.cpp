@@ -430,6 +430,22 @@ TEST(SemanticGrid, FurnitureSpecksInsideAWallAreWall) {
             C::furniture);
 }
 
+// A piece of furniture in the north room 0.14 m from the wall between the rooms and a speck of
+// furniture 0.36 m from it in the south room: closed over the 0.75 m join gap they are one piece
+// across the wall, whose hull covers the south room's floor beside the speck. No furniture stands
+// across a wall: each side is filled on its own, and that floor stays floor.
+TEST(SemanticGrid, FurnitureIsNotFilledAcrossAWall) {
+  using C = SemanticClass;
+  LabelledPoints s = two_rooms_with_a_wall_between();
+  s.box_face({1.012, 2.302, 0.02}, {1.612, 2.302, 0.8}, C::furniture);  // north room
+  s.box_face({1.012, 1.602, 0.02}, {1.112, 1.602, 0.8}, C::furniture);  // south room
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.312, 2.302).first, C::furniture);
+  EXPECT_EQ(class_at(grid, 1.062, 1.602).first, C::furniture);
+  EXPECT_EQ(class_at(grid, 1.162, 1.852), std::pair(C::floor, false));
+  EXPECT_EQ(class_at(grid, 1.112, 1.752), std::pair(C::floor, false));
+}
+
 // The outer north wall is seen but for 1 m behind a cabinet standing 0.1 m in front of it (its
 // front seen as furniture): the wall line runs on through the hidden stretch, as thick as on
 // either side of it. Without the backs (back_one_sided_walls off) the stretch stays unseen.

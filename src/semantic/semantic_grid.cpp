@@ -284,6 +284,34 @@ void fill_piece(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   }
 }
 
+// The pieces of the furniture cells `marked` (a mask) inside a closed piece (its outline), taken
+// apart where walls cross the piece and each side closed again over `size` cells: no furniture
+// stands across a wall, and a piece joined over one (a layer on one face, specks in the room
+// beyond) has a hull over the room's floor between them. A piece no wall crosses is itself.
+std::vector<std::vector<cv::Point>> pieces_between_walls(const std::vector<cv::Point>& outline,
+                                                         const cv::Mat& marked,
+                                                         const cv::Mat& walls, int size) {
+  const cv::Rect box = cv::boundingRect(outline);
+  cv::Mat inside = cv::Mat::zeros(box.size(), CV_8U);
+  cv::drawContours(inside, std::vector<std::vector<cv::Point>>{outline}, 0, 255, cv::FILLED,
+                   cv::LINE_8, cv::noArray(), 0, -box.tl());
+  if (cv::countNonZero(inside & walls(box)) == 0) return {outline};
+  inside.setTo(0, walls(box));
+  std::vector<std::vector<cv::Point>> sides, pieces;
+  cv::findContours(inside.clone(), sides, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
+  if (sides.size() <= 1) return {outline};
+  for (std::size_t k = 0; k < sides.size(); ++k) {
+    cv::Mat side = cv::Mat::zeros(box.size(), CV_8U), closed;
+    cv::drawContours(side, sides, static_cast<int>(k), 255, cv::FILLED);
+    cv::morphologyEx(side & marked(box), closed, cv::MORPH_CLOSE,
+                     cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
+    std::vector<std::vector<cv::Point>> found;
+    cv::findContours(closed, found, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE, box.tl());
+    pieces.insert(pieces.end(), found.begin(), found.end());
+  }
+  return pieces;
+}
+
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
 // piece, closed over gaps of join_gap, whose convex hull is at most max_area is filled
 // (fill_piece): the robot cannot drive under it within its height band. The marked cells of a
@@ -302,6 +330,10 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   const double cell_area = grid.resolution * grid.resolution;
   std::vector<int> sizes{cells_of(join_gap)};
   if (cells_of(kJoinAgainGap) < sizes.front()) sizes.push_back(cells_of(kJoinAgainGap));
+  cv::Mat walls = cv::Mat::zeros(left.size(), CV_8U);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      if (grid.classes(col, row) == SemanticClass::wall) walls.at<std::uint8_t>(row, col) = 255;
   for (const int size : sizes) {
     cv::Mat closed;
     cv::morphologyEx(left, closed, cv::MORPH_CLOSE,
@@ -316,14 +348,18 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
         cv::drawContours(too_large, pieces, static_cast<int>(k), 255, cv::FILLED);
         continue;
       }
-      // What the piece fills: with the free space, the rectangle around it, where that is
-      // furniture sized too; pieces joined in an L (a table and a cabinet beside it) have a hull
-      // of furniture size and a rectangle over the open floor between them.
-      if (free_space) {
-        std::vector<cv::Point> rectangle = rectangle_around(pieces[k]);
-        if (cv::contourArea(rectangle) * cell_area <= max_area) hull = std::move(rectangle);
+      for (const std::vector<cv::Point>& part :
+           pieces_between_walls(pieces[k], left, walls, size)) {
+        cv::convexHull(part, hull);
+        // What the piece fills: with the free space, the rectangle around it, where that is
+        // furniture sized too; pieces joined in an L (a table and a cabinet beside it) have a
+        // hull of furniture size and a rectangle over the open floor between them.
+        if (free_space) {
+          std::vector<cv::Point> rectangle = rectangle_around(part);
+          if (cv::contourArea(rectangle) * cell_area <= max_area) hull = std::move(rectangle);
+        }
+        fill_piece(grid, evidence, free_space, furniture, hull, furniture_weight);
       }
-      fill_piece(grid, evidence, free_space, furniture, hull, furniture_weight);
     }
     cv::bitwise_and(left, too_large, left);
   }
