@@ -423,6 +423,7 @@ TEST(SemanticGrid, FurnitureSpecksInsideAWallAreWall) {
   EXPECT_EQ(class_at(grid, 1.112, 2.062), std::pair(C::wall, false));
   EXPECT_EQ(class_at(grid, 1.5, 4.062), std::pair(C::wall, false));
   EXPECT_EQ(class_at(grid, 1.5, 4.012 + 0.12), std::pair(C::wall, false));
+  EXPECT_GE(grid.wall_specks, 2);
   // Where floor was seen beside them, such points are furniture against the wall.
   LabelledPoints against = two_rooms_with_a_wall_between();
   against.box_face({1.012, 3.912, 0.02}, {2.012, 3.912, 0.9}, C::furniture);

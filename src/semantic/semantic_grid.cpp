@@ -986,8 +986,8 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   const int max_wall = cells(options.max_wall_thickness);
   // First: a speck inside a wall would stop every fill across the wall below.
   if (max_wall > 0) {
-    detail::furniture_specks_in_walls(grid, max_wall, options.weights.of(SemanticClass::wall),
-                                      masks.furniture);
+    grid.wall_specks = detail::furniture_specks_in_walls(
+        grid, max_wall, options.weights.of(SemanticClass::wall), masks.furniture);
   }
   const int across =
       max_wall > 0 ? detail::two_sided_wall_thickness(grid, max_wall, kMinTwoSidedWallCells, true)
@@ -1130,6 +1130,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.wall_thickness = grid.wall_thickness;
   d.furniture_fronts = grid.furniture_fronts;
   d.furniture_pockets = grid.furniture_pockets;
+  d.wall_specks = grid.wall_specks;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);
