@@ -1,6 +1,7 @@
 #pragma once
 // Cell queries shared by the semantic grid's steps (semantic_grid.cpp, grid_walls.cpp,
 // grid_furniture.cpp).
+#include <array>
 #include <cmath>
 #include <vector>
 
@@ -9,6 +10,10 @@
 #include "kartograf/semantic/semantic_grid.hpp"
 
 namespace kartograf::semantic::detail {
+
+// The steps to a cell's four edge neighbours.
+inline const std::array<Eigen::Vector2i, 4> kFourNeighbours = {
+    Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0), Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)};
 
 // No view saw the cell (outside the grid: false).
 inline bool unobserved(const SemanticGrid& grid, const Eigen::Vector2i& c) {

@@ -132,8 +132,7 @@ namespace {
 // lie on its far side (a face on the cell boundary), seen through but for them. The wall faces'
 // placement judges it.
 bool beside_unobserved(const SemanticGrid& grid, const Eigen::Vector2i& cell) {
-  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
-                                      Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
+  for (const Eigen::Vector2i& step : kFourNeighbours) {
     if (unobserved(grid, cell + step)) return true;
   }
   return false;

@@ -34,6 +34,15 @@ struct Pieces {
   std::vector<std::vector<cv::Point>> cells;  // index = label; 0 is the background
 };
 
+// The cells seen as `wanted`, as a mask (255).
+cv::Mat seen_mask(const SemanticGrid& grid, SemanticClass wanted) {
+  cv::Mat mask(grid.height(), grid.width(), CV_8U);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      mask.at<std::uint8_t>(row, col) = seen_as(grid, {col, row}, wanted) ? 255 : 0;
+  return mask;
+}
+
 Pieces pieces_of(const cv::Mat& mask) {
   Pieces p;
   const int count = cv::connectedComponents(mask, p.labels, 8, CV_32S);
@@ -60,10 +69,8 @@ bool furniture_sized(const std::vector<cv::Point>& cells, double resolution, dou
 bool faces_floor(const SemanticGrid& grid, const std::vector<cv::Point>& cells) {
   std::size_t facing = 0;
   for (const cv::Point& c : cells) {
-    for (const cv::Point d :
-         {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
-      const cv::Point n = c + d;
-      if (seen_as(grid, {n.x, n.y}, SemanticClass::floor)) {
+    for (const Eigen::Vector2i& d : kFourNeighbours) {
+      if (seen_as(grid, Eigen::Vector2i(c.x, c.y) + d, SemanticClass::floor)) {
         ++facing;
         break;
       }
@@ -77,9 +84,9 @@ template <typename Visit>
 void for_each_neighbour(const SemanticGrid& grid, const std::vector<cv::Point>& cells,
                         Visit&& visit) {
   for (const cv::Point& c : cells) {
-    for (const cv::Point d :
-         {cv::Point(1, 0), cv::Point(-1, 0), cv::Point(0, 1), cv::Point(0, -1)}) {
-      if (grid.contains({(c + d).x, (c + d).y})) visit(c + d);
+    for (const Eigen::Vector2i& d : kFourNeighbours) {
+      const cv::Point n = c + cv::Point(d.x(), d.y());
+      if (grid.contains({n.x, n.y})) visit(n);
     }
   }
 }
@@ -194,11 +201,7 @@ struct WallPieces {
 };
 
 WallPieces wall_pieces(const SemanticGrid& grid, double max_extent, double max_area) {
-  cv::Mat wall_mask(grid.height(), grid.width(), CV_8U);
-  for (int row = 0; row < grid.height(); ++row)
-    for (int col = 0; col < grid.width(); ++col)
-      wall_mask.at<std::uint8_t>(row, col) = is_wall(grid, col, row) ? 255 : 0;
-  WallPieces w{pieces_of(wall_mask), {}, {}};
+  WallPieces w{pieces_of(seen_mask(grid, SemanticClass::wall)), {}, {}};
   w.long_wall.resize(w.pieces.cells.size());
   w.front_like.resize(w.pieces.cells.size());
   for (std::size_t k = 1; k < w.pieces.cells.size(); ++k) {
@@ -322,15 +325,12 @@ constexpr int kNoiseLayerCells = 2;
 
 // Whether wall closes every row of the piece at both ends (`step` (1, 0)), or every column
 // (`step` (0, 1)): the piece lies inside a wall's line.
-bool walled_in(const SemanticGrid& grid, const std::vector<cv::Point>& piece,
+bool walled_in(const SemanticGrid& grid, const Pieces& pieces, int label,
                const Eigen::Vector2i& step) {
-  std::set<std::pair<int, int>> cells;
-  for (const cv::Point& c : piece) cells.insert({c.x, c.y});
-  for (const cv::Point& c : piece) {
-    const Eigen::Vector2i cell(c.x, c.y);
+  for (const cv::Point& c : pieces.cells[static_cast<std::size_t>(label)]) {
     for (const int sign : {-1, 1}) {
-      const Eigen::Vector2i n = cell + sign * step;
-      if (cells.count({n.x(), n.y()})) continue;
+      const Eigen::Vector2i n = Eigen::Vector2i(c.x, c.y) + sign * step;
+      if (grid.contains(n) && pieces.labels.at<int>(n.y(), n.x()) == label) continue;
       if (!is_wall(grid, n.x(), n.y())) return false;
     }
   }
@@ -368,18 +368,15 @@ bool floor_around(const SemanticGrid& grid, const std::vector<cv::Point>& cells)
 
 int furniture_specks_in_walls(SemanticGrid& grid, int max_cells, float weight,
                               Image<std::uint8_t>& furniture) {
-  cv::Mat seen = cv::Mat::zeros(grid.height(), grid.width(), CV_8U);
-  for (int row = 0; row < grid.height(); ++row)
-    for (int col = 0; col < grid.width(); ++col)
-      if (seen_as(grid, {col, row}, SemanticClass::furniture))
-        seen.at<std::uint8_t>(row, col) = 255;
-  const Pieces pieces = pieces_of(seen);
+  const Pieces pieces = pieces_of(seen_mask(grid, SemanticClass::furniture));
   int specks = 0;
   for (std::size_t p = 1; p < pieces.cells.size(); ++p) {
     const std::vector<cv::Point>& piece = pieces.cells[p];
     if (floor_around(grid, piece)) continue;
-    const bool small_in_line = piece.size() <= static_cast<std::size_t>(max_cells) &&
-                               (walled_in(grid, piece, {1, 0}) || walled_in(grid, piece, {0, 1}));
+    const int label = static_cast<int>(p);
+    const bool small_in_line =
+        piece.size() <= static_cast<std::size_t>(max_cells) &&
+        (walled_in(grid, pieces, label, {1, 0}) || walled_in(grid, pieces, label, {0, 1}));
     if (!small_in_line && !hugs_wall(grid, piece, kNoiseLayerCells)) continue;
     ++specks;
     for (const cv::Point& c : piece) {

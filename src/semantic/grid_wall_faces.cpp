@@ -67,14 +67,12 @@ bool wall_or_unseen(const SemanticGrid& grid, const Eigen::Vector2i& c) {
 int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
                      const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights) {
   const double res = grid.resolution;
-  const std::array<Eigen::Vector2i, 4> steps = {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
-                                                Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)};
   int moved = 0;
   for (int row = 0; row < grid.height(); ++row) {
     for (int col = 0; col < grid.width(); ++col) {
       const Eigen::Vector2i c(col, row);
       if (!seen_as(grid, c, SemanticClass::wall) || !floor_seen(col, row)) continue;
-      for (const Eigen::Vector2i& step : steps) {
+      for (const Eigen::Vector2i& step : kFourNeighbours) {
         // Two cells of wall stay behind (a wall is thicker than a cell; one cell of it lets the
         // rooms leak diagonally), so the two faces of a thin wall never both move in. In scan
         // order: the first face judged wins.

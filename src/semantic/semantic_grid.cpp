@@ -330,10 +330,10 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   const double cell_area = grid.resolution * grid.resolution;
   std::vector<int> sizes{cells_of(join_gap)};
   if (cells_of(kJoinAgainGap) < sizes.front()) sizes.push_back(cells_of(kJoinAgainGap));
-  cv::Mat walls = cv::Mat::zeros(left.size(), CV_8U);
-  for (int row = 0; row < grid.height(); ++row)
-    for (int col = 0; col < grid.width(); ++col)
-      if (grid.classes(col, row) == SemanticClass::wall) walls.at<std::uint8_t>(row, col) = 255;
+  const cv::Mat walls =
+      closed_cell_mask(
+          grid, [&](int col, int row) { return grid.classes(col, row) == SemanticClass::wall; }, 1)
+          .mask;
   for (const int size : sizes) {
     cv::Mat closed;
     cv::morphologyEx(left, closed, cv::MORPH_CLOSE,
@@ -455,8 +455,7 @@ void fill_floor_holes(SemanticGrid& grid, double max_area, float weight) {
     if (hole.size() > max_cells) continue;
     bool enclosed = true;
     for (const Eigen::Vector2i& c : hole) {
-      for (const Eigen::Vector2i& d : {Eigen::Vector2i(1, 0), Eigen::Vector2i(-1, 0),
-                                       Eigen::Vector2i(0, 1), Eigen::Vector2i(0, -1)}) {
+      for (const Eigen::Vector2i& d : detail::kFourNeighbours) {
         const Eigen::Vector2i n = c + d;
         enclosed &= grid.contains(n) &&
                     (detail::unobserved(grid, n) || detail::seen_as(grid, n, SemanticClass::floor));
