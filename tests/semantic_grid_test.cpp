@@ -477,6 +477,33 @@ TEST(SemanticGrid, AnOuterWallHiddenBehindACabinetRunsOnBehindIt) {
             std::pair(C::unknown, true));
 }
 
+// The same cabinet standing against the outer wall, its top's points reaching into the wall's
+// face row (the depth noise of its back): furniture does not stand in a wall's line, so the line
+// runs on through those cells too, and the cabinet in front of it stays furniture.
+TEST(SemanticGrid, FurnitureInTheLineOfAWallHiddenBehindItIsWall) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);
+  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 2.162; y <= 4.012; y += 0.02) {
+      if (!(x > 1.5 && x < 2.5 && y > 3.9)) s.add({x, y, 0}, C::floor);
+    }
+  }
+  s.box_face({0.012, 4.012, 0.02}, {1.492, 4.012, 1.4}, C::wall);
+  s.box_face({2.532, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);
+  s.box_face({1.512, 3.912, 0.02}, {2.512, 3.912, 0.9}, C::furniture);  // the front
+  s.box_face({1.512, 3.912, 0.9}, {2.512, 4.032, 0.9}, C::furniture);   // the top
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double x : {1.7, 2.0, 2.3}) {
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.02), std::pair(C::wall, false)) << "x " << x;
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.12), std::pair(C::wall, false)) << "x " << x;
+    EXPECT_EQ(class_at(grid, x, 3.952).first, C::furniture) << "x " << x;
+  }
+  EXPECT_GE(grid.furniture_in_wall_lines, 15);
+}
+
 // With an outer east wall too, the block where the two outer walls meet, which no view sees, is
 // wall as thick as their backs; without the backs it stays unseen.
 TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {

@@ -70,7 +70,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
   json["inferred"] = {{"wall_thickness_m", d.wall_thickness ? Json(*d.wall_thickness) : Json()},
                       {"furniture_fronts", d.furniture_fronts},
                       {"furniture_pockets", d.furniture_pockets},
-                      {"wall_specks", d.wall_specks}};
+                      {"wall_specks", d.wall_specks},
+                      {"furniture_in_wall_lines", d.furniture_in_wall_lines}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

@@ -219,8 +219,8 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
   }
 }
 
-void wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
-                                 float weight) {
+int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                                float weight, Image<std::uint8_t>& furniture) {
   const auto hidden = [&](const Eigen::Vector2i& c) {
     return unobserved(grid, c) || seen_as(grid, c, SemanticClass::furniture);
   };
@@ -243,15 +243,19 @@ void wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyo
         if (gap > max_gap_cells || !furniture || !seen_as(grid, c, SemanticClass::wall) ||
             wall_run(grid, c, step, beyond_cells) < beyond_cells)
           continue;
-        for (Eigen::Vector2i k = start + step; k != c; k += step)
-          if (unobserved(grid, k)) bridged.push_back(k);
+        for (Eigen::Vector2i k = start + step; k != c; k += step) bridged.push_back(k);
       }
     }
   }
+  int from_furniture = 0;
   for (const Eigen::Vector2i& c : bridged) {
+    if (seen_as(grid, c, SemanticClass::wall)) continue;  // bridged along both axes
+    from_furniture += seen_as(grid, c, SemanticClass::furniture) ? 1 : 0;
     grid.classes(c.x(), c.y()) = SemanticClass::wall;
     grid.weight(c.x(), c.y()) = weight;
+    furniture(c.x(), c.y()) = 0;
   }
+  return from_furniture;
 }
 
 }  // namespace kartograf::semantic::detail

@@ -46,9 +46,12 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight);
 // A wall line hidden behind furniture: along a row or a column, a gap of at most `max_gap_cells`
 // unseen or furniture cells, with furniture within `beyond_cells` across it, between two wall
 // cells from which the wall runs on for at least `beyond_cells` each way (more than a wall is
-// thick, so that the line is a wall's length, not another wall's thickness); its unseen cells are
-// wall.
-void wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
-                                 float weight);
+// thick, so that the line is a wall's length, not another wall's thickness), is wall: its unseen
+// cells, and its furniture cells (the wall's face seen above the furniture, which the views left
+// unlabelled in a region the furniture cut small, or the furniture's back in the noise of the face:
+// furniture stands in front of a wall, not in its line); `furniture` unmarks those. Returns the
+// furniture cells made wall.
+int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                                float weight, Image<std::uint8_t>& furniture);
 
 }  // namespace kartograf::semantic::detail

@@ -1043,8 +1043,9 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
     detail::fill_wall_corners(grid, thickness, options.weights.of(SemanticClass::wall));
   // Last: the backs and corners above make the wall lines whose hidden stretches it joins.
   if (options.back_one_sided_walls && max_wall > 0 && options.furniture_max_extent > 0)
-    detail::wall_lines_behind_furniture(grid, cells(options.furniture_max_extent), max_wall + 1,
-                                        options.weights.of(SemanticClass::wall));
+    grid.furniture_in_wall_lines = detail::wall_lines_behind_furniture(
+        grid, cells(options.furniture_max_extent), max_wall + 1,
+        options.weights.of(SemanticClass::wall), masks.furniture);
   if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
 }
 
@@ -1130,6 +1131,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.furniture_fronts = grid.furniture_fronts;
   d.furniture_pockets = grid.furniture_pockets;
   d.wall_specks = grid.wall_specks;
+  d.furniture_in_wall_lines = grid.furniture_in_wall_lines;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);
