@@ -128,6 +128,11 @@ SemanticClass class_at(const SemanticGrid& grid, double x, double y) {
   return grid.classes(c.x(), c.y());
 }
 
+// Six places at 1 m height around the 5 x 4 m room, over 1 m from its middle.
+std::vector<Eigen::Vector3d> six_places() {
+  return {{0.8, 0.5, 1}, {4.4, 0.5, 1}, {4.4, 3.5, 1}, {0.8, 3.5, 1}, {0.6, 2.0, 1}, {4.6, 2.0, 1}};
+}
+
 // A 5 x 4 m room with a 1.2 x 0.8 m table (top 0.72-0.76 m, 5 cm legs) seen from six places at
 // 1 m height, all over 1 m from it: its top is too grazing to return, its edges come back as
 // "wall" (as the views label a 4 cm strip cut by the image), its legs as unknown.
@@ -137,10 +142,7 @@ Views table_seen_from_six_places(bool mixed_pixels) {
   for (const double x : {2.04, 3.11})
     for (const double y : {1.64, 2.31})
       scene.push_back({{x, y, 0}, {x + 0.05, y + 0.05, 0.72}, C::unknown, C::unknown});
-  return look(
-      scene,
-      {{0.8, 0.5, 1}, {4.4, 0.5, 1}, {4.4, 3.5, 1}, {0.8, 3.5, 1}, {0.6, 2.0, 1}, {4.6, 2.0, 1}},
-      {}, mixed_pixels);
+  return look(scene, six_places(), {}, mixed_pixels);
 }
 
 TEST(SemanticGridFreeSpace, TheFloorUnderATableWhoseTopNoViewReturnedIsFurniture) {
@@ -158,6 +160,28 @@ TEST(SemanticGridFreeSpace, TheFloorUnderATableWhoseTopNoViewReturnedIsFurniture
   const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
   EXPECT_EQ(class_at(blind, 2.01, 2.0), C::wall);
   EXPECT_EQ(class_at(blind, 2.6, 2.0), C::floor);
+}
+
+// A low cabinet (1 x 0.5 m, 0.7 m high) whose sides the views label wall (vertical faces standing
+// on the floor, as a cabinet's front is labelled) and whose top they label furniture. Walls reach
+// the ceiling; the views saw through these sides' cells just above their top: they are the
+// cabinet's, and furniture with it. The room's walls stay walls. Without the origins the sides are
+// walls.
+TEST(SemanticGridFreeSpace, WallCellsSeenThroughAboveTheirTopAreALowCabinets) {
+  std::vector<Box> scene = room();
+  scene.push_back({{2.0, 1.5, 0}, {3.0, 2.0, 0.7}, C::furniture, C::wall});
+  const Views v = look(scene, six_places());
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  EXPECT_EQ(class_at(grid, 2.01, 1.75), C::furniture);  // the west side
+  EXPECT_EQ(class_at(grid, 2.5, 1.51), C::furniture);   // the south side
+  EXPECT_EQ(class_at(grid, 2.5, 1.75), C::furniture);   // the top
+  EXPECT_EQ(class_at(grid, 2.5, 1.2), C::floor);
+  EXPECT_EQ(class_at(grid, -0.025, 2.0), C::wall);  // the room's walls
+  EXPECT_EQ(class_at(grid, 2.5, 4.025), C::wall);
+
+  const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
+  EXPECT_EQ(class_at(blind, 2.01, 1.75), C::wall);
 }
 
 // Furniture cells inside the room (0.25 m from its walls) and over 0.1 m from the table of the

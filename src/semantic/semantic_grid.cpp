@@ -40,6 +40,9 @@ constexpr double kTopDepth = 0.04;
 // Wall cells whose points start this high above the floor, and that the views saw through below
 // them (to kBelowWall under their lowest point), stand on nothing: a table's edge, not a wall.
 constexpr double kRaisedWall = 0.3, kBelowWall = 0.05;
+// Wall cells are judged seen through this far above their highest point (the noise on it), in a
+// slab kTopDepth thick.
+constexpr double kAboveWall = 0.05;
 
 constexpr std::size_t index_of(SemanticClass c) {
   return static_cast<std::size_t>(c);
@@ -210,15 +213,28 @@ bool open_beside(const detail::BandFreeSpace& free_space, const std::array<doubl
   });
 }
 
-// Wall cells that the views saw under (a table's edge or a shelf board the views took for a wall:
-// walls stand on the floor) become unclassified obstacles, for the furniture passes to judge.
+// Wall cells that stand on nothing or reach no higher than a cabinet: the views saw under them
+// (a table's edge or a shelf board the views took for a wall: walls stand on the floor), or saw
+// through them just above their highest point (a low cabinet's front or side, which the views
+// label as they label a wall: walls reach the ceiling, and no ray crosses a wall above its top).
+// Views that look across a room see its walls above their own eye height, beyond what they
+// observe, so a wall's cells are seldom judged above at all.
+bool wall_stands_apart(const CellEvidence& e, double floor_z,
+                       const detail::BandFreeSpace& free_space, const Eigen::Vector2i& cell) {
+  const double lowest = e.z_min - floor_z, highest = e.z_max - floor_z;
+  if (lowest >= kRaisedWall && free_space.clear_below(cell, lowest - kBelowWall)) return true;
+  const double above = highest + kAboveWall;
+  return std::isfinite(highest) && free_space.observable(above + kTopDepth) &&
+         free_space.clear_between(cell, above, above + kTopDepth);
+}
+
+// Such wall cells become unclassified obstacles, for the furniture passes to judge.
 void raised_walls_to_unclassified(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                                   const detail::BandFreeSpace& free_space, float weight) {
   for (int row = 0; row < grid.height(); ++row) {
     for (int col = 0; col < grid.width(); ++col) {
-      const double lowest = evidence(col, row).z_min - grid.floor_z;
-      if (grid.classes(col, row) != SemanticClass::wall || !(lowest >= kRaisedWall) ||
-          !free_space.clear_below({col, row}, lowest - kBelowWall))
+      if (grid.classes(col, row) != SemanticClass::wall ||
+          !wall_stands_apart(evidence(col, row), grid.floor_z, free_space, {col, row}))
         continue;
       grid.classes(col, row) = SemanticClass::unknown;
       grid.weight(col, row) = weight;
