@@ -447,10 +447,9 @@ TEST(SemanticGrid, FurnitureIsNotFilledAcrossAWall) {
   EXPECT_EQ(class_at(grid, 1.112, 1.752), std::pair(C::floor, false));
 }
 
-// The outer north wall is seen but for 1 m behind a cabinet standing 0.1 m in front of it (its
-// front seen as furniture): the wall line runs on through the hidden stretch, as thick as on
-// either side of it. Without the backs (back_one_sided_walls off) the stretch stays unseen.
-TEST(SemanticGrid, AnOuterWallHiddenBehindACabinetRunsOnBehindIt) {
+// Two rooms, the north one's outer north wall seen but for 1 m behind a cabinet whose front stands
+// 0.1 m in front of it (x 1.5-2.5), and whose floor no view saw behind that front.
+LabelledPoints outer_wall_behind_a_cabinet() {
   using C = SemanticClass;
   LabelledPoints s;
   s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);      // south room
@@ -464,6 +463,15 @@ TEST(SemanticGrid, AnOuterWallHiddenBehindACabinetRunsOnBehindIt) {
   s.box_face({0.012, 4.012, 0.02}, {1.492, 4.012, 1.4}, C::wall);  // the outer north wall
   s.box_face({2.532, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  //   but behind the cabinet
   s.box_face({1.512, 3.912, 0.02}, {2.512, 3.912, 0.9}, C::furniture);
+  return s;
+}
+
+// The outer north wall is seen but for 1 m behind a cabinet standing 0.1 m in front of it (its
+// front seen as furniture): the wall line runs on through the hidden stretch, as thick as on
+// either side of it. Without the backs (back_one_sided_walls off) the stretch stays unseen.
+TEST(SemanticGrid, AnOuterWallHiddenBehindACabinetRunsOnBehindIt) {
+  using C = SemanticClass;
+  const LabelledPoints s = outer_wall_behind_a_cabinet();
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   EXPECT_EQ(class_at(grid, 1.0, 4.012 + 0.12), std::pair(C::wall, false));  // a back, beside it
   for (const double x : {1.7, 2.0, 2.3}) {
@@ -482,19 +490,8 @@ TEST(SemanticGrid, AnOuterWallHiddenBehindACabinetRunsOnBehindIt) {
 // runs on through those cells too, and the cabinet in front of it stays furniture.
 TEST(SemanticGrid, FurnitureInTheLineOfAWallHiddenBehindItIsWall) {
   using C = SemanticClass;
-  LabelledPoints s;
-  s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);
-  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);
-  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
-  for (double x = 0.012; x <= 4.012; x += 0.02) {
-    for (double y = 2.162; y <= 4.012; y += 0.02) {
-      if (!(x > 1.5 && x < 2.5 && y > 3.9)) s.add({x, y, 0}, C::floor);
-    }
-  }
-  s.box_face({0.012, 4.012, 0.02}, {1.492, 4.012, 1.4}, C::wall);
-  s.box_face({2.532, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);
-  s.box_face({1.512, 3.912, 0.02}, {2.512, 3.912, 0.9}, C::furniture);  // the front
-  s.box_face({1.512, 3.912, 0.9}, {2.512, 4.032, 0.9}, C::furniture);   // the top
+  LabelledPoints s = outer_wall_behind_a_cabinet();
+  s.box_face({1.512, 3.912, 0.9}, {2.512, 4.032, 0.9}, C::furniture);  // the top
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   for (const double x : {1.7, 2.0, 2.3}) {
     EXPECT_EQ(class_at(grid, x, 4.012 + 0.02), std::pair(C::wall, false)) << "x " << x;
