@@ -162,26 +162,38 @@ TEST(SemanticGridFreeSpace, TheFloorUnderATableWhoseTopNoViewReturnedIsFurniture
   EXPECT_EQ(class_at(blind, 2.6, 2.0), C::floor);
 }
 
-// A low cabinet (1 x 0.5 m, 0.7 m high) whose sides the views label wall (vertical faces standing
+// A cabinet (1 x 0.5 m, 0.7 m high) whose sides the views label wall (vertical faces standing
 // on the floor, as a cabinet's front is labelled) and whose top they label furniture. Walls reach
 // the ceiling; the views saw through these sides' cells just above their top: they are the
 // cabinet's, and furniture with it. The room's walls stay walls. Without the origins the sides are
 // walls.
-TEST(SemanticGridFreeSpace, WallCellsSeenThroughAboveTheirTopAreALowCabinets) {
+void expect_a_cabinet_not_walls(double height) {
   std::vector<Box> scene = room();
-  scene.push_back({{2.0, 1.5, 0}, {3.0, 2.0, 0.7}, C::furniture, C::wall});
+  scene.push_back({{2.0, 1.5, 0}, {3.0, 2.0, height}, C::furniture, C::wall});
   const Views v = look(scene, six_places());
   const SemanticGrid grid =
       build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
   EXPECT_EQ(class_at(grid, 2.01, 1.75), C::furniture);  // the west side
+  EXPECT_EQ(class_at(grid, 2.99, 1.75), C::furniture);  // the east side
   EXPECT_EQ(class_at(grid, 2.5, 1.51), C::furniture);   // the south side
   EXPECT_EQ(class_at(grid, 2.5, 1.75), C::furniture);   // the top
   EXPECT_EQ(class_at(grid, 2.5, 1.2), C::floor);
   EXPECT_EQ(class_at(grid, -0.025, 2.0), C::wall);  // the room's walls
   EXPECT_EQ(class_at(grid, 2.5, 4.025), C::wall);
+  EXPECT_EQ(class_at(grid, 5.025, 2.0), C::wall);
 
   const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
   EXPECT_EQ(class_at(blind, 2.01, 1.75), C::wall);
+}
+
+TEST(SemanticGridFreeSpace, WallCellsSeenThroughAboveTheirTopAreALowCabinets) {
+  expect_a_cabinet_not_walls(0.7);
+}
+
+// The same cabinet 1.1 m high, its top above the views' eyes (1 m): the rays that cross just
+// above it rise from across the room, fewer than below the eyes, but they do.
+TEST(SemanticGridFreeSpace, ACabinetTallerThanTheViewsEyesIsNoWall) {
+  expect_a_cabinet_not_walls(1.1);
 }
 
 // Furniture cells inside the room (0.25 m from its walls) and over 0.1 m from the table of the

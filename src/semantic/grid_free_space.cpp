@@ -111,6 +111,18 @@ int BandFreeSpace::passes(const Eigen::Vector2i& cell, double height) const {
   return v ? passes_[*v] : 0;
 }
 
+int BandFreeSpace::fewest_passes(const Eigen::Vector2i& cell, double low, double high) const {
+  const int bottom = std::max(slab_of(low), 0), top = slab_of(high);
+  if (!grid_.contains(cell) || top < bottom || top >= kSlabs) return 0;
+  const std::size_t index =
+      static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
+      static_cast<std::size_t>(cell.x());
+  int fewest = std::numeric_limits<int>::max();
+  for (int slab = bottom; slab <= top; ++slab)
+    fewest = std::min<int>(fewest, passes_[index * kSlabs + static_cast<std::size_t>(slab)]);
+  return fewest;
+}
+
 bool BandFreeSpace::observable(double height) const {
   const int slab = slab_of(height);
   return slab >= 0 && slab < kSlabs && height < eye_height_ - kEyeMargin;

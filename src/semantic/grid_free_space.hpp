@@ -39,6 +39,9 @@ class BandFreeSpace {
   // observable height from `low` (clamped to the band's bottom) up to `high`. False when no such
   // height is observable.
   bool clear_between(const Eigen::Vector2i& cell, double low, double high) const;
+  // The fewest rays that crossed `cell` in a slab from `low` up to `high`, at any height, the
+  // unobservable ones too; 0 when a slab of them lies outside the tracked ones.
+  int fewest_passes(const Eigen::Vector2i& cell, double low, double high) const;
   // ... from the band's bottom: nothing stands there below `height`.
   bool clear_below(const Eigen::Vector2i& cell, double height) const {
     return clear_between(cell, band_min_, height);

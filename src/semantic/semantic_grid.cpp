@@ -43,6 +43,10 @@ constexpr double kRaisedWall = 0.3, kBelowWall = 0.05;
 // Wall cells are judged seen through this far above their highest point (the noise on it), in a
 // slab kTopDepth thick.
 constexpr double kAboveWall = 0.05;
+// Above the heights the views observe, few rays pass and each counts: a slab is judged seen
+// through there when this many crossed it (twice the two asked below the eyes, where one stray
+// ray of many may cross a surface's noise).
+constexpr int kRaysAboveTheEyes = 4;
 
 constexpr std::size_t index_of(SemanticClass c) {
   return static_cast<std::size_t>(c);
@@ -217,15 +221,18 @@ bool open_beside(const detail::BandFreeSpace& free_space, const std::array<doubl
 // (a table's edge or a shelf board the views took for a wall: walls stand on the floor), or saw
 // through them just above their highest point (a low cabinet's front or side, which the views
 // label as they label a wall: walls reach the ceiling, and no ray crosses a wall above its top).
-// Views that look across a room see its walls above their own eye height, beyond what they
-// observe, so a wall's cells are seldom judged above at all.
+// A cabinet's top is often above the views' eyes (a camera 1 m up, a cabinet 0.9-1.3 m tall):
+// the rays that cross just above it then rise from the far side of the room to the wall behind it,
+// few but enough to judge it by (kRaysAboveTheEyes).
 bool wall_stands_apart(const CellEvidence& e, double floor_z,
                        const detail::BandFreeSpace& free_space, const Eigen::Vector2i& cell) {
   const double lowest = e.z_min - floor_z, highest = e.z_max - floor_z;
   if (lowest >= kRaisedWall && free_space.clear_below(cell, lowest - kBelowWall)) return true;
+  if (!std::isfinite(highest)) return false;
   const double above = highest + kAboveWall;
-  return std::isfinite(highest) && free_space.observable(above + kTopDepth) &&
-         free_space.clear_between(cell, above, above + kTopDepth);
+  if (free_space.observable(above + kTopDepth))
+    return free_space.clear_between(cell, above, above + kTopDepth);
+  return free_space.fewest_passes(cell, above, above + kTopDepth) >= kRaysAboveTheEyes;
 }
 
 // Such wall cells become unclassified obstacles, for the furniture passes to judge.
