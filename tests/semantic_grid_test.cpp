@@ -501,6 +501,22 @@ TEST(SemanticGrid, FurnitureInTheLineOfAWallHiddenBehindItIsWall) {
   EXPECT_GE(grid.furniture_in_wall_lines, 15);
 }
 
+// The same, with a few floor points seen in the wall's back 0.2 m west of the cabinet (noise
+// through the wall): the back's row beside the cabinet runs on too short to bridge, but the line's
+// face has a back of its own, as thick as the wall's beside it.
+TEST(SemanticGrid, AWallLineHiddenBehindFurnitureHasABack) {
+  using C = SemanticClass;
+  LabelledPoints s = outer_wall_behind_a_cabinet();
+  s.box_face({1.512, 3.912, 0.9}, {2.512, 4.032, 0.9}, C::furniture);  // the top
+  for (int k = 0; k < 6; ++k) s.add({1.262 + 0.005 * k, 4.112, 0}, C::floor);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 1.262, 4.112).first, C::floor);
+  for (const double x : {1.7, 2.0, 2.3}) {
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.02), std::pair(C::wall, false)) << "x " << x;
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.12), std::pair(C::wall, false)) << "x " << x;
+  }
+}
+
 // With an outer east wall too, the block where the two outer walls meet, which no view sees, is
 // wall as thick as their backs; without the backs it stays unseen.
 TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {

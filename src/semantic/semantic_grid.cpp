@@ -1069,6 +1069,9 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
     grid.furniture_in_wall_lines = detail::wall_lines_behind_furniture(
         grid, cells(options.furniture_max_extent), max_wall + 1,
         options.weights.of(SemanticClass::wall), masks.furniture);
+  // The lines' faces have their backs too, where the backs beside them were too short to bridge
+  // (a cell no view saw, or a speck seen, ends a back's row).
+  detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
   if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
 }
 
