@@ -317,6 +317,39 @@ TEST(SemanticGridFreeSpace, AFarWallsLayerThatNearerViewsSeeThroughIsFloor) {
   EXPECT_EQ(class_at(blind, 4.925, 2.0), C::wall);
 }
 
+// Views along the room's east wall (x = 5), and a few of its points spilled into the cell in front
+// of it for a metre (y 1.5-2.5), as a depth camera's noise spreads a face: the cell holds the
+// floor the views saw there and rays cross it at every height, beside the wall's own cells with a
+// hundred times its points. It is the face's spill: floor, and the wall stays wall. The faces'
+// placement, which frees such cells when their points lie on the cell boundary, is off. Without
+// the rule (face_spill_ratio 0) or the origins they are an obstacle of their own.
+TEST(SemanticGridFreeSpace, AWallFacesSpillIntoTheCellInFrontIsFloor) {
+  std::vector<Eigen::Vector3d> places = six_places();
+  for (const double y : {0.9, 1.6, 2.4, 3.1}) places.push_back({4.75, y, 1});
+  Views v = look(room(), places);
+  for (double y = 1.5; y < 2.5; y += 0.025) {
+    for (double z = 0.12; z < 1.4; z += 0.1) {
+      v.points.push_back({4.975, y, z});
+      v.labels.push_back(C::wall);
+      v.ids.push_back(v.points.size() % 2 == 0 ? 6 : 7);
+    }
+  }
+  SemanticGridParams params = every_ray();
+  params.min_obstacle_floor_ratio = 0;
+  params.place_wall_faces = false;
+  const SemanticGrid grid = build_semantic_grid(v.points, v.labels, params, {}, v.ids, v.origins);
+  for (const double y : {1.7, 2.0, 2.3}) {
+    EXPECT_EQ(class_at(grid, 4.975, y), C::floor) << "the spill at y " << y;
+    EXPECT_EQ(class_at(grid, 5.025, y), C::wall) << "the wall at y " << y;
+  }
+  SemanticGridParams off = params;
+  off.face_spill_ratio = 0;
+  const SemanticGrid kept = build_semantic_grid(v.points, v.labels, off, {}, v.ids, v.origins);
+  EXPECT_EQ(class_at(kept, 4.975, 2.0), C::wall);
+  const SemanticGrid blind = build_semantic_grid(v.points, v.labels, params, {}, v.ids);
+  EXPECT_EQ(class_at(blind, 4.975, 2.0), C::wall);
+}
+
 // Bad free-space options and origins that do not match the views are refused.
 TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
   const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};
@@ -337,6 +370,9 @@ TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
   p = {};
   p.seen_through_wall_range = -1;
   EXPECT_THROW(p.validate(), Error);
+  p = {};
+  p.face_spill_ratio = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_ERROR_MENTIONS(p.validate(), "face_spill_ratio");
   p = {};
   p.phantom_pass_ratio = -1;
   EXPECT_ERROR_MENTIONS(p.validate(), "phantom_pass_ratio");

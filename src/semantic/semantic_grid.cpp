@@ -235,6 +235,42 @@ bool wall_stands_apart(const CellEvidence& e, double floor_z,
   return free_space.fewest_passes(cell, above, above + kTopDepth) >= kRaysAboveTheEyes;
 }
 
+// A wall's face puts its depth noise into the room cell in front of it: a few of the face's
+// points among the floor the views saw there, and rays crossing it at every height they observe.
+// Such a cell beside a wall cell with `ratio` times its band points is the face's spill, and floor
+// (a cell that stands on its own, a table's edge, has no such neighbour). The faces' placement
+// frees such cells when they are wall and the face's points lie on a cell boundary; this takes
+// those the views labelled otherwise (unclassified obstacles), and faces off the boundary.
+int free_face_spill(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                    const detail::BandFreeSpace& free_space, const Image<std::uint8_t>& floor_seen,
+                    double ratio, float floor_weight) {
+  const auto spill_of_a_face = [&](const Eigen::Vector2i& c) {
+    const int band = evidence(c.x(), c.y()).band_total();
+    for (const Eigen::Vector2i& step : detail::kFourNeighbours) {
+      const Eigen::Vector2i n = c + step;
+      if (grid.contains(n) && grid.classes(n.x(), n.y()) == SemanticClass::wall &&
+          evidence(n.x(), n.y()).band_total() >= ratio * band)
+        return true;
+    }
+    return false;
+  };
+  std::vector<Eigen::Vector2i> freed;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2i c(col, row);
+      const bool obstacle =
+          grid.classes(col, row) == SemanticClass::wall || detail::unclassified_obstacle(grid, c);
+      if (obstacle && floor_seen(col, row) && free_space.clear_throughout(c) && spill_of_a_face(c))
+        freed.push_back(c);
+    }
+  }
+  for (const Eigen::Vector2i& c : freed) {
+    grid.classes(c.x(), c.y()) = SemanticClass::floor;
+    grid.weight(c.x(), c.y()) = floor_weight;
+  }
+  return static_cast<int>(freed.size());
+}
+
 // Such wall cells become unclassified obstacles, for the furniture passes to judge.
 void raised_walls_to_unclassified(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                                   const detail::BandFreeSpace& free_space, float weight) {
@@ -948,6 +984,8 @@ void SemanticGridParams::validate() const {
           "SemanticGridParams: free_space_end_margin must be >= 0");
   require(std::isfinite(seen_through_wall_range) && seen_through_wall_range >= 0,
           "SemanticGridParams: seen_through_wall_range must be >= 0");
+  require(std::isfinite(face_spill_ratio) && face_spill_ratio >= 0,
+          "SemanticGridParams: face_spill_ratio must be >= 0");
   require(min_door_width > 0 && min_door_width < max_door_width,
           "SemanticGridParams: need 0 < min_door_width < max_door_width");
   weights.validate();
@@ -1110,6 +1148,10 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
           grid, *free_space,
           detail::nearest_wall_ranges(grid, points, labels, view_ids, view_origins, options),
           floor_seen(evidence, options), masks.furniture, options);
+    }
+    if (options.face_spill_ratio > 0) {
+      free_face_spill(grid, evidence, *free_space, floor_seen(evidence, options),
+                      options.face_spill_ratio, options.weights.of(SemanticClass::floor));
     }
   }
   if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);

@@ -134,6 +134,11 @@ struct SemanticGridParams {
   // it), with floor seen in them and no furniture beside them, are floor [m]. 0: off. At 3 m the
   // free space's own end margin, free_space_end_margin x (1 + range), is two cells.
   double seen_through_wall_range = 3.0;
+  // A wall or unclassified obstacle cell in which floor was seen and which was seen through at
+  // every observable height, beside a wall cell with at least this many times its band points, is
+  // floor: the depth noise of that wall's face spread into the room (a face's own cell holds its
+  // points by the thousand, the spill a few percent of them). 0: off.
+  double face_spill_ratio = 10.0;
   int free_space_ray_stride = 4;         // 0: no free space
   double free_space_slab = 0.02;         // m
   double free_space_end_margin = 0.025;  // m per m of range
