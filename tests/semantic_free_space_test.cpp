@@ -322,7 +322,7 @@ TEST(SemanticGridFreeSpace, AFarWallsLayerThatNearerViewsSeeThroughIsFloor) {
 // floor the views saw there and rays cross it at every height, beside the wall's own cells with a
 // hundred times its points. It is the face's spill: floor, and the wall stays wall. The faces'
 // placement, which frees such cells when their points lie on the cell boundary, is off. Without
-// the rule (face_spill_ratio 0) or the origins they are an obstacle of their own.
+// the rule (face_spill_ratio 0) or the origins they are wall.
 TEST(SemanticGridFreeSpace, AWallFacesSpillIntoTheCellInFrontIsFloor) {
   std::vector<Eigen::Vector3d> places = six_places();
   for (const double y : {0.9, 1.6, 2.4, 3.1}) places.push_back({4.75, y, 1});

@@ -501,7 +501,7 @@ TEST(SemanticGrid, FurnitureInTheLineOfAWallHiddenBehindItIsWall) {
   EXPECT_GE(grid.furniture_in_wall_lines, 15);
 }
 
-// The same, with a few floor points seen in the wall's back 0.2 m west of the cabinet (noise
+// The same, with a few floor points seen in the wall's back 0.25 m west of the cabinet (noise
 // through the wall): the back's row beside the cabinet runs on too short to bridge, but the line's
 // face has a back of its own, as thick as the wall's beside it.
 TEST(SemanticGrid, AWallLineHiddenBehindFurnitureHasABack) {
