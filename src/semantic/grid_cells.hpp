@@ -1,8 +1,9 @@
 #pragma once
-// Cell queries shared by the semantic grid's steps (semantic_grid.cpp, grid_walls.cpp,
-// grid_furniture.cpp).
+// Cell queries and updates shared by the semantic grid's steps (semantic_grid.cpp and the
+// grid_*.cpp files).
 #include <array>
 #include <cmath>
+#include <span>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,6 +30,15 @@ inline bool seen_as(const SemanticGrid& grid, const Eigen::Vector2i& c, Semantic
 inline bool unclassified_obstacle(const SemanticGrid& grid, const Eigen::Vector2i& c) {
   return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::unknown &&
          grid.weight(c.x(), c.y()) == 0.0f;
+}
+
+// Gives the cells class `c` with its weight.
+inline void set_class(SemanticGrid& grid, std::span<const Eigen::Vector2i> cells, SemanticClass c,
+                      float weight) {
+  for (const Eigen::Vector2i& cell : cells) {
+    grid.classes(cell.x(), cell.y()) = c;
+    grid.weight(cell.x(), cell.y()) = weight;
+  }
 }
 
 // Any run's two ends.

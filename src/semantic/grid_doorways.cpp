@@ -6,6 +6,7 @@
 #include <optional>
 #include <utility>
 
+#include "semantic/grid_cells.hpp"
 #include "semantic/grid_wall_points.hpp"
 #include "semantic/quantile.hpp"
 
@@ -309,10 +310,7 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Wa
   const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
   std::vector<Eigen::Vector2i> cells = opening_cells(grid, opening, centre, u, n, reach);
   if (cells.empty()) return;
-  for (const auto& c : cells) {
-    grid.classes(c.x(), c.y()) = SemanticClass::door;
-    grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::door);
-  }
+  set_class(grid, cells, SemanticClass::door, options.weights.of(SemanticClass::door));
   SemanticObject& door = add_object(ObjectKind::doorway, SemanticClass::door,
                                     "doorway " + std::to_string(++doorway_count), std::move(cells));
   door.centre = door_centre;

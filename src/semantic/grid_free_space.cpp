@@ -91,19 +91,19 @@ int BandFreeSpace::slab_of(double height) const {
   return static_cast<int>(std::floor((height - band_min_) / slab_height_));
 }
 
+std::size_t BandFreeSpace::index_of(const Eigen::Vector2i& cell) const {
+  return static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
+         static_cast<std::size_t>(cell.x());
+}
+
 std::uint64_t BandFreeSpace::crossed_twice(const Eigen::Vector2i& cell) const {
-  return cells_[static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
-                static_cast<std::size_t>(cell.x())]
-      .twice;
+  return cells_[index_of(cell)].twice;
 }
 
 std::optional<std::size_t> BandFreeSpace::voxel(const Eigen::Vector2i& cell, double height) const {
   const int slab = slab_of(height);
   if (!grid_.contains(cell) || slab < 0 || slab >= kSlabs) return std::nullopt;
-  const std::size_t index =
-      static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
-      static_cast<std::size_t>(cell.x());
-  return index * kSlabs + static_cast<std::size_t>(slab);
+  return index_of(cell) * kSlabs + static_cast<std::size_t>(slab);
 }
 
 int BandFreeSpace::passes(const Eigen::Vector2i& cell, double height) const {
@@ -114,12 +114,10 @@ int BandFreeSpace::passes(const Eigen::Vector2i& cell, double height) const {
 int BandFreeSpace::fewest_passes(const Eigen::Vector2i& cell, double low, double high) const {
   const int bottom = std::max(slab_of(low), 0), top = slab_of(high);
   if (!grid_.contains(cell) || top < bottom || top >= kSlabs) return 0;
-  const std::size_t index =
-      static_cast<std::size_t>(cell.y()) * static_cast<std::size_t>(grid_.width()) +
-      static_cast<std::size_t>(cell.x());
+  const std::size_t first = index_of(cell) * kSlabs;
   int fewest = std::numeric_limits<int>::max();
   for (int slab = bottom; slab <= top; ++slab)
-    fewest = std::min<int>(fewest, passes_[index * kSlabs + static_cast<std::size_t>(slab)]);
+    fewest = std::min<int>(fewest, passes_[first + static_cast<std::size_t>(slab)]);
   return fewest;
 }
 
@@ -203,10 +201,7 @@ int free_seen_through_walls(SemanticGrid& grid, const BandFreeSpace& free_space,
     }
   }
   // Judged on the cells as classified, then changed: a freed cell does not free its neighbours.
-  for (const Eigen::Vector2i& c : freed) {
-    grid.classes(c.x(), c.y()) = SemanticClass::floor;
-    grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::floor);
-  }
+  set_class(grid, freed, SemanticClass::floor, options.weights.of(SemanticClass::floor));
   return static_cast<int>(freed.size());
 }
 

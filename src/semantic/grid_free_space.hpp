@@ -63,6 +63,7 @@ class BandFreeSpace {
   };
   void walk(const Eigen::Vector3d& entry, const Eigen::Vector3d& d, double t0, double t1);
   int slab_of(double height) const;
+  std::size_t index_of(const Eigen::Vector2i& cell) const;  // row-major, rows as the grid's
   std::uint64_t crossed_twice(const Eigen::Vector2i& cell) const;
 
   const SemanticGrid& grid_;

@@ -173,10 +173,7 @@ void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, floa
       backing.push_back(c);
     }
   }
-  for (const Eigen::Vector2i& c : backing) {
-    grid.classes(c.x(), c.y()) = SemanticClass::wall;
-    grid.weight(c.x(), c.y()) = weight;
-  }
+  set_class(grid, backing, SemanticClass::wall, weight);
 }
 
 namespace {
@@ -212,10 +209,7 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
       }
     }
     if (corners.empty()) return;
-    for (const Eigen::Vector2i& c : corners) {
-      grid.classes(c.x(), c.y()) = SemanticClass::wall;
-      grid.weight(c.x(), c.y()) = weight;
-    }
+    set_class(grid, corners, SemanticClass::wall, weight);
   }
 }
 

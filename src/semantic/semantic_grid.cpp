@@ -264,10 +264,7 @@ int free_face_spill(SemanticGrid& grid, const Image<CellEvidence>& evidence,
         freed.push_back(c);
     }
   }
-  for (const Eigen::Vector2i& c : freed) {
-    grid.classes(c.x(), c.y()) = SemanticClass::floor;
-    grid.weight(c.x(), c.y()) = floor_weight;
-  }
+  detail::set_class(grid, freed, SemanticClass::floor, floor_weight);
   return static_cast<int>(freed.size());
 }
 
@@ -521,10 +518,7 @@ void fill_floor_holes(SemanticGrid& grid, double max_area, float weight) {
       }
     }
     if (!enclosed) continue;
-    for (const Eigen::Vector2i& c : hole) {
-      grid.classes(c.x(), c.y()) = SemanticClass::floor;
-      grid.weight(c.x(), c.y()) = weight;
-    }
+    detail::set_class(grid, hole, SemanticClass::floor, weight);
   }
 }
 
@@ -1141,17 +1135,18 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   cell_options.min_obstacle_views = std::min(options.min_obstacle_views, count_views(view_ids));
   ObstacleMasks masks = classify_cells(grid, evidence, cell_options);
   if (free_space) {
+    const Image<std::uint8_t> seen_floor = floor_seen(evidence, options);
     raised_walls_to_unclassified(grid, evidence, *free_space,
                                  options.weights.unclassified_obstacle);
     if (options.seen_through_wall_range > 0) {
       detail::free_seen_through_walls(
           grid, *free_space,
           detail::nearest_wall_ranges(grid, points, labels, view_ids, view_origins, options),
-          floor_seen(evidence, options), masks.furniture, options);
+          seen_floor, masks.furniture, options);
     }
     if (options.face_spill_ratio > 0) {
-      free_face_spill(grid, evidence, *free_space, floor_seen(evidence, options),
-                      options.face_spill_ratio, options.weights.of(SemanticClass::floor));
+      free_face_spill(grid, evidence, *free_space, seen_floor, options.face_spill_ratio,
+                      options.weights.of(SemanticClass::floor));
     }
   }
   if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);
