@@ -111,21 +111,27 @@ TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
   EXPECT_EQ(class_at(kX1 + 0.2, 1.5), SemanticClass::unknown);
 }
 
+// How the doorway scene's wall was seen.
+struct DoorwayWall {
+  bool ragged_ends = false;   // a 5 cm strip that no view saw 10-15 cm from each jamb
+  bool far_face_seen = true;  // the hall's face of the wall (else only the room's was seen)
+};
+
 // A room and a hall with a wall `thickness` thick between them (faces at y = 3.012 and beyond),
-// both faces and the doorway's reveals seen. With `ragged_ends`, the wall has a 5 cm strip that no
-// view saw 10-15 cm from each jamb.
-LabelledPoints doorway_scene(double thickness, bool ragged_ends) {
+// and the doorway's reveals seen.
+LabelledPoints doorway_scene(double thickness, DoorwayWall wall = {}) {
   using C = SemanticClass;
   const double kFace0 = 3.012, kFace1 = kFace0 + thickness;
   LabelledPoints s;
   s.box_face({kX0, kY0, 0}, {kX1, kFace0, 0}, C::floor);             // room
   s.box_face({kX0, kFace1, 0}, {kX1, kHallY1, 0}, C::floor);         // hall
   s.box_face({kDoorX0, kFace0, 0}, {kDoorX1, kFace1, 0}, C::floor);  // doorway floor
-  const double strip = ragged_ends ? 0.05 : 0.0, stub = ragged_ends ? 0.10 : 0.0;
-  for (const double y : {kFace0, kFace1}) {  // both faces
+  const double strip = wall.ragged_ends ? 0.05 : 0.0, stub = wall.ragged_ends ? 0.10 : 0.0;
+  for (const double y : {kFace0, kFace1}) {
+    if (y == kFace1 && !wall.far_face_seen) continue;
     s.box_face({kX0, y, 0.02}, {kDoorX0 - stub - strip, y, kHeight}, C::wall);
     s.box_face({kDoorX1 + stub + strip, y, 0.02}, {kX1, y, kHeight}, C::wall);
-    if (!ragged_ends) continue;
+    if (!wall.ragged_ends) continue;
     s.box_face({kDoorX0 - stub, y, 0.02}, {kDoorX0, y, kHeight}, C::wall);
     s.box_face({kDoorX1, y, 0.02}, {kDoorX1 + stub, y, kHeight}, C::wall);
   }
@@ -143,35 +149,41 @@ std::vector<const SemanticObject*> doorways(const SemanticGrid& grid) {
   return doors;
 }
 
+// Expects the cells well inside the opening (away from the jambs and the wall's faces, at y) to be
+// door, and returns their count; expects no door cell in the room or the hall.
+int expect_door_cells_fill_the_opening(const SemanticGrid& grid, double face0, double face1) {
+  int inside = 0;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2d c = grid.cell_center({col, row});
+      const bool in_opening = c.x() > kDoorX0 + 0.03 && c.x() < kDoorX1 - 0.03 &&
+                              c.y() > face0 + 0.005 && c.y() < face1 - 0.005;
+      if (in_opening) {
+        ++inside;
+        EXPECT_EQ(grid.classes(col, row), SemanticClass::door) << c.transpose();
+      }
+      if (grid.classes(col, row) == SemanticClass::door) {
+        EXPECT_GT(c.y(), face0 - 0.01) << "sticks out into the room at " << c.transpose();
+        EXPECT_LT(c.y(), face1 + 0.01) << "sticks out into the hall at " << c.transpose();
+      }
+    }
+  }
+  return inside;
+}
+
 // A doorway in a wall `thickness` thick: its opening is measured on the jambs' points, finer than
 // the cells, and its cells fill the wall's thickness, no more. A 0.1 m wall measures a hair under
 // two cells: still a wall's thickness.
 void expect_doorway_spans_the_wall(double thickness) {
-  using C = SemanticClass;
   const double kFace0 = 3.012, kFace1 = kFace0 + thickness;  // the wall's faces (y)
-  const LabelledPoints s = doorway_scene(thickness, false);
+  const LabelledPoints s = doorway_scene(thickness);
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   const std::vector<const SemanticObject*> doors = doorways(grid);
   ASSERT_EQ(doors.size(), 1u);
   EXPECT_NEAR(doors[0]->width, kDoorX1 - kDoorX0, 0.03);
   EXPECT_NEAR(doors[0]->centre.x(), 0.5 * (kDoorX0 + kDoorX1), 0.02);
   EXPECT_NEAR(doors[0]->centre.y(), 0.5 * (kFace0 + kFace1), 0.02);
-  int inside = 0;
-  for (int row = 0; row < grid.height(); ++row) {
-    for (int col = 0; col < grid.width(); ++col) {
-      const Eigen::Vector2d c = grid.cell_center({col, row});
-      const bool in_opening = c.x() > kDoorX0 + 0.03 && c.x() < kDoorX1 - 0.03 &&
-                              c.y() > kFace0 + 0.005 && c.y() < kFace1 - 0.005;
-      if (in_opening) {
-        ++inside;
-        EXPECT_EQ(grid.classes(col, row), C::door) << c.transpose();
-      }
-      if (grid.classes(col, row) == C::door) {
-        EXPECT_GT(c.y(), kFace0 - 0.01) << "sticks out into the room at " << c.transpose();
-        EXPECT_LT(c.y(), kFace1 + 0.01) << "sticks out into the hall at " << c.transpose();
-      }
-    }
-  }
+  const int inside = expect_door_cells_fill_the_opening(grid, kFace0, kFace1);
   // The rows of cells in the wall; 16 or 17 columns well inside the opening, as the lattice falls.
   const int rows = static_cast<int>(std::floor((thickness - 0.01) / grid.resolution));
   EXPECT_GE(inside, rows * 16);
@@ -182,12 +194,26 @@ TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
   expect_doorway_spans_the_wall(0.0995);
 }
 
+// A wall seen from the room only (its hall face never in view, as with a corridor's wall whose
+// other side no view saw): the jambs' faces cannot be measured (one face), and the doorway takes
+// the rows the wall's cells hold at its jambs, here the face and the reveals' depth. The whole
+// band of the faces' misalignment put two rows of door on the room's floor.
+TEST(SemanticGrid, ADoorwayInAWallSeenFromOneSideKeepsToTheWallsRows) {
+  // The hall's floor spills into the wall's last row (points on the cell boundary): the opening's
+  // cells are the three rows from the room's face.
+  const double kFace0 = 3.012, kFace1 = kFace0 + 0.2;
+  const LabelledPoints s = doorway_scene(kFace1 - kFace0, {.far_face_seen = false});
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  ASSERT_EQ(doorways(grid).size(), 1u);
+  EXPECT_GE(expect_door_cells_fill_the_opening(grid, kFace0, kFace1 - 0.05), 3 * 16);
+}
+
 // A doorway whose wall has a 5 cm strip that no view saw 10-15 cm from each jamb (as a wall's end
 // comes out with drift: ragged): each wall piece ends at its strip, and the walk from its end
 // meets the stub beyond it before a door's width. The stub is still the piece's end, so the walk
 // goes on across the opening; stopping there found no doorway.
 TEST(SemanticGrid, ADoorwayBeyondANotchInTheWallsEndIsFound) {
-  const LabelledPoints s = doorway_scene(0.2, true);
+  const LabelledPoints s = doorway_scene(0.2, {.ragged_ends = true});
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   const std::vector<const SemanticObject*> doors = doorways(grid);
   ASSERT_EQ(doors.size(), 1u);

@@ -292,6 +292,35 @@ std::vector<Eigen::Vector2i> opening_cells(const SemanticGrid& grid, const Openi
   return cells;
 }
 
+// The span across the wall line (in the frame centre, u, n) of the wall cells within 3 cells
+// beyond either end of the opening and within `band` of its line: the rows the map's wall
+// occupies at the jambs. Empty unless both ends have a wall cell. A doorway whose jambs cannot be
+// measured (a wall seen from one side only: one face, its back filled in) takes these rows rather
+// than the whole misalignment band, which put a row of door on the floor either side.
+std::optional<std::pair<double, double>> wall_rows_beside(
+    const SemanticGrid& grid, const Opening& opening, const Eigen::Vector2d& centre,
+    const Eigen::Vector2d& u, const Eigen::Vector2d& n, double band, int reach) {
+  const double depth = 3 * grid.resolution;
+  std::array<double, 2> lo{1e9, 1e9}, hi{-1e9, -1e9};
+  const Eigen::Vector2i c0 = grid.cell_of(centre);
+  for (int dy = -reach; dy <= reach; ++dy) {
+    for (int dx = -reach; dx <= reach; ++dx) {
+      const Eigen::Vector2i c = c0 + Eigen::Vector2i(dx, dy);
+      if (!grid.contains(c) || grid.classes(c.x(), c.y()) != SemanticClass::wall) continue;
+      const double along = u.dot(grid.cell_center(c) - centre);
+      const double across = n.dot(grid.cell_center(c) - centre);
+      if (std::fabs(across) > band) continue;
+      const bool side_a = along < opening.along_min && along >= opening.along_min - depth;
+      const bool side_b = along > opening.along_max && along <= opening.along_max + depth;
+      if (!side_a && !side_b) continue;
+      const int side = side_a ? 0 : 1;
+      lo[side] = std::min(lo[side], across), hi[side] = std::max(hi[side], across);
+    }
+  }
+  if (lo[0] > hi[0] || lo[1] > hi[1]) return std::nullopt;
+  return std::pair{std::min(lo[0], lo[1]), std::max(hi[0], hi[1])};
+}
+
 // The doorway of one (merged) gap: its cells become door cells and a doorway object.
 void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const WallPointIndex& walls,
                  const WallGap& gap, int& doorway_count, const AddObject& add_object) {
@@ -303,11 +332,13 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Wa
   const Eigen::Vector2d u = (gap.b - gap.a) / width, n(-u.y(), u.x());
   const double across = 0.5 * options.max_wall_misalignment + res;
   Opening opening{-0.5 * width, 0.5 * width, -across, across};
+  const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
   if (const auto measured = measure_jambs(grid, walls, centre, u, width, options))
     opening = *measured;
+  else if (const auto rows = wall_rows_beside(grid, opening, centre, u, n, across, reach))
+    opening.across_min = rows->first - 0.5 * res, opening.across_max = rows->second + 0.5 * res;
   const Eigen::Vector2d door_centre = centre + 0.5 * (opening.along_min + opening.along_max) * u +
                                       0.5 * (opening.across_min + opening.across_max) * n;
-  const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
   std::vector<Eigen::Vector2i> cells = opening_cells(grid, opening, centre, u, n, reach);
   if (cells.empty()) return;
   set_class(grid, cells, SemanticClass::door, options.weights.of(SemanticClass::door));
