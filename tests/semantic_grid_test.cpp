@@ -581,6 +581,32 @@ TEST(SemanticGrid, APocketDeeperThanTheWallsInsidesIsACabinets) {
   EXPECT_EQ(grid.furniture_fronts, 1);
 }
 
+// Walls 0.15 m thick, and a cabinet 0.4 m in front of the wall between two rooms, near the east
+// wall, its front taken for a wall. The wall's near face was seen only west of the cabinet (so no
+// wall line runs on past it: the east wall is 0.2 m beyond it): the unseen run behind the front
+// reaches the far face, which the north room saw. The wall's inside at the far face's back is
+// wall, the rest of the run the cabinet's pocket; the whole run was furniture before.
+TEST(SemanticGrid, AFrontsPocketStopsAtTheInsideOfAWallSeenFromBeyond) {
+  using C = SemanticClass;
+  constexpr double kEast = 4.112;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {kEast, 1.542, 0}, C::floor);  // south room, but behind the front
+  s.box_face({0.012, 1.562, 0}, {2.892, 1.952, 0}, C::floor);
+  s.box_face({3.932, 1.562, 0}, {kEast, 1.952, 0}, C::floor);
+  s.box_face({0.012, 2.122, 0}, {kEast, 4.012, 0}, C::floor);      // north room
+  s.box_face({0.012, 1.962, 0.02}, {2.892, 1.962, 1.4}, C::wall);  // the near face, in part
+  s.box_face({0.012, 2.112, 0.02}, {kEast, 2.112, 1.4}, C::wall);  // the far face
+  s.box_face({kEast, 0.012, 0.02}, {kEast, 4.012, 1.4}, C::wall);  // the east wall
+  s.box_face({2.912, 1.552, 0.02}, {3.912, 1.552, 1.2}, C::wall);  // the cabinet's front
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double x : {3.2, 3.4, 3.6}) {
+    EXPECT_EQ(class_at(grid, x, 1.56).first, C::furniture) << "the front at x " << x;
+    EXPECT_EQ(class_at(grid, x, 1.8).first, C::furniture) << "the pocket at x " << x;
+    EXPECT_EQ(class_at(grid, x, 2.04), std::pair(C::wall, false)) << "the wall's inside at x " << x;
+  }
+  EXPECT_EQ(grid.furniture_fronts, 1);
+}
+
 // Rows of wall one cell thick with floor on both sides (a face's spill, a face seen twice), more of
 // them than runs across the real wall: they measure no wall's thickness, and the outer wall's
 // hidden back is still as thick as the wall seen from both sides. The median of every run gave

@@ -26,6 +26,14 @@ inline bool seen_as(const SemanticGrid& grid, const Eigen::Vector2i& c, Semantic
   return grid.contains(c) && grid.classes(c.x(), c.y()) == wanted && !unobserved(grid, c);
 }
 
+// Wall cells in a row from `cell` (not counted) in steps of `step`, up to `enough`.
+inline int wall_run(const SemanticGrid& grid, Eigen::Vector2i cell, const Eigen::Vector2i& step,
+                    int enough) {
+  int run = 0;
+  for (cell += step; run < enough && seen_as(grid, cell, SemanticClass::wall); cell += step) ++run;
+  return run;
+}
+
 // An obstacle the views could not name (weight 0, class unknown), as opposed to an unseen cell.
 inline bool unclassified_obstacle(const SemanticGrid& grid, const Eigen::Vector2i& c) {
   return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::unknown &&

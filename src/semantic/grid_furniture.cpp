@@ -4,6 +4,7 @@
 #include <array>
 #include <cmath>
 #include <set>
+#include <span>
 #include <vector>
 
 #include <opencv2/core.hpp>
@@ -164,11 +165,17 @@ bool floor_beyond(const SemanticGrid& grid, const BoxSide& side) {
   return 2 * facing > side.length;
 }
 
+// A cabinet's front and sides joined to the wall behind it: their wall cells, and the step from
+// the pocket towards the wall behind.
+struct JoinedFront {
+  std::vector<cv::Point> cells;
+  Eigen::Vector2i back;
+};
+
 // The wall cells around a pocket but for its back: the front and sides of a cabinet whose faces
 // the views took for walls, joined to the wall behind it. Empty unless exactly one side of the
 // pocket's box runs on as a wall past its corners, and the side opposite faces floor.
-std::vector<cv::Point> front_and_sides(const SemanticGrid& grid,
-                                       const std::vector<cv::Point>& pocket) {
+JoinedFront front_and_sides(const SemanticGrid& grid, const std::vector<cv::Point>& pocket) {
   const cv::Rect box = cv::boundingRect(pocket);
   // A cabinet's inside is a few cells each way; a sliver of unseen cells in a noisy wall is not.
   if (box.width < kMinPocketCells || box.height < kMinPocketCells) return {};
@@ -187,11 +194,12 @@ std::vector<cv::Point> front_and_sides(const SemanticGrid& grid,
   if (back == 1) x1 = box.x + box.width - 1;
   if (back == 2) y0 = box.y;
   if (back == 3) y1 = box.y + box.height - 1;
-  std::vector<cv::Point> cells;
+  const cv::Point out = sides[static_cast<std::size_t>(back)].out;
+  JoinedFront joined{{}, Eigen::Vector2i(out.x, out.y)};
   for (int row = y0; row <= y1; ++row)
     for (int col = x0; col <= x1; ++col)
-      if (is_wall(grid, col, row)) cells.push_back({col, row});
-  return cells;
+      if (is_wall(grid, col, row)) joined.cells.push_back({col, row});
+  return joined;
 }
 
 // The wall pieces of the grid (8-neighbours) and which are longer than furniture.
@@ -223,6 +231,39 @@ bool backed_pocket(const SemanticGrid& grid, const WallPieces& walls,
   return std::any_of(beside.begin(), beside.end(), [&](int w) { return walls.long_wall[w]; });
 }
 
+// How far a wall's far face runs on either way along its line from a cell of it [m]: farther than
+// a wall is thick, so the side of a cabinet that joins a wall (wall cells with floor beyond them
+// too) is no far face.
+constexpr double kFarFaceRunsOn = 0.4;
+
+// Whether a cell of a longer wall's face whose other side the room saw (floor within 2 cells beyond
+// it, the line running on either way) lies within `inside` cells of unseen cell c along `step`.
+bool far_face_within(const SemanticGrid& grid, const WallPieces& walls, const Eigen::Vector2i& c,
+                     const Eigen::Vector2i& step, int inside) {
+  const int runs_on = static_cast<int>(std::ceil(kFarFaceRunsOn / grid.resolution));
+  const Eigen::Vector2i along(step.y(), step.x());
+  for (int k = 1; k <= inside; ++k) {
+    const Eigen::Vector2i n = c + k * step;
+    if (unobserved(grid, n)) continue;
+    return is_wall(grid, n.x(), n.y()) &&
+           walls.long_wall[static_cast<std::size_t>(walls.pieces.labels.at<int>(n.y(), n.x()))] &&
+           floor_within(grid, n, step, 2) && wall_run(grid, n, along, runs_on) >= runs_on &&
+           wall_run(grid, n, -along, runs_on) >= runs_on;
+  }
+  return false;
+}
+
+// Whether unseen cell c lies in the inside of a longer wall seen from its far side only, towards
+// one of `steps`. A cabinet against a wall hides the wall's near face, and the pocket between the
+// cabinet's front and the far face spans the wall's inside too: that is wall, not the cabinet.
+bool inside_a_wall_seen_from_beyond(const SemanticGrid& grid, const WallPieces& walls,
+                                    const cv::Point& c, int inside,
+                                    std::span<const Eigen::Vector2i> steps) {
+  return std::any_of(steps.begin(), steps.end(), [&](const Eigen::Vector2i& step) {
+    return far_face_within(grid, walls, {c.x, c.y}, step, inside);
+  });
+}
+
 void mark_furniture(SemanticGrid& grid, const std::vector<cv::Point>& cells, float weight,
                     Image<std::uint8_t>& furniture) {
   for (const cv::Point& c : cells) {
@@ -232,49 +273,72 @@ void mark_furniture(SemanticGrid& grid, const std::vector<cv::Point>& cells, flo
   }
 }
 
+// A cabinet's pocket split into its own cells and the inside of the wall it stands against.
+struct PocketSplit {
+  std::vector<cv::Point> furniture;
+  std::vector<Eigen::Vector2i> wall_inside;
+
+  void add(const SemanticGrid& grid, const WallPieces& walls, const std::vector<cv::Point>& pocket,
+           int inside_cells, std::span<const Eigen::Vector2i> towards_wall) {
+    for (const cv::Point& c : pocket) {
+      if (inside_a_wall_seen_from_beyond(grid, walls, c, inside_cells, towards_wall))
+        wall_inside.emplace_back(c.x, c.y);
+      else
+        furniture.push_back(c);
+    }
+  }
+  void mark(SemanticGrid& grid, const TraversabilityWeights& weights,
+            Image<std::uint8_t>& mask) const {
+    mark_furniture(grid, furniture, weights.of(SemanticClass::furniture), mask);
+    set_class(grid, wall_inside, SemanticClass::wall, weights.of(SemanticClass::wall));
+  }
+};
+
 }  // namespace
 
 int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                         int min_depth_cells, int max_depth_cells, float weight,
-                         Image<std::uint8_t>& furniture) {
+                         int min_depth_cells, int inside_cells, int max_depth_cells,
+                         const TraversabilityWeights& weights, Image<std::uint8_t>& furniture) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);
   const Pieces pockets = pieces_of(pockets_between_walls(grid, min_depth_cells, max_depth_cells));
   int fronts = 0;
-  std::vector<cv::Point> to_furniture;
+  PocketSplit split;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
     std::set<int> beside;
     if (!backed_pocket(grid, walls, pockets.cells[p], max_extent, max_area, beside)) continue;
     if (std::none_of(beside.begin(), beside.end(), [&](int w) { return walls.front_like[w]; }))
       continue;
     ++fronts;
-    to_furniture.insert(to_furniture.end(), pockets.cells[p].begin(), pockets.cells[p].end());
+    split.add(grid, walls, pockets.cells[p], inside_cells, kFourNeighbours);
     for (const int w : beside) {
       if (walls.front_like[w])
-        to_furniture.insert(to_furniture.end(), walls.pieces.cells[w].begin(),
-                            walls.pieces.cells[w].end());
+        split.furniture.insert(split.furniture.end(), walls.pieces.cells[w].begin(),
+                               walls.pieces.cells[w].end());
     }
   }
-  mark_furniture(grid, to_furniture, weight, furniture);
+  split.mark(grid, weights, furniture);
   return fronts;
 }
 
 int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                                int max_depth_cells, float weight, Image<std::uint8_t>& furniture) {
+                                int inside_cells, int max_depth_cells,
+                                const TraversabilityWeights& weights,
+                                Image<std::uint8_t>& furniture) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);
   const Pieces pockets = pieces_of(pockets_between_walls(grid, 1, max_depth_cells));
   int fronts = 0;
-  std::vector<cv::Point> to_furniture;
+  PocketSplit split;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
     std::set<int> beside;
     const std::vector<cv::Point>& pocket = pockets.cells[p];
     if (!backed_pocket(grid, walls, pocket, max_extent, max_area, beside)) continue;
-    const std::vector<cv::Point> joined = front_and_sides(grid, pocket);
-    if (joined.empty()) continue;
+    const JoinedFront joined = front_and_sides(grid, pocket);
+    if (joined.cells.empty()) continue;
     ++fronts;
-    to_furniture.insert(to_furniture.end(), pocket.begin(), pocket.end());
-    to_furniture.insert(to_furniture.end(), joined.begin(), joined.end());
+    split.add(grid, walls, pocket, inside_cells, std::span(&joined.back, 1));
+    split.furniture.insert(split.furniture.end(), joined.cells.begin(), joined.cells.end());
   }
-  mark_furniture(grid, to_furniture, weight, furniture);
+  split.mark(grid, weights, furniture);
   return fronts;
 }
 

@@ -12,20 +12,26 @@ namespace kartograf::semantic::detail {
 // that stands in front of a longer wall with only unseen cells between them (rows or columns of
 // more than `min_depth_cells`, a wall's inside, and at most `max_depth_cells`: the pocket its top
 // and sides hid) and no door beside them. The front and the pocket become furniture (`furniture`
-// marks them, weight `weight`). Returns the number of fronts.
+// marks them), but for the pocket's cells within `inside_cells` of a longer wall whose far side
+// the next room saw (floor within 2 cells beyond it; the line running on 0.4 m either way): the
+// inside of the wall the cabinet stands against, whose near face it hid, which become wall. Returns
+// the number of fronts.
 int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                         int min_depth_cells, int max_depth_cells, float weight,
-                         Image<std::uint8_t>& furniture);
+                         int min_depth_cells, int inside_cells, int max_depth_cells,
+                         const TraversabilityWeights& weights, Image<std::uint8_t>& furniture);
 
 // A cabinet against a wall whose front and sides the views took for walls, joined to the wall
 // behind it: a furniture-sized pocket of unseen cells (rows or columns of at least two cells
 // between wall cells, at most `max_depth_cells`), no door beside it, whose box has exactly one side
 // that runs on as a wall past both corners (the wall behind; a wall's inside between two faces has
-// two such sides) and floor beyond the opposite side (the front faces the room). The pocket and the
-// wall cells around it up to two cells out, but for the back's line, become furniture. Runs after
-// fronts_against_walls and the walls' insides. Returns the number of fronts.
+// two such sides) and floor beyond the opposite side (the front faces the room). The pocket (but
+// for the wall's inside towards the back, as above) and the wall cells around it up to two cells
+// out, but for the back's line, become furniture. Runs after fronts_against_walls and the walls'
+// insides. Returns the number of fronts.
 int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                                int max_depth_cells, float weight, Image<std::uint8_t>& furniture);
+                                int inside_cells, int max_depth_cells,
+                                const TraversabilityWeights& weights,
+                                Image<std::uint8_t>& furniture);
 
 // The unseen cells behind furniture: row and column runs of at most `max_depth_cells` unseen cells
 // from a furniture cell with seen floor within 3 cells in front of it (a face the room saw) to a

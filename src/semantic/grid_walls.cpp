@@ -178,14 +178,6 @@ void back_one_sided_walls(SemanticGrid& grid, int thickness, int max_cells, floa
 
 namespace {
 
-// Wall cells in a row from `cell` (not counted) in steps of `step`, up to `enough`.
-int wall_run(const SemanticGrid& grid, Eigen::Vector2i cell, const Eigen::Vector2i& step,
-             int enough) {
-  int run = 0;
-  for (cell += step; run < enough && seen_as(grid, cell, SemanticClass::wall); cell += step) ++run;
-  return run;
-}
-
 // Whether wall runs on for `enough` cells from the cell one way or the other along `step`'s axis.
 bool wall_either_way(const SemanticGrid& grid, const Eigen::Vector2i& cell,
                      const Eigen::Vector2i& step, int enough) {

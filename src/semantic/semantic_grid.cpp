@@ -1059,14 +1059,15 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   // After the furniture fills (no hull should span a front and its pocket) and the walls' insides
   // (which are no pockets).
   if (fronts) {
+    // A wall's inside, which a pocket reaching a far face stops short of: unknown without the
+    // walls' thickness.
+    const int inside = across > 0 ? min_pocket : 0;
     grid.furniture_fronts = detail::fronts_against_walls(
-        grid, options.furniture_max_extent, options.max_furniture_fill_area, min_pocket,
-        cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
-        masks.furniture);
+        grid, options.furniture_max_extent, options.max_furniture_fill_area, min_pocket, inside,
+        cells(options.furniture_max_depth), options.weights, masks.furniture);
     grid.furniture_fronts += detail::joined_fronts_against_walls(
-        grid, options.furniture_max_extent, options.max_furniture_fill_area,
-        cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
-        masks.furniture);
+        grid, options.furniture_max_extent, options.max_furniture_fill_area, inside,
+        cells(options.furniture_max_depth), options.weights, masks.furniture);
     // Last: the fronts above are among the faces whose hidden backs it fills.
     grid.furniture_pockets = detail::pockets_behind_furniture(
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
