@@ -605,6 +605,9 @@ TEST(SemanticGrid, AFrontsPocketStopsAtTheInsideOfAWallSeenFromBeyond) {
     EXPECT_EQ(class_at(grid, x, 2.04), std::pair(C::wall, false)) << "the wall's inside at x " << x;
   }
   EXPECT_EQ(grid.furniture_fronts, 1);
+  // Two rows along most of the cabinet's 20 cells: near the east wall the far face's line runs on
+  // for less than 0.4 m.
+  EXPECT_GE(grid.wall_insides_behind_fronts, 2 * 15);
 }
 
 // Rows of wall one cell thick with floor on both sides (a face's spill, a face seen twice), more of

@@ -296,9 +296,10 @@ struct PocketSplit {
 
 }  // namespace
 
-int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                         int min_depth_cells, int inside_cells, int max_depth_cells,
-                         const TraversabilityWeights& weights, Image<std::uint8_t>& furniture) {
+FrontsFound fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
+                                 int min_depth_cells, int inside_cells, int max_depth_cells,
+                                 const TraversabilityWeights& weights,
+                                 Image<std::uint8_t>& furniture) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);
   const Pieces pockets = pieces_of(pockets_between_walls(grid, min_depth_cells, max_depth_cells));
   int fronts = 0;
@@ -317,13 +318,13 @@ int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
     }
   }
   split.mark(grid, weights, furniture);
-  return fronts;
+  return {fronts, static_cast<int>(split.wall_inside.size())};
 }
 
-int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                                int inside_cells, int max_depth_cells,
-                                const TraversabilityWeights& weights,
-                                Image<std::uint8_t>& furniture) {
+FrontsFound joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
+                                        int inside_cells, int max_depth_cells,
+                                        const TraversabilityWeights& weights,
+                                        Image<std::uint8_t>& furniture) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);
   const Pieces pockets = pieces_of(pockets_between_walls(grid, 1, max_depth_cells));
   int fronts = 0;
@@ -339,7 +340,7 @@ int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double ma
     split.furniture.insert(split.furniture.end(), joined.cells.begin(), joined.cells.end());
   }
   split.mark(grid, weights, furniture);
-  return fronts;
+  return {fronts, static_cast<int>(split.wall_inside.size())};
 }
 
 int pockets_behind_furniture(SemanticGrid& grid, double max_extent, double max_area,

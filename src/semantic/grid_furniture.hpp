@@ -7,6 +7,12 @@
 
 namespace kartograf::semantic::detail {
 
+// What a front rule found: the fronts, and the cells of their pockets made wall.
+struct FrontsFound {
+  int fronts = 0;
+  int wall_inside_cells = 0;
+};
+
 // A cabinet or shelf against a wall, whose front the views took for a wall: a piece of wall cells
 // of furniture size (at most `max_extent` long, `max_area` in hull), most of them next to floor,
 // that stands in front of a longer wall with only unseen cells between them (rows or columns of
@@ -14,11 +20,11 @@ namespace kartograf::semantic::detail {
 // and sides hid) and no door beside them. The front and the pocket become furniture (`furniture`
 // marks them), but for the pocket's cells within `inside_cells` of a longer wall whose far side
 // the next room saw (floor within 2 cells beyond it; the line running on 0.4 m either way): the
-// inside of the wall the cabinet stands against, whose near face it hid, which become wall. Returns
-// the number of fronts.
-int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                         int min_depth_cells, int inside_cells, int max_depth_cells,
-                         const TraversabilityWeights& weights, Image<std::uint8_t>& furniture);
+// inside of the wall the cabinet stands against, whose near face it hid, which become wall.
+FrontsFound fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
+                                 int min_depth_cells, int inside_cells, int max_depth_cells,
+                                 const TraversabilityWeights& weights,
+                                 Image<std::uint8_t>& furniture);
 
 // A cabinet against a wall whose front and sides the views took for walls, joined to the wall
 // behind it: a furniture-sized pocket of unseen cells (rows or columns of at least two cells
@@ -27,11 +33,11 @@ int fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
 // two such sides) and floor beyond the opposite side (the front faces the room). The pocket (but
 // for the wall's inside towards the back, as above) and the wall cells around it up to two cells
 // out, but for the back's line, become furniture. Runs after fronts_against_walls and the walls'
-// insides. Returns the number of fronts.
-int joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
-                                int inside_cells, int max_depth_cells,
-                                const TraversabilityWeights& weights,
-                                Image<std::uint8_t>& furniture);
+// insides.
+FrontsFound joined_fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
+                                        int inside_cells, int max_depth_cells,
+                                        const TraversabilityWeights& weights,
+                                        Image<std::uint8_t>& furniture);
 
 // The unseen cells behind furniture: row and column runs of at most `max_depth_cells` unseen cells
 // from a furniture cell with seen floor within 3 cells in front of it (a face the room saw) to a

@@ -1062,12 +1062,14 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
     // A wall's inside, which a pocket reaching a far face stops short of: unknown without the
     // walls' thickness.
     const int inside = across > 0 ? min_pocket : 0;
-    grid.furniture_fronts = detail::fronts_against_walls(
+    const detail::FrontsFound apart = detail::fronts_against_walls(
         grid, options.furniture_max_extent, options.max_furniture_fill_area, min_pocket, inside,
         cells(options.furniture_max_depth), options.weights, masks.furniture);
-    grid.furniture_fronts += detail::joined_fronts_against_walls(
+    const detail::FrontsFound joined = detail::joined_fronts_against_walls(
         grid, options.furniture_max_extent, options.max_furniture_fill_area, inside,
         cells(options.furniture_max_depth), options.weights, masks.furniture);
+    grid.furniture_fronts = apart.fronts + joined.fronts;
+    grid.wall_insides_behind_fronts = apart.wall_inside_cells + joined.wall_inside_cells;
     // Last: the fronts above are among the faces whose hidden backs it fills.
     grid.furniture_pockets = detail::pockets_behind_furniture(
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
@@ -1196,6 +1198,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.furniture_pockets = grid.furniture_pockets;
   d.wall_specks = grid.wall_specks;
   d.furniture_in_wall_lines = grid.furniture_in_wall_lines;
+  d.wall_insides_behind_fronts = grid.wall_insides_behind_fronts;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

@@ -202,13 +202,15 @@ struct SemanticGrid {
   // What the grid inferred beyond the views: the wall thickness measured on walls seen from both
   // sides and given to walls seen from one side (none: too few two-sided walls, none backed), and
   // the cabinet fronts the views had taken for walls, the unseen pockets behind furniture faces
-  // filled as furniture, the furniture specks inside walls or on their faces made wall, and the
-  // furniture cells in a wall's line behind furniture made wall.
+  // filled as furniture, the furniture specks inside walls or on their faces made wall, the
+  // furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
+  // pockets made wall as the inside of a wall seen from its far side.
   std::optional<double> wall_thickness;  // m
   int furniture_fronts = 0;
   int furniture_pockets = 0;
   int wall_specks = 0;
   int furniture_in_wall_lines = 0;
+  int wall_insides_behind_fronts = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -266,6 +268,7 @@ struct MapDescription {
   int furniture_pockets = 0;
   int wall_specks = 0;
   int furniture_in_wall_lines = 0;
+  int wall_insides_behind_fronts = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
