@@ -327,7 +327,7 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Wa
   const double res = grid.resolution;
   const Eigen::Vector2d centre = 0.5 * (gap.a + gap.b);
   // Its cells: passable cells inside the opening as its jambs measure it, else along the gap
-  // within the faces' misalignment of its line.
+  // in the wall's rows at its jambs, within the faces' misalignment of its line.
   const double width = (gap.b - gap.a).norm();
   const Eigen::Vector2d u = (gap.b - gap.a) / width, n(-u.y(), u.x());
   const double across = 0.5 * options.max_wall_misalignment + res;
@@ -335,8 +335,10 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Wa
   const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
   if (const auto measured = measure_jambs(grid, walls, centre, u, width, options))
     opening = *measured;
-  else if (const auto rows = wall_rows_beside(grid, opening, centre, u, n, across, reach))
-    opening.across_min = rows->first - 0.5 * res, opening.across_max = rows->second + 0.5 * res;
+  else if (const auto rows = wall_rows_beside(grid, opening, centre, u, n, across, reach)) {
+    opening.across_min = std::max(rows->first - 0.5 * res, -across);
+    opening.across_max = std::min(rows->second + 0.5 * res, across);
+  }
   const Eigen::Vector2d door_centre = centre + 0.5 * (opening.along_min + opening.along_max) * u +
                                       0.5 * (opening.across_min + opening.across_max) * n;
   std::vector<Eigen::Vector2i> cells = opening_cells(grid, opening, centre, u, n, reach);
