@@ -543,6 +543,30 @@ TEST(SemanticGrid, AWallLineHiddenBehindFurnitureHasABack) {
   }
 }
 
+// The north room's north-east corner hidden behind a cabinet 0.5 m square standing in it (its two
+// faces seen as furniture): the outer north and east walls were seen only up to the cabinet's
+// sides. Each runs on behind the cabinet to where the other's line meets it, and the corner is
+// wall; without the rule they stop at the cabinet's sides, the corner unseen.
+TEST(SemanticGrid, ARoomsCornerHiddenBehindACabinetIsWall) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);  // south room
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);
+  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
+  for (double x = 0.012; x <= 4.012; x += 0.02)
+    for (double y = 2.162; y <= 4.012; y += 0.02)
+      if (!(x > 3.5 && y > 3.5)) s.add({x, y, 0}, C::floor);          // north room, but the cabinet
+  s.box_face({0.012, 4.012, 0.02}, {3.492, 4.012, 1.4}, C::wall);     // the outer north wall
+  s.box_face({4.012, 0.012, 0.02}, {4.012, 3.492, 1.4}, C::wall);     // the outer east wall
+  s.box_face({3.512, 3.512, 0.02}, {4.0, 3.512, 0.9}, C::furniture);  // the cabinet's faces
+  s.box_face({3.512, 3.512, 0.02}, {3.512, 4.0, 0.9}, C::furniture);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 3.8, 4.012 + 0.02), std::pair(C::wall, false));  // the north wall
+  EXPECT_EQ(class_at(grid, 4.012 + 0.02, 3.8), std::pair(C::wall, false));  // the east wall
+  EXPECT_EQ(class_at(grid, 4.012 + 0.02, 4.012 + 0.02), std::pair(C::wall, false));
+  EXPECT_GT(grid.wall_corners_behind_furniture, 0);
+}
+
 // With an outer east wall too, the block where the two outer walls meet, which no view sees, is
 // wall as thick as their backs; without the backs it stays unseen.
 TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {

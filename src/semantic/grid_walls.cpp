@@ -244,4 +244,69 @@ int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyon
   return from_furniture;
 }
 
+namespace {
+
+// The cells of an L from `start` (a wall cell, not included) through hidden cells along `step`,
+// then along `turn`, to a wall cell that runs on beyond it, with furniture within `beyond` across
+// a leg; empty when there is none within `max_gap` cells on either leg.
+std::vector<Eigen::Vector2i> hidden_corner(const SemanticGrid& grid, const Eigen::Vector2i& start,
+                                           const Eigen::Vector2i& step, int max_gap, int beyond) {
+  const auto hidden = [&](const Eigen::Vector2i& c) {
+    return unobserved(grid, c) || seen_as(grid, c, SemanticClass::furniture);
+  };
+  const auto furniture_across = [&](const Eigen::Vector2i& c, const Eigen::Vector2i& across) {
+    for (int k = -beyond; k <= beyond; ++k)
+      if (seen_as(grid, c + k * across, SemanticClass::furniture)) return true;
+    return false;
+  };
+  const Eigen::Vector2i side(step.y(), step.x());
+  bool furniture = false;
+  Eigen::Vector2i c = start + step;
+  for (int gap = 1; gap <= max_gap && hidden(c); ++gap, c += step) {
+    furniture |= furniture_across(c, side);
+    for (const Eigen::Vector2i& turn : {side, Eigen::Vector2i(-side)}) {
+      bool near_furniture = furniture;
+      Eigen::Vector2i e = c + turn;
+      int length = 1;
+      for (; length <= max_gap && hidden(e); ++length, e += turn)
+        near_furniture |= furniture_across(e, step);
+      if (length > max_gap || !near_furniture || !seen_as(grid, e, SemanticClass::wall) ||
+          wall_run(grid, e, turn, beyond) < beyond)
+        continue;
+      std::vector<Eigen::Vector2i> cells;
+      for (Eigen::Vector2i k = start + step; k != c + step; k += step) cells.push_back(k);
+      for (Eigen::Vector2i k = c + turn; k != e; k += turn) cells.push_back(k);
+      return cells;
+    }
+  }
+  return {};
+}
+
+}  // namespace
+
+int wall_corners_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                                  float weight) {
+  std::vector<Eigen::Vector2i> bridged;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2i start(col, row);
+      if (!seen_as(grid, start, SemanticClass::wall)) continue;
+      for (const Eigen::Vector2i& step : kFourNeighbours) {
+        if (wall_run(grid, start, -step, beyond_cells) < beyond_cells) continue;
+        const std::vector<Eigen::Vector2i> corner =
+            hidden_corner(grid, start, step, max_gap_cells, beyond_cells);
+        bridged.insert(bridged.end(), corner.begin(), corner.end());
+      }
+    }
+  }
+  int made = 0;
+  for (const Eigen::Vector2i& c : bridged) {
+    if (seen_as(grid, c, SemanticClass::wall)) continue;  // on two corners' legs
+    grid.classes(c.x(), c.y()) = SemanticClass::wall;
+    grid.weight(c.x(), c.y()) = weight;
+    ++made;
+  }
+  return made;
+}
+
 }  // namespace kartograf::semantic::detail

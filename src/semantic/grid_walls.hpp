@@ -51,6 +51,16 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight);
 // unlabelled in a region the furniture cut small, or the furniture's back in the noise of the face:
 // furniture stands in front of a wall, not in its line); `furniture` unmarks those. Returns the
 // furniture cells made wall.
+// A room's corner hidden behind furniture: from a wall cell whose wall runs on for `beyond_cells`
+// behind it, along its row or column through unseen or furniture cells, then across through such
+// cells, to a wall cell whose wall runs on for `beyond_cells` beyond it (the perpendicular wall),
+// both legs at most `max_gap_cells` long, with furniture within `beyond_cells` across either leg:
+// the legs' cells become wall (weight `weight`). The two outer walls of a corner that a cabinet
+// hid end at its sides; the wall-line rule needs wall at both ends of a straight gap. Returns the
+// cells made wall. Runs after wall_lines_behind_furniture.
+int wall_corners_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                                  float weight);
+
 int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
                                 float weight, Image<std::uint8_t>& furniture);
 

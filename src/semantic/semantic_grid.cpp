@@ -1027,6 +1027,30 @@ int whole_cells(double metres, double resolution) {
   return static_cast<int>(std::floor(metres / resolution + 1e-9));
 }
 
+// The walls seen from one side: their hidden backs and corners, then the wall lines and room
+// corners hidden behind furniture, then the backs of those lines' faces; `thickness` cells thick
+// (the two-sided walls'; 0: unknown, no backs).
+void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& options, int thickness,
+                              int max_wall, ObstacleMasks& masks) {
+  const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
+  detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
+  if (options.back_one_sided_walls)
+    detail::fill_wall_corners(grid, thickness, options.weights.of(SemanticClass::wall));
+  // Last: the backs and corners above make the wall lines whose hidden stretches it joins.
+  if (options.back_one_sided_walls && max_wall > 0 && options.furniture_max_extent > 0) {
+    const int gap = cells(options.furniture_max_extent);
+    const float wall = options.weights.of(SemanticClass::wall);
+    grid.furniture_in_wall_lines =
+        detail::wall_lines_behind_furniture(grid, gap, max_wall + 1, wall, masks.furniture);
+    grid.wall_corners_behind_furniture =
+        detail::wall_corners_behind_furniture(grid, gap, max_wall + 1, wall);
+  }
+  // The lines' faces have their backs too, where the backs beside them were too short to bridge
+  // (a cell no view saw, or a speck seen, ends a back's row).
+  detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
+  if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
+}
+
 // The cells no view saw that the seen ones imply (walls' insides and hidden backs, furniture
 // pockets, floor shadows), and the wall faces placed on the wall points.
 void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& evidence,
@@ -1096,18 +1120,7 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         grid, wall_points, floor_seen(evidence, options),
         {options.weights.of(SemanticClass::floor), options.weights.of(SemanticClass::wall)});
   }
-  detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
-  if (options.back_one_sided_walls)
-    detail::fill_wall_corners(grid, thickness, options.weights.of(SemanticClass::wall));
-  // Last: the backs and corners above make the wall lines whose hidden stretches it joins.
-  if (options.back_one_sided_walls && max_wall > 0 && options.furniture_max_extent > 0)
-    grid.furniture_in_wall_lines = detail::wall_lines_behind_furniture(
-        grid, cells(options.furniture_max_extent), max_wall + 1,
-        options.weights.of(SemanticClass::wall), masks.furniture);
-  // The lines' faces have their backs too, where the backs beside them were too short to bridge
-  // (a cell no view saw, or a speck seen, ends a back's row).
-  detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
-  if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
+  complete_one_sided_walls(grid, options, thickness, max_wall, masks);
 }
 
 }  // namespace
@@ -1199,6 +1212,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.wall_specks = grid.wall_specks;
   d.furniture_in_wall_lines = grid.furniture_in_wall_lines;
   d.wall_insides_behind_fronts = grid.wall_insides_behind_fronts;
+  d.wall_corners_behind_furniture = grid.wall_corners_behind_furniture;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

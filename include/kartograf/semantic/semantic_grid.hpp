@@ -204,13 +204,15 @@ struct SemanticGrid {
   // the cabinet fronts the views had taken for walls, the unseen pockets behind furniture faces
   // filled as furniture, the furniture specks inside walls or on their faces made wall, the
   // furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
-  // pockets made wall as the inside of a wall seen from its far side.
+  // pockets made wall as the inside of a wall seen from its far side, and the cells of room
+  // corners hidden behind furniture made wall.
   std::optional<double> wall_thickness;  // m
   int furniture_fronts = 0;
   int furniture_pockets = 0;
   int wall_specks = 0;
   int furniture_in_wall_lines = 0;
   int wall_insides_behind_fronts = 0;
+  int wall_corners_behind_furniture = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -269,6 +271,7 @@ struct MapDescription {
   int wall_specks = 0;
   int furniture_in_wall_lines = 0;
   int wall_insides_behind_fronts = 0;
+  int wall_corners_behind_furniture = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
