@@ -185,6 +185,19 @@ bool wall_either_way(const SemanticGrid& grid, const Eigen::Vector2i& cell,
          wall_run(grid, cell, -step, enough) >= enough;
 }
 
+// Unseen, or seen as furniture: where a wall line may run on behind furniture.
+bool hidden_by_furniture(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return unobserved(grid, c) || seen_as(grid, c, SemanticClass::furniture);
+}
+
+// Whether a furniture cell lies within `reach` cells of c along `across`, either way.
+bool furniture_across(const SemanticGrid& grid, const Eigen::Vector2i& c,
+                      const Eigen::Vector2i& across, int reach) {
+  for (int k = -reach; k <= reach; ++k)
+    if (seen_as(grid, c + k * across, SemanticClass::furniture)) return true;
+  return false;
+}
+
 }  // namespace
 
 void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
@@ -207,9 +220,7 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
 
 int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
                                 float weight, Image<std::uint8_t>& furniture) {
-  const auto hidden = [&](const Eigen::Vector2i& c) {
-    return unobserved(grid, c) || seen_as(grid, c, SemanticClass::furniture);
-  };
+  const auto hidden = [&](const Eigen::Vector2i& c) { return hidden_by_furniture(grid, c); };
   std::vector<Eigen::Vector2i> bridged;
   for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
     const Eigen::Vector2i across(step.y(), step.x());
@@ -222,10 +233,8 @@ int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyon
         Eigen::Vector2i c = start + step;
         int gap = 0;
         bool furniture = false;
-        for (; hidden(c) && gap <= max_gap_cells; c += step, ++gap) {
-          for (int k = -beyond_cells; k <= beyond_cells; ++k)
-            furniture |= seen_as(grid, c + k * across, SemanticClass::furniture);
-        }
+        for (; hidden(c) && gap <= max_gap_cells; c += step, ++gap)
+          furniture |= furniture_across(grid, c, across, beyond_cells);
         if (gap > max_gap_cells || !furniture || !seen_as(grid, c, SemanticClass::wall) ||
             wall_run(grid, c, step, beyond_cells) < beyond_cells)
           continue;
@@ -251,25 +260,18 @@ namespace {
 // a leg; empty when there is none within `max_gap` cells on either leg.
 std::vector<Eigen::Vector2i> hidden_corner(const SemanticGrid& grid, const Eigen::Vector2i& start,
                                            const Eigen::Vector2i& step, int max_gap, int beyond) {
-  const auto hidden = [&](const Eigen::Vector2i& c) {
-    return unobserved(grid, c) || seen_as(grid, c, SemanticClass::furniture);
-  };
-  const auto furniture_across = [&](const Eigen::Vector2i& c, const Eigen::Vector2i& across) {
-    for (int k = -beyond; k <= beyond; ++k)
-      if (seen_as(grid, c + k * across, SemanticClass::furniture)) return true;
-    return false;
-  };
+  const auto hidden = [&](const Eigen::Vector2i& c) { return hidden_by_furniture(grid, c); };
   const Eigen::Vector2i side(step.y(), step.x());
   bool furniture = false;
   Eigen::Vector2i c = start + step;
   for (int gap = 1; gap <= max_gap && hidden(c); ++gap, c += step) {
-    furniture |= furniture_across(c, side);
+    furniture |= furniture_across(grid, c, side, beyond);
     for (const Eigen::Vector2i& turn : {side, Eigen::Vector2i(-side)}) {
       bool near_furniture = furniture;
       Eigen::Vector2i e = c + turn;
       int length = 1;
       for (; length <= max_gap && hidden(e); ++length, e += turn)
-        near_furniture |= furniture_across(e, step);
+        near_furniture |= furniture_across(grid, e, step, beyond);
       if (length > max_gap || !near_furniture || !seen_as(grid, e, SemanticClass::wall) ||
           wall_run(grid, e, turn, beyond) < beyond)
         continue;
