@@ -304,6 +304,68 @@ TEST(PhotometricRefinement, RecoversTheSlideAlongATexturedWall) {
                Error);
 }
 
+// A dark cabinet 0.6 m away covers the left of a textured wall 3 m away. Each pixel's ray is cast
+// from a camera at `camera_x` on the x axis, looking along z.
+struct CabinetBeforeAWall {
+  PinholeIntrinsics camera = testing::qvga_camera();
+  double cabinet_z = 0.6, wall_z = 3.0, cabinet_right_edge = -0.1;
+
+  bool on_cabinet(int u, double camera_x) const {
+    return camera_x + (u - camera.cx) / camera.fx * cabinet_z < cabinet_right_edge;
+  }
+  std::uint8_t grey_at(int u, int v, double camera_x) const {
+    if (on_cabinet(u, camera_x)) return 30;
+    const double x = camera_x + (u - camera.cx) / camera.fx * wall_z;
+    const double y = (v - camera.cy) / camera.fy * wall_z;
+    const double grain =
+        std::sin(2 * std::numbers::pi * x / 0.2) * std::cos(2 * std::numbers::pi * y / 0.15);
+    return static_cast<std::uint8_t>(std::lround(170.0 + 30.0 * grain));
+  }
+  template <typename Picture, typename PixelOf>
+  Picture render(PixelOf pixel_of) const {
+    Picture picture(camera.width, camera.height);
+    for (int v = 0; v < camera.height; ++v) {
+      for (int u = 0; u < camera.width; ++u) picture(u, v) = pixel_of(u, v);
+    }
+    return picture;
+  }
+  RgbImage color(double camera_x) const {
+    return render<RgbImage>([&](int u, int v) {
+      const std::uint8_t c = grey_at(u, v, camera_x);
+      return Rgb8{c, c, c};
+    });
+  }
+  DepthImage depth(double camera_x) const {  // millimetres
+    return render<DepthImage>([&](int u, int) {
+      return static_cast<std::uint16_t>(
+          std::lround(1000.0 * (on_cabinet(u, camera_x) ? cabinet_z : wall_z)));
+    });
+  }
+};
+
+// The wall pixels beside the cabinet's edge are smoothed with the cabinet, which moves across
+// them: kept, they pull the slide off (measured 0.27 mm; 0.005 mm without them).
+TEST(PhotometricRefinement, ACabinetsEdgeMovingAcrossTheWallBehindItDoesNotPullTheSlide) {
+  const CabinetBeforeAWall scene;
+  const double slide = -0.05;  // the cabinet's edge hides wall, so no source pixel is occluded
+  const Eigen::Isometry3d truth{Eigen::Translation3d(slide, 0, 0)};
+  const Eigen::Isometry3d start = truth * Eigen::Translation3d(0.004, 0, 0);
+  const std::vector<se3::Vector6d> along_x{(se3::Vector6d() << 0, 0, 0, 1, 0, 0).finished()};
+  const auto error_of = [&](const registration::PhotometricParams& params) {
+    const registration::PhotometricResult refined = registration::refine_photometrically(
+        scene.depth(slide), scene.color(slide), scene.color(0.0), scene.camera, 1000.0, start,
+        along_x, params);
+    EXPECT_TRUE(refined.refined);
+    return (truth.inverse() * refined.motion).translation().norm();
+  };
+  const double masked = error_of({});
+  RecordProperty("error_m", testing::scientific(masked));
+  EXPECT_LT(masked, 5e-5);
+  registration::PhotometricParams with_edges;
+  with_edges.mask_depth_edges = false;
+  EXPECT_GT(error_of(with_edges), 1.5e-4);
+}
+
 registration::GeometricInformation information_of(const testing::Scene& scene,
                                                   const compute::Context& context) {
   const PinholeIntrinsics camera = testing::qvga_camera();

@@ -53,8 +53,9 @@ void validate(const OdometryParams& params) {
   require(params.feature_seed_m >= 0 && params.feature_seed_deg >= 0,
           "odometry: feature_seed_m and feature_seed_deg must be >= 0");
   require(params.feature_arbitration_m >= 0 && params.feature_arbitration_deg >= 0 &&
-              params.feature_arbitration_ratio > 0,
-          "odometry: feature_arbitration_m and _deg must be >= 0, feature_arbitration_ratio > 0");
+              params.feature_arbitration_ratio > 0 && params.photometric_doubt_rmse > 0,
+          "odometry: feature_arbitration_m and _deg must be >= 0, feature_arbitration_ratio and "
+          "photometric_doubt_rmse > 0");
   require(params.keyframes.max_interval >= 1, "odometry: keyframes.max_interval must be >= 1");
   require(params.anchor.max_translation >= 0 && params.anchor.max_rotation_deg >= 0 &&
               params.anchor.max_interval >= 0,
@@ -433,8 +434,10 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
     return best_of_other_starts(previous, predicted, std::move(attempt), frame);
   }
   // Only where the images did not measure the weak directions themselves (a step beyond the
-  // refinement's basin, or too little texture): elsewhere they already had their say.
-  if (geometry_.degeneracy.degenerate && !attempt.photometric && attempt.photometric_rmse > 0) {
+  // refinement's basin, or too little texture) or left them far apart: elsewhere they already
+  // had their say.
+  if (geometry_.degeneracy.degenerate && attempt.photometric_rmse > 0 &&
+      (!attempt.photometric || attempt.photometric_rmse > params_.photometric_doubt_rmse)) {
     if (std::optional<Attempt> arbitrated = arbitrate_by_intensity(attempt)) {
       frame.from_features = true;
       return std::move(*arbitrated);

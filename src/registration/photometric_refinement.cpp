@@ -142,15 +142,74 @@ Eigen::Isometry3d step(const Eigen::Isometry3d& motion, std::span<const se3::Vec
   return motion * se3::exp(xi);
 }
 
+using Mask = Image<std::uint8_t>;
+
+// Depth steps between neighbouring pixels larger than this are surfaces apart, not one surface
+// seen at a grazing angle (a floor 4 m away steps about 3 cm a pixel at 640x480).
+constexpr double kEdgeJumpFraction = 0.03;
+constexpr double kEdgeJumpMetres = 0.01;
+
+// Set wherever a set pixel lies within `radius` (a square window), in two separable passes.
+Mask dilated(const Mask& mask, int radius) {
+  const int w = mask.width(), h = mask.height();
+  const auto pass = [&](const Mask& in, bool along_rows) {
+    Mask out(w, h, 0);
+    for (int y = 0; y < h; ++y) {
+      for (int x = 0; x < w; ++x) {
+        if (!in(x, y)) continue;
+        for (int d = -radius; d <= radius; ++d) {
+          const int u = along_rows ? x + d : x, v = along_rows ? y : y + d;
+          if (u >= 0 && u < w && v >= 0 && v < h) out(u, v) = 1;
+        }
+      }
+    }
+    return out;
+  };
+  return pass(pass(mask, true), false);
+}
+
+// Source pixels whose smoothed grey level mixes two surfaces apart in depth (a cabinet's edge
+// against the wall behind it): as the camera moves the two slide apart, so their residuals pull
+// the motion towards the parallax rather than the camera's motion. Only steps between pixels that
+// both have depth count: a dark surface's dropouts or a range limit say nothing of depth. Their
+// reach is the fine pass's (one binomial pass, 2 pixels, and the gradient's 1). The coarse pass
+// keeps them, as its wide basin needs the edges' contrast, and the fine pass removes what they
+// pull: masked to the coarse blur's reach of 6 pixels, survey seed 8's degenerate views kept too
+// few textured pixels to refine; masked to 3 in both passes, seeds 5, 6 and 10 drifted more.
+Mask near_depth_edges(const DepthImage& depth, double units_per_metre) {
+  const int w = depth.width(), h = depth.height();
+  Mask edge(w, h, 0);
+  const auto apart = [&](int x0, int y0, int x1, int y1) {
+    const double a = depth(x0, y0) / units_per_metre, b = depth(x1, y1) / units_per_metre;
+    return depth(x0, y0) != 0 && depth(x1, y1) != 0 &&
+           std::abs(a - b) > kEdgeJumpFraction * std::min(a, b) + kEdgeJumpMetres;
+  };
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      if (x + 1 < w && apart(x, y, x + 1, y)) edge(x, y) = edge(x + 1, y) = 1;
+      if (y + 1 < h && apart(x, y, x, y + 1)) edge(x, y) = edge(x, y + 1) = 1;
+    }
+  }
+  constexpr int kFinePassReach = 3;
+  return dilated(edge, kFinePassReach);
+}
+
+// The pixels the fine pass and intensity_rmse leave out: none unless params.mask_depth_edges.
+Mask excluded_pixels(const DepthImage& depth, double units_per_metre,
+                     const PhotometricParams& params) {
+  if (!params.mask_depth_edges) return Mask(depth.width(), depth.height(), 0);
+  return near_depth_edges(depth, units_per_metre);
+}
+
 std::vector<Sample> samples_of(const DepthImage& depth, const Textured& source,
                                const PinholeIntrinsics& k, double units_per_metre,
-                               const PhotometricParams& params) {
+                               const PhotometricParams& params, const Mask& excluded) {
   std::vector<Sample> samples;
   const double min_squared = params.min_gradient * params.min_gradient;
   for (int y = 2; y + 2 < depth.height(); y += params.pixel_step) {
     for (int x = 2; x + 2 < depth.width(); x += params.pixel_step) {
       const double z = depth(x, y) / units_per_metre;
-      if (depth(x, y) == 0 || z > params.max_depth) continue;
+      if (depth(x, y) == 0 || z > params.max_depth || excluded(x, y)) continue;
       const double gx = source.dx(x, y), gy = source.dy(x, y);
       if (gx * gx + gy * gy < min_squared) continue;
       samples.push_back(
@@ -250,8 +309,9 @@ std::vector<double> intensity_rmse(const DepthImage& source_depth, const RgbImag
   std::vector<double> rmse(source_to_target.size(), 0.0);
   const Textured source(blurred(grey_of(source_color), 1));
   const Textured target(blurred(grey_of(target_color), 1));
+  const Mask excluded = excluded_pixels(source_depth, units_per_metre, params);
   const std::vector<Sample> samples =
-      samples_of(source_depth, source, camera, units_per_metre, params);
+      samples_of(source_depth, source, camera, units_per_metre, params, excluded);
   if (samples.size() < params.min_pixels) return rmse;
   for (std::size_t m = 0; m < source_to_target.size(); ++m) {
     const Sums sums =
@@ -280,13 +340,15 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
   Prior prior(start_information, directions, params.intensity_sigma);
   const GreyImage source_grey = grey_of(source_color);
   const GreyImage target_grey = grey_of(target_color);
+  const Mask kept_all(source_depth.width(), source_depth.height(), 0);
+  const Mask fine_excluded = excluded_pixels(source_depth, units_per_metre, params);
   double start_cost = 0, end_cost = 0;  // mean costs of the fine pass
   // Coarse (wide basin), then fine (sharp minimum).
   for (const int passes : {params.blur_passes, 1}) {
     const Textured source(blurred(source_grey, passes));
     const Textured target(blurred(target_grey, passes));
-    const std::vector<Sample> samples =
-        samples_of(source_depth, source, camera, units_per_metre, params);
+    const std::vector<Sample> samples = samples_of(source_depth, source, camera, units_per_metre,
+                                                   params, passes == 1 ? fine_excluded : kept_all);
     if (samples.size() < params.min_pixels) return result;
     if (passes == 1) {
       const Sums original =

@@ -188,7 +188,9 @@ struct OdometryParams {
   // for degenerate frames in general: features matched a few centimetres off, worse than the
   // motion model (survey seed 2: 8.5 cm ATE against 2.8).
   // But on a degenerate frame with colour whose weak directions the images did not measure
-  // (photometric refinement not kept), ICP from the features' motion is also run, and taken
+  // (photometric refinement not kept, or kept with a grey-level RMSE above
+  // photometric_doubt_rmse: a step beyond its basin that moved a few millimetres downhill, as
+  // where the robot sets off from rest), ICP from the features' motion is also run, and taken
   // when it differs from the prediction's registration by more than feature_arbitration_m or
   // _deg and its images agree better: a grey-level RMSE (after the photometric refinement of both)
   // below feature_arbitration_ratio times the other's (a robot setting off from rest facing a wall,
@@ -199,6 +201,7 @@ struct OdometryParams {
   double feature_arbitration_m = 0.05;
   double feature_arbitration_deg = 2;
   double feature_arbitration_ratio = 0.9;
+  double photometric_doubt_rmse = 10;  // grey levels; the synthetic camera's noise is about 1
 };
 
 // A measured (or, for fallbacks, predicted) motion between two frames, for a pose graph:

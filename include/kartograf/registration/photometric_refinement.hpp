@@ -44,6 +44,12 @@ struct PhotometricParams {
   // measurement: on the synthetic surveys, floors with texture gave 0.04-0.2 mm, a grey floor or
   // a weak wood grain under the sensor noise 3-8 mm, with answers 2-17 cm wrong.
   double max_sigma_m = 0.001;
+  // Leave out of the fine pass (and of intensity_rmse) the source pixels within 3 pixels of a
+  // step in depth between two pixels that have depth (more than 3 % of the depth + 1 cm): their
+  // smoothed grey level mixes two surfaces that slide apart as the camera moves (a cabinet's edge
+  // against the wall behind it). On survey seed 4, frames 1041-1048, they pulled the steps 1-2 cm
+  // off, a dark cabinet passing a wall. False keeps them, as before 2026-11-30.
+  bool mask_depth_edges = true;
   // The grey-level noise a residual is taken to have when start_information is weighed against
   // the images. Set once (the synthetic camera has 2 levels per channel); the weight of the other
   // side, OdometryParams::photometric_geometry_weight, was chosen on the surveys.
