@@ -334,40 +334,51 @@ PhotometricResult refine_photometrically(const DepthImage& source_depth,
               units_per_metre > 0,
           "photometric refinement: pixel_step, blur_passes >= 1, iterations >= 0 and "
           "units_per_metre > 0 are required");
-  PhotometricResult result;
-  result.motion = source_to_target;
-  if (directions.empty()) return result;
+  PhotometricResult unrefined;
+  unrefined.motion = source_to_target;
+  if (directions.empty()) return unrefined;
   Prior prior(start_information, directions, params.intensity_sigma);
   const GreyImage source_grey = grey_of(source_color);
   const GreyImage target_grey = grey_of(target_color);
   const Mask kept_all(source_depth.width(), source_depth.height(), 0);
-  const Mask fine_excluded = excluded_pixels(source_depth, units_per_metre, params);
-  double start_cost = 0, end_cost = 0;  // mean costs of the fine pass
-  // Coarse (wide basin), then fine (sharp minimum).
-  for (const int passes : {params.blur_passes, 1}) {
-    const Textured source(blurred(source_grey, passes));
-    const Textured target(blurred(target_grey, passes));
-    const std::vector<Sample> samples = samples_of(source_depth, source, camera, units_per_metre,
-                                                   params, passes == 1 ? fine_excluded : kept_all);
-    if (samples.size() < params.min_pixels) return result;
-    if (passes == 1) {
-      const Sums original =
-          evaluate(samples, target, camera, source_to_target, directions, params.huber_levels);
-      start_cost = mean_cost(original);
-      result.rmse_before = original.count ? std::sqrt(original.squared / original.count) : 0.0;
-    }
-    Sums sums = descend(samples, target, camera, directions, params, result.motion, prior);
-    if (passes == 1) {
-      result.sigma_m = motion_sigma(sums, directions, measured_directions);
-      end_cost = mean_cost(sums) + prior.cost(prior.amounts, sums.count);
-      result.pixels = sums.count;
-      result.rmse_after = sums.count ? std::sqrt(sums.squared / sums.count) : 0.0;
-    }
+  // Coarse (wide basin), on every textured pixel.
+  Eigen::Isometry3d coarse = source_to_target;
+  {
+    const Textured source(blurred(source_grey, params.blur_passes));
+    const Textured target(blurred(target_grey, params.blur_passes));
+    const std::vector<Sample> samples =
+        samples_of(source_depth, source, camera, units_per_metre, params, kept_all);
+    if (samples.size() < params.min_pixels) return unrefined;
+    descend(samples, target, camera, directions, params, coarse, prior);
   }
-  result.refined = end_cost < start_cost && result.pixels >= params.min_pixels &&
-                   result.sigma_m <= params.max_sigma_m;
-  if (!result.refined) result.motion = source_to_target;
-  return result;
+  // Fine (sharp minimum), from the coarse answer, without the pixels `excluded`.
+  const Textured source(blurred(source_grey, 1));
+  const Textured target(blurred(target_grey, 1));
+  const auto fine = [&](const Mask& excluded) {
+    const std::vector<Sample> samples =
+        samples_of(source_depth, source, camera, units_per_metre, params, excluded);
+    if (samples.size() < params.min_pixels) return unrefined;
+    PhotometricResult result;
+    const Sums original =
+        evaluate(samples, target, camera, source_to_target, directions, params.huber_levels);
+    result.rmse_before = original.count ? std::sqrt(original.squared / original.count) : 0.0;
+    result.motion = coarse;
+    Prior held = prior;
+    const Sums sums = descend(samples, target, camera, directions, params, result.motion, held);
+    result.sigma_m = motion_sigma(sums, directions, measured_directions);
+    result.pixels = sums.count;
+    result.rmse_after = sums.count ? std::sqrt(sums.squared / sums.count) : 0.0;
+    result.refined = mean_cost(sums) + held.cost(held.amounts, sums.count) < mean_cost(original) &&
+                     result.pixels >= params.min_pixels && result.sigma_m <= params.max_sigma_m;
+    if (!result.refined) result.motion = source_to_target;
+    return result;
+  };
+  const PhotometricResult masked = fine(excluded_pixels(source_depth, units_per_metre, params));
+  // Where the images cannot measure the motion without the pixels beside depth edges (too few
+  // left, or sigma over the gate: the 320x240 hand-held views), those pixels measure it as they
+  // did before they were left out.
+  if (masked.refined || !params.mask_depth_edges) return masked;
+  return fine(kept_all);
 }
 
 }  // namespace kartograf::registration
