@@ -204,7 +204,8 @@ TEST(DoubtfulRegistration, ASidewaysErrorAtAnArcsOnsetIsNotRepeated) {
 // images alone drew steps 11.5 cm off, and ICP's own information on what it measured holds them
 // (11.2 mm, as before the change: 11.4 mm). Both failures were measured with the pixels beside
 // depth edges in the images' fit; without them (PhotometricParams::mask_depth_edges) the free
-// direction alone is 15 mm off on the first stretch and the images alone 4 mm on the second.
+// direction alone is 15 mm off on the first stretch, and on the second the images alone are 7.6
+// mm off and the defaults 1.2 mm.
 TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGeometry) {
   const DegenerateStretch cabinet{4, 842, 22, true};
   const auto [metres, degrees] = worst_step(cabinet, {});
