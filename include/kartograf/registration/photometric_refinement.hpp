@@ -47,10 +47,10 @@ struct PhotometricParams {
   // Leave out of the fine pass (and of intensity_rmse) the source pixels within 3 pixels of a
   // step in depth between two pixels that have depth (more than 3 % of the depth + 1 cm): their
   // smoothed grey level mixes two surfaces that slide apart as the camera moves (a cabinet's edge
-  // against the wall behind it). On survey seed 4, frames 1041-1048, they pulled the steps 1-2 cm
-  // off, a dark cabinet passing a wall. Where the fit without them fails (too few pixels, or
-  // sigma over max_sigma_m: 320x240 hand-held views), it is done again with them. False keeps
-  // them always, as before 2026-11-30.
+  // against the wall behind it). On survey seed 4, frames 1041-1050, they pulled the steps
+  // 0.3-1.7 cm off, a dark cabinet passing a wall. Where the fit without them fails (too few
+  // pixels, or sigma over max_sigma_m: 320x240 hand-held views), it is done again with them. False
+  // keeps them always, as before 2026-11-30.
   bool mask_depth_edges = true;
   // The grey-level noise a residual is taken to have when start_information is weighed against
   // the images. Set once (the synthetic camera has 2 levels per channel); the weight of the other
