@@ -286,6 +286,36 @@ TEST(SemanticGridFreeSpace, AHullOverOpenFloorLeavesItFloor) {
   EXPECT_EQ(class_at(blind, 1.7, 1.7), C::furniture);
 }
 
+// The table above and, 0.65 m north of it, a cabinet 1.3 m high (above the views' eyes), larger
+// than the table: one piece over the join gap, whose tops are mostly the cabinet's. The floor
+// between them lies in the table's shadow for the views from the south (a band of heights under
+// its top, lower the farther from it) and in the cabinet's for those from the north: seen through
+// above the table's top, not at every height below the cabinet's. Beyond the shadow of the
+// table's own top (0.35 m from it) it stays floor; the table and the cabinet are furniture.
+TEST(SemanticGridFreeSpace, FloorBetweenATableAndATallerCabinetStaysFloor) {
+  std::vector<Box> scene = room();
+  scene.push_back({{2.0, 1.6, 0.72}, {3.2, 2.4, 0.76}, C::unknown, C::wall});
+  for (const double x : {2.04, 3.11})
+    for (const double y : {1.64, 2.31})
+      scene.push_back({{x, y, 0}, {x + 0.05, y + 0.05, 0.72}, C::unknown, C::unknown});
+  scene.push_back({{1.9, 3.05, 0}, {3.3, 3.45, 1.3}, C::furniture, C::furniture});
+  const Views v =
+      look(scene, {{0.8, 0.5, 1}, {4.4, 0.5, 1}, {2.6, 0.4, 1}, {1.2, 3.7, 1}, {4.0, 3.7, 1}});
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  EXPECT_EQ(class_at(grid, 2.6, 2.0), C::furniture);  // the table
+  EXPECT_EQ(class_at(grid, 2.1, 1.7), C::furniture);
+  EXPECT_EQ(class_at(grid, 2.6, 3.04), C::furniture);  // the cabinet's front
+  int floor = 0, cells = 0;
+  for (double x = 2.125; x < 3.1; x += 0.05) {
+    for (double y = 2.775; y < 2.99; y += 0.05) {
+      floor += class_at(grid, x, y) == C::floor;
+      ++cells;
+    }
+  }
+  EXPECT_GE(floor, cells * 9 / 10) << floor << " of " << cells << " cells between them";
+}
+
 // Two views 4.4 m from the room's east wall (x = 5) read it 8 cm short, as a depth step does: a
 // layer of wall points a cell in front of it, with a cell of floor between. Three views nearby
 // see through that layer at every height: it is floor, and the wall behind it stays wall.

@@ -187,34 +187,70 @@ CellMask closed_cell_mask(const SemanticGrid& grid, const Selected& selected, in
   return m;
 }
 
-// The tops of a piece of furniture (its cells' highest points above the floor, less a little so
-// that the slab judged lies inside a 2-5 cm table top): the median and the 90th percentile, which
-// differ where a table joins a taller cabinet.
-std::array<double, 2> piece_tops(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+// The height above the floor at which a cell of furniture is judged seen through: its highest
+// point, less a little so that the slab judged lies inside a 2-5 cm table top.
+double judged_top(const SemanticGrid& grid, const Image<CellEvidence>& evidence, cv::Point cell) {
+  return evidence(cell.x, cell.y).z_max - grid.floor_z - kBelowTop;
+}
+
+// The tops of a piece of furniture (its cells' judged tops): the median and the 90th percentile,
+// which differ where a table joins a taller cabinet; and where the median is above what the views
+// observe, the median of the tops they observe (a table joined to a larger shelf), if any: the
+// median again otherwise.
+std::array<double, 3> piece_tops(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                                 const detail::BandFreeSpace* free_space,
                                  const std::vector<cv::Point>& cells) {
-  std::vector<float> tops;
+  std::vector<double> tops, observed;
   for (const cv::Point& c : cells) {
-    const float top = evidence(c.x, c.y).z_max;
-    if (std::isfinite(top)) tops.push_back(top);
+    const double top = judged_top(grid, evidence, c);
+    if (!std::isfinite(top)) continue;
+    tops.push_back(top);
+    if (free_space && free_space->observable(top)) observed.push_back(top);
   }
   const double none = std::numeric_limits<double>::quiet_NaN();
-  if (tops.empty()) return {none, none};
+  if (tops.empty()) return {none, none, none};
   std::sort(tops.begin(), tops.end());
-  const double base = grid.floor_z + kBelowTop;
-  return {tops[tops.size() / 2] - base, tops[tops.size() * 9 / 10] - base};
+  std::sort(observed.begin(), observed.end());
+  const double median = tops[tops.size() / 2];
+  const bool tall = free_space && !free_space->observable(median) && !observed.empty();
+  return {median, tops[tops.size() * 9 / 10], tall ? observed[observed.size() / 2] : median};
 }
 
 // Whether a piece of furniture with these tops leaves `cell` open floor: the views saw through it
-// in the few centimetres under each top (where a table's top stands), or, for a top above what
-// they observe (a tall shelf), at every height they observe below it.
-bool open_beside(const detail::BandFreeSpace& free_space, const std::array<double, 2>& tops,
-                 const cv::Point& cell) {
+// in the few centimetres under each top (where a table's top stands), and, for a top above what
+// they observe (a tall shelf), at every height they observe below it. Every height in the
+// footprint of the piece's tall parts (`under_tall`): a shelf's boards stop the rays at heights
+// of their own. Outside it, down to the highest top they observe: a table joined to a taller
+// cabinet shadows the floor between them below its top, where rays to that floor pass through it.
+bool open_beside(const detail::BandFreeSpace& free_space, const std::array<double, 3>& tops,
+                 const cv::Point& cell, bool under_tall) {
+  double highest_observed = 0;  // clear_between clamps it to the band's bottom
+  for (const double top : tops)
+    if (!under_tall && std::isfinite(top) && free_space.observable(top))
+      highest_observed = std::max(highest_observed, top);
   return std::all_of(tops.begin(), tops.end(), [&](double top) {
     if (!std::isfinite(top)) return false;
     return free_space.observable(top)
                ? free_space.clear_between({cell.x, cell.y}, top - kTopDepth, top)
-               : free_space.clear_below({cell.x, cell.y}, top);
+               : free_space.clear_between({cell.x, cell.y}, highest_observed, top);
   });
+}
+
+// The cells of `box` (a mask of its size) in the convex hull of the `marked` cells whose tops
+// stand above the heights the views observe.
+cv::Mat tall_footprint(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                       const detail::BandFreeSpace& free_space,
+                       const std::vector<cv::Point>& marked, const cv::Rect& box) {
+  std::vector<cv::Point> tall, hull;
+  for (const cv::Point& c : marked) {
+    const double top = judged_top(grid, evidence, c);
+    if (std::isfinite(top) && !free_space.observable(top)) tall.push_back(c - box.tl());
+  }
+  cv::Mat footprint = cv::Mat::zeros(box.size(), CV_8U);
+  if (tall.empty()) return footprint;
+  cv::convexHull(tall, hull);
+  cv::fillConvexPoly(footprint, hull, 255);
+  return footprint;
 }
 
 // Wall cells that stand on nothing or reach no higher than a cabinet: the views saw under them
@@ -327,12 +363,14 @@ void fill_piece(SemanticGrid& grid, const Image<CellEvidence>& evidence,
       if (furniture(cells.back().x, cells.back().y)) marked.push_back(cells.back());
     }
   }
-  const std::array<double, 2> tops = piece_tops(grid, evidence, marked);
+  const std::array<double, 3> tops = piece_tops(grid, evidence, free_space, marked);
+  const cv::Mat tall =
+      free_space ? tall_footprint(grid, evidence, *free_space, marked, box) : cv::Mat();
   for (const cv::Point& c : cells) {
     // Only floor changes: walls and doors keep their class, and what no view saw stays
     // unknown (filling it made rooms leak where the views were few).
     if (furniture(c.x, c.y) || grid.classes(c.x, c.y) != SemanticClass::floor ||
-        (free_space && open_beside(*free_space, tops, c)))
+        (free_space && open_beside(*free_space, tops, c, tall.at<std::uint8_t>(c - box.tl()) != 0)))
       continue;
     furniture(c.x, c.y) = 1;
     grid.classes(c.x, c.y) = SemanticClass::furniture;
