@@ -406,11 +406,27 @@ std::vector<std::vector<cv::Point>> pieces_between_walls(const std::vector<cv::P
   return pieces;
 }
 
+// A depth edge's mixed pixels pile up in a cell one or two a view (a line of them along a view's
+// ray behind a table's or a cabinet's outline); a surface puts tens of points a view in a cell.
+constexpr double kMixedPixelsPerView = 5;
+
+// Whether a cell's band points are that sparse: fewer than kMixedPixelsPerView for each view that
+// put points in it.
+bool mixed_pixels_only(const CellEvidence& e) {
+  return e.band_views > 0 && e.band_total() < kMixedPixelsPerView * e.band_views;
+}
+
+// One closing of fill_furniture's: its size in cells, and whether the mixed pixels take part.
+struct JoinPass {
+  int size;
+  bool solid_only;
+};
+
 // Furniture seen as outlines (a table's legs and edges; its top drops out at grazing views): each
 // piece, closed over gaps of join_gap, whose convex hull is at most max_area is filled
 // (fill_piece): the robot cannot drive under it within its height band. The marked cells of a
-// piece too large (the tables and cabinets of a room joined into one) are judged again closed
-// over kJoinAgainGap.
+// piece too large (the tables and cabinets of a room joined into one) are judged again without
+// the cells of mixed pixels only, then closed over kJoinAgainGap.
 void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                     const detail::BandFreeSpace* free_space, Image<std::uint8_t>& furniture,
                     double join_gap, double max_area, float furniture_weight) {
@@ -421,16 +437,28 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   cv::Mat left = closed_cell_mask(
                      grid, [&](int col, int row) { return furniture(col, row) != 0; }, 1)
                      .mask;
+  const cv::Mat solid = closed_cell_mask(
+                            grid,
+                            [&](int col, int row) {
+                              return furniture(col, row) && !mixed_pixels_only(evidence(col, row));
+                            },
+                            1)
+                            .mask;
   const double cell_area = grid.resolution * grid.resolution;
-  std::vector<int> sizes{cells_of(join_gap)};
-  if (cells_of(kJoinAgainGap) < sizes.front()) sizes.push_back(cells_of(kJoinAgainGap));
+  // A piece too large over all its cells is judged again without its mixed pixels (a line of
+  // them joins a table to its neighbours), then over the smaller gap.
+  std::vector<JoinPass> passes{{cells_of(join_gap), false}, {cells_of(join_gap), true}};
+  if (cells_of(kJoinAgainGap) < passes.front().size)
+    passes.push_back({cells_of(kJoinAgainGap), false});
   const cv::Mat walls =
       closed_cell_mask(
           grid, [&](int col, int row) { return grid.classes(col, row) == SemanticClass::wall; }, 1)
           .mask;
-  for (const int size : sizes) {
+  for (const JoinPass& pass : passes) {
+    const int size = pass.size;
+    const cv::Mat input = pass.solid_only ? cv::Mat(left & solid) : left;
     cv::Mat closed;
-    cv::morphologyEx(left, closed, cv::MORPH_CLOSE,
+    cv::morphologyEx(input, closed, cv::MORPH_CLOSE,
                      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
     std::vector<std::vector<cv::Point>> pieces;
     cv::findContours(closed, pieces, cv::RETR_EXTERNAL, cv::CHAIN_APPROX_SIMPLE);
@@ -443,7 +471,7 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
         continue;
       }
       for (const std::vector<cv::Point>& part :
-           pieces_between_walls(pieces[k], left, walls, size)) {
+           pieces_between_walls(pieces[k], input, walls, size)) {
         cv::convexHull(part, hull);
         // What the piece fills: with the free space, the rectangle around it, where that is
         // furniture sized too; pieces joined in an L (a table and a cabinet beside it) have a
@@ -455,7 +483,9 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
         fill_piece(grid, evidence, free_space, furniture, hull, furniture_weight);
       }
     }
-    cv::bitwise_and(left, too_large, left);
+    // What is left for the next pass: the pieces too large, and after the pass without the
+    // mixed pixels, those no piece took.
+    cv::bitwise_and(left, pass.solid_only ? cv::Mat(~closed | too_large) : too_large, left);
   }
 }
 
