@@ -457,6 +457,8 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   for (const JoinPass& pass : passes) {
     const int size = pass.size;
     const cv::Mat input = pass.solid_only ? cv::Mat(left & solid) : left;
+    // Without mixed pixels among what is left, the pass would judge the same pieces again.
+    if (pass.solid_only && cv::countNonZero(left) == cv::countNonZero(input)) continue;
     cv::Mat closed;
     cv::morphologyEx(input, closed, cv::MORPH_CLOSE,
                      cv::getStructuringElement(cv::MORPH_RECT, cv::Size(size, size)));
