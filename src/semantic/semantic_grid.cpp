@@ -193,13 +193,32 @@ double judged_top(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
   return evidence(cell.x, cell.y).z_max - grid.floor_z - kBelowTop;
 }
 
+// A piece's cells' tops in levels (sorted, split where they step by more than kLevelStep): a
+// level holding at least kLevelShare of them is a piece of furniture's own top (a table joined
+// to a taller cabinet in one piece, a third of its cells).
+constexpr double kLevelStep = 0.05, kLevelShare = 0.2;
+
+// The median of each such level of the `sorted` tops but the one holding their median.
+void add_levels(const std::vector<double>& sorted, std::vector<double>& tops) {
+  const std::size_t median = sorted.size() / 2;
+  std::size_t begin = 0;
+  for (std::size_t end = 1; end <= sorted.size(); ++end) {
+    if (end < sorted.size() && sorted[end] - sorted[end - 1] <= kLevelStep) continue;
+    const bool own = begin <= median && median < end;
+    if (!own &&
+        static_cast<double>(end - begin) >= kLevelShare * static_cast<double>(sorted.size()))
+      tops.push_back(sorted[(begin + end) / 2]);
+    begin = end;
+  }
+}
+
 // The tops of a piece of furniture (its cells' judged tops): the median and the 90th percentile,
-// which differ where a table joins a taller cabinet; and where the median is above what the views
-// observe, the median of the tops they observe (a table joined to a larger shelf), if any: the
-// median again otherwise.
-std::array<double, 3> piece_tops(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                                 const detail::BandFreeSpace* free_space,
-                                 const std::vector<cv::Point>& cells) {
+// which differ where a table joins a taller cabinet; where the median is above what the views
+// observe, the median of the tops they observe (a table joined to a larger shelf), if any; and
+// the median of each other level that holds a large share of its cells (add_levels).
+std::vector<double> piece_tops(const SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                               const detail::BandFreeSpace* free_space,
+                               const std::vector<cv::Point>& cells) {
   std::vector<double> tops, observed;
   for (const cv::Point& c : cells) {
     const double top = judged_top(grid, evidence, c);
@@ -207,13 +226,15 @@ std::array<double, 3> piece_tops(const SemanticGrid& grid, const Image<CellEvide
     tops.push_back(top);
     if (free_space && free_space->observable(top)) observed.push_back(top);
   }
-  const double none = std::numeric_limits<double>::quiet_NaN();
-  if (tops.empty()) return {none, none, none};
+  if (tops.empty()) return {std::numeric_limits<double>::quiet_NaN()};
   std::sort(tops.begin(), tops.end());
   std::sort(observed.begin(), observed.end());
   const double median = tops[tops.size() / 2];
-  const bool tall = free_space && !free_space->observable(median) && !observed.empty();
-  return {median, tops[tops.size() * 9 / 10], tall ? observed[observed.size() / 2] : median};
+  std::vector<double> judged{median, tops[tops.size() * 9 / 10]};
+  if (free_space && !free_space->observable(median) && !observed.empty())
+    judged.push_back(observed[observed.size() / 2]);
+  add_levels(tops, judged);
+  return judged;
 }
 
 // Whether a piece of furniture with these tops leaves `cell` open floor: the views saw through it
@@ -222,7 +243,7 @@ std::array<double, 3> piece_tops(const SemanticGrid& grid, const Image<CellEvide
 // footprint of the piece's tall parts (`under_tall`): a shelf's boards stop the rays at heights
 // of their own. Outside it, down to the highest top they observe: a table joined to a taller
 // cabinet shadows the floor between them below its top, where rays to that floor pass through it.
-bool open_beside(const detail::BandFreeSpace& free_space, const std::array<double, 3>& tops,
+bool open_beside(const detail::BandFreeSpace& free_space, const std::vector<double>& tops,
                  const cv::Point& cell, bool under_tall) {
   double highest_observed = 0;  // clear_between clamps it to the band's bottom
   for (const double top : tops)
@@ -363,7 +384,7 @@ void fill_piece(SemanticGrid& grid, const Image<CellEvidence>& evidence,
       if (furniture(cells.back().x, cells.back().y)) marked.push_back(cells.back());
     }
   }
-  const std::array<double, 3> tops = piece_tops(grid, evidence, free_space, marked);
+  const std::vector<double> tops = piece_tops(grid, evidence, free_space, marked);
   const cv::Mat tall =
       free_space ? tall_footprint(grid, evidence, *free_space, marked, box) : cv::Mat();
   for (const cv::Point& c : cells) {
