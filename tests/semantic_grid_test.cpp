@@ -758,6 +758,32 @@ TEST(SemanticGrid, NoisyWallFacesAreMeasuredAlongTheWall) {
   EXPECT_GT(wrong(build_semantic_grid(s.points, s.labels, off)).first, 18);  // of 36 probes
 }
 
+// Such a room with a cabinet against its south wall (1 m wide, 0.5 m deep, 0.8 m high; its top,
+// front and sides) standing up to the wall's face: the cells in front of the face where it stands
+// hold more of the wall's noise than of the cabinet, and the face, measured along the wall, puts
+// them in the cabinet, as it puts those beside it on the floor. Left as wall, the wall is a cell
+// thicker behind furniture than elsewhere.
+TEST(SemanticGrid, WallFacesMoveUnderFurnitureStandingAgainstThem) {
+  using C = SemanticClass;
+  constexpr double kWest = 0.512, kEast = 4.012, kSouth = 0.512, kNorth = 3.012;
+  constexpr double kLeft = 1.5, kRight = 2.5, kFront = kSouth + 0.5, kTop = 0.8;
+  LabelledPoints s = noisy_room({kWest, kSouth}, {kEast, kNorth}, 0.02, 11);
+  s.box_face({kLeft, kSouth, kTop}, {kRight, kFront, kTop}, C::furniture);
+  s.box_face({kLeft, kFront, 0.02}, {kRight, kFront, kTop}, C::furniture);
+  for (const double x : {kLeft, kRight})
+    s.box_face({x, kSouth, 0.02}, {x, kFront, kTop}, C::furniture);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  int in_front = 0, behind = 0, probes = 0;
+  for (double x = kLeft + 0.1; x < kRight - 0.05; x += 0.05, ++probes) {
+    const Eigen::Vector2i front = grid.cell_of({x, kSouth + 0.035});
+    const Eigen::Vector2i back = grid.cell_of({x, kSouth - 0.035});
+    in_front += grid.classes(front.x(), front.y()) == C::furniture;
+    behind += grid.classes(back.x(), back.y()) == C::wall;
+  }
+  EXPECT_GE(in_front, probes - 1) << "of " << probes << " cells in front of the face";
+  EXPECT_EQ(behind, probes);
+}
+
 // The doorways found across a 1.4 m corridor that two rooms' dividers meet at a T from either
 // side, the north one `offset` metres east of the south one; `ragged`: each corridor wall is unseen
 // for 0.1 m beside the divider that meets it (as mapped: a wall breaks up at a junction).

@@ -62,10 +62,23 @@ bool wall_or_unseen(const SemanticGrid& grid, const Eigen::Vector2i& c) {
          (unobserved(grid, c) || grid.classes(c.x(), c.y()) == SemanticClass::wall);
 }
 
+// What a wall cell moved into the room (a step from `wall`) becomes: what the room holds in front
+// of it, floor, or furniture two cells deep (a table or a cabinet against the wall stands up to its
+// face; a speck of furniture in front of a face is the face's noise).
+std::optional<SemanticClass> room_in_front(const SemanticGrid& grid, const Eigen::Vector2i& wall,
+                                           const Eigen::Vector2i& step) {
+  if (seen_as(grid, wall + step, SemanticClass::floor)) return SemanticClass::floor;
+  if (seen_as(grid, wall + step, SemanticClass::furniture) &&
+      seen_as(grid, wall + 2 * step, SemanticClass::furniture))
+    return SemanticClass::furniture;
+  return std::nullopt;
+}
+
 }  // namespace
 
 int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
-                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights) {
+                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights,
+                     Image<std::uint8_t>& furniture) {
   const double res = grid.resolution;
   int moved = 0;
   for (int row = 0; row < grid.height(); ++row) {
@@ -76,13 +89,15 @@ int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
         // Two cells of wall stay behind (a wall is thicker than a cell; one cell of it lets the
         // rooms leak diagonally), so the two faces of a thin wall never both move in. In scan
         // order: the first face judged wins.
-        if (!seen_as(grid, c + step, SemanticClass::floor) || !wall_or_unseen(grid, c - step) ||
-            !wall_or_unseen(grid, c - 2 * step))
+        const std::optional<SemanticClass> room = room_in_front(grid, c, step);
+        if (!room || !wall_or_unseen(grid, c - step) || !wall_or_unseen(grid, c - 2 * step))
           continue;
         const std::optional<double> face =
             face_offset(grid, walls, c, step, boundary_between(grid, c, c + step));
         if (!face || *face >= -0.5 * res) continue;  // the cell's centre is inside the wall
-        grid.classes(col, row) = SemanticClass::floor, grid.weight(col, row) = weights.floor;
+        grid.classes(col, row) = *room;
+        grid.weight(col, row) = *room == SemanticClass::floor ? weights.floor : weights.furniture;
+        if (*room == SemanticClass::furniture) furniture(col, row) = 1;
         const Eigen::Vector2i behind = c - step;
         if (*face > -1.5 * res && unobserved(grid, behind)) {
           grid.classes(behind.x(), behind.y()) = SemanticClass::wall;

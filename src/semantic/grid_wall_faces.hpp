@@ -11,17 +11,18 @@
 namespace kartograf::semantic::detail {
 
 struct WallFaceWeights {
-  float floor, wall;
+  float floor, wall, furniture;
 };
 
-// Each wall cell beside a floor cell is judged on the face between them, measured as the median
-// offset of the wall points along kFaceStretch cells of it: a cell whose centre lies on the room's
-// side of the face holds less wall than room and becomes floor where floor was seen
-// (floor_seen), and an unseen cell behind it whose centre the wall then covers becomes wall. Two
-// cells of wall (or unseen) stay behind every moved cell. One pass, in scan order: a bulge of
-// noise two cells into the room is judged from its outer cell only. Returns the number of wall
-// cells that became floor.
+// Each wall cell beside a floor cell (or furniture two cells deep) is judged on the face between
+// them, measured as the median offset of the wall points along kFaceStretch cells of it: a cell
+// whose centre lies on the room's side of the face holds less wall than room and becomes what the
+// room holds there, floor or furniture (marked in `furniture`), where floor was seen (floor_seen),
+// and an unseen cell behind it whose centre the wall then covers becomes wall. Two cells of wall
+// (or unseen) stay behind every moved cell. One pass, in scan order: a bulge of noise two cells
+// into the room is judged from its outer cell only. Returns the number of wall cells moved.
 int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
-                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights);
+                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights,
+                     Image<std::uint8_t>& furniture);
 
 }  // namespace kartograf::semantic::detail

@@ -1209,7 +1209,9 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   if (options.place_wall_faces) {
     detail::place_wall_faces(
         grid, wall_points, floor_seen(evidence, options),
-        {options.weights.of(SemanticClass::floor), options.weights.of(SemanticClass::wall)});
+        {options.weights.of(SemanticClass::floor), options.weights.of(SemanticClass::wall),
+         options.weights.of(SemanticClass::furniture)},
+        masks.furniture);
   }
   complete_one_sided_walls(grid, options, thickness, max_wall, masks);
 }
