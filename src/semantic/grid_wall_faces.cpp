@@ -77,7 +77,7 @@ std::optional<SemanticClass> room_in_front(const SemanticGrid& grid, const Eigen
 }  // namespace
 
 int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
-                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights,
+                     const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
                      Image<std::uint8_t>& furniture) {
   const double res = grid.resolution;
   int moved = 0;
@@ -96,12 +96,12 @@ int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
             face_offset(grid, walls, c, step, boundary_between(grid, c, c + step));
         if (!face || *face >= -0.5 * res) continue;  // the cell's centre is inside the wall
         grid.classes(col, row) = *room;
-        grid.weight(col, row) = *room == SemanticClass::floor ? weights.floor : weights.furniture;
+        grid.weight(col, row) = weights.of(*room);
         if (*room == SemanticClass::furniture) furniture(col, row) = 1;
         const Eigen::Vector2i behind = c - step;
         if (*face > -1.5 * res && unobserved(grid, behind)) {
           grid.classes(behind.x(), behind.y()) = SemanticClass::wall;
-          grid.weight(behind.x(), behind.y()) = weights.wall;
+          grid.weight(behind.x(), behind.y()) = weights.of(SemanticClass::wall);
         }
         ++moved;
         break;

@@ -10,10 +10,6 @@
 
 namespace kartograf::semantic::detail {
 
-struct WallFaceWeights {
-  float floor, wall, furniture;
-};
-
 // Each wall cell beside a floor cell (or furniture two cells deep) is judged on the face between
 // them, measured as the median offset of the wall points along kFaceStretch cells of it: a cell
 // whose centre lies on the room's side of the face holds less wall than room and becomes what the
@@ -22,7 +18,7 @@ struct WallFaceWeights {
 // (or unseen) stay behind every moved cell. One pass, in scan order: a bulge of noise two cells
 // into the room is judged from its outer cell only. Returns the number of wall cells moved.
 int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
-                     const Image<std::uint8_t>& floor_seen, const WallFaceWeights& weights,
+                     const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
                      Image<std::uint8_t>& furniture);
 
 }  // namespace kartograf::semantic::detail

@@ -234,6 +234,9 @@ std::vector<double> piece_tops(const SemanticGrid& grid, const Image<CellEvidenc
   if (free_space && !free_space->observable(median) && !observed.empty())
     judged.push_back(observed[observed.size() / 2]);
   add_levels(tops, judged);
+  // A level's median may be one of the tops above: each is judged once.
+  std::sort(judged.begin(), judged.end());
+  judged.erase(std::unique(judged.begin(), judged.end()), judged.end());
   return judged;
 }
 
@@ -1207,11 +1210,8 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   // After the fronts (a front's face moved in would take a row from its pocket), before the
   // walls' hidden backs (which start at the faces).
   if (options.place_wall_faces) {
-    detail::place_wall_faces(
-        grid, wall_points, floor_seen(evidence, options),
-        {options.weights.of(SemanticClass::floor), options.weights.of(SemanticClass::wall),
-         options.weights.of(SemanticClass::furniture)},
-        masks.furniture);
+    detail::place_wall_faces(grid, wall_points, floor_seen(evidence, options), options.weights,
+                             masks.furniture);
   }
   complete_one_sided_walls(grid, options, thickness, max_wall, masks);
 }
