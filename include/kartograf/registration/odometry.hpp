@@ -201,7 +201,10 @@ struct OdometryParams {
   double feature_arbitration_m = 0.05;
   double feature_arbitration_deg = 2;
   double feature_arbitration_ratio = 0.9;
-  double photometric_doubt_rmse = 10;  // grey levels; the synthetic camera's noise is about 1
+  // Grey levels; the synthetic camera's noise is about 1. Also: a photometric refinement whose
+  // answer lies beyond the registration's correction limits (frame_limits, reestimate_limits) is
+  // kept only at an RMSE within this (docs/slam.md, "An images' correction beyond the limits").
+  double photometric_doubt_rmse = 10;
 };
 
 // A measured (or, for fallbacks, predicted) motion between two frames, for a pose graph:
