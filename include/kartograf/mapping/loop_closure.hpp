@@ -82,8 +82,11 @@ struct LoopClosureParams {
   double baseline_error_fraction = 0.02;
   // Directions whose balanced eigenvalue of the query's geometric information is below this
   // fraction of the largest are left to the expected motion, with no information in the edge
-  // (0: ICP's answer in every direction).
-  double weak_direction_ratio = 0.03;
+  // (0: ICP's answer in every direction). 0.05 since 2026-12-01 (was 0.03, the odometry's
+  // degeneracy ratio): a loop spans a wider baseline than a frame step, and on survey seed 5 a loop
+  // between a doorway in a plain wall and a shelf beside one (eigenvalue ratio 0.044) was 2.9 cm
+  // off the truth with full information (docs/slam.md, "Loop closure").
+  double weak_direction_ratio = 0.05;
   // A candidate by pose whose ICP corrected the estimate by more than min_correction_m leans on
   // the drift allowance (5 % of a 40 m path is 2 m): with a feature front end, the features of
   // the two keyframes must then find the same motion within this (else: unconfirmed).
