@@ -41,10 +41,8 @@ std::unique_ptr<CorrespondenceFinder> finder_for(const compute::Context& context
 bool keeps_refinement(const Eigen::Isometry3d& expected, const PhotometricResult& refined,
                       const RegistrationLimits& limits, double doubt_rmse) {
   if (!refined.refined) return false;
-  const Eigen::Isometry3d correction = expected.inverse() * refined.motion;
-  const bool within_limits = correction.translation().norm() <= limits.max_correction_m &&
-                             se3::rotation_angle(correction) <= limits.max_correction_deg * kDegree;
-  return within_limits || refined.rmse_after <= doubt_rmse;
+  return within_limits(correction_of(expected, refined.motion), limits) ||
+         refined.rmse_after <= doubt_rmse;
 }
 
 PyramidParams pyramid_params(const OdometryParams& params, int finest_level,

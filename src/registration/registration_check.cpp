@@ -26,6 +26,17 @@ std::string_view to_string(RegistrationVerdict verdict) {
   return "unknown";
 }
 
+Correction correction_of(const Eigen::Isometry3d& expected, const Eigen::Isometry3d& motion) {
+  const Eigen::Isometry3d correction = expected.inverse() * motion;
+  return {correction.translation().norm(),
+          se3::rotation_angle(correction) * 180.0 / std::numbers::pi};
+}
+
+bool within_limits(const Correction& correction, const RegistrationLimits& limits) {
+  return correction.metres <= limits.max_correction_m &&
+         correction.degrees <= limits.max_correction_deg;
+}
+
 RegistrationReport judge_registration(const IcpResult& result, const Eigen::Isometry3d& expected,
                                       const RegistrationLimits& limits) {
   return judge_registration(result, expected, limits, result.degeneracy);
@@ -42,9 +53,9 @@ RegistrationReport judge_registration(const IcpResult& result, const Eigen::Isom
   report.converged = result.converged;
   report.degenerate = degeneracy.degenerate;
   report.eigenvalue_ratio = degeneracy.eigenvalue_ratio;
-  const Eigen::Isometry3d correction = expected.inverse() * result.source_to_target;
-  report.correction_m = correction.translation().norm();
-  report.correction_deg = se3::rotation_angle(correction) * 180.0 / std::numbers::pi;
+  const Correction correction = correction_of(expected, result.source_to_target);
+  report.correction_m = correction.metres;
+  report.correction_deg = correction.degrees;
 
   const bool finite = result.source_to_target.matrix().allFinite();
   if (!finite || result.inlier_count < limits.min_inliers) {
@@ -55,8 +66,7 @@ RegistrationReport judge_registration(const IcpResult& result, const Eigen::Isom
     report.verdict = RegistrationVerdict::high_rmse;
   } else if (limits.reject_degenerate && degeneracy.degenerate) {
     report.verdict = RegistrationVerdict::degenerate;
-  } else if (!(report.correction_m <= limits.max_correction_m &&
-               report.correction_deg <= limits.max_correction_deg)) {
+  } else if (!within_limits(correction, limits)) {
     report.verdict = RegistrationVerdict::implausible;
   } else {
     report.verdict = RegistrationVerdict::accepted;

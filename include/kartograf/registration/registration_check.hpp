@@ -51,6 +51,14 @@ struct RegistrationReport {
   bool accepted() const { return verdict == RegistrationVerdict::accepted; }
 };
 
+// The correction T_expected^-1 T of a registration's answer: translation (metres), rotation
+// (degrees); and whether it is within RegistrationLimits' max_correction_m and _deg.
+struct Correction {
+  double metres = 0, degrees = 0;
+};
+Correction correction_of(const Eigen::Isometry3d& expected, const Eigen::Isometry3d& motion);
+bool within_limits(const Correction& correction, const RegistrationLimits& limits);
+
 // Degeneracy as ICP's sums see it (IcpResult::degeneracy), or as given (geometric_information.hpp).
 RegistrationReport judge_registration(const IcpResult& result, const Eigen::Isometry3d& expected,
                                       const RegistrationLimits& limits);
