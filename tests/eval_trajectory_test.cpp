@@ -1,6 +1,7 @@
 // Trajectory metrics (eval/trajectory_metrics.hpp) on cases whose answers are known by hand: a
 // trajectory against itself, against a rigidly moved or scaled copy, a perturbation of a straight
 // line, a hand-computed RPE (the real TUM fr1/xyz ground truth: eval_real_data_test.cpp).
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <string>
@@ -195,6 +196,59 @@ TEST(EvalTrajectory, RejectsWhatCannotBeEvaluated) {
                Error);
   eval::MatchedPoses uneven{gt, two};
   EXPECT_THROW(eval::compute_rpe(uneven, {}), Error);
+}
+
+// The helix with the steps ending at `wrong` moved by `slip` in their start's frame, the poses
+// after each chained on: what a lost frame does to a trajectory.
+Trajectory with_slips(const Trajectory& gt, const std::vector<std::size_t>& wrong,
+                      const Eigen::Vector3d& slip) {
+  Trajectory estimate = gt;
+  for (std::size_t k = 1; k < gt.size(); ++k) {
+    Eigen::Isometry3d step = gt[k - 1].pose.inverse() * gt[k].pose;
+    if (std::find(wrong.begin(), wrong.end(), k) != wrong.end()) step.pretranslate(slip);
+    estimate[k].pose = estimate[k - 1].pose * step;
+  }
+  return estimate;
+}
+
+TEST(EvalTrajectory, TheWorstStepsAreFoundAndCarryTheirShareOfTheError) {
+  const Trajectory gt = helix(60);
+  const Trajectory estimate = with_slips(gt, {20, 41}, {0.10, -0.05, 0.02});
+  Trajectory slightly = estimate;  // one more step 3 mm off: found third
+  for (std::size_t k = 50; k < slightly.size(); ++k) {
+    slightly[k].pose.translation() += slightly[49].pose.linear() * Eigen::Vector3d(0.003, 0, 0);
+  }
+  const eval::WorstSteps worst = eval::worst_steps(same_instants(gt, slightly), 3, Alignment::se3);
+  ASSERT_EQ(worst.steps.size(), 3u);
+  EXPECT_TRUE((worst.steps[0].pose == 20 && worst.steps[1].pose == 41) ||
+              (worst.steps[0].pose == 41 && worst.steps[1].pose == 20));
+  EXPECT_NEAR(worst.steps[0].translation_m, std::sqrt(0.0129), 1e-9);
+  EXPECT_LT(worst.steps[0].rotation_deg, 1e-6);
+  EXPECT_EQ(worst.steps[2].pose, 50u);
+  EXPECT_NEAR(worst.steps[2].translation_m, 0.003, 1e-9);
+  EXPECT_DOUBLE_EQ(worst.steps[2].timestamp, gt[50].timestamp);
+  // One slip taken away leaves the other (here the two partly cancel: taking one away can raise
+  // the ATE); all three taken away leave nothing.
+  EXPECT_GT(worst.ate_rmse_m, 0.02);
+  for (int k = 0; k < 2; ++k) EXPECT_GT(worst.steps[k].ate_rmse_with_true_step_m, 0.02);
+  EXPECT_LT(worst.ate_rmse_with_true_steps_m, 1e-9);
+  // A single slip carries the whole error.
+  const eval::WorstSteps one = eval::worst_steps(
+      same_instants(gt, with_slips(gt, {20}, {0.10, -0.05, 0.02})), 1, Alignment::se3);
+  ASSERT_EQ(one.steps.size(), 1u);
+  EXPECT_EQ(one.steps[0].pose, 20u);
+  EXPECT_GT(one.ate_rmse_m, 0.02);
+  EXPECT_LT(one.steps[0].ate_rmse_with_true_step_m, 1e-9);
+}
+
+TEST(EvalTrajectory, WorstStepsAskForNoMoreThanThereAre) {
+  const Trajectory gt = helix(5);
+  const eval::WorstSteps all = eval::worst_steps(same_instants(gt, gt), 10, Alignment::none);
+  EXPECT_EQ(all.steps.size(), 4u);
+  EXPECT_LT(all.ate_rmse_m, 1e-12);
+  const Trajectory two(gt.begin(), gt.begin() + 2);
+  EXPECT_THROW(eval::worst_steps(same_instants(two, two), 1, Alignment::se3), Error);
+  EXPECT_THROW(eval::worst_steps(eval::MatchedPoses{gt, two}, 1, Alignment::se3), Error);
 }
 
 TEST(EvalTrajectory, SummarizesErrors) {

@@ -1,6 +1,7 @@
 #pragma once
 // The CLI's subcommands. Each returns the process exit code and throws kartograf::Error on
 // failure (main reports it).
+#include <cstddef>
 #include <cstdint>
 #include <filesystem>
 #include <iosfwd>
@@ -46,6 +47,7 @@ struct EvalOptions {
   std::string delta_unit = "frames";  // traj
   bool sim3 = false;                  // traj
   double max_difference = 0.02;       // traj
+  std::size_t worst_steps = 0;        // traj: 0 lists none
   double threshold = 0.8;             // planes
 };
 CLI::App* add_eval_command(CLI::App& app, EvalOptions& options);

@@ -57,7 +57,11 @@ io::MetricReport trajectory_report(const EvalOptions& options) {
   input.sim3 = options.sim3;
   input.delta = options.delta;
   input.delta_unit = options.delta_unit;
-  return io::trajectory_report(result, input);
+  io::MetricReport report = io::trajectory_report(result, input);
+  if (options.worst_steps > 0) {
+    io::add_worst_steps(report, eval::worst_steps(matched, options.worst_steps, alignment));
+  }
+  return report;
 }
 
 io::MetricReport plane_report(const EvalOptions& options) {
@@ -110,6 +114,11 @@ CLI::App* add_eval_command(CLI::App& app, EvalOptions& options) {
       ->check(CLI::IsMember({"frames", "seconds"}))
       ->capture_default_str();
   traj->add_flag("--sim3", options.sim3, "Align with a scale too (monocular estimates)");
+  traj->add_option("--worst-steps", options.worst_steps,
+                   "Also list the N steps with the largest error, each with the ATE the "
+                   "estimate would have with that step from the ground truth")
+      ->check(CLI::Range(0, 100000))
+      ->capture_default_str();
   traj->add_option("--max-difference", options.max_difference,
                    "Largest timestamp difference of a matched pose pair [s]")
       ->check(finite_number())

@@ -199,6 +199,59 @@ RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options) {
   return {summarize_errors(std::move(translation)), summarize_errors(std::move(rotation))};
 }
 
+namespace {
+
+// The estimate re-chained from its first pose, with the steps ending at `true_steps` (sorted)
+// taken from the ground truth.
+MatchedPoses with_true_steps(const MatchedPoses& poses, std::span<const std::size_t> true_steps) {
+  MatchedPoses result = poses;
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const Trajectory& source = std::binary_search(true_steps.begin(), true_steps.end(), k)
+                                   ? poses.ground_truth
+                                   : poses.estimate;
+    result.estimate[k].pose =
+        result.estimate[k - 1].pose * (source[k - 1].pose.inverse() * source[k].pose);
+  }
+  return result;
+}
+
+}  // namespace
+
+WorstSteps worst_steps(const MatchedPoses& poses, std::size_t count, Alignment alignment) {
+  require_matched(poses, "worst steps");
+  require(poses.size() >= 3,
+          "worst steps: need at least 3 matched poses, got " + std::to_string(poses.size()));
+  std::vector<StepError> steps(poses.size() - 1);
+  for (std::size_t k = 1; k < poses.size(); ++k) {
+    const Eigen::Isometry3d error =
+        (poses.ground_truth[k - 1].pose.inverse() * poses.ground_truth[k].pose).inverse() *
+        (poses.estimate[k - 1].pose.inverse() * poses.estimate[k].pose);
+    steps[k - 1] = {k, poses.estimate[k].timestamp, error.translation().norm(),
+                    rotation_angle_deg(error.linear()), 0};
+  }
+  const auto larger = [](const StepError& a, const StepError& b) {
+    return a.translation_m > b.translation_m;
+  };
+  count = std::min(count, steps.size());
+  std::partial_sort(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(count), steps.end(),
+                    larger);
+  steps.resize(count);
+  WorstSteps result;
+  result.ate_rmse_m = compute_ate(poses, alignment).translation_m.rmse;
+  std::vector<std::size_t> all;
+  for (StepError& step : steps) {
+    const std::size_t one[] = {step.pose};
+    step.ate_rmse_with_true_step_m =
+        compute_ate(with_true_steps(poses, one), alignment).translation_m.rmse;
+    all.push_back(step.pose);
+  }
+  std::sort(all.begin(), all.end());
+  result.ate_rmse_with_true_steps_m =
+      compute_ate(with_true_steps(poses, all), alignment).translation_m.rmse;
+  result.steps = std::move(steps);
+  return result;
+}
+
 TrajectoryEvaluation evaluate_trajectory(const MatchedPoses& poses, Alignment alignment,
                                          const RpeParams& rpe_options) {
   TrajectoryEvaluation evaluation;

@@ -65,6 +65,17 @@ void MetricReport::add_matrix(const std::string& key,
   json_->object[key] = std::move(matrix);
 }
 
+void MetricReport::add_records(const std::string& key, const std::vector<std::string>& columns,
+                               const std::vector<std::vector<double>>& rows) {
+  nlohmann::ordered_json records = nlohmann::ordered_json::array();
+  for (const std::vector<double>& row : rows) {
+    nlohmann::ordered_json record = nlohmann::ordered_json::object();
+    for (std::size_t c = 0; c < columns.size() && c < row.size(); ++c) record[columns[c]] = row[c];
+    records.push_back(std::move(record));
+  }
+  json_->object[key] = std::move(records);
+}
+
 void MetricReport::add_block(std::string text) {
   blocks_.push_back(std::move(text));
 }
@@ -138,6 +149,29 @@ MetricReport trajectory_report(const eval::TrajectoryEvaluation& result,
   report.add_number("delta", input.delta);
   report.add_text("delta_unit", input.delta_unit);
   return report;
+}
+
+void add_worst_steps(MetricReport& report, const eval::WorstSteps& worst) {
+  report.add("ate_true_steps_m", worst.ate_rmse_with_true_steps_m,
+             "ATE RMSE with the " + std::to_string(worst.steps.size()) +
+                 " worst steps from the ground truth");
+  std::string block =
+      "worst steps (largest translation error first; ATE RMSE with that step "
+      "from the ground truth):\n";
+  std::vector<std::vector<double>> rows;
+  for (const eval::StepError& step : worst.steps) {
+    char line[160];
+    std::snprintf(line, sizeof(line), "  pose %6zu  t %14.6f  %9.2f mm  %7.3f deg  ATE %.4f m\n",
+                  step.pose, step.timestamp, 1000 * step.translation_m, step.rotation_deg,
+                  step.ate_rmse_with_true_step_m);
+    block += line;
+    rows.push_back({static_cast<double>(step.pose), step.timestamp, step.translation_m,
+                    step.rotation_deg, step.ate_rmse_with_true_step_m});
+  }
+  report.add_block(std::move(block));
+  report.add_records(
+      "worst_steps",
+      {"pose", "timestamp", "translation_m", "rotation_deg", "ate_rmse_with_true_step_m"}, rows);
 }
 
 MetricReport plane_report(const eval::SegCompResult& result, const std::string& ground_truth_file,

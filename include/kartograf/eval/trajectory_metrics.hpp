@@ -94,6 +94,28 @@ struct RpeResult {
 // Throws Error when no pair is delta apart (or, for seconds, the timestamps are not increasing).
 RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options);
 
+// The steps that carry a trajectory's error. A step is the motion between consecutive matched
+// poses (pose - 1 -> pose), its error that of an RPE pair one frame apart. For the `count` steps
+// with the largest translation error (largest first): the ATE RMSE the estimate would have with
+// that step alone taken from the ground truth and every other step as estimated (chained from the
+// first pose, aligned as `alignment`), and with all of them at once. A few wrong steps (a lost
+// frame, a wrong basin) show as an ATE that falls to a fraction; drift spread over every step as
+// one that barely moves. Errors may cancel: one step taken from the ground truth alone can raise
+// the ATE. Throws Error on fewer than 3 matched poses.
+struct StepError {
+  std::size_t pose = 0;  // matched index of the step's end
+  double timestamp = 0;  // the estimate's, at the step's end
+  double translation_m = 0;
+  double rotation_deg = 0;
+  double ate_rmse_with_true_step_m = 0;
+};
+struct WorstSteps {
+  std::vector<StepError> steps;
+  double ate_rmse_m = 0;                  // as estimated
+  double ate_rmse_with_true_steps_m = 0;  // with all of `steps` from the ground truth
+};
+WorstSteps worst_steps(const MatchedPoses& poses, std::size_t count, Alignment alignment);
+
 // ATE with the given alignment, and RPE on the estimate that alignment moved.
 struct TrajectoryEvaluation {
   AteResult ate;

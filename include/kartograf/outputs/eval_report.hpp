@@ -32,6 +32,9 @@ class MetricReport {
   void add_text(const std::string& key, const std::string& value);
   void add_number(const std::string& key, double value);
   void add_matrix(const std::string& key, const std::vector<std::vector<std::int64_t>>& rows);
+  // JSON only: an array of objects, one per row, with the columns' names as keys.
+  void add_records(const std::string& key, const std::vector<std::string>& columns,
+                   const std::vector<std::vector<double>>& rows);
   void add_block(std::string text);  // table only: text after the rows, as it is
 
   std::string table() const;
@@ -61,6 +64,9 @@ struct TrajectoryReportInput {
 };
 MetricReport trajectory_report(const eval::TrajectoryEvaluation& result,
                                const TrajectoryReportInput& input);
+// The steps that carry the error (eval::worst_steps): a row of the ATE with all of them from the
+// ground truth, the steps themselves as a block in the table and an array in JSON.
+void add_worst_steps(MetricReport& report, const eval::WorstSteps& worst);
 
 // Reports on a pair of images, noting both files.
 MetricReport plane_report(const eval::SegCompResult& result, const std::string& ground_truth_file,
