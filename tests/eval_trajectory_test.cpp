@@ -241,6 +241,19 @@ TEST(EvalTrajectory, TheWorstStepsAreFoundAndCarryTheirShareOfTheError) {
   EXPECT_LT(one.steps[0].ate_rmse_with_true_step_m, 1e-9);
 }
 
+TEST(EvalTrajectory, WorstStepsOfAScaledEstimateAreInItsOwnUnits) {
+  const Trajectory gt = helix(40);
+  Trajectory half = with_slips(gt, {12}, {0.08, 0, 0});
+  for (StampedPose& p : half) p.pose.translation() *= 0.5;  // a monocular estimate's scale
+  const eval::WorstSteps worst = eval::worst_steps(same_instants(gt, half), 1, Alignment::sim3);
+  ASSERT_EQ(worst.steps.size(), 1u);
+  EXPECT_EQ(worst.steps[0].pose, 12u);
+  EXPECT_NEAR(worst.steps[0].translation_m, 0.04, 0.004);
+  // The scale is fitted with the slip in, so the true steps are scaled a little off: not nil.
+  EXPECT_GT(worst.ate_rmse_m, 0.005);
+  EXPECT_LT(worst.steps[0].ate_rmse_with_true_step_m, 0.1 * worst.ate_rmse_m);
+}
+
 TEST(EvalTrajectory, WorstStepsAskForNoMoreThanThereAre) {
   const Trajectory gt = helix(5);
   const eval::WorstSteps all = eval::worst_steps(same_instants(gt, gt), 10, Alignment::none);

@@ -202,15 +202,17 @@ RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options) {
 namespace {
 
 // The estimate re-chained from its first pose, with the steps ending at `true_steps` (sorted)
-// taken from the ground truth.
-MatchedPoses with_true_steps(const MatchedPoses& poses, std::span<const std::size_t> true_steps) {
+// taken from the ground truth, in the estimate's units (`scale`: the alignment's, ground truth
+// per estimate).
+MatchedPoses with_true_steps(const MatchedPoses& poses, std::span<const std::size_t> true_steps,
+                             double scale) {
   MatchedPoses result = poses;
   for (std::size_t k = 1; k < poses.size(); ++k) {
-    const Trajectory& source = std::binary_search(true_steps.begin(), true_steps.end(), k)
-                                   ? poses.ground_truth
-                                   : poses.estimate;
-    result.estimate[k].pose =
-        result.estimate[k - 1].pose * (source[k - 1].pose.inverse() * source[k].pose);
+    const bool true_step = std::binary_search(true_steps.begin(), true_steps.end(), k);
+    const Trajectory& source = true_step ? poses.ground_truth : poses.estimate;
+    Eigen::Isometry3d step = source[k - 1].pose.inverse() * source[k].pose;
+    if (true_step) step.translation() /= scale;
+    result.estimate[k].pose = result.estimate[k - 1].pose * step;
   }
   return result;
 }
@@ -221,11 +223,17 @@ WorstSteps worst_steps(const MatchedPoses& poses, std::size_t count, Alignment a
   require_matched(poses, "worst steps");
   require(poses.size() >= 3,
           "worst steps: need at least 3 matched poses, got " + std::to_string(poses.size()));
+  WorstSteps result;
+  const AteResult as_estimated = compute_ate(poses, alignment);
+  result.ate_rmse_m = as_estimated.translation_m.rmse;
+  const double scale = as_estimated.alignment.scale;
   std::vector<StepError> steps(poses.size() - 1);
   for (std::size_t k = 1; k < poses.size(); ++k) {
+    Eigen::Isometry3d true_step =
+        poses.ground_truth[k - 1].pose.inverse() * poses.ground_truth[k].pose;
+    true_step.translation() /= scale;
     const Eigen::Isometry3d error =
-        (poses.ground_truth[k - 1].pose.inverse() * poses.ground_truth[k].pose).inverse() *
-        (poses.estimate[k - 1].pose.inverse() * poses.estimate[k].pose);
+        true_step.inverse() * (poses.estimate[k - 1].pose.inverse() * poses.estimate[k].pose);
     steps[k - 1] = {k, poses.estimate[k].timestamp, error.translation().norm(),
                     rotation_angle_deg(error.linear()), 0};
   }
@@ -236,18 +244,16 @@ WorstSteps worst_steps(const MatchedPoses& poses, std::size_t count, Alignment a
   std::partial_sort(steps.begin(), steps.begin() + static_cast<std::ptrdiff_t>(count), steps.end(),
                     larger);
   steps.resize(count);
-  WorstSteps result;
-  result.ate_rmse_m = compute_ate(poses, alignment).translation_m.rmse;
   std::vector<std::size_t> all;
   for (StepError& step : steps) {
     const std::size_t one[] = {step.pose};
     step.ate_rmse_with_true_step_m =
-        compute_ate(with_true_steps(poses, one), alignment).translation_m.rmse;
+        compute_ate(with_true_steps(poses, one, scale), alignment).translation_m.rmse;
     all.push_back(step.pose);
   }
   std::sort(all.begin(), all.end());
   result.ate_rmse_with_true_steps_m =
-      compute_ate(with_true_steps(poses, all), alignment).translation_m.rmse;
+      compute_ate(with_true_steps(poses, all, scale), alignment).translation_m.rmse;
   result.steps = std::move(steps);
   return result;
 }

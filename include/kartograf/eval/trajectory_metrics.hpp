@@ -101,7 +101,8 @@ RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options);
 // first pose, aligned as `alignment`), and with all of them at once. A few wrong steps (a lost
 // frame, a wrong basin) show as an ATE that falls to a fraction; drift spread over every step as
 // one that barely moves. Errors may cancel: one step taken from the ground truth alone can raise
-// the ATE. Throws Error on fewer than 3 matched poses.
+// the ATE. With Alignment::sim3 the steps are compared, and taken, in the ground truth's units
+// divided by the alignment's scale (the estimate's). Throws Error on fewer than 3 matched poses.
 struct StepError {
   std::size_t pose = 0;  // matched index of the step's end
   double timestamp = 0;  // the estimate's, at the step's end
