@@ -43,7 +43,10 @@ from .results import (  # noqa: E402
     SEMANTIC_CLASSES,
     SemanticGrid,
     SlamRun,
+    StepError,
+    WorstSteps,
     ate,
+    worst_steps,
 )
 from .scene import (  # noqa: E402
     Plane,
@@ -91,7 +94,9 @@ __all__ = [
     "SemanticGrid",
     "Sequence",
     "SlamRun",
+    "StepError",
     "ViewLabels",
+    "WorstSteps",
     "ate",
     "backends",
     "evaluate_rooms",
@@ -108,5 +113,6 @@ __all__ = [
     "rosbag",
     "run_slam",
     "segment_rooms",
+    "worst_steps",
     "synthesize",
 ]

@@ -28,6 +28,35 @@ def ate(estimate: np.ndarray, ground_truth: list, align: str = "se3") -> Ate:
 
 
 @dataclass
+class StepError:
+    """One step's error, and the ATE with that step from the ground truth."""
+
+    frame: int  # the frame the step ends at
+    translation_m: float
+    rotation_deg: float
+    ate_rmse_with_true_step_m: float
+
+
+@dataclass
+class WorstSteps:
+    """The steps that carry a trajectory's error (`kartograf eval traj --worst-steps`)."""
+
+    steps: list  # StepError, largest translation error first
+    ate_rmse_m: float
+    ate_rmse_with_true_steps_m: float  # with all of `steps` from the ground truth
+
+
+def worst_steps(estimate: np.ndarray, ground_truth: list, count: int = 10,
+                align: str = "se3") -> WorstSteps:
+    """The `count` steps with the largest error, each with the ATE the trajectory would have
+    with that step from the ground truth; meant for an odometry's trajectory."""
+    d = _kartograf.worst_steps(np.asarray(estimate, dtype=np.float64), list(ground_truth), count,
+                               align)
+    return WorstSteps(steps=[StepError(**step) for step in d["steps"]], ate_rmse_m=d["ate_rmse_m"],
+                      ate_rmse_with_true_steps_m=d["ate_rmse_with_true_steps_m"])
+
+
+@dataclass
 class FrameReport:
     """What the odometry did with one frame (see registration/odometry.hpp)."""
 
@@ -83,6 +112,12 @@ class OdometryRun:
     def ate(self, align: str = "se3") -> Optional[Ate]:
         """ATE against the sequence's ground truth; None without (3 frames or more needed)."""
         return ate(self.poses, self.ground_truth, align) if _has_truth(self.ground_truth) else None
+
+    def worst_steps(self, count: int = 10, align: str = "se3") -> Optional[WorstSteps]:
+        """The steps that carry the ATE (see worst_steps); None without ground truth."""
+        if not _has_truth(self.ground_truth):
+            return None
+        return worst_steps(self.poses, self.ground_truth, count, align)
 
 
 @dataclass

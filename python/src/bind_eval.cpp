@@ -31,25 +31,35 @@ std::vector<Eigen::Isometry3d> poses_of(const PoseStack& stack, const char* what
   return poses;
 }
 
-// Frame k of the estimate against frame k of the ground truth (None: no ground truth there).
-nb::dict ate(const PoseStack& estimate, const nb::list& ground_truth, const std::string& align) {
+eval::Alignment alignment_of(const std::string& align, const std::string& what) {
   require(align == "se3" || align == "sim3" || align == "none",
-          "ate: align must be 'se3', 'sim3' or 'none', not '" + align + "'");
+          what + ": align must be 'se3', 'sim3' or 'none', not '" + align + "'");
+  return align == "se3"    ? eval::Alignment::se3
+         : align == "sim3" ? eval::Alignment::sim3
+                           : eval::Alignment::none;
+}
+
+// Frame k of the estimate against frame k of the ground truth (None: no ground truth there).
+eval::MatchedPoses matched_frames(const PoseStack& estimate, const nb::list& ground_truth,
+                                  const std::string& what) {
   std::vector<std::optional<Eigen::Isometry3d>> truth;
   for (const nb::handle item : ground_truth) {
     if (item.is_none()) {
       truth.emplace_back();
     } else {
-      truth.emplace_back(to_pose(nb::cast<PoseArray>(item), "ate: ground truth"));
+      truth.emplace_back(to_pose(nb::cast<PoseArray>(item), (what + ": ground truth").c_str()));
     }
   }
-  const std::vector<Eigen::Isometry3d> poses = poses_of(estimate, "ate: estimate");
-  const eval::MatchedPoses matched = eval::match_frames(truth, poses);
-  require(matched.size() >= 3, "ate: fewer than 3 frames have both a pose and ground truth");
+  const std::vector<Eigen::Isometry3d> poses = poses_of(estimate, (what + ": estimate").c_str());
+  eval::MatchedPoses matched = eval::match_frames(truth, poses);
+  require(matched.size() >= 3, what + ": fewer than 3 frames have both a pose and ground truth");
+  return matched;
+}
+
+nb::dict ate(const PoseStack& estimate, const nb::list& ground_truth, const std::string& align) {
+  const eval::Alignment alignment = alignment_of(align, "ate");
   const eval::AteResult result =
-      eval::compute_ate(matched, align == "se3"    ? eval::Alignment::se3
-                                 : align == "sim3" ? eval::Alignment::sim3
-                                                   : eval::Alignment::none);
+      eval::compute_ate(matched_frames(estimate, ground_truth, "ate"), alignment);
   nb::dict d;
   d["rmse_m"] = result.translation_m.rmse;
   d["mean_m"] = result.translation_m.mean;
@@ -60,11 +70,38 @@ nb::dict ate(const PoseStack& estimate, const nb::list& ground_truth, const std:
   return d;
 }
 
+// eval::worst_steps; a step's "frame" is the frame it ends at (steps join frames with ground
+// truth).
+nb::dict worst_steps(const PoseStack& estimate, const nb::list& ground_truth, std::size_t count,
+                     const std::string& align) {
+  const eval::Alignment alignment = alignment_of(align, "worst_steps");
+  const eval::MatchedPoses matched = matched_frames(estimate, ground_truth, "worst_steps");
+  const eval::WorstSteps worst = eval::worst_steps(matched, count, alignment);
+  nb::list steps;
+  for (const eval::StepError& step : worst.steps) {
+    nb::dict d;
+    d["frame"] = static_cast<std::size_t>(matched.estimate[step.pose].timestamp);
+    d["translation_m"] = step.translation_m;
+    d["rotation_deg"] = step.rotation_deg;
+    d["ate_rmse_with_true_step_m"] = step.ate_rmse_with_true_step_m;
+    steps.append(d);
+  }
+  nb::dict d;
+  d["steps"] = steps;
+  d["ate_rmse_m"] = worst.ate_rmse_m;
+  d["ate_rmse_with_true_steps_m"] = worst.ate_rmse_with_true_steps_m;
+  return d;
+}
+
 }  // namespace
 
 void bind_eval(nb::module_& m) {
   m.def("ate", &ate, nb::arg("estimate"), nb::arg("ground_truth"), nb::arg("align") = "se3",
         "Absolute trajectory error: estimate N x 4 x 4 against a list of 4 x 4 or None");
+  m.def("worst_steps", &worst_steps, nb::arg("estimate"), nb::arg("ground_truth"),
+        nb::arg("count") = 10, nb::arg("align") = "se3",
+        "The steps with the largest error, each with the ATE with that step from the ground "
+        "truth (kartograf eval traj --worst-steps)");
 }
 
 }  // namespace kartograf::python

@@ -45,6 +45,22 @@ def test_frame_by_frame_equals_the_sequence_run(cpu, synthetic):
     assert ate.rmse_m < 0.05, ate
 
 
+def test_worst_steps_are_the_largest_and_agree_with_the_ate(cpu, synthetic):
+    run = kg.run_odometry(cpu, kg.open_sequence(synthetic))
+    worst = run.worst_steps(count=5)
+    assert len(worst.steps) == 5
+    errors = [s.translation_m for s in worst.steps]
+    assert errors == sorted(errors, reverse=True) and errors[0] > 0
+    assert abs(worst.ate_rmse_m - run.ate().rmse_m) < 1e-12
+    steps = [np.linalg.inv(a) @ b for a, b in zip(run.poses[:-1], run.poses[1:])]
+    truth = [np.linalg.inv(a) @ b for a, b in zip(run.ground_truth[:-1], run.ground_truth[1:])]
+    first = worst.steps[0]
+    error = np.linalg.inv(truth[first.frame - 1]) @ steps[first.frame - 1]
+    assert abs(np.linalg.norm(error[:3, 3]) - first.translation_m) < 1e-9
+    with pytest.raises(Exception, match="align"):
+        kg.worst_steps(run.poses, run.ground_truth, 3, "affine")
+
+
 def test_results_pickle(cpu, synthetic):
     run = kg.run_odometry(cpu, kg.open_sequence(synthetic, frames=8))
     copy = pickle.loads(pickle.dumps(run))
