@@ -34,6 +34,22 @@ double rotation_angle_deg(const Eigen::Matrix3d& r) {
          std::numbers::pi;
 }
 
+// The ground truth's motion from pose i to pose j, its translation divided by `scale` (ground
+// truth per estimate: in the estimate's units).
+Eigen::Isometry3d true_motion(const MatchedPoses& poses, std::size_t i, std::size_t j,
+                              double scale = 1) {
+  Eigen::Isometry3d motion = poses.ground_truth[i].pose.inverse() * poses.ground_truth[j].pose;
+  motion.translation() /= scale;
+  return motion;
+}
+
+// E = (Q_i^-1 Q_j)^-1 (P_i^-1 P_j): the estimate's motion from pose i to j against the truth's.
+Eigen::Isometry3d motion_error(const MatchedPoses& poses, std::size_t i, std::size_t j,
+                               double scale = 1) {
+  return true_motion(poses, i, j, scale).inverse() *
+         (poses.estimate[i].pose.inverse() * poses.estimate[j].pose);
+}
+
 // The (i, j) pairs delta apart, as documented in the header.
 std::vector<std::pair<std::size_t, std::size_t>> rpe_pairs(const MatchedPoses& poses,
                                                            const RpeParams& options) {
@@ -188,11 +204,7 @@ RpeResult compute_rpe(const MatchedPoses& poses, const RpeParams& options) {
   std::vector<double> translation(pairs.size()), rotation(pairs.size());
   for (std::size_t k = 0; k < pairs.size(); ++k) {
     const auto [i, j] = pairs[k];
-    const Eigen::Isometry3d gt_motion =
-        poses.ground_truth[i].pose.inverse() * poses.ground_truth[j].pose;
-    const Eigen::Isometry3d estimated_motion =
-        poses.estimate[i].pose.inverse() * poses.estimate[j].pose;
-    const Eigen::Isometry3d error = gt_motion.inverse() * estimated_motion;
+    const Eigen::Isometry3d error = motion_error(poses, i, j);
     translation[k] = error.translation().norm();
     rotation[k] = rotation_angle_deg(error.linear());
   }
@@ -208,10 +220,10 @@ MatchedPoses with_true_steps(const MatchedPoses& poses, std::span<const std::siz
                              double scale) {
   MatchedPoses result = poses;
   for (std::size_t k = 1; k < poses.size(); ++k) {
-    const bool true_step = std::binary_search(true_steps.begin(), true_steps.end(), k);
-    const Trajectory& source = true_step ? poses.ground_truth : poses.estimate;
-    Eigen::Isometry3d step = source[k - 1].pose.inverse() * source[k].pose;
-    if (true_step) step.translation() /= scale;
+    const Eigen::Isometry3d step =
+        std::binary_search(true_steps.begin(), true_steps.end(), k)
+            ? true_motion(poses, k - 1, k, scale)
+            : poses.estimate[k - 1].pose.inverse() * poses.estimate[k].pose;
     result.estimate[k].pose = result.estimate[k - 1].pose * step;
   }
   return result;
@@ -229,11 +241,7 @@ WorstSteps worst_steps(const MatchedPoses& poses, std::size_t count, Alignment a
   const double scale = as_estimated.alignment.scale;
   std::vector<StepError> steps(poses.size() - 1);
   for (std::size_t k = 1; k < poses.size(); ++k) {
-    Eigen::Isometry3d true_step =
-        poses.ground_truth[k - 1].pose.inverse() * poses.ground_truth[k].pose;
-    true_step.translation() /= scale;
-    const Eigen::Isometry3d error =
-        true_step.inverse() * (poses.estimate[k - 1].pose.inverse() * poses.estimate[k].pose);
+    const Eigen::Isometry3d error = motion_error(poses, k - 1, k, scale);
     steps[k - 1] = {k, poses.estimate[k].timestamp, error.translation().norm(),
                     rotation_angle_deg(error.linear()), 0};
   }
