@@ -101,7 +101,7 @@ TEST(RunDocuments, FrameCountsLine) {
   EXPECT_EQ(counts.frames, 2u);
   EXPECT_EQ(io::frame_counts_line(counts),
             "keyframes 1, fallbacks 1, re-estimates 0 (rejected 0), degenerate frames 0 (0 "
-            "measured by image intensity)");
+            "measured by image intensity, 0 held to the heading)");
 }
 
 TEST(RunDocuments, LoopClosureCounts) {

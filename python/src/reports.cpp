@@ -35,6 +35,7 @@ nb::dict frame_dict(const registration::OdometryFrame& frame) {
   d["fallback"] = frame.fallback;
   d["degenerate"] = frame.degenerate;
   d["photometric"] = frame.photometric;
+  d["heading_sigma_m"] = frame.heading_sigma_m;
   d["eigenvalue_ratio"] = frame.eigenvalue_ratio;
   d["keyframe"] = frame.keyframe;
   d["seconds"] = frame.seconds;

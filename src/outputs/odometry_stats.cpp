@@ -54,6 +54,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["from_features"] = frame.from_features;
   json["degenerate"] = frame.degenerate;
   json["photometric"] = frame.photometric;
+  json["heading_sigma_m"] = frame.heading_sigma_m;
   json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
   json["step_frame"] = std::string(registration::to_string(frame.step_frame));
   json["previous"] = frame.previous ? registration_report_json(*frame.previous) : RunJson();
@@ -75,6 +76,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["from_features"] = counts.from_features;
   json["degenerate_frames"] = counts.degenerate_frames;
   json["photometric_frames"] = counts.photometric_frames;
+  json["heading_prior_frames"] = counts.heading_prior_frames;
   json["reestimates"] = counts.reestimates;
   json["reestimates_rejected"] = counts.reestimates_rejected;
   return json;
@@ -102,6 +104,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.keyframes += f.keyframe;
     counts.degenerate_frames += f.degenerate;
     counts.photometric_frames += f.photometric;
+    counts.heading_prior_frames += f.heading_sigma_m > 0;
     counts.reestimates += f.reestimate.has_value();
     counts.reestimates_rejected += f.reestimate && !f.reestimate->accepted();
   }
@@ -115,7 +118,7 @@ std::string frame_counts_line(const OdometryFrameCounts& c) {
   return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) + seeded +
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
          "), degenerate frames " + count(c.degenerate_frames) + " (" + count(c.photometric_frames) +
-         " measured by image intensity)";
+         " measured by image intensity, " + count(c.heading_prior_frames) + " held to the heading)";
 }
 
 OdometryThroughput odometry_throughput(const mapping::OdometryRun& run) {

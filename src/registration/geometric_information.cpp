@@ -5,6 +5,7 @@
 #include <vector>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/QR>
 
 #include "kartograf/registration/depth_weighted_finder.hpp"
 
@@ -161,6 +162,18 @@ std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
     directions.push_back(from_centre * u.cwiseProduct(eigen.scale));
   }
   return directions;
+}
+
+se3::Matrix6d information_along(const se3::Matrix6d& information,
+                                std::span<const se3::Vector6d> directions) {
+  if (directions.empty()) return se3::Matrix6d::Zero();
+  Eigen::Matrix<double, 6, Eigen::Dynamic> along(6, static_cast<Eigen::Index>(directions.size()));
+  for (std::size_t k = 0; k < directions.size(); ++k) {
+    along.col(static_cast<Eigen::Index>(k)) = directions[k];
+  }
+  // The amounts of a perturbation xi: along^+ xi.
+  const Eigen::MatrixXd amounts = along.completeOrthogonalDecomposition().pseudoInverse();
+  return amounts.transpose() * (along.transpose() * information * along) * amounts;
 }
 
 Eigen::Isometry3d keep_constrained_directions(const Eigen::Isometry3d& measured,

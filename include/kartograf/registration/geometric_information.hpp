@@ -17,6 +17,7 @@
 // `about_centre` is the same sum with p taken relative to the weighted centroid; degeneracy is
 // analyse_degeneracy() of it.
 #include <cstddef>
+#include <span>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -60,6 +61,12 @@ se3::Matrix6d motion_prior_information(const GeometricInformation& geometry, dou
 // vectors of the right perturbation of a motion applied to the cloud, weakest first.
 std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
                                            double min_eigenvalue_ratio);
+
+// `information` restricted to `directions` (tangent vectors, as weak_directions gives them): it
+// says as much about their amounts and nothing about the directions off their span (the
+// least-squares amounts of a perturbation are what it weighs).
+se3::Matrix6d information_along(const se3::Matrix6d& information,
+                                std::span<const se3::Vector6d> directions);
 
 // The motion that keeps `measured` in the well-constrained directions of `geometry` and takes
 // `predicted` (e.g. the motion model's) in those whose balanced eigenvalue is below

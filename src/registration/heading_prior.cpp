@@ -1,0 +1,79 @@
+#include "kartograf/registration/heading_prior.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace kartograf::registration {
+
+namespace {
+
+constexpr double kKeep = 0.95;  // decay per learned step: about the last 20 steps
+
+// The step's translation with half its turn undone: on an arc of constant curvature, the
+// direction of travel at no turn.
+Eigen::Vector3d untwisted(const Eigen::Isometry3d& step) {
+  const Eigen::AngleAxisd turn(step.linear());
+  return Eigen::AngleAxisd(-0.5 * turn.angle(), turn.axis()) * step.translation();
+}
+
+// The direction of travel on `step`'s arc: the heading turned by half the step's turn.
+Eigen::Vector3d travel_on(const Eigen::Isometry3d& step, const Eigen::Vector3d& heading) {
+  const Eigen::AngleAxisd turn(step.linear());
+  return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()) * heading.normalized();
+}
+
+constexpr double kVarianceFloor = 1e-12;  // m^2: a spread of nothing is no reason to divide by 0
+
+}  // namespace
+
+void HeadingPrior::learn(const Eigen::Isometry3d& step) {
+  const Eigen::Vector3d travel = untwisted(step);
+  if (heading_.squaredNorm() > 0) {
+    const Eigen::Vector3d along = heading_.normalized();
+    across_squared_ =
+        kKeep * across_squared_ + (1 - kKeep) * (travel - travel.dot(along) * along).squaredNorm();
+    weight_ = kKeep * weight_ + (1 - kKeep);
+  }
+  // Weighted by its length: short steps are mostly noise.
+  heading_ = kKeep * heading_ + (1 - kKeep) * travel;
+}
+
+bool HeadingPrior::ready() const {
+  static const double kTwentySteps = 1 - std::pow(kKeep, 20);
+  return weight_ >= kTwentySteps && heading_.squaredNorm() > 0;
+}
+
+double HeadingPrior::across_variance() const {
+  return weight_ > 0 ? across_squared_ / weight_ : 0.0;
+}
+
+se3::Matrix6d HeadingPrior::information(const Eigen::Isometry3d& step) const {
+  se3::Matrix6d information = se3::Matrix6d::Zero();
+  if (!ready()) return information;
+  const Eigen::Vector3d along = travel_on(step, heading_);
+  const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - along * along.transpose();
+  // The translation moves by R v under the right perturbation (omega, v).
+  const Eigen::Matrix3d jacobian = across * step.linear();
+  information.bottomRightCorner<3, 3>() =
+      jacobian.transpose() * jacobian / std::max(across_variance(), kVarianceFloor);
+  return information;
+}
+
+Eigen::Isometry3d HeadingPrior::combine(const Eigen::Isometry3d& step,
+                                        const se3::Matrix6d& measured) const {
+  if (!ready()) return step;
+  const se3::Matrix6d prior = information(step);
+  const Eigen::Vector3d along = travel_on(step, heading_);
+  const Eigen::Vector3d across = step.translation() - step.translation().dot(along) * along;
+  se3::Vector6d gradient = se3::Vector6d::Zero();
+  gradient.tail<3>() =
+      step.linear().transpose() * across / std::max(across_variance(), kVarianceFloor);
+  se3::Matrix6d system = measured + prior;
+  // Directions neither side measures (a free turn) get a negligible ridge and stay put.
+  system.diagonal().array() += 1e-12 * system.trace() + 1e-300;
+  const se3::Vector6d xi = -system.ldlt().solve(gradient);
+  if (!xi.allFinite()) return step;
+  return step * se3::exp(xi);
+}
+
+}  // namespace kartograf::registration
