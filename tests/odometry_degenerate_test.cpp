@@ -204,7 +204,8 @@ TEST(PhotometricRefinement, AFloorTooFaintForTheCoarsePassIsMeasuredByTheFinePas
 // images, which now measure them as well). ICP at the onset took the turn 0.1 degrees short and the
 // step 4 mm sideways; kept in the camera frame, that sideways step was repeated on the degenerate
 // frames after it (0.4 cm each). The arc model predicts the step from the turn and the direction of
-// travel.
+// travel. Both without the heading prior, which since holds those sideways steps itself (the
+// camera frame's worst step 0.2 mm with it).
 TEST(DoubtfulRegistration, ASidewaysErrorAtAnArcsOnsetIsNotRepeated) {
   const DegenerateStretch onset{10, 263, 37, false};
   const auto worst_after_onset = [&](const registration::OdometryParams& params) {
@@ -215,9 +216,11 @@ TEST(DoubtfulRegistration, ASidewaysErrorAtAnArcsOnsetIsNotRepeated) {
     }
     return metres;
   };
-  registration::OdometryParams camera;
+  registration::OdometryParams adaptive_alone;
+  adaptive_alone.heading_prior = false;
+  registration::OdometryParams camera = adaptive_alone;
   camera.step_frame = registration::StepFrame::camera;
-  const double adaptive = worst_after_onset({});
+  const double adaptive = worst_after_onset(adaptive_alone);
   RecordProperty("worst_step_adaptive_m", std::to_string(adaptive));
   const double in_camera = worst_after_onset(camera);
   RecordProperty("worst_step_camera_m", std::to_string(in_camera));
@@ -292,12 +295,15 @@ TEST(Reestimation, AfterADegenerateStretchTheImagesConfirmALargeCorrection) {
 // moved it 3.7 cm and 1.1 degrees on, fitting what the step occluded (grey-level RMSE 25, then
 // 15); the correction was spread over frames 146-150. A refinement beyond the re-estimate's
 // correction limits (3 cm, 2 degrees) is now kept only where the images fit it (an RMSE within
-// photometric_doubt_rmse, 10 grey levels).
+// photometric_doubt_rmse, 10 grey levels). Both without the heading prior, which since keeps the
+// images' correction small there itself (0.03 degrees with any fit).
 TEST(Reestimation, AnImagesCorrectionBeyondTheLimitsNeedsTheImagesToFitIt) {
   const DegenerateStretch straight{4, 120, 31, true};
   const std::size_t frame = 150 - straight.first;
-  const StepError limited = track_frames(straight, {}).error_at(frame);
-  registration::OdometryParams any_fit;
+  registration::OdometryParams limits_alone;
+  limits_alone.heading_prior = false;
+  const StepError limited = track_frames(straight, limits_alone).error_at(frame);
+  registration::OdometryParams any_fit = limits_alone;
   any_fit.photometric_doubt_rmse = 1e3;
   const StepError unlimited = track_frames(straight, any_fit).error_at(frame);
   RecordProperty("frame_150_error_deg", std::to_string(limited.degrees));
