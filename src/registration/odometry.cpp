@@ -438,6 +438,14 @@ void RgbdOdometry::score_step_frames(const Eigen::Isometry3d& measured) {
   heading_prior_.learn(measured);
 }
 
+RegistrationLimits RgbdOdometry::frame_limits_now() const {
+  RegistrationLimits limits = params_.frame_limits;
+  if (params_.corrections_up_to_largest_step) {
+    limits.max_correction_m = std::max(limits.max_correction_m, largest_step_m_);
+  }
+  return limits;
+}
+
 bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
   return motion.translation().norm() > params_.feature_seed_m ||
          se3::rotation_angle(motion) > params_.feature_seed_deg * kDegree;
@@ -452,7 +460,7 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   // weighed against the features: by fitness they picked wrong turns in rooms that look alike.
   std::optional<Attempt> seeded;
   if (is_large(predicted)) seeded = register_from_features();
-  Attempt attempt = register_frames(previous, predicted, params_.frame_limits);
+  Attempt attempt = register_frames(previous, predicted, frame_limits_now());
   if (seeded) {
     if (agrees_better(attempt, *seeded)) return attempt;
     frame.from_features = true;
@@ -537,7 +545,7 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
   };
   for (const Eigen::Isometry3d& start : other_starts(predicted)) {
     if (is_identity(predicted.inverse() * start)) continue;  // where the first one started
-    consider(register_frames(previous, start, params_.frame_limits), false);
+    consider(register_frames(previous, start, frame_limits_now()), false);
   }
   if (std::optional<Attempt> seeded = register_from_features()) consider(std::move(*seeded), true);
   return best;
@@ -553,6 +561,7 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   frame.heading_sigma_m = attempt.heading_sigma_m;
   if (attempt.report.accepted() && !geometry_.degeneracy.degenerate) {
     score_step_frames(attempt.motion);
+    largest_step_m_ = std::max(largest_step_m_, attempt.motion.translation().norm());
   }
 
   RelativePose constraint{n - 1, n, predicted, {}, false};
@@ -675,7 +684,7 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::register_from_features() {
       features.align(*current_features_, *previous_features_);
   if (!aligned) return {};
   Attempt attempt =
-      register_frames(frames_.size() - 1, aligned->source_to_target, params_.frame_limits);
+      register_frames(frames_.size() - 1, aligned->source_to_target, frame_limits_now());
   if (!attempt.report.accepted()) return {};
   return attempt;
 }

@@ -169,6 +169,12 @@ struct OdometryParams {
   StepFrame step_frame = StepFrame::adaptive;
   // Frame-to-frame acceptance; the correction is relative to the initial guess.
   RegistrationLimits frame_limits{200, 0.1, 0.02, false, 0.3, 20};
+  // The frame-to-frame correction may reach the largest step measured on a well-constrained
+  // frame so far, where that is beyond frame_limits': a robot can set off from rest to its speed,
+  // or stop, within one frame of a sequence taken sparsely (the survey every 10th frame: 0.5 m
+  // from rest, found at the best fitness but refused at 0.3 m). Frames 30 Hz apart never step
+  // that far, so they keep frame_limits.
+  bool corrections_up_to_largest_step = true;
   // Re-estimation acceptance; the correction is relative to the chained estimate. After a
   // fallback, and after degenerate frames since the anchor when the re-estimate's own view is not
   // degenerate, corrections up to frame_limits' are allowed; in the second case one beyond these
@@ -381,6 +387,9 @@ class RgbdOdometry {
   double arc_step_error_ = 0;
   // StepFrame::arc's direction of travel with no turn, and OdometryParams::heading_prior.
   HeadingPrior heading_prior_;
+  // OdometryParams::corrections_up_to_largest_step: the largest step of a well-constrained frame.
+  double largest_step_m_ = 0;
+  RegistrationLimits frame_limits_now() const;
 };
 
 }  // namespace kartograf::registration
