@@ -305,9 +305,9 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
 
 se3::Matrix6d RgbdOdometry::information_of(const Attempt& attempt) const {
   // Degenerate without a photometric measurement: the weak directions are the motion model's, so
-  // only the prior speaks for them and a loop closure can move them at little cost. The heading
-  // prior, where it held the sideways slide, holds it in the pose graph too: a loop seen along a
-  // corridor cannot pull a robot sideways.
+  // only the prior speaks for them and a loop closure can move them at little cost. Where the
+  // heading prior held the sideways slide, it holds it in the pose graph too (along the free
+  // directions): a loop cannot pull a robot sideways there.
   const se3::Matrix6d measured =
       geometry_.degeneracy.degenerate && !attempt.photometric
           ? constrained_information(geometry_, params_.icp.min_eigenvalue_ratio)

@@ -1,9 +1,10 @@
 #pragma once
 // A camera on a wheeled robot moves along the robot's heading: its step, with half the step's
-// turn undone, points the same way in the camera frame every frame (forward, and down by the
-// camera's tilt), and a turn on the spot moves it not at all. Nothing moves it sideways. Where a
-// frame's geometry leaves the sideways slide free (a wall over the floor, ahead) the odometry can
-// take that slide from this instead of from ICP's or the images' weakest answer.
+// turn undone, points the same way in the camera frame every frame (forward and, for a camera
+// tilted down, a little up), and a turn on the spot moves it not at all. Nothing moves it
+// sideways. Where a frame's geometry leaves the sideways slide free (a wall over the floor,
+// ahead) the odometry can take that slide from this instead of from ICP's or the images'
+// weakest answer.
 //
 // HeadingPrior learns, from the steps of frames whose geometry measured every direction, the
 // direction of travel (a mean weighted by step length) and how far the steps stray across it
