@@ -297,10 +297,8 @@ class RgbdOdometry {
     // Grey-level RMSE of the images at the motion (degenerate frames with colour; 0: not measured).
     double photometric_rmse = 0;
     RegistrationReport report;
-    // The heading prior's information on the step (zero where it did not hold it), that
-    // information in the directions the geometry left free (the pose-graph edge's), its spread.
+    // The heading prior's information on the step (zero where it did not hold it), its spread.
     se3::Matrix6d across_heading = se3::Matrix6d::Zero();
-    se3::Matrix6d across_in_graph = se3::Matrix6d::Zero();
     double heading_sigma_m = 0;
   };
   // Registers the current frame against an earlier one.
