@@ -36,6 +36,8 @@ nb::dict frame_dict(const registration::OdometryFrame& frame) {
   d["degenerate"] = frame.degenerate;
   d["photometric"] = frame.photometric;
   d["heading_sigma_m"] = frame.heading_sigma_m;
+  d["accelerated"] = frame.accelerated;
+  d["speed_bounded"] = frame.speed_bounded;
   d["eigenvalue_ratio"] = frame.eigenvalue_ratio;
   d["keyframe"] = frame.keyframe;
   d["seconds"] = frame.seconds;

@@ -55,6 +55,8 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["degenerate"] = frame.degenerate;
   json["photometric"] = frame.photometric;
   json["heading_sigma_m"] = frame.heading_sigma_m;
+  json["accelerated"] = frame.accelerated;
+  json["speed_bounded"] = frame.speed_bounded;
   json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
   json["step_frame"] = std::string(registration::to_string(frame.step_frame));
   json["previous"] = frame.previous ? registration_report_json(*frame.previous) : RunJson();
@@ -77,6 +79,8 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["degenerate_frames"] = counts.degenerate_frames;
   json["photometric_frames"] = counts.photometric_frames;
   json["heading_prior_frames"] = counts.heading_prior_frames;
+  json["accelerated_frames"] = counts.accelerated_frames;
+  json["speed_bounded_frames"] = counts.speed_bounded_frames;
   json["reestimates"] = counts.reestimates;
   json["reestimates_rejected"] = counts.reestimates_rejected;
   return json;
@@ -105,11 +109,29 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.degenerate_frames += f.degenerate;
     counts.photometric_frames += f.photometric;
     counts.heading_prior_frames += f.heading_sigma_m > 0;
+    counts.accelerated_frames += f.accelerated;
+    counts.speed_bounded_frames += f.speed_bounded;
     counts.reestimates += f.reestimate.has_value();
     counts.reestimates_rejected += f.reestimate && !f.reestimate->accepted();
   }
   return counts;
 }
+
+namespace {
+
+// Sparse sequences only (OdometryParams::acceleration_start, speed_change_margin).
+std::string speed_changes_text(const OdometryFrameCounts& c) {
+  std::string text;
+  if (c.accelerated_frames > 0) {
+    text += ", " + std::to_string(c.accelerated_frames) + " followed a change of speed";
+  }
+  if (c.speed_bounded_frames > 0) {
+    text += ", " + std::to_string(c.speed_bounded_frames) + " decided by the speed bound";
+  }
+  return text;
+}
+
+}  // namespace
 
 std::string frame_counts_line(const OdometryFrameCounts& c) {
   const auto count = [](std::size_t n) { return std::to_string(n); };
@@ -118,7 +140,8 @@ std::string frame_counts_line(const OdometryFrameCounts& c) {
   return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) + seeded +
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
          "), degenerate frames " + count(c.degenerate_frames) + " (" + count(c.photometric_frames) +
-         " measured by image intensity, " + count(c.heading_prior_frames) + " held to the heading)";
+         " measured by image intensity, " + count(c.heading_prior_frames) + " held to the heading" +
+         speed_changes_text(c) + ")";
 }
 
 OdometryThroughput odometry_throughput(const mapping::OdometryRun& run) {

@@ -16,12 +16,6 @@ Eigen::Vector3d untwisted(const Eigen::Isometry3d& step) {
   return Eigen::AngleAxisd(-0.5 * turn.angle(), turn.axis()) * step.translation();
 }
 
-// The direction of travel on `step`'s arc: the heading turned by half the step's turn.
-Eigen::Vector3d travel_on(const Eigen::Isometry3d& step, const Eigen::Vector3d& heading) {
-  const Eigen::AngleAxisd turn(step.linear());
-  return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()) * heading.normalized();
-}
-
 constexpr double kVarianceFloor = 1e-12;  // m^2: a spread of nothing is no reason to divide by 0
 
 }  // namespace
@@ -38,6 +32,12 @@ void HeadingPrior::learn(const Eigen::Isometry3d& step) {
   heading_ = kKeep * heading_ + (1 - kKeep) * travel;
 }
 
+Eigen::Vector3d HeadingPrior::travel_on(const Eigen::Isometry3d& step) const {
+  if (heading_.squaredNorm() == 0) return Eigen::Vector3d::Zero();
+  const Eigen::AngleAxisd turn(step.linear());
+  return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()) * heading_.normalized();
+}
+
 bool HeadingPrior::ready() const {
   static const double kTwentySteps = 1 - std::pow(kKeep, 20);
   return weight_ >= kTwentySteps && heading_.squaredNorm() > 0;
@@ -50,7 +50,7 @@ double HeadingPrior::across_variance() const {
 se3::Matrix6d HeadingPrior::information(const Eigen::Isometry3d& step) const {
   se3::Matrix6d information = se3::Matrix6d::Zero();
   if (!ready()) return information;
-  const Eigen::Vector3d along = travel_on(step, heading_);
+  const Eigen::Vector3d along = travel_on(step);
   const Eigen::Matrix3d across = Eigen::Matrix3d::Identity() - along * along.transpose();
   // The translation moves by R v under the right perturbation (omega, v).
   const Eigen::Matrix3d jacobian = across * step.linear();
@@ -63,7 +63,7 @@ Eigen::Isometry3d HeadingPrior::combine(const Eigen::Isometry3d& step,
                                         const se3::Matrix6d& measured) const {
   if (!ready()) return step;
   const se3::Matrix6d prior = information(step);
-  const Eigen::Vector3d along = travel_on(step, heading_);
+  const Eigen::Vector3d along = travel_on(step);
   const Eigen::Vector3d across = step.translation() - step.translation().dot(along) * along;
   se3::Vector6d gradient = se3::Vector6d::Zero();
   gradient.tail<3>() =

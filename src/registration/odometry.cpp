@@ -69,6 +69,7 @@ void validate(const OdometryParams& params) {
               params.feature_arbitration_ratio > 0 && params.photometric_doubt_rmse > 0,
           "odometry: feature_arbitration_m and _deg must be >= 0, feature_arbitration_ratio and "
           "photometric_doubt_rmse > 0");
+  require(params.speed_change_margin >= 0, "odometry: speed_change_margin must be >= 0");
   require(params.keyframes.max_interval >= 1, "odometry: keyframes.max_interval must be >= 1");
   require(params.anchor.max_translation >= 0 && params.anchor.max_rotation_deg >= 0 &&
               params.anchor.max_interval >= 0,
@@ -177,7 +178,8 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
       information_level_(
           pyramid_level_at_most(camera.width, std::max(params_.information_width, 1))),
       builder_(context, camera, params_.depth_range),
-      engine_(context, params_.icp, finder_for(context, params_)) {
+      engine_(context, params_.icp, finder_for(context, params_)),
+      speed_bound_(params_.speed_change_margin, params_.feature_arbitration_m) {
   validate(params_);
   // The frame being tracked, the previous one and, with re-estimation, the anchor: whatever k and
   // the anchor policy, no other frame is registered against again.
@@ -393,8 +395,12 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
 }
 
 Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame) const {
+  return predict(step_frame, params_.motion_model);
+}
+
+Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame, MotionModel model) const {
   const std::size_t n = poses_.size();  // the frame to predict
-  if (params_.motion_model == MotionModel::still || n < 2) return Eigen::Isometry3d::Identity();
+  if (model == MotionModel::still || n < 2) return Eigen::Isometry3d::Identity();
   // Rotation: the last turn again, in the camera frame. Translation: the camera centre's last
   // step (with `acceleration`, changed as it changed before), in the world or the camera frame.
   const auto step_of = [&](std::size_t to) -> Eigen::Vector3d {
@@ -404,19 +410,16 @@ Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame) const {
                : world;
   };
   Eigen::Vector3d step = step_of(n - 1);
-  if (params_.motion_model == MotionModel::acceleration && n >= 3) step += step - step_of(n - 2);
+  if (model == MotionModel::acceleration && n >= 3) step += step - step_of(n - 2);
   const Eigen::Isometry3d& last = poses_[n - 1];
   const Eigen::Isometry3d& before = poses_[n - 2];
   Eigen::Isometry3d predicted = Eigen::Isometry3d::Identity();
   predicted.linear() = before.linear().transpose() * last.linear();
   predicted.translation() =
       step_frame == StepFrame::world ? Eigen::Vector3d(last.linear().transpose() * step) : step;
-  const Eigen::Vector3d& heading = heading_prior_.heading();
-  if (step_frame == StepFrame::arc && heading.squaredNorm() > 0) {
+  if (step_frame == StepFrame::arc && heading_prior_.heading().squaredNorm() > 0) {
     // A wheeled robot's step on an arc: its heading turned by half the turn, the last speed.
-    const Eigen::AngleAxisd turn(predicted.linear());
-    predicted.translation() =
-        step.norm() * (Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()) * heading.normalized());
+    predicted.translation() = step.norm() * heading_prior_.travel_on(predicted);
   }
   return orthonormalized(predicted);
 }
@@ -463,7 +466,8 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   // weighed against the features: by fitness they picked wrong turns in rooms that look alike.
   std::optional<Attempt> seeded;
   if (is_large(predicted)) seeded = register_from_features();
-  Attempt attempt = register_frames(previous, predicted, frame_limits_now());
+  Attempt attempt = accelerating_if_better(
+      frame.step_frame, predicted, register_frames(previous, predicted, frame_limits_now()));
   if (seeded) {
     if (agrees_better(attempt, *seeded)) return attempt;
     frame.from_features = true;
@@ -485,6 +489,24 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   return attempt;
 }
 
+RgbdOdometry::Attempt RgbdOdometry::accelerating_if_better(StepFrame step_frame,
+                                                           const Eigen::Isometry3d& predicted,
+                                                           Attempt attempt) {
+  if (!params_.acceleration_start || !geometry_.degeneracy.degenerate ||
+      params_.motion_model != MotionModel::velocity) {
+    return attempt;
+  }
+  const Eigen::Isometry3d accelerated = predict(step_frame, MotionModel::acceleration);
+  if ((accelerated.translation() - predicted.translation()).norm() <=
+      params_.feature_arbitration_m) {
+    return attempt;  // no change of speed the images could tell
+  }
+  Attempt other = register_frames(frames_.size() - 1, accelerated, frame_limits_now());
+  if (!agrees_better(other, attempt)) return attempt;
+  other.accelerated = true;
+  return other;
+}
+
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
     const Attempt& predicted) {
   std::optional<Attempt> seeded = register_from_features();
@@ -492,7 +514,7 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
   return seeded;
 }
 
-bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incumbent) const {
+bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incumbent) {
   if (!challenger.report.accepted()) return false;
   const Eigen::Isometry3d difference = challenger.motion.inverse() * incumbent.motion;
   if (difference.translation().norm() <= params_.feature_arbitration_m &&
@@ -500,11 +522,22 @@ bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incum
     return false;
   }
   if (challenger.report.degenerate || incumbent.report.degenerate) {
+    // The images can prefer a repeated floor pattern a tile over: a step the robot cannot make
+    // loses first.
+    const bool allowed = speed_allows(challenger);
+    if (allowed != speed_allows(incumbent)) {
+      speed_bound_decided_ = true;
+      return allowed;
+    }
     return challenger.photometric_rmse > 0 && incumbent.photometric_rmse > 0 &&
            challenger.photometric_rmse <
                params_.feature_arbitration_ratio * incumbent.photometric_rmse;
   }
   return challenger.report.fitness > incumbent.report.fitness;
+}
+
+bool RgbdOdometry::speed_allows(const Attempt& attempt) const {
+  return speed_bound_.admits(frames_.size(), attempt.motion.translation().norm());
 }
 
 bool RgbdOdometry::is_doubtful(const Attempt& attempt) const {
@@ -551,20 +584,45 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
     consider(register_frames(previous, start, frame_limits_now()), false);
   }
   if (std::optional<Attempt> seeded = register_from_features()) consider(std::move(*seeded), true);
+  if (params_.recheck_from_turn && best.report.accepted()) {
+    for (const Eigen::Isometry3d& start : starts_from_turn(best.motion)) {
+      consider(register_frames(previous, start, frame_limits_now()), false);
+    }
+  }
   return best;
+}
+
+std::vector<Eigen::Isometry3d> RgbdOdometry::starts_from_turn(
+    const Eigen::Isometry3d& motion) const {
+  // A turn moves most points far more than the slide it can be traded for, so ICP's turn is
+  // better than its step: that turn again, on the spot and, once the heading is known, with the
+  // same step length along the heading on the turn's arc.
+  Eigen::Isometry3d on_the_spot = motion;
+  on_the_spot.translation().setZero();
+  std::vector<Eigen::Isometry3d> starts = {on_the_spot};
+  if (heading_prior_.ready()) {
+    Eigen::Isometry3d on_the_arc = motion;
+    on_the_arc.translation() = motion.translation().norm() * heading_prior_.travel_on(motion);
+    starts.push_back(on_the_arc);
+  }
+  return starts;
 }
 
 void RgbdOdometry::track_previous(OdometryFrame& frame) {
   const std::size_t n = frame.index;
   frame.step_frame = step_frame_in_use();
   const Eigen::Isometry3d predicted = predict(frame.step_frame);
+  speed_bound_decided_ = false;
   const Attempt attempt = attempt_previous(predicted, frame);
   frame.previous = attempt.report;
+  frame.accelerated = attempt.accelerated;
+  frame.speed_bounded = speed_bound_decided_;
   frame.photometric = attempt.photometric;
   frame.heading_sigma_m = attempt.heading_sigma_m;
   if (attempt.report.accepted() && !geometry_.degeneracy.degenerate) {
     score_step_frames(attempt.motion);
     largest_step_m_ = std::max(largest_step_m_, attempt.motion.translation().norm());
+    speed_bound_.learn(n, attempt.motion.translation().norm());
   }
 
   RelativePose constraint{n - 1, n, predicted, {}, false};

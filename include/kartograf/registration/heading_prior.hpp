@@ -27,6 +27,10 @@ class HeadingPrior {
   // mean, only its direction means anything. Zero before the first step.
   const Eigen::Vector3d& heading() const { return heading_; }
 
+  // The unit direction of travel on `step`'s arc (camera frame of the step's start): the heading
+  // turned by half the step's turn. Zero before the first step.
+  Eigen::Vector3d travel_on(const Eigen::Isometry3d& step) const;
+
   // Whether enough steps were learned for the spread to mean anything.
   bool ready() const;
 

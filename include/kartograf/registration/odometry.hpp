@@ -58,6 +58,7 @@
 #include "kartograf/registration/photometric_refinement.hpp"
 #include "kartograf/registration/registration_check.hpp"
 #include "kartograf/registration/rgbd_frame.hpp"
+#include "kartograf/registration/speed_bound.hpp"
 
 namespace kartograf::registration {
 
@@ -195,6 +196,12 @@ struct OdometryParams {
   double recheck_correction_m = 0.03;
   double recheck_fitness = 0.3;
   std::vector<double> recheck_turns_deg = {-40, -20, 20, 40};
+  // Then ICP also starts from the best one's turn, on the spot and (once the heading prior has
+  // learned the robot's heading) with the best one's step length along the heading on that turn's
+  // arc: ICP measures a turn better than the slide it trades it for. Found on the survey every 10th
+  // frame: a turn on the spot taken with a 14 cm slide, and a robot setting off on a turn 24 cm
+  // sideways, both at a good fitness.
+  bool recheck_from_turn = true;
   // Local features (optional; the features layer's OrbFrontEnd): the current and the previous
   // frame's features are matched, and ICP starts from their motion, when the motion model
   // predicts more than feature_seed_m or feature_seed_deg (beyond the coarsest ICP gate; ICP from
@@ -221,6 +228,20 @@ struct OdometryParams {
   // answer lies beyond the registration's correction limits (frame_limits, reestimate_limits) is
   // kept only at an RMSE within this (docs/slam.md, "An images' correction beyond the limits").
   double photometric_doubt_rmse = 10;
+  // Two registrations of a degenerate view that disagree (above): one whose step length lies
+  // beyond what the robot's drive can change in the frames since the geometry last measured its
+  // speed (this many times the largest change of step length between two consecutive
+  // well-constrained frames, once one over feature_arbitration_m was seen; speed_bound.hpp) loses
+  // to one within it. Found on the survey taken every 10th frame (frame 27: the features and the
+  // images took a checkered floor two tiles over, a step of 0.26 m where the robot, at 0.87 m a
+  // frame, made 0.98 m). 0: off.
+  double speed_change_margin = 2;
+  // A degenerate view while the robot speeds up or slows down (the last step changed its length or
+  // direction by more than feature_arbitration_m): the velocity model lags by that change, and a
+  // floor or wall pattern can hold the images at its lag. ICP is also run from the step changed as
+  // it last changed (MotionModel::acceleration), and taken where the pair agrees better with it
+  // (agrees_better). Frames 30 Hz apart never change by that much.
+  bool acceleration_start = true;
 };
 
 // A measured (or, for fallbacks, predicted) motion between two frames, for a pose graph:
@@ -253,6 +274,12 @@ struct OdometryFrame {
   // The step's slide across the robot's heading was held by the heading prior
   // (OdometryParams::heading_prior) with this spread (metres; 0: it did not hold it).
   double heading_sigma_m = 0;
+  // The step came from ICP started at the step changed as it last changed
+  // (OdometryParams::acceleration_start).
+  bool accelerated = false;
+  // Two registrations disagreed and one was refused for a change of speed beyond the robot's
+  // (OdometryParams::speed_change_margin).
+  bool speed_bounded = false;
   double eigenvalue_ratio = 0;  // of the frame's geometric information
   // The frame the prediction kept the camera centre's step in (OdometryParams::step_frame).
   StepFrame step_frame = StepFrame::world;
@@ -300,6 +327,7 @@ class RgbdOdometry {
     // The heading prior's information on the step (zero where it did not hold it), its spread.
     se3::Matrix6d across_heading = se3::Matrix6d::Zero();
     double heading_sigma_m = 0;
+    bool accelerated = false;  // OdometryFrame::accelerated
   };
   // Registers the current frame against an earlier one.
   Attempt register_frames(std::size_t target, const Eigen::Isometry3d& initial,
@@ -310,9 +338,15 @@ class RgbdOdometry {
   void track_previous(OdometryFrame& frame);
   // The registration against the previous frame, from the prediction, rest or the features.
   Attempt attempt_previous(const Eigen::Isometry3d& predicted, OdometryFrame& frame);
+  // OdometryParams::acceleration_start: `attempt` (from `predicted`) or ICP from the step changed
+  // as it last changed, whichever the pair agrees better with.
+  Attempt accelerating_if_better(StepFrame step_frame, const Eigen::Isometry3d& predicted,
+                                 Attempt attempt);
   // A registration worth checking from other starts (OdometryParams::recheck_*).
   bool is_doubtful(const Attempt& attempt) const;
   std::vector<Eigen::Isometry3d> other_starts(const Eigen::Isometry3d& predicted) const;
+  // Starts at `motion`'s turn: with no step, and with its step's length along the heading.
+  std::vector<Eigen::Isometry3d> starts_from_turn(const Eigen::Isometry3d& motion) const;
   // The best fit of `first` (from the prediction) and ICP from other_starts() and the features.
   Attempt best_of_other_starts(std::size_t previous, const Eigen::Isometry3d& predicted,
                                Attempt first, OdometryFrame& frame);
@@ -321,7 +355,10 @@ class RgbdOdometry {
   // two starts, when they differ by more than feature_arbitration_m or _deg: on a degenerate
   // pair the images (grey-level RMSE below feature_arbitration_ratio times the other's), since
   // the fitness cannot tell a slide along the free direction; otherwise the fitness.
-  bool agrees_better(const Attempt& challenger, const Attempt& incumbent) const;
+  bool agrees_better(const Attempt& challenger, const Attempt& incumbent);
+  // Whether the attempt's step into the frame being tracked is one the robot's drive allows
+  // (OdometryParams::speed_change_margin).
+  bool speed_allows(const Attempt& attempt) const;
   // A degenerate frame's registration from the prediction against ICP from the features' motion:
   // the latter when the two disagree and its images agree better (photometric_rmse).
   std::optional<Attempt> arbitrate_by_intensity(const Attempt& predicted);
@@ -376,6 +413,7 @@ class RgbdOdometry {
   // The motion model's T_{n-1}^-1 T_n for the next frame n, from the last poses, with the step
   // kept in the world or the camera frame, or on an arc (StepFrame).
   Eigen::Isometry3d predict(StepFrame frame) const;
+  Eigen::Isometry3d predict(StepFrame frame, MotionModel model) const;
   StepFrame step_frame_in_use() const;
   // StepFrame::adaptive: each frame's mean squared step error (metres^2, decaying) of the three
   // predictions on frames whose geometry measured every direction.
@@ -387,6 +425,9 @@ class RgbdOdometry {
   HeadingPrior heading_prior_;
   // OdometryParams::corrections_up_to_largest_step: the largest step of a well-constrained frame.
   double largest_step_m_ = 0;
+  // OdometryParams::speed_change_margin.
+  SpeedBound speed_bound_;
+  bool speed_bound_decided_ = false;  // for the frame being tracked (OdometryFrame::speed_bounded)
   RegistrationLimits frame_limits_now() const;
 };
 
