@@ -37,6 +37,9 @@ TEST(SpeedBound, BoundsTheStepByTheMarginTimesTheChangePerFrameSinceTheLastMeasu
   bound.learn(2, 0.4);
   bound.learn(3, 0.6);
   bound.learn(4, 0.8);  // largest change 0.2: one frame later, 0.8 +- 0.4
+  const auto [low, high] = bound.admitted(5);
+  EXPECT_NEAR(low, 0.4, 1e-9);
+  EXPECT_NEAR(high, 1.2, 1e-9);
   EXPECT_TRUE(bound.admits(5, 1.15));
   EXPECT_TRUE(bound.admits(5, 0.45));
   EXPECT_FALSE(bound.admits(5, 0.3));  // a tile over on a checkered floor

@@ -38,6 +38,7 @@ nb::dict frame_dict(const registration::OdometryFrame& frame) {
   d["heading_sigma_m"] = frame.heading_sigma_m;
   d["accelerated"] = frame.accelerated;
   d["speed_bounded"] = frame.speed_bounded;
+  d["scanned"] = frame.scanned;
   d["eigenvalue_ratio"] = frame.eigenvalue_ratio;
   d["keyframe"] = frame.keyframe;
   d["seconds"] = frame.seconds;

@@ -57,6 +57,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["heading_sigma_m"] = frame.heading_sigma_m;
   json["accelerated"] = frame.accelerated;
   json["speed_bounded"] = frame.speed_bounded;
+  json["scanned"] = frame.scanned;
   json["eigenvalue_ratio"] = frame.eigenvalue_ratio;
   json["step_frame"] = std::string(registration::to_string(frame.step_frame));
   json["previous"] = frame.previous ? registration_report_json(*frame.previous) : RunJson();
@@ -81,6 +82,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["heading_prior_frames"] = counts.heading_prior_frames;
   json["accelerated_frames"] = counts.accelerated_frames;
   json["speed_bounded_frames"] = counts.speed_bounded_frames;
+  json["scanned_frames"] = counts.scanned_frames;
   json["reestimates"] = counts.reestimates;
   json["reestimates_rejected"] = counts.reestimates_rejected;
   return json;
@@ -111,6 +113,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.heading_prior_frames += f.heading_sigma_m > 0;
     counts.accelerated_frames += f.accelerated;
     counts.speed_bounded_frames += f.speed_bounded;
+    counts.scanned_frames += f.scanned;
     counts.reestimates += f.reestimate.has_value();
     counts.reestimates_rejected += f.reestimate && !f.reestimate->accepted();
   }
@@ -124,6 +127,9 @@ std::string speed_changes_text(const OdometryFrameCounts& c) {
   std::string text;
   if (c.accelerated_frames > 0) {
     text += ", " + std::to_string(c.accelerated_frames) + " followed a change of speed";
+  }
+  if (c.scanned_frames > 0) {
+    text += ", " + std::to_string(c.scanned_frames) + " found along the step";
   }
   if (c.speed_bounded_frames > 0) {
     text += ", " + std::to_string(c.speed_bounded_frames) + " decided by the speed bound";

@@ -468,6 +468,13 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   if (is_large(predicted)) seeded = register_from_features();
   Attempt attempt = accelerating_if_better(
       frame.step_frame, predicted, register_frames(previous, predicted, frame_limits_now()));
+  if (images_left_open(attempt)) {
+    std::optional<Attempt> scanned = scan_step_lengths(frame.step_frame, predicted, attempt);
+    if (scanned && agrees_better(*scanned, attempt)) {
+      attempt = std::move(*scanned);
+      attempt.scanned = true;
+    }
+  }
   if (seeded) {
     if (agrees_better(attempt, *seeded)) return attempt;
     frame.from_features = true;
@@ -476,17 +483,20 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   if (is_doubtful(attempt)) {
     return best_of_other_starts(previous, predicted, std::move(attempt), frame);
   }
-  // Only where the images did not measure the weak directions themselves (a step beyond the
-  // refinement's basin, or too little texture) or left them far apart: elsewhere they already
-  // had their say.
-  if (geometry_.degeneracy.degenerate && attempt.photometric_rmse > 0 &&
-      (!attempt.photometric || attempt.photometric_rmse > params_.photometric_doubt_rmse)) {
+  if (images_left_open(attempt)) {
     if (std::optional<Attempt> arbitrated = arbitrate_by_intensity(attempt)) {
       frame.from_features = true;
       return std::move(*arbitrated);
     }
   }
   return attempt;
+}
+
+bool RgbdOdometry::images_left_open(const Attempt& attempt) const {
+  // The images did not measure the weak directions themselves (a step beyond the refinement's
+  // basin, or too little texture) or left them far apart: elsewhere they already had their say.
+  return geometry_.degeneracy.degenerate && attempt.photometric_rmse > 0 &&
+         (!attempt.photometric || attempt.photometric_rmse > params_.photometric_doubt_rmse);
 }
 
 RgbdOdometry::Attempt RgbdOdometry::accelerating_if_better(StepFrame step_frame,
@@ -505,6 +515,50 @@ RgbdOdometry::Attempt RgbdOdometry::accelerating_if_better(StepFrame step_frame,
   if (!agrees_better(other, attempt)) return attempt;
   other.accelerated = true;
   return other;
+}
+
+std::pair<double, double> RgbdOdometry::plausible_step_lengths(
+    StepFrame step_frame, const Eigen::Isometry3d& predicted) const {
+  // Around the velocity and acceleration models' steps by their difference: the speed keeps
+  // changing as it did, or stops changing, or changes as much again the other way.
+  const double velocity = predicted.translation().norm();
+  const double accelerated = predict(step_frame, MotionModel::acceleration).translation().norm();
+  const double change = std::abs(accelerated - velocity);
+  double shortest = std::max(0.0, std::min(velocity, accelerated) - change);
+  double longest = std::max(velocity, accelerated) + change;
+  if (speed_bound_.ready()) {  // and never beyond what the drive can do
+    const auto [low, high] = speed_bound_.admitted(frames_.size());
+    shortest = std::max(shortest, low);
+    longest = std::min(longest, high);
+  }
+  return {shortest, longest};
+}
+
+std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_step_lengths(
+    StepFrame step_frame, const Eigen::Isometry3d& predicted, const Attempt& attempt) {
+  constexpr double kSpacing = 0.01;  // metres: about the images' basin along a step
+  const auto [shortest, longest] = plausible_step_lengths(step_frame, predicted);
+  const Eigen::Vector3d step = attempt.motion.translation();
+  const RgbImage& target_color = colors_[slot_of(frames_.size() - 1)];
+  if (!params_.step_scan || longest - shortest <= params_.feature_arbitration_m ||
+      step.norm() < kSpacing || color_ == nullptr || color_->empty() || target_color.empty()) {
+    return {};
+  }
+  std::vector<Eigen::Isometry3d> candidates;
+  for (double length = shortest; length <= longest; length += kSpacing) {
+    Eigen::Isometry3d candidate = attempt.motion;
+    candidate.translation() = length * step.normalized();
+    candidates.push_back(candidate);
+  }
+  const std::vector<double> rmse =
+      intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
+                     params_.depth_range.units_per_metre, candidates, params_.photometric);
+  std::size_t best = candidates.size();
+  for (std::size_t i = 0; i < rmse.size(); ++i) {
+    if (rmse[i] > 0 && (best == candidates.size() || rmse[i] < rmse[best])) best = i;
+  }
+  if (best == candidates.size()) return {};
+  return register_frames(frames_.size() - 1, candidates[best], frame_limits_now());
 }
 
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
@@ -616,6 +670,7 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   const Attempt attempt = attempt_previous(predicted, frame);
   frame.previous = attempt.report;
   frame.accelerated = attempt.accelerated;
+  frame.scanned = attempt.scanned;
   frame.speed_bounded = speed_bound_decided_;
   frame.photometric = attempt.photometric;
   frame.heading_sigma_m = attempt.heading_sigma_m;

@@ -21,8 +21,14 @@ bool SpeedBound::ready() const {
 
 bool SpeedBound::admits(std::size_t frame, double step_m) const {
   if (!ready() || frame <= last_frame_) return true;
-  const auto frames = static_cast<double>(frame - last_frame_);
-  return std::abs(step_m - last_step_m_) <= margin_ * largest_change_m_ * frames;
+  const auto [low, high] = admitted(frame);
+  return step_m >= low && step_m <= high;
+}
+
+std::pair<double, double> SpeedBound::admitted(std::size_t frame) const {
+  const auto frames = static_cast<double>(frame > last_frame_ ? frame - last_frame_ : 1);
+  const double change = margin_ * largest_change_m_ * frames;
+  return {std::max(0.0, last_step_m_ - change), last_step_m_ + change};
 }
 
 }  // namespace kartograf::registration

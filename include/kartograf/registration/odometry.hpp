@@ -242,6 +242,16 @@ struct OdometryParams {
   // it last changed (MotionModel::acceleration), and taken where the pair agrees better with it
   // (agrees_better). Frames 30 Hz apart never change by that much.
   bool acceleration_start = true;
+  // A degenerate view whose images the registration left doubtful (not refined, or refined to
+  // a grey-level RMSE above photometric_doubt_rmse) while the robot moves fast: the images' fit
+  // along the step is narrow (1-2 cm) and has other minima (a floor pattern a tile over), so no
+  // start but one near the truth finds it. The grey-level RMSE (intensity_rmse) is evaluated at
+  // step lengths 1 cm apart along the registration's own step, over the lengths around the
+  // velocity and acceleration models' steps by their difference, within speed_change_margin's
+  // bound once it is set, where that range is wider than feature_arbitration_m; ICP starts from
+  // the best, kept where the pair agrees better with it (agrees_better). Over the bound's whole
+  // range (metres wide after long degenerate stretches) the images took wrong minima.
+  bool step_scan = true;
 };
 
 // A measured (or, for fallbacks, predicted) motion between two frames, for a pose graph:
@@ -280,6 +290,9 @@ struct OdometryFrame {
   // Two registrations disagreed and one was refused for a change of speed beyond the robot's
   // (OdometryParams::speed_change_margin).
   bool speed_bounded = false;
+  // The step came from ICP started at the step length whose images fit best
+  // (OdometryParams::step_scan).
+  bool scanned = false;
   double eigenvalue_ratio = 0;  // of the frame's geometric information
   // The frame the prediction kept the camera centre's step in (OdometryParams::step_frame).
   StepFrame step_frame = StepFrame::world;
@@ -328,6 +341,7 @@ class RgbdOdometry {
     se3::Matrix6d across_heading = se3::Matrix6d::Zero();
     double heading_sigma_m = 0;
     bool accelerated = false;  // OdometryFrame::accelerated
+    bool scanned = false;      // OdometryFrame::scanned
   };
   // Registers the current frame against an earlier one.
   Attempt register_frames(std::size_t target, const Eigen::Isometry3d& initial,
@@ -342,6 +356,16 @@ class RgbdOdometry {
   // as it last changed, whichever the pair agrees better with.
   Attempt accelerating_if_better(StepFrame step_frame, const Eigen::Isometry3d& predicted,
                                  Attempt attempt);
+  // A degenerate view whose images did not measure, or fit far apart.
+  bool images_left_open(const Attempt& attempt) const;
+  // OdometryParams::step_scan: ICP from the step length along the attempt's direction whose images
+  // fit best, over the lengths the robot can have stepped; none where that range is narrow.
+  std::optional<Attempt> scan_step_lengths(StepFrame step_frame, const Eigen::Isometry3d& predicted,
+                                           const Attempt& attempt);
+  // The range of step lengths scanned: around the velocity and acceleration models' steps by
+  // their difference, within the speed bound once it is set.
+  std::pair<double, double> plausible_step_lengths(StepFrame step_frame,
+                                                   const Eigen::Isometry3d& predicted) const;
   // A registration worth checking from other starts (OdometryParams::recheck_*).
   bool is_doubtful(const Attempt& attempt) const;
   std::vector<Eigen::Isometry3d> other_starts(const Eigen::Isometry3d& predicted) const;

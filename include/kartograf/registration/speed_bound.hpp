@@ -16,6 +16,7 @@
 // change speed that much, so only sparse sequences are bounded. A hand-held camera's speed changes
 // erratically, so its bound is wide.
 #include <cstddef>
+#include <utility>
 
 namespace kartograf::registration {
 
@@ -33,6 +34,9 @@ class SpeedBound {
   // Whether a step of `step_m` metres into `frame` (after every learned frame) is within the
   // bound; always true before ready().
   bool admits(std::size_t frame, double step_m) const;
+
+  // The step lengths admits() admits into `frame` (metres; only meaningful once ready()).
+  std::pair<double, double> admitted(std::size_t frame) const;
 
   double largest_change_m() const { return largest_change_m_; }
 
