@@ -476,7 +476,7 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
     }
   }
   if (seeded) {
-    if (agrees_better(attempt, *seeded)) return attempt;
+    if (agrees_better(attempt, *seeded) || images_tell_apart(attempt, *seeded)) return attempt;
     frame.from_features = true;
     return std::move(*seeded);
   }
@@ -568,13 +568,25 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
   return seeded;
 }
 
+bool RgbdOdometry::within_arbitration(const Attempt& a, const Attempt& b) const {
+  const Eigen::Isometry3d difference = a.motion.inverse() * b.motion;
+  return difference.translation().norm() <= params_.feature_arbitration_m &&
+         se3::rotation_angle(difference) <= params_.feature_arbitration_deg * kDegree;
+}
+
+bool RgbdOdometry::images_tell_apart(const Attempt& challenger, const Attempt& incumbent) const {
+  // Two answers of a degenerate view within the arbitration distance differ along the free
+  // directions, which only the images measure (a turn on the spot: the features' 3 cm slide).
+  return params_.feature_ties_by_images && challenger.report.accepted() &&
+         within_arbitration(challenger, incumbent) &&
+         (challenger.report.degenerate || incumbent.report.degenerate) && challenger.photometric &&
+         challenger.photometric_rmse > 0 && incumbent.photometric_rmse > 0 &&
+         challenger.photometric_rmse <
+             params_.feature_arbitration_ratio * incumbent.photometric_rmse;
+}
+
 bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incumbent) {
-  if (!challenger.report.accepted()) return false;
-  const Eigen::Isometry3d difference = challenger.motion.inverse() * incumbent.motion;
-  if (difference.translation().norm() <= params_.feature_arbitration_m &&
-      se3::rotation_angle(difference) <= params_.feature_arbitration_deg * kDegree) {
-    return false;
-  }
+  if (!challenger.report.accepted() || within_arbitration(challenger, incumbent)) return false;
   if (challenger.report.degenerate || incumbent.report.degenerate) {
     // The images can prefer a repeated floor pattern a tile over: a step the robot cannot make
     // loses first.
