@@ -122,7 +122,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
 
 namespace {
 
-// Sparse sequences only (OdometryParams::acceleration_start, speed_change_margin).
+// Sparse sequences only (OdometryParams::acceleration_start, step_scan, speed_change_margin).
 std::string speed_changes_text(const OdometryFrameCounts& c) {
   std::string text;
   if (c.accelerated_frames > 0) {
