@@ -689,6 +689,10 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   if (attempt.report.accepted() && !geometry_.degeneracy.degenerate) {
     score_step_frames(attempt.motion);
     largest_step_m_ = std::max(largest_step_m_, attempt.motion.translation().norm());
+  }
+  const bool measured = !geometry_.degeneracy.degenerate ||
+                        (params_.speed_bound_learns_from_images && attempt.photometric);
+  if (attempt.report.accepted() && measured) {
     speed_bound_.learn(n, attempt.motion.translation().norm());
   }
 

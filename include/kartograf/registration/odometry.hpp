@@ -243,6 +243,11 @@ struct OdometryParams {
   // images took a checkered floor two tiles over, a step of 0.26 m where the robot, at 0.87 m a
   // frame, made 0.98 m). 0: off.
   double speed_change_margin = 2;
+  // The bound also learns from the steps of degenerate views the images measured (photometric):
+  // where a sparse sequence starts in a degenerate view (seed 8's survey every 10th frame: frames
+  // 1-3), the features' "standing still" on a floor repeating a step ahead otherwise wins at frame
+  // 4. False: from well-constrained frames only.
+  bool speed_bound_learns_from_images = true;
   // A degenerate view while the robot speeds up or slows down (the last step changed its length or
   // direction by more than feature_arbitration_m): the velocity model lags by that change, and a
   // floor or wall pattern can hold the images at its lag. ICP is also run from the step changed as

@@ -6,8 +6,9 @@
 // the floor less). A step whose speed lies farther from the last speed the geometry measured than
 // the drive could have changed it since is not one the robot made.
 //
-// SpeedBound learns, from the steps of frames whose geometry measured every direction, the largest
-// change of step length between two consecutive such frames (metres per frame per frame), and
+// SpeedBound learns, from the steps it is given (the odometry gives those of frames whose geometry
+// measured every direction and, by default, those the images measured), the largest change of
+// step length between two consecutive such frames (metres per frame per frame), and
 // admits a step whose length lies within `margin` times that change, per frame since the last
 // measured step, of that step's length. It admits every step until it has seen one change larger
 // than `least_change_m`: the bound must come from the drive speeding up or slowing down, not from
