@@ -567,6 +567,73 @@ TEST(SemanticGrid, ARoomsCornerHiddenBehindACabinetIsWall) {
   EXPECT_GT(grid.wall_corners_behind_furniture, 0);
 }
 
+// The north room's outer north wall seen only at its ends (x < 1 m and x > 3 m): the views never
+// looked along the 2 m between, nor at the 0.5 m of floor in front of it. The wall line runs on
+// between its two pieces, as thick as they are; without the rule (max_unseen_wall_gap 0) that
+// stretch stays unseen. Floor seen in the line (a doorway, x 1.8-2.2 m) leaves it open.
+LabelledPoints outer_wall_seen_at_its_ends(bool doorway) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.962, 0}, C::floor);      // south room
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);  // the wall between
+  s.box_face({0.012, 2.162, 0.02}, {4.012, 2.162, 1.4}, C::wall);
+  for (double x = 0.012; x <= 4.012; x += 0.02)
+    for (double y = 2.162; y <= 4.012; y += 0.02)
+      if (x < 1.0 || x > 3.0 || y < 3.5) s.add({x, y, 0}, C::floor);  // north room
+  s.box_face({0.012, 4.012, 0.02}, {0.992, 4.012, 1.4}, C::wall);
+  s.box_face({3.012, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);
+  if (doorway) s.box_face({1.812, 3.5, 0}, {2.192, 4.5, 0}, C::floor);
+  return s;
+}
+
+TEST(SemanticGrid, AWallLineRunsOnAcrossWhatNoViewSaw) {
+  using C = SemanticClass;
+  const LabelledPoints s = outer_wall_seen_at_its_ends(false);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double x : {1.2, 2.0, 2.8}) {
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.02), std::pair(C::wall, false)) << "x " << x;
+    EXPECT_EQ(class_at(grid, x, 4.012 + 0.12), std::pair(C::wall, false)) << "x " << x;
+  }
+  EXPECT_EQ(class_at(grid, 2.0, 3.8), std::pair(C::unknown, true));           // in front: unseen
+  EXPECT_EQ(class_at(grid, 2.0, 4.012 + 0.23), std::pair(C::unknown, true));  // beyond its back
+  EXPECT_GE(grid.wall_cells_across_unseen, 2 * 38);
+  SemanticGridParams off;
+  off.max_unseen_wall_gap = 0;
+  const SemanticGrid without = build_semantic_grid(s.points, s.labels, off);
+  EXPECT_EQ(class_at(without, 2.0, 4.012 + 0.02), std::pair(C::unknown, true));
+  EXPECT_EQ(without.wall_cells_across_unseen, 0);
+  SemanticGridParams short_gap;
+  short_gap.max_unseen_wall_gap = 1.5;  // less than the 2 m unseen
+  EXPECT_EQ(class_at(build_semantic_grid(s.points, s.labels, short_gap), 2.0, 4.012 + 0.02),
+            std::pair(C::unknown, true));
+
+  const LabelledPoints door = outer_wall_seen_at_its_ends(true);
+  const SemanticGrid open = build_semantic_grid(door.points, door.labels);
+  EXPECT_EQ(class_at(open, 2.0, 4.012 + 0.02).first, C::floor);
+  EXPECT_NE(class_at(open, 1.4, 4.012 + 0.02).first, C::wall);
+
+  SemanticGridParams bad;
+  bad.max_unseen_wall_gap = -1;
+  EXPECT_ERROR_MENTIONS(bad.validate(), "max_unseen_wall_gap");
+}
+
+// Against the outer north wall's back, two blocks of wall 0.3 m wide stand 2 m apart (what a view
+// saw of a building next door, say): the row between them runs along the back, a wall's outside,
+// not a line of its own, and stays unseen.
+TEST(SemanticGrid, NoWallLineRunsAlongAWallsOutside) {
+  using C = SemanticClass;
+  LabelledPoints s = two_rooms_with_a_wall_between();
+  for (const double x0 : {0.712, 3.012}) {
+    s.box_face({x0, 4.232, 0.02}, {x0 + 0.3, 4.232, 1.4}, C::wall);
+    s.box_face({x0, 4.232, 0.02}, {x0, 4.6, 1.4}, C::wall);
+    s.box_face({x0 + 0.3, 4.232, 0.02}, {x0 + 0.3, 4.6, 1.4}, C::wall);
+  }
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  EXPECT_EQ(class_at(grid, 2.0, 4.012 + 0.12), std::pair(C::wall, false));  // the back
+  EXPECT_EQ(class_at(grid, 0.85, 4.237).first, C::wall);                    // a block
+  EXPECT_EQ(class_at(grid, 2.0, 4.237), std::pair(C::unknown, true));
+}
+
 // With an outer east wall too, the block where the two outer walls meet, which no view sees, is
 // wall as thick as their backs; without the backs it stays unseen.
 TEST(SemanticGrid, TheHiddenCornerWhereTwoOuterWallsMeetIsWall) {

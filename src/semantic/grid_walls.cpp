@@ -5,6 +5,7 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
+#include <utility>
 #include <vector>
 
 #include "semantic/grid_cells.hpp"
@@ -251,6 +252,60 @@ int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyon
     furniture(c.x(), c.y()) = 0;
   }
   return from_furniture;
+}
+
+namespace {
+
+// Unseen, or an obstacle the views could not name: where a wall line may run on unseen.
+bool unseen_or_unnamed(const SemanticGrid& grid, const Eigen::Vector2i& c) {
+  return unobserved(grid, c) || unclassified_obstacle(grid, c);
+}
+
+// The gap's cells from `start` (a wall cell, not included) along `step` up to a wall cell, when
+// all are unseen or unnamed, at most `max_gap` of them, and at most half of them run beside a
+// wall (a line along a wall's side is its thickness or its outside, not a wall of its own).
+std::vector<Eigen::Vector2i> unseen_gap_to_wall(const SemanticGrid& grid,
+                                                const Eigen::Vector2i& start,
+                                                const Eigen::Vector2i& step, int max_gap) {
+  const Eigen::Vector2i across(step.y(), step.x());
+  std::vector<Eigen::Vector2i> gap;
+  int beside_wall = 0;
+  Eigen::Vector2i c = start + step;
+  for (; unseen_or_unnamed(grid, c); c += step) {
+    if (static_cast<int>(gap.size()) == max_gap) return {};
+    gap.push_back(c);
+    beside_wall += seen_as(grid, c + across, SemanticClass::wall) ||
+                   seen_as(grid, c - across, SemanticClass::wall);
+  }
+  if (!seen_as(grid, c, SemanticClass::wall) || 2 * beside_wall > static_cast<int>(gap.size()))
+    return {};
+  return gap;
+}
+
+}  // namespace
+
+int wall_lines_across_unseen(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
+                             float weight) {
+  std::vector<Eigen::Vector2i> bridged;
+  for (const Eigen::Vector2i& step : kFourNeighbours) {
+    for (int row = 0; row < grid.height(); ++row) {
+      for (int col = 0; col < grid.width(); ++col) {
+        const Eigen::Vector2i start(col, row);
+        if (!seen_as(grid, start, SemanticClass::wall) || !unseen_or_unnamed(grid, start + step) ||
+            wall_run(grid, start, -step, beyond_cells) < beyond_cells)
+          continue;
+        const std::vector<Eigen::Vector2i> gap =
+            unseen_gap_to_wall(grid, start, step, max_gap_cells);
+        bridged.insert(bridged.end(), gap.begin(), gap.end());
+      }
+    }
+  }
+  std::sort(bridged.begin(), bridged.end(), [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    return std::pair(a.y(), a.x()) < std::pair(b.y(), b.x());
+  });
+  bridged.erase(std::unique(bridged.begin(), bridged.end()), bridged.end());
+  set_class(grid, bridged, SemanticClass::wall, weight);
+  return static_cast<int>(bridged.size());
 }
 
 namespace {

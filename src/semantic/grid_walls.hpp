@@ -64,4 +64,12 @@ int wall_corners_behind_furniture(SemanticGrid& grid, int max_gap_cells, int bey
 int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
                                 float weight, Image<std::uint8_t>& furniture);
 
+// A wall line no view looked along: from a wall cell whose wall runs on for `beyond_cells` behind
+// it, along its row or column through at most `max_gap_cells` cells that no view saw or that hold
+// an obstacle the views could not name, to a wall cell (the line's far piece, or the wall it
+// meets at a corner), when at most half of those cells lie beside a wall cell across the line (a
+// wall's own thickness or outside). Those cells become wall (weight `weight`): walls run on
+// between their seen pieces, where a doorway would have shown floor. Returns the cells made wall.
+int wall_lines_across_unseen(SemanticGrid& grid, int max_gap_cells, int beyond_cells, float weight);
+
 }  // namespace kartograf::semantic::detail

@@ -1061,6 +1061,8 @@ void SemanticGridParams::validate() const {
               std::isfinite(max_floor_hole) && max_floor_hole >= 0,
           "SemanticGridParams: max_wall_thickness, max_floor_shadow and max_floor_hole must be "
           ">= 0");
+  require(std::isfinite(max_unseen_wall_gap) && max_unseen_wall_gap >= 0,
+          "SemanticGridParams: max_unseen_wall_gap must be >= 0");
   require(free_space_ray_stride >= 0, "SemanticGridParams: free_space_ray_stride must be >= 0");
   positive(free_space_slab, "free_space_slab");
   positive(furniture_join_gap, "furniture_join_gap");
@@ -1122,8 +1124,8 @@ int whole_cells(double metres, double resolution) {
 }
 
 // The walls seen from one side: their hidden backs and corners, then the wall lines and room
-// corners hidden behind furniture, then the backs of those lines' faces; `thickness` cells thick
-// (the two-sided walls'; 0: unknown, no backs).
+// corners hidden behind furniture, the wall lines across what no view saw, then the backs of those
+// lines' faces; `thickness` cells thick (the two-sided walls'; 0: unknown, no backs).
 void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& options, int thickness,
                               int max_wall, ObstacleMasks& masks) {
   const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
@@ -1138,6 +1140,11 @@ void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& opti
         detail::wall_lines_behind_furniture(grid, gap, max_wall + 1, wall, masks.furniture);
     grid.wall_corners_behind_furniture =
         detail::wall_corners_behind_furniture(grid, gap, max_wall + 1, wall);
+  }
+  if (options.back_one_sided_walls && max_wall > 0 && options.max_unseen_wall_gap > 0) {
+    grid.wall_cells_across_unseen =
+        detail::wall_lines_across_unseen(grid, cells(options.max_unseen_wall_gap), max_wall + 1,
+                                         options.weights.of(SemanticClass::wall));
   }
   // The lines' faces have their backs too, where the backs beside them were too short to bridge
   // (a cell no view saw, or a speck seen, ends a back's row).
@@ -1306,6 +1313,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.furniture_in_wall_lines = grid.furniture_in_wall_lines;
   d.wall_insides_behind_fronts = grid.wall_insides_behind_fronts;
   d.wall_corners_behind_furniture = grid.wall_corners_behind_furniture;
+  d.wall_cells_across_unseen = grid.wall_cells_across_unseen;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

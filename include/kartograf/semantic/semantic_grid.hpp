@@ -114,6 +114,11 @@ struct SemanticGridParams {
   // unseen block where two walls meet at a corner is wall: a wall is a solid, and its hidden back
   // is no more traversable than its face.
   bool back_one_sided_walls = true;
+  // With the backs: a wall line runs on between two of its seen pieces (or to the wall it meets at
+  // a corner) through up to this much of what no view saw or named [m]: a room's side the robot
+  // never looked along (behind the furniture it turned away from, beyond its views' reach), where a
+  // doorway would have shown floor. 0: off.
+  double max_unseen_wall_gap = 3.0;
   // The cell lattice is shifted (less than a cell) so that wall faces lie on cell boundaries where
   // the wall points agree on such a shift: a face inside a cell makes it half wall, half room.
   bool align_cells_to_walls = true;
@@ -204,8 +209,9 @@ struct SemanticGrid {
   // the cabinet fronts the views had taken for walls, the unseen pockets behind furniture faces
   // filled as furniture, the furniture specks inside walls or on their faces made wall, the
   // furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
-  // pockets made wall as the inside of a wall seen from its far side, and the cells of room
-  // corners hidden behind furniture made wall.
+  // pockets made wall as the inside of a wall seen from its far side, the cells of room
+  // corners hidden behind furniture made wall, and the cells of wall lines run on across what no
+  // view saw.
   std::optional<double> wall_thickness;  // m
   int furniture_fronts = 0;
   int furniture_pockets = 0;
@@ -213,6 +219,7 @@ struct SemanticGrid {
   int furniture_in_wall_lines = 0;
   int wall_insides_behind_fronts = 0;
   int wall_corners_behind_furniture = 0;
+  int wall_cells_across_unseen = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -272,6 +279,7 @@ struct MapDescription {
   int furniture_in_wall_lines = 0;
   int wall_insides_behind_fronts = 0;
   int wall_corners_behind_furniture = 0;
+  int wall_cells_across_unseen = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
