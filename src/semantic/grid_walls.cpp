@@ -5,7 +5,6 @@
 #include <cmath>
 #include <complex>
 #include <numbers>
-#include <utility>
 #include <vector>
 
 #include "semantic/grid_cells.hpp"
@@ -300,12 +299,14 @@ int wall_lines_across_unseen(SemanticGrid& grid, int max_gap_cells, int beyond_c
       }
     }
   }
-  std::sort(bridged.begin(), bridged.end(), [](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
-    return std::pair(a.y(), a.x()) < std::pair(b.y(), b.x());
-  });
-  bridged.erase(std::unique(bridged.begin(), bridged.end()), bridged.end());
-  set_class(grid, bridged, SemanticClass::wall, weight);
-  return static_cast<int>(bridged.size());
+  int made_wall = 0;
+  for (const Eigen::Vector2i& c : bridged) {
+    if (seen_as(grid, c, SemanticClass::wall)) continue;  // bridged from both ends
+    grid.classes(c.x(), c.y()) = SemanticClass::wall;
+    grid.weight(c.x(), c.y()) = weight;
+    ++made_wall;
+  }
+  return made_wall;
 }
 
 namespace {
