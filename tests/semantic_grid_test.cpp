@@ -701,6 +701,58 @@ TEST(SemanticGrid, AFrontsPocketStopsAtTheInsideOfAWallSeenFromBeyond) {
   EXPECT_GE(grid.wall_insides_behind_fronts, 2 * 15);
 }
 
+// A cabinet 1 m wide and 0.6 m deep against the outer north wall, taller than the views look over:
+// its front and east side taken for walls, the wall behind it never seen; the wall's line is seen
+// beyond the cabinet's ends only (not at all with kNoLine), the floor before it too. No pocket is
+// closed by walls (its west side and back were never seen), so the front rules leave it; the room
+// running on behind the front's plane to the wall's line makes it a cabinet against that wall.
+// kLongerWall: no cabinet but a wall whose stretch west of x 1 m has a closet behind it (seen
+// from both sides) and which steps back 0.6 m east of x 2 m, the space behind it outside: the
+// "front" runs on west as the wall it is.
+enum class BehindTheFront { kCabinet, kNoLine, kLongerWall };
+
+LabelledPoints front_before_a_hidden_wall(BehindTheFront variant) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  s.box_face({0.012, 0.012, 0}, {4.012, 1.952, 0}, C::floor);      // south room
+  s.box_face({0.012, 2.122, 0}, {4.012, 3.402, 0}, C::floor);      // north room, before the front
+  s.box_face({0.012, 3.422, 0}, {1.002, 4.002, 0}, C::floor);      // west of the front
+  s.box_face({2.022, 3.422, 0}, {4.012, 4.002, 0}, C::floor);      // east of it
+  s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);  // the wall between
+  s.box_face({0.012, 2.112, 0.02}, {4.012, 2.112, 1.4}, C::wall);
+  s.box_face({1.012, 3.412, 0.02}, {2.012, 3.412, 1.2}, C::wall);  // the front
+  s.box_face({2.012, 3.412, 0.02}, {2.012, 4.002, 1.2}, C::wall);  // and east side
+  if (variant == BehindTheFront::kNoLine) return s;
+  s.box_face({2.112, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the north wall, east
+  if (variant == BehindTheFront::kCabinet)
+    s.box_face({0.012, 4.012, 0.02}, {0.912, 4.012, 1.4}, C::wall);  // the north wall, west
+  else
+    s.box_face({0.012, 3.412, 0.02}, {1.012, 3.412, 1.4}, C::wall);  // the closet's wall
+  return s;
+}
+
+TEST(SemanticGrid, ACabinetStandsAgainstTheWallLineSeenBeyondItsEnds) {
+  using C = SemanticClass;
+  const LabelledPoints s = front_before_a_hidden_wall(BehindTheFront::kCabinet);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double x : {1.2, 1.5, 1.8}) {
+    EXPECT_EQ(class_at(grid, x, 3.42).first, C::furniture) << "the front at x " << x;
+    EXPECT_EQ(class_at(grid, x, 3.7).first, C::furniture) << "behind it at x " << x;
+    EXPECT_EQ(class_at(grid, x, 4.02), std::pair(C::wall, false)) << "the wall at x " << x;
+  }
+  EXPECT_EQ(class_at(grid, 0.5, 3.7).first, C::floor);
+  EXPECT_GE(grid.furniture_fronts, 1);
+
+  for (const auto variant : {BehindTheFront::kNoLine, BehindTheFront::kLongerWall}) {
+    const LabelledPoints other = front_before_a_hidden_wall(variant);
+    const SemanticGrid alone = build_semantic_grid(other.points, other.labels);
+    const int name = static_cast<int>(variant);
+    EXPECT_EQ(class_at(alone, 1.5, 3.42).first, C::wall) << name;
+    EXPECT_EQ(class_at(alone, 1.5, 3.7), std::pair(C::unknown, true)) << name;
+    EXPECT_EQ(alone.furniture_fronts, 0) << name;
+  }
+}
+
 // Rows of wall one cell thick with floor on both sides (a face's spill, a face seen twice), more of
 // them than runs across the real wall: they measure no wall's thickness, and the outer wall's
 // hidden back is still as thick as the wall seen from both sides. The median of every run gave

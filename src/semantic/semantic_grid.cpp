@@ -17,6 +17,7 @@
 #include "kartograf/core/connected_components.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
+#include "semantic/grid_cabinets.hpp"
 #include "semantic/grid_cells.hpp"
 #include "semantic/grid_doorways.hpp"
 #include "semantic/grid_free_space.hpp"
@@ -1193,7 +1194,14 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
     const detail::FrontsFound joined = detail::joined_fronts_against_walls(
         grid, options.furniture_max_extent, options.max_furniture_fill_area, inside,
         cells(options.furniture_max_depth), options.weights, masks.furniture);
-    grid.furniture_fronts = apart.fronts + joined.fronts;
+    // After the other front rules, whose pockets are closed (a cabinet's pocket here is open
+    // at the back, which it closes with the wall line).
+    const int cabinets = detail::cabinets_before_hidden_walls(
+        grid,
+        {cells(options.furniture_max_extent), min_pocket, cells(options.furniture_max_depth),
+         options.max_furniture_fill_area},
+        options.weights, masks.furniture);
+    grid.furniture_fronts = apart.fronts + joined.fronts + cabinets;
     grid.wall_insides_behind_fronts = apart.wall_inside_cells + joined.wall_inside_cells;
     // Last: the fronts above are among the faces whose hidden backs it fills.
     grid.furniture_pockets = detail::pockets_behind_furniture(
