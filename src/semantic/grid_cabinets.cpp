@@ -1,6 +1,7 @@
 #include "semantic/grid_cabinets.hpp"
 
 #include <algorithm>
+#include <array>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -85,6 +86,13 @@ std::vector<Front> fronts_of(const SemanticGrid& grid, const Frame& f) {
   return fronts;
 }
 
+// A front's two ends, each with the step that leads on beyond it along the front.
+std::array<std::pair<Eigen::Vector2i, Eigen::Vector2i>, 2> ends_of(const Front& front,
+                                                                   const Frame& f) {
+  return {std::pair{front.front(), Eigen::Vector2i(-f.along)},
+          std::pair{front.back(), Eigen::Vector2i(f.along)}};
+}
+
 // Whether the front's faces lie within kMaxFrontThickness cells across: a cabinet's front is
 // straight, a line of faces stepping across the grid is not one.
 bool straight(const Front& front, const Frame& f) {
@@ -98,8 +106,7 @@ bool straight(const Front& front, const Frame& f) {
 // (where a cabinet's side, and its front's last rows that the fills took, end): then it is a
 // stretch of a longer wall, such as a building's wall at a notch, not a cabinet's front.
 bool part_of_a_longer_wall(const SemanticGrid& grid, const Front& front, const Frame& f) {
-  for (const auto& [end, step] : {std::pair{front.front(), Eigen::Vector2i(-f.along)},
-                                  std::pair{front.back(), Eigen::Vector2i(f.along)}}) {
+  for (const auto& [end, step] : ends_of(front, f)) {
     int run = 0;
     for (Eigen::Vector2i c = end + step; run <= kRowsBeyondEnd; c += step, ++run) {
       if (!wall_at(grid, c) && !wall_at(grid, c - f.into) && !wall_at(grid, c + f.into)) break;
@@ -121,8 +128,7 @@ std::optional<int> line_behind(const SemanticGrid& grid, const Front& front, con
   std::nth_element(depths.begin(), depths.begin() + depths.size() / 2, depths.end());
   const int face = depths[depths.size() / 2];
   std::vector<int> rows_at(static_cast<std::size_t>(max_depth + 1), 0);
-  for (const auto& [end, step] : {std::pair{front.front(), Eigen::Vector2i(-f.along)},
-                                  std::pair{front.back(), Eigen::Vector2i(f.along)}}) {
+  for (const auto& [end, step] : ends_of(front, f)) {
     const Eigen::Vector2i base = end + (face - f.depth(end)) * f.into;
     for (int k = 1; k <= kRowsBeyondEnd; ++k) {
       for (int d = min_depth + 1; d <= max_depth; ++d) {
@@ -161,13 +167,6 @@ CabinetRow cabinet_row(const SemanticGrid& grid, const Eigen::Vector2i& face, co
   if (!unobserved(grid, c) && !wall_at(grid, c)) return {};
   row.line = c;
   return row;
-}
-
-bool beside_door(const SemanticGrid& grid, const std::vector<Eigen::Vector2i>& cells) {
-  for (const Eigen::Vector2i& c : cells)
-    for (const Eigen::Vector2i& d : kFourNeighbours)
-      if (seen_as(grid, c + d, SemanticClass::door)) return true;
-  return false;
 }
 
 }  // namespace

@@ -34,6 +34,18 @@ inline int wall_run(const SemanticGrid& grid, Eigen::Vector2i cell, const Eigen:
   return run;
 }
 
+// Whether a door cell is a 4-neighbour of any of the cells: beside a door, an unseen pocket is a
+// wall's inside behind its leaf, not what furniture hid.
+inline bool beside_door(const SemanticGrid& grid, std::span<const Eigen::Vector2i> cells) {
+  for (const Eigen::Vector2i& c : cells) {
+    for (const Eigen::Vector2i& d : kFourNeighbours) {
+      const Eigen::Vector2i n = c + d;
+      if (grid.contains(n) && grid.classes(n.x(), n.y()) == SemanticClass::door) return true;
+    }
+  }
+  return false;
+}
+
 // An obstacle the views could not name (weight 0, class unknown), as opposed to an unseen cell.
 inline bool unclassified_obstacle(const SemanticGrid& grid, const Eigen::Vector2i& c) {
   return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::unknown &&

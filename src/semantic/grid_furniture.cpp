@@ -102,14 +102,11 @@ std::set<int> walls_around(const SemanticGrid& grid, const cv::Mat& wall_labels,
   return walls;
 }
 
-// Whether a door cell touches the cells: beside a door, an unseen pocket is a wall's inside behind
-// its leaf, not what furniture hid.
 bool beside_door(const SemanticGrid& grid, const std::vector<cv::Point>& cells) {
-  bool door = false;
-  for_each_neighbour(grid, cells, [&](const cv::Point& n) {
-    door |= grid.classes(n.x, n.y) == SemanticClass::door;
-  });
-  return door;
+  std::vector<Eigen::Vector2i> at;
+  at.reserve(cells.size());
+  for (const cv::Point& c : cells) at.emplace_back(c.x, c.y);
+  return detail::beside_door(grid, at);
 }
 
 // Whether a seen floor cell lies within `cells` steps of `out` beyond c.
