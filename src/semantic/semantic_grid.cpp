@@ -23,6 +23,7 @@
 #include "semantic/grid_free_space.hpp"
 #include "semantic/grid_furniture.hpp"
 #include "semantic/grid_phantoms.hpp"
+#include "semantic/grid_tables.hpp"
 #include "semantic/grid_wall_faces.hpp"
 #include "semantic/grid_walls.hpp"
 
@@ -514,6 +515,61 @@ void fill_furniture(SemanticGrid& grid, const Image<CellEvidence>& evidence,
     // mixed pixels, those no piece took.
     cv::bitwise_and(left, pass.solid_only ? cv::Mat(~closed | too_large) : too_large, left);
   }
+}
+
+// A table's leg: a post of furniture or unnamed obstacle cells whose points are solid (not a depth
+// edge's mixed pixels), start within kLegFoot of the band's bottom and reach kMinLegHeight or
+// higher, but no higher than furniture; at most kMaxLegCells across, with no wall beside it.
+constexpr double kLegFoot = 0.1, kMinLegHeight = 0.3;
+constexpr int kMaxLegCells = 3;
+
+bool leg_cell(const SemanticGrid& grid, const CellEvidence& e, const Eigen::Vector2i& c,
+              const SemanticGridParams& options) {
+  const bool obstacle = grid.classes(c.x(), c.y()) == SemanticClass::furniture ||
+                        detail::unclassified_obstacle(grid, c);
+  const double bottom = e.z_min - grid.floor_z, top = e.z_max - grid.floor_z;
+  return obstacle && e.band_views > 0 && !mixed_pixels_only(e) &&
+         bottom <= options.band_min + kLegFoot && top >= kMinLegHeight &&
+         top <= options.furniture_max_height;
+}
+
+std::vector<detail::TableLeg> table_legs(const SemanticGrid& grid,
+                                         const Image<CellEvidence>& evidence,
+                                         const SemanticGridParams& options) {
+  Image<std::uint8_t> mask(grid.width(), grid.height(), 0);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      mask(col, row) = leg_cell(grid, evidence(col, row), {col, row}, options);
+  std::vector<detail::TableLeg> legs;
+  for (std::vector<Eigen::Vector2i>& cells : components(mask)) {
+    Eigen::Vector2i lo = cells.front(), hi = cells.front();
+    bool beside_wall = false;
+    detail::TableLeg leg;
+    for (const Eigen::Vector2i& c : cells) {
+      lo = lo.cwiseMin(c), hi = hi.cwiseMax(c);
+      leg.top = std::max(leg.top, double{evidence(c.x(), c.y()).z_max} - grid.floor_z);
+      for (int dy = -1; dy <= 1; ++dy)
+        for (int dx = -1; dx <= 1; ++dx)
+          beside_wall |= detail::seen_as(grid, c + Eigen::Vector2i(dx, dy), SemanticClass::wall);
+    }
+    if (beside_wall || (hi - lo).maxCoeff() >= kMaxLegCells) continue;
+    leg.cells = std::move(cells);
+    legs.push_back(std::move(leg));
+  }
+  return legs;
+}
+
+// Tables seen by their legs (grid_tables.hpp), after the fill: the legs of a table longer than
+// the join gap stand apart, and its edges join only where the views saw them. Returns how many.
+int tables_on_legs(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                   const detail::BandFreeSpace& free_space, const SemanticGridParams& options,
+                   Image<std::uint8_t>& furniture) {
+  constexpr double kMinLegSpacing = 0.3;  // m: a table's legs stand farther apart
+  const double res = grid.resolution;
+  const detail::LegLimits limits{kMinLegSpacing / res, options.furniture_max_extent / res,
+                                 options.max_furniture_fill_area / (res * res)};
+  return detail::fill_tables_on_legs(grid, table_legs(grid, evidence, options), limits, free_space,
+                                     options.weights.of(SemanticClass::furniture), furniture);
 }
 
 // The pieces of `mask` closed with a size x size square (8-connected): each piece's cells of the
@@ -1289,6 +1345,8 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
     fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture,
                    options.furniture_join_gap, options.max_furniture_fill_area,
                    options.weights.of(SemanticClass::furniture));
+    if (free_space)
+      grid.tables_on_legs = tables_on_legs(grid, evidence, *free_space, options, masks.furniture);
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
@@ -1322,6 +1380,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.wall_insides_behind_fronts = grid.wall_insides_behind_fronts;
   d.wall_corners_behind_furniture = grid.wall_corners_behind_furniture;
   d.wall_cells_across_unseen = grid.wall_cells_across_unseen;
+  d.tables_on_legs = grid.tables_on_legs;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

@@ -210,8 +210,8 @@ struct SemanticGrid {
   // filled as furniture, the furniture specks inside walls or on their faces made wall, the
   // furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
   // pockets made wall as the inside of a wall seen from its far side, the cells of room
-  // corners hidden behind furniture made wall, and the cells of wall lines run on across what no
-  // view saw.
+  // corners hidden behind furniture made wall, the cells of wall lines run on across what no
+  // view saw, and the tables found by their legs.
   std::optional<double> wall_thickness;  // m
   int furniture_fronts = 0;
   int furniture_pockets = 0;
@@ -220,6 +220,7 @@ struct SemanticGrid {
   int wall_insides_behind_fronts = 0;
   int wall_corners_behind_furniture = 0;
   int wall_cells_across_unseen = 0;
+  int tables_on_legs = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -280,6 +281,7 @@ struct MapDescription {
   int wall_insides_behind_fronts = 0;
   int wall_corners_behind_furniture = 0;
   int wall_cells_across_unseen = 0;
+  int tables_on_legs = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
