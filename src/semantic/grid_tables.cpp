@@ -188,10 +188,10 @@ std::vector<LegTable> tables_on_legs(std::span<const TableLeg> legs, const LegLi
   return tables;
 }
 
-int fill_tables_on_legs(SemanticGrid& grid, std::span<const TableLeg> legs, const LegLimits& limits,
-                        const BandFreeSpace& free_space, float weight,
-                        Image<std::uint8_t>& furniture) {
-  int tables = 0;
+std::vector<LegTable> fill_tables_on_legs(SemanticGrid& grid, std::span<const TableLeg> legs,
+                                          const LegLimits& limits, const BandFreeSpace& free_space,
+                                          float weight, Image<std::uint8_t>& furniture) {
+  std::vector<LegTable> tables;
   for (const LegTable& table : tables_on_legs(legs, limits)) {
     std::vector<double> tops;
     for (const int k : table.legs) tops.push_back(legs[k].top);
@@ -206,9 +206,56 @@ int fill_tables_on_legs(SemanticGrid& grid, std::span<const TableLeg> legs, cons
       grid.weight(c.x(), c.y()) = weight;
       furniture(c.x(), c.y()) = 1;
     }
-    ++tables;
+    tables.push_back(table);
   }
   return tables;
+}
+
+int trim_fills_around_tables(SemanticGrid& grid, std::span<const LegTable> tables,
+                             const Image<std::uint8_t>& marked, float floor_weight,
+                             Image<std::uint8_t>& furniture) {
+  constexpr double kTopMargin = 1;  // cells: a top overhangs its legs
+  constexpr int kWallReach = 3;     // cells: a wall's face with floor this near is a front
+  constexpr std::size_t kAllLegs = 4;
+  std::vector<Frame> frames;
+  for (const LegTable& table : tables)
+    if (table.legs.size() == kAllLegs) frames.emplace_back(table.top);
+  const auto near_a_table = [&](const Eigen::Vector2i& c) {
+    return std::any_of(frames.begin(), frames.end(),
+                       [&](const Frame& f) { return f.outside(c.cast<double>()) <= kTopMargin; });
+  };
+  const auto near_a_wall = [&](const Eigen::Vector2i& c) {
+    for (int dy = -kWallReach; dy <= kWallReach; ++dy)
+      for (int dx = -kWallReach; dx <= kWallReach; ++dx)
+        if (seen_as(grid, c + Eigen::Vector2i(dx, dy), SemanticClass::wall)) return true;
+    return false;
+  };
+  Image<std::uint8_t> seen(grid.width(), grid.height(), 0);
+  std::vector<Eigen::Vector2i> stack, trimmed;
+  for (const LegTable& table : tables) {
+    if (table.legs.size() != kAllLegs) continue;
+    for (const Eigen::Vector2i& c : cells_under(table.top))
+      if (grid.contains(c) && furniture(c.x(), c.y()) && !seen(c.x(), c.y()))
+        seen(c.x(), c.y()) = 1, stack.push_back(c);
+  }
+  while (!stack.empty()) {
+    const Eigen::Vector2i c = stack.back();
+    stack.pop_back();
+    if (!marked(c.x(), c.y()) && !near_a_table(c) && !near_a_wall(c)) trimmed.push_back(c);
+    for (int dy = -1; dy <= 1; ++dy) {
+      for (int dx = -1; dx <= 1; ++dx) {
+        const Eigen::Vector2i n = c + Eigen::Vector2i(dx, dy);
+        if (grid.contains(n) && furniture(n.x(), n.y()) && !seen(n.x(), n.y()))
+          seen(n.x(), n.y()) = 1, stack.push_back(n);
+      }
+    }
+  }
+  for (const Eigen::Vector2i& c : trimmed) {
+    grid.classes(c.x(), c.y()) = SemanticClass::floor;
+    grid.weight(c.x(), c.y()) = floor_weight;
+    furniture(c.x(), c.y()) = 0;
+  }
+  return static_cast<int>(trimmed.size());
 }
 
 }  // namespace kartograf::semantic::detail

@@ -46,9 +46,20 @@ std::vector<LegTable> tables_on_legs(std::span<const TableLeg> legs, const LegLi
 
 // Fills the floor under each table of tables_on_legs whose top the rays did not pass through
 // (under_solid_top, at the heights around its legs' median top), `furniture` marking the cells;
-// walls, doors and what no view saw keep their class. Returns the tables.
-int fill_tables_on_legs(SemanticGrid& grid, std::span<const TableLeg> legs, const LegLimits& limits,
-                        const BandFreeSpace& free_space, float weight,
-                        Image<std::uint8_t>& furniture);
+// walls, doors and what no view saw keep their class. Returns the tables filled.
+std::vector<LegTable> fill_tables_on_legs(SemanticGrid& grid, std::span<const TableLeg> legs,
+                                          const LegLimits& limits, const BandFreeSpace& free_space,
+                                          float weight, Image<std::uint8_t>& furniture);
+
+// The floor a fill joined to a table found by all four legs (its top is where they stand): in
+// each piece of furniture cells (8-neighbours) that holds such a table, the cells not `marked`
+// (no obstacle seen there: what the fill made furniture) more than a cell outside every table's
+// top and more than 3 cells from a wall are floor again. The fill had joined the table's outline
+// to lines of a depth edge's points along the views' rays, and its hull covered the floor between
+// them; near a wall the fill is left (floor before a wall's face makes it a cabinet's front for
+// the rules after). Returns how many cells.
+int trim_fills_around_tables(SemanticGrid& grid, std::span<const LegTable> tables,
+                             const Image<std::uint8_t>& marked, float floor_weight,
+                             Image<std::uint8_t>& furniture);
 
 }  // namespace kartograf::semantic::detail
