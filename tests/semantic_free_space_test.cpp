@@ -373,6 +373,7 @@ TEST(SemanticGridFreeSpace, ATableSeenOnlyByItsLegsIsFurniture) {
   EXPECT_EQ(class_at(grid, 2.5, 1.3), C::floor);  // 0.25 m beside it
   EXPECT_EQ(class_at(grid, 1.4, 2.0), C::floor);
   EXPECT_EQ(grid.tables_on_legs, 1);
+  EXPECT_EQ(grid.fill_cells_trimmed_at_tables, 0);  // no fill joined to it
 }
 
 // The same four posts with no top: the rays crossed the floor between them at the posts' height

@@ -107,16 +107,21 @@ TEST(TablesOnLegs, AFillJoinedToATableIsFloorAgainBeyondItsTop) {
   SemanticGrid untrimmed = grid;
   Image<std::uint8_t> untouched = furniture;
   EXPECT_EQ(trim_fills_around_tables(untrimmed, {{on_three_legs}}, marked, 1.0f, untouched), 0);
-  const int trimmed = trim_fills_around_tables(grid, {{table}}, marked, 1.0f, furniture);
+  // A table on three legs at the fill's far end: its top keeps the fill under and beside it.
+  LegTable further = on_three_legs;
+  for (Eigen::Vector2d& corner : further.top) corner.x() += 22;  // x 32-42, y 10-18
+  const std::vector<LegTable> tables = {table, further};
+  const int trimmed = trim_fills_around_tables(grid, tables, marked, 1.0f, furniture);
   EXPECT_EQ(grid.classes(15, 14), C::furniture);  // the table
   EXPECT_EQ(grid.classes(21, 14), C::furniture);  // a cell beyond its top: its overhang
-  EXPECT_EQ(grid.classes(30, 14), C::floor);      // the fill beyond it
-  EXPECT_EQ(furniture(30, 14), 0);
+  EXPECT_EQ(grid.classes(28, 14), C::floor);      // the fill beyond it
+  EXPECT_EQ(furniture(28, 14), 0);
+  EXPECT_EQ(grid.classes(31, 14), C::furniture);  // a cell beside the second table's top
   EXPECT_EQ(grid.classes(41, 14), C::furniture);  // what the views saw stays
   EXPECT_EQ(grid.classes(27, 25), C::floor);
   EXPECT_EQ(grid.classes(27, 37), C::furniture);  // within 3 cells of the wall: a front's floor
   EXPECT_EQ(grid.classes(52, 4), C::furniture);   // not joined to the table
-  EXPECT_EQ(trimmed, 19 * 5 + 6 * 19);            // 22-40 x 12-16 and 25-30 x 17-35
+  EXPECT_EQ(trimmed, 9 * 5 + 6 * 19);             // 22-30 x 12-16 and 25-30 x 17-35
 }
 
 }  // namespace

@@ -75,7 +75,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
                       {"wall_insides_behind_fronts", d.wall_insides_behind_fronts},
                       {"wall_corners_behind_furniture", d.wall_corners_behind_furniture},
                       {"wall_cells_across_unseen", d.wall_cells_across_unseen},
-                      {"tables_on_legs", d.tables_on_legs}};
+                      {"tables_on_legs", d.tables_on_legs},
+                      {"fill_cells_trimmed_at_tables", d.fill_cells_trimmed_at_tables}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

@@ -217,9 +217,8 @@ int trim_fills_around_tables(SemanticGrid& grid, std::span<const LegTable> table
   constexpr double kTopMargin = 1;  // cells: a top overhangs its legs
   constexpr int kWallReach = 3;     // cells: a wall's face with floor this near is a front
   constexpr std::size_t kAllLegs = 4;
-  std::vector<Frame> frames;
-  for (const LegTable& table : tables)
-    if (table.legs.size() == kAllLegs) frames.emplace_back(table.top);
+  std::vector<Frame> frames;  // every table's top, where the fill stays
+  for (const LegTable& table : tables) frames.emplace_back(table.top);
   const auto near_a_table = [&](const Eigen::Vector2i& c) {
     return std::any_of(frames.begin(), frames.end(),
                        [&](const Frame& f) { return f.outside(c.cast<double>()) <= kTopMargin; });

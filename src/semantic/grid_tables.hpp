@@ -54,10 +54,10 @@ std::vector<LegTable> fill_tables_on_legs(SemanticGrid& grid, std::span<const Ta
 // The floor a fill joined to a table found by all four legs (its top is where they stand): in
 // each piece of furniture cells (8-neighbours) that holds such a table, the cells not `marked`
 // (no obstacle seen there: what the fill made furniture) more than a cell outside every table's
-// top and more than 3 cells from a wall are floor again. The fill had joined the table's outline
-// to lines of a depth edge's points along the views' rays, and its hull covered the floor between
-// them; near a wall the fill is left (floor before a wall's face makes it a cabinet's front for
-// the rules after). Returns how many cells.
+// top (on three legs too) and more than 3 cells from a wall are floor again. The fill had joined
+// the table's outline to lines of a depth edge's points along the views' rays, and its hull covered
+// the floor between them; near a wall the fill is left (floor before a wall's face makes it a
+// cabinet's front for the rules after). Returns how many cells.
 int trim_fills_around_tables(SemanticGrid& grid, std::span<const LegTable> tables,
                              const Image<std::uint8_t>& marked, float floor_weight,
                              Image<std::uint8_t>& furniture);

@@ -562,10 +562,10 @@ std::vector<detail::TableLeg> table_legs(const SemanticGrid& grid,
 // Tables seen by their legs (grid_tables.hpp), after the fill: the legs of a table longer than
 // the join gap stand apart, and its edges join only where the views saw them. The fill's cells
 // joined to such a table beyond its top are floor again; `marked` holds the furniture cells the
-// views saw, before the fill. Returns the tables.
-int tables_on_legs(SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                   const detail::BandFreeSpace& free_space, const SemanticGridParams& options,
-                   const Image<std::uint8_t>& marked, Image<std::uint8_t>& furniture) {
+// views saw, before the fill. Both are counted in the grid.
+void tables_on_legs(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                    const detail::BandFreeSpace& free_space, const SemanticGridParams& options,
+                    const Image<std::uint8_t>& marked, Image<std::uint8_t>& furniture) {
   constexpr double kMinLegSpacing = 0.3;  // m: a table's legs stand farther apart
   const double res = grid.resolution;
   const detail::LegLimits limits{kMinLegSpacing / res, options.furniture_max_extent / res,
@@ -573,9 +573,9 @@ int tables_on_legs(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   const std::vector<detail::LegTable> tables =
       detail::fill_tables_on_legs(grid, table_legs(grid, evidence, options), limits, free_space,
                                   options.weights.of(SemanticClass::furniture), furniture);
-  detail::trim_fills_around_tables(grid, tables, marked, options.weights.of(SemanticClass::floor),
-                                   furniture);
-  return static_cast<int>(tables.size());
+  grid.tables_on_legs = static_cast<int>(tables.size());
+  grid.fill_cells_trimmed_at_tables = detail::trim_fills_around_tables(
+      grid, tables, marked, options.weights.of(SemanticClass::floor), furniture);
 }
 
 // The pieces of `mask` closed with a size x size square (8-connected): each piece's cells of the
@@ -1352,10 +1352,7 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
     fill_furniture(grid, evidence, free_space ? &*free_space : nullptr, masks.furniture,
                    options.furniture_join_gap, options.max_furniture_fill_area,
                    options.weights.of(SemanticClass::furniture));
-    if (free_space) {
-      grid.tables_on_legs =
-          tables_on_legs(grid, evidence, *free_space, options, marked, masks.furniture);
-    }
+    if (free_space) tables_on_legs(grid, evidence, *free_space, options, marked, masks.furniture);
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
@@ -1390,6 +1387,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.wall_corners_behind_furniture = grid.wall_corners_behind_furniture;
   d.wall_cells_across_unseen = grid.wall_cells_across_unseen;
   d.tables_on_legs = grid.tables_on_legs;
+  d.fill_cells_trimmed_at_tables = grid.fill_cells_trimmed_at_tables;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);
