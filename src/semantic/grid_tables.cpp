@@ -103,6 +103,21 @@ std::optional<Candidate> candidate(std::span<const TableLeg> legs,
   return found;
 }
 
+// Calls visit(cell, how far the cell lies outside `top` [cells]) for every cell of the top's
+// bounding box grown by `reach` cells.
+template <typename Visit>
+void cells_around(const TableTop& top, double reach, Visit&& visit) {
+  const Frame frame(top);
+  Eigen::Vector2d lo = top[0], hi = top[0];
+  for (const Eigen::Vector2d& corner : top) lo = lo.cwiseMin(corner), hi = hi.cwiseMax(corner);
+  for (int y = static_cast<int>(std::floor(lo.y() - reach));
+       y <= static_cast<int>(std::ceil(hi.y() + reach)); ++y) {
+    for (int x = static_cast<int>(std::floor(lo.x() - reach));
+         x <= static_cast<int>(std::ceil(hi.x() + reach)); ++x)
+      visit(Eigen::Vector2i(x, y), frame.outside(Eigen::Vector2d(x, y)));
+  }
+}
+
 // Whether rays passed over `top` as over a solid top: at some observable height from `low` to
 // `high` above the floor, at least kMinBlockedShare of its inner cells (kInnerMargin in from its
 // edges) were crossed at most kSolidTopShare as often as the cells around it (kRingFrom-kRingTo
@@ -110,19 +125,11 @@ std::optional<Candidate> candidate(std::span<const TableLeg> legs,
 // two tables is crossed like the floor around it.
 bool under_solid_top(const BandFreeSpace& free_space, const TableTop& top, double low,
                      double high) {
-  const Frame frame(top);
   std::vector<Eigen::Vector2i> inner, ring;
-  Eigen::Vector2d lo = top[0], hi = top[0];
-  for (const Eigen::Vector2d& corner : top) lo = lo.cwiseMin(corner), hi = hi.cwiseMax(corner);
-  for (int y = static_cast<int>(std::floor(lo.y() - kRingTo));
-       y <= static_cast<int>(std::ceil(hi.y() + kRingTo)); ++y) {
-    for (int x = static_cast<int>(std::floor(lo.x() - kRingTo));
-         x <= static_cast<int>(std::ceil(hi.x() + kRingTo)); ++x) {
-      const double out = frame.outside(Eigen::Vector2d(x, y));
-      if (out <= -kInnerMargin) inner.emplace_back(x, y);
-      if (out >= kRingFrom && out <= kRingTo) ring.emplace_back(x, y);
-    }
-  }
+  cells_around(top, kRingTo, [&](const Eigen::Vector2i& c, double out) {
+    if (out <= -kInnerMargin) inner.push_back(c);
+    if (out >= kRingFrom && out <= kRingTo) ring.push_back(c);
+  });
   if (inner.empty() || ring.empty()) return false;
   for (double height = low; height <= high; height += kSlabStep) {
     if (!free_space.observable(height)) continue;
@@ -138,14 +145,10 @@ bool under_solid_top(const BandFreeSpace& free_space, const TableTop& top, doubl
 }
 
 std::vector<Eigen::Vector2i> cells_under(const TableTop& top) {
-  const Frame frame(top);
-  Eigen::Vector2d lo = top[0], hi = top[0];
-  for (const Eigen::Vector2d& corner : top) lo = lo.cwiseMin(corner), hi = hi.cwiseMax(corner);
   std::vector<Eigen::Vector2i> cells;
-  for (int y = static_cast<int>(std::floor(lo.y())); y <= static_cast<int>(std::ceil(hi.y())); ++y)
-    for (int x = static_cast<int>(std::floor(lo.x())); x <= static_cast<int>(std::ceil(hi.x()));
-         ++x)
-      if (frame.outside(Eigen::Vector2d(x, y)) <= 1e-6) cells.emplace_back(x, y);
+  cells_around(top, 0, [&](const Eigen::Vector2i& c, double out) {
+    if (out <= 1e-6) cells.push_back(c);
+  });
   return cells;
 }
 
@@ -200,12 +203,11 @@ std::vector<LegTable> fill_tables_on_legs(SemanticGrid& grid, std::span<const Ta
     const bool solid =
         under_solid_top(free_space, table.top, middle - kBelowLegTops, middle + kAboveLegTops);
     if (!solid) continue;
-    for (const Eigen::Vector2i& c : cells_under(table.top)) {
-      if (!seen_as(grid, c, SemanticClass::floor)) continue;
-      grid.classes(c.x(), c.y()) = SemanticClass::furniture;
-      grid.weight(c.x(), c.y()) = weight;
-      furniture(c.x(), c.y()) = 1;
-    }
+    std::vector<Eigen::Vector2i> filled = cells_under(table.top);
+    std::erase_if(
+        filled, [&](const Eigen::Vector2i& c) { return !seen_as(grid, c, SemanticClass::floor); });
+    set_class(grid, filled, SemanticClass::furniture, weight);
+    for (const Eigen::Vector2i& c : filled) furniture(c.x(), c.y()) = 1;
     tables.push_back(table);
   }
   return tables;
@@ -249,11 +251,8 @@ int trim_fills_around_tables(SemanticGrid& grid, std::span<const LegTable> table
       }
     }
   }
-  for (const Eigen::Vector2i& c : trimmed) {
-    grid.classes(c.x(), c.y()) = SemanticClass::floor;
-    grid.weight(c.x(), c.y()) = floor_weight;
-    furniture(c.x(), c.y()) = 0;
-  }
+  set_class(grid, trimmed, SemanticClass::floor, floor_weight);
+  for (const Eigen::Vector2i& c : trimmed) furniture(c.x(), c.y()) = 0;
   return static_cast<int>(trimmed.size());
 }
 
