@@ -444,6 +444,25 @@ TEST(SemanticGridFreeSpace, MixedPixelsDoNotJoinATableToItsNeighbours) {
   EXPECT_EQ(class_at(grid, 1.5, 2.0), C::floor);  // beside the table
 }
 
+// A post 3 cm across inside one cell (a chair's leg), solid from the floor up in three views, has
+// no obstacle beside it and stays one: a robot must not drive into it. A speck of points 0.4-0.5 m
+// up, standing on nothing, is removed as before.
+TEST(SemanticGridFreeSpace, ALonePostInsideOneCellStaysAnObstacle) {
+  Pooled pooled;
+  pooled.box({0, 0, 0}, {3, 3, 0}, C::floor, 0.025);
+  pooled.box({1.51, 1.51, 0.02}, {1.54, 1.54, 0.7}, C::furniture);
+  pooled.box({2.01, 1.01, 0.4}, {2.04, 1.04, 0.5}, C::unknown);
+  SemanticGridParams params;
+  params.min_obstacle_floor_ratio = 0;
+  const Views v = pooled.merged();
+  const SemanticGrid grid = build_semantic_grid(v.points, v.labels, params, {}, v.ids);
+  EXPECT_EQ(class_at(grid, 1.525, 1.525), C::furniture);
+  EXPECT_EQ(grid.weight(grid.cell_of({1.525, 1.525}).x(), grid.cell_of({1.525, 1.525}).y()), 0.0f);
+  EXPECT_EQ(class_at(grid, 2.025, 1.025), C::floor);
+  EXPECT_EQ(class_at(grid, 1.575, 1.525), C::floor);  // beside the post
+  EXPECT_EQ(grid.lone_posts_kept, 1);
+}
+
 // Two views 4.4 m from the room's east wall (x = 5) read it 8 cm short, as a depth step does: a
 // layer of wall points a cell in front of it, with a cell of floor between. Three views nearby
 // see through that layer at every height: it is floor, and the wall behind it stays wall.

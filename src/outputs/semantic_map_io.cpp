@@ -76,7 +76,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
                       {"wall_corners_behind_furniture", d.wall_corners_behind_furniture},
                       {"wall_cells_across_unseen", d.wall_cells_across_unseen},
                       {"tables_on_legs", d.tables_on_legs},
-                      {"fill_cells_trimmed_at_tables", d.fill_cells_trimmed_at_tables}};
+                      {"fill_cells_trimmed_at_tables", d.fill_cells_trimmed_at_tables},
+                      {"lone_posts_kept", d.lone_posts_kept}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

@@ -755,7 +755,10 @@ bool is_obstacle(float weight_value) {
   return weight_value == 0.0f;
 }
 
-// Obstacle cells with no obstacle among their 8 neighbours become what their floor evidence says.
+// Obstacle cells with no obstacle among their 8 neighbours become what their floor evidence says,
+// but for posts (leg_cell: solid points from the floor up, furniture or unnamed): a table's or a
+// chair's leg inside one cell, which the robot must not drive into and the tables seen by their
+// legs need.
 void remove_isolated_obstacles(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                                const SemanticGridParams& options, Image<std::uint8_t>& leaf,
                                Image<std::uint8_t>& furniture) {
@@ -772,7 +775,11 @@ void remove_isolated_obstacles(SemanticGrid& grid, const Image<CellEvidence>& ev
             alone = false;
         }
       }
-      if (alone) specks.push_back({col, row});
+      if (!alone) continue;
+      if (leg_cell(grid, evidence(col, row), {col, row}, options))
+        ++grid.lone_posts_kept;
+      else
+        specks.push_back({col, row});
     }
   }
   for (const auto& c : specks) {
@@ -1388,6 +1395,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.wall_cells_across_unseen = grid.wall_cells_across_unseen;
   d.tables_on_legs = grid.tables_on_legs;
   d.fill_cells_trimmed_at_tables = grid.fill_cells_trimmed_at_tables;
+  d.lone_posts_kept = grid.lone_posts_kept;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

@@ -211,8 +211,9 @@ struct SemanticGrid {
   // furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
   // pockets made wall as the inside of a wall seen from its far side, the cells of room
   // corners hidden behind furniture made wall, the cells of wall lines run on across what no
-  // view saw, the tables found by their legs, and the cells a fill had joined to such a table made
-  // floor again.
+  // view saw, the tables found by their legs, the cells a fill had joined to such a table made
+  // floor again, and the lone posts kept as obstacles (a leg inside one cell, no obstacle beside
+  // it, which the speck removal would have dropped).
   std::optional<double> wall_thickness;  // m
   int furniture_fronts = 0;
   int furniture_pockets = 0;
@@ -223,6 +224,7 @@ struct SemanticGrid {
   int wall_cells_across_unseen = 0;
   int tables_on_legs = 0;
   int fill_cells_trimmed_at_tables = 0;
+  int lone_posts_kept = 0;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -285,6 +287,7 @@ struct MapDescription {
   int wall_cells_across_unseen = 0;
   int tables_on_legs = 0;
   int fill_cells_trimmed_at_tables = 0;
+  int lone_posts_kept = 0;
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
