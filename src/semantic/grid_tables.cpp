@@ -6,6 +6,7 @@
 #include <optional>
 #include <set>
 
+#include "kartograf/core/connected_components.hpp"
 #include "semantic/grid_cells.hpp"
 
 namespace kartograf::semantic::detail {
@@ -231,24 +232,21 @@ int trim_fills_around_tables(SemanticGrid& grid, std::span<const LegTable> table
         if (seen_as(grid, c + Eigen::Vector2i(dx, dy), SemanticClass::wall)) return true;
     return false;
   };
-  Image<std::uint8_t> seen(grid.width(), grid.height(), 0);
-  std::vector<Eigen::Vector2i> stack, trimmed;
+  // The pieces of furniture (8-connected) that hold a four-legged table's cells.
+  const LabelImage pieces = label_connected_components(furniture, {Connectivity::eight, 1});
+  std::set<Label> at_tables;
   for (const LegTable& table : tables) {
     if (table.legs.size() != kAllLegs) continue;
     for (const Eigen::Vector2i& c : cells_under(table.top))
-      if (grid.contains(c) && furniture(c.x(), c.y()) && !seen(c.x(), c.y()))
-        seen(c.x(), c.y()) = 1, stack.push_back(c);
+      if (grid.contains(c) && pieces(c.x(), c.y())) at_tables.insert(pieces(c.x(), c.y()));
   }
-  while (!stack.empty()) {
-    const Eigen::Vector2i c = stack.back();
-    stack.pop_back();
-    if (!marked(c.x(), c.y()) && !near_a_table(c) && !near_a_wall(c)) trimmed.push_back(c);
-    for (int dy = -1; dy <= 1; ++dy) {
-      for (int dx = -1; dx <= 1; ++dx) {
-        const Eigen::Vector2i n = c + Eigen::Vector2i(dx, dy);
-        if (grid.contains(n) && furniture(n.x(), n.y()) && !seen(n.x(), n.y()))
-          seen(n.x(), n.y()) = 1, stack.push_back(n);
-      }
+  std::vector<Eigen::Vector2i> trimmed;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2i c(col, row);
+      if (at_tables.count(pieces(col, row)) && !marked(col, row) && !near_a_table(c) &&
+          !near_a_wall(c))
+        trimmed.push_back(c);
     }
   }
   set_class(grid, trimmed, SemanticClass::floor, floor_weight);
