@@ -476,7 +476,11 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
     }
   }
   if (seeded) {
-    if (agrees_better(attempt, *seeded) || images_tell_apart(attempt, *seeded)) return attempt;
+    if (agrees_better(attempt, *seeded) || images_tell_apart(attempt, *seeded)) {
+      if (params_.recheck_after_features && is_doubtful(attempt))
+        return best_of_other_starts(previous, predicted, std::move(attempt), frame);
+      return attempt;
+    }
     frame.from_features = true;
     return std::move(*seeded);
   }
@@ -636,11 +640,11 @@ std::vector<Eigen::Isometry3d> RgbdOdometry::other_starts(
 RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
                                                          const Eigen::Isometry3d& predicted,
                                                          Attempt first, OdometryFrame& frame) {
-  // The pair is the same for every start, so the fitness decides; the first stays on a tie.
+  // The pair is the same for every start: the speed bound and the images where they are
+  // decisive, else the fitness, choose (better_start); the first stays on a tie.
   Attempt best = std::move(first);
   const auto consider = [&](Attempt other, bool seeded_by_features) {
-    if (!other.report.accepted()) return;
-    if (best.report.accepted() && other.report.fitness <= best.report.fitness) return;
+    if (!better_start(previous, other, best)) return;
     best = std::move(other);
     frame.retried = !seeded_by_features;
     frame.from_features = seeded_by_features;
@@ -656,6 +660,32 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
     }
   }
   return best;
+}
+
+bool RgbdOdometry::better_start(std::size_t target, const Attempt& other,
+                                const Attempt& best) const {
+  if (!other.report.accepted()) return false;
+  if (!best.report.accepted()) return true;
+  if (params_.recheck_by_images && !within_arbitration(other, best)) {
+    if (other.report.degenerate || best.report.degenerate) {
+      const bool allowed = speed_allows(other);
+      if (allowed != speed_allows(best)) return allowed;
+    }
+    const RgbImage& target_color = colors_[slot_of(target)];
+    if (color_ && !color_->empty() && !target_color.empty()) {
+      const Eigen::Isometry3d candidates[] = {other.motion, best.motion};
+      const std::vector<double> rmse =
+          intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
+                         params_.depth_range.units_per_metre, candidates, params_.photometric);
+      const auto decisive = [&](double winner, double loser) {
+        return winner > 0 && winner <= params_.photometric_doubt_rmse &&
+               winner < params_.recheck_images_ratio * loser;
+      };
+      if (decisive(rmse[0], rmse[1])) return true;
+      if (decisive(rmse[1], rmse[0])) return false;
+    }
+  }
+  return other.report.fitness > best.report.fitness;
 }
 
 std::vector<Eigen::Isometry3d> RgbdOdometry::starts_from_turn(

@@ -191,8 +191,8 @@ struct OdometryParams {
   // (typical corrections are a few millimetres) or has a fitness under recheck_fitness is checked
   // against ICP from rest, from the predicted turn alone, from its step alone, from the predicted
   // motion turned about the camera's vertical axis by each of recheck_turns_deg, and from the
-  // features; the accepted one with the best fitness is kept (OdometryFrame::retried or
-  // from_features say which).
+  // features; the accepted one the pair agrees with best is kept (recheck_by_images below;
+  // OdometryFrame::retried or from_features say which).
   double recheck_correction_m = 0.03;
   double recheck_fitness = 0.3;
   std::vector<double> recheck_turns_deg = {-40, -20, 20, 40};
@@ -202,6 +202,21 @@ struct OdometryParams {
   // frame: a turn on the spot taken with a 14 cm slide, and a robot setting off on a turn 24 cm
   // sideways, both at a good fitness.
   bool recheck_from_turn = true;
+  // Among those starts, two answers more than the arbitration distance apart
+  // (feature_arbitration_m, feature_arbitration_deg) are told apart first by a step the robot can
+  // have (on a degenerate view: the speed bound), then by the images where they are decisive: a
+  // grey-level RMSE of at most photometric_doubt_rmse and below recheck_images_ratio times the
+  // other's. The fitness decides the rest. It is the overlap, and it favours the smaller motion
+  // where the geometry leaves a direction free: the survey every 10th frame, seed 4, frame 30 (a
+  // turn on the spot of 38.8 degrees over the floor, taken as rest at a fitness of 0.46, RMSE 40,
+  // against the turn's 0.29, RMSE 2.0; four frames running) and frame 92 (the turn taken with a 52
+  // cm slide at 0.42, RMSE 9.5, against 0.36, RMSE 1.2). At large baselines the images fit nowhere
+  // (RMSE 9-20 at every start) and differ by less than that ratio.
+  bool recheck_by_images = true;
+  double recheck_images_ratio = 0.5;
+  // A doubtful registration from the prediction that beat the features' (attempted on a large
+  // predicted motion) is checked against the other starts too.
+  bool recheck_after_features = true;
   // Local features (optional; the features layer's OrbFrontEnd): the current and the previous
   // frame's features are matched, and ICP starts from their motion, when the motion model
   // predicts more than feature_seed_m or feature_seed_deg (beyond the coarsest ICP gate; ICP from
@@ -392,6 +407,9 @@ class RgbdOdometry {
   // pair the images (grey-level RMSE below feature_arbitration_ratio times the other's), since
   // the fitness cannot tell a slide along the free direction; otherwise the fitness.
   bool agrees_better(const Attempt& challenger, const Attempt& incumbent);
+  // Whether `other` replaces `best` among a doubtful registration's starts
+  // (OdometryParams::recheck_by_images).
+  bool better_start(std::size_t target, const Attempt& other, const Attempt& best) const;
   // Whether two registrations differ by at most feature_arbitration_m and _deg.
   bool within_arbitration(const Attempt& a, const Attempt& b) const;
   // Within that distance on a degenerate view: whether `challenger`'s images were refined to a
