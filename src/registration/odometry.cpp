@@ -594,16 +594,20 @@ bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incum
   if (challenger.report.degenerate || incumbent.report.degenerate) {
     // The images can prefer a repeated floor pattern a tile over: a step the robot cannot make
     // loses first.
-    const bool allowed = speed_allows(challenger);
-    if (allowed != speed_allows(incumbent)) {
-      speed_bound_decided_ = true;
-      return allowed;
-    }
+    if (const std::optional<bool> allowed = speed_decides(challenger, incumbent)) return *allowed;
     return challenger.photometric_rmse > 0 && incumbent.photometric_rmse > 0 &&
            challenger.photometric_rmse <
                params_.feature_arbitration_ratio * incumbent.photometric_rmse;
   }
   return challenger.report.fitness > incumbent.report.fitness;
+}
+
+std::optional<bool> RgbdOdometry::speed_decides(const Attempt& challenger,
+                                                const Attempt& incumbent) {
+  const bool allowed = speed_allows(challenger);
+  if (allowed == speed_allows(incumbent)) return std::nullopt;
+  speed_bound_decided_ = true;
+  return allowed;
 }
 
 bool RgbdOdometry::speed_allows(const Attempt& attempt) const {
@@ -662,28 +666,34 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
   return best;
 }
 
-bool RgbdOdometry::better_start(std::size_t target, const Attempt& other,
-                                const Attempt& best) const {
+double RgbdOdometry::images_rmse_at(std::size_t target, Attempt& attempt) const {
+  if (attempt.start_rmse < 0) {
+    const RgbImage& target_color = colors_[slot_of(target)];
+    attempt.start_rmse = 0;
+    if (color_ && !color_->empty() && !target_color.empty()) {
+      attempt.start_rmse = intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
+                                          params_.depth_range.units_per_metre, {&attempt.motion, 1},
+                                          params_.photometric)[0];
+    }
+  }
+  return attempt.start_rmse;
+}
+
+bool RgbdOdometry::better_start(std::size_t target, Attempt& other, Attempt& best) {
   if (!other.report.accepted()) return false;
   if (!best.report.accepted()) return true;
   if (params_.recheck_by_images && !within_arbitration(other, best)) {
     if (other.report.degenerate || best.report.degenerate) {
-      const bool allowed = speed_allows(other);
-      if (allowed != speed_allows(best)) return allowed;
+      if (const std::optional<bool> allowed = speed_decides(other, best)) return *allowed;
     }
-    const RgbImage& target_color = colors_[slot_of(target)];
-    if (color_ && !color_->empty() && !target_color.empty()) {
-      const Eigen::Isometry3d candidates[] = {other.motion, best.motion};
-      const std::vector<double> rmse =
-          intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
-                         params_.depth_range.units_per_metre, candidates, params_.photometric);
-      const auto decisive = [&](double winner, double loser) {
-        return winner > 0 && winner <= params_.photometric_doubt_rmse &&
-               winner < params_.recheck_images_ratio * loser;
-      };
-      if (decisive(rmse[0], rmse[1])) return true;
-      if (decisive(rmse[1], rmse[0])) return false;
-    }
+    const double rmse_other = images_rmse_at(target, other);
+    const double rmse_best = images_rmse_at(target, best);
+    const auto decisive = [&](double winner, double loser) {
+      return winner > 0 && winner <= params_.photometric_doubt_rmse &&
+             winner < params_.recheck_images_ratio * loser;
+    };
+    if (decisive(rmse_other, rmse_best)) return true;
+    if (decisive(rmse_best, rmse_other)) return false;
   }
   return other.report.fitness > best.report.fitness;
 }

@@ -369,6 +369,9 @@ class RgbdOdometry {
     double heading_sigma_m = 0;
     bool accelerated = false;  // OdometryFrame::accelerated
     bool scanned = false;      // OdometryFrame::scanned
+    // Grey-level RMSE of the images at the motion against the target, computed once when a
+    // doubtful registration's starts are compared (images_rmse_at; < 0: not yet; 0: no images).
+    double start_rmse = -1;
   };
   // Registers the current frame against an earlier one.
   Attempt register_frames(std::size_t target, const Eigen::Isometry3d& initial,
@@ -409,7 +412,11 @@ class RgbdOdometry {
   bool agrees_better(const Attempt& challenger, const Attempt& incumbent);
   // Whether `other` replaces `best` among a doubtful registration's starts
   // (OdometryParams::recheck_by_images).
-  bool better_start(std::size_t target, const Attempt& other, const Attempt& best) const;
+  bool better_start(std::size_t target, Attempt& other, Attempt& best);
+  double images_rmse_at(std::size_t target, Attempt& attempt) const;
+  // Between two registrations of a degenerate pair: the challenger's verdict where the speed
+  // bound admits one and not the other (and OdometryFrame::speed_bounded is set), else none.
+  std::optional<bool> speed_decides(const Attempt& challenger, const Attempt& incumbent);
   // Whether two registrations differ by at most feature_arbitration_m and _deg.
   bool within_arbitration(const Attempt& a, const Attempt& b) const;
   // Within that distance on a degenerate view: whether `challenger`'s images were refined to a
