@@ -221,6 +221,7 @@ void label_views(const compute::Context& context, const mapping::FrameSource& so
 features::OrbParams map_orb_params() {
   features::OrbParams params;
   params.fast_threshold = 5;
+  params.features_per_frame = 3000;
   return params;
 }
 

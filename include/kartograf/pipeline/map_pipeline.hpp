@@ -46,7 +46,10 @@ namespace kartograf::pipeline {
 segmentation::PlaneExtractionParams view_plane_params();
 
 // ORB for whole sequences: a low FAST threshold, since the synthetic world's smooth textures give
-// too few corners at OpenCV's default (20: 43-49 per 640x480 frame, 5: 270-350).
+// too few corners at OpenCV's default (20: 43-49 per 640x480 frame, 5: 270-350), and 3000 corners
+// a frame: on a tiled floor or a striped wall most corners repeat and Lowe's ratio test drops
+// them, and of 1000 too few distinct ones were left for RANSAC's consensus where the geometry
+// leaves the robot's step to the features (docs/slam.md, "The features' budget").
 features::OrbParams map_orb_params();
 
 struct MapPipelineParams {
