@@ -543,9 +543,8 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_step_lengths(
   constexpr double kSpacing = 0.01;  // metres: about the images' basin along a step
   const auto [shortest, longest] = plausible_step_lengths(step_frame, predicted);
   const Eigen::Vector3d step = attempt.motion.translation();
-  const RgbImage& target_color = colors_[slot_of(frames_.size() - 1)];
   if (!params_.step_scan || longest - shortest <= params_.feature_arbitration_m ||
-      step.norm() < kSpacing || color_ == nullptr || color_->empty() || target_color.empty()) {
+      step.norm() < kSpacing) {
     return {};
   }
   std::vector<Eigen::Isometry3d> candidates;
@@ -554,9 +553,7 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_step_lengths(
     candidate.translation() = length * step.normalized();
     candidates.push_back(candidate);
   }
-  const std::vector<double> rmse =
-      intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
-                     params_.depth_range.units_per_metre, candidates, params_.photometric);
+  const std::vector<double> rmse = images_rmse(frames_.size() - 1, candidates);
   std::size_t best = candidates.size();
   for (std::size_t i = 0; i < rmse.size(); ++i) {
     if (rmse[i] > 0 && (best == candidates.size() || rmse[i] < rmse[best])) best = i;
@@ -666,15 +663,18 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
   return best;
 }
 
+std::vector<double> RgbdOdometry::images_rmse(std::size_t target,
+                                              std::span<const Eigen::Isometry3d> motions) const {
+  const RgbImage& target_color = colors_[slot_of(target)];
+  if (!color_ || color_->empty() || target_color.empty()) return {};
+  return intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
+                        params_.depth_range.units_per_metre, motions, params_.photometric);
+}
+
 double RgbdOdometry::images_rmse_at(std::size_t target, Attempt& attempt) const {
   if (attempt.start_rmse < 0) {
-    const RgbImage& target_color = colors_[slot_of(target)];
-    attempt.start_rmse = 0;
-    if (color_ && !color_->empty() && !target_color.empty()) {
-      attempt.start_rmse = intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
-                                          params_.depth_range.units_per_metre, {&attempt.motion, 1},
-                                          params_.photometric)[0];
-    }
+    const std::vector<double> rmse = images_rmse(target, {&attempt.motion, 1});
+    attempt.start_rmse = rmse.empty() ? 0 : rmse[0];
   }
   return attempt.start_rmse;
 }
@@ -782,12 +782,9 @@ RgbdOdometry::ReestimateLimits RgbdOdometry::reestimate_limits(const OdometryFra
 // starts (agrees_better): the grey levels must agree clearly better at the re-estimate.
 bool RgbdOdometry::images_confirm(std::size_t anchor, const Eigen::Isometry3d& motion,
                                   const Eigen::Isometry3d& chained) const {
-  const RgbImage& anchor_color = colors_[slot_of(anchor)];
-  if (!color_ || color_->empty() || anchor_color.empty()) return false;
   const Eigen::Isometry3d candidates[] = {motion, chained};
-  const std::vector<double> rmse =
-      intensity_rmse(*depth_, *color_, anchor_color, builder_.camera(),
-                     params_.depth_range.units_per_metre, candidates, params_.photometric);
+  const std::vector<double> rmse = images_rmse(anchor, candidates);
+  if (rmse.empty()) return false;
   const double at_reestimate = rmse[0], at_chain = rmse[1];
   return at_reestimate > 0 && at_chain > 0 &&
          at_reestimate < params_.feature_arbitration_ratio * at_chain;

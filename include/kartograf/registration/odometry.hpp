@@ -414,6 +414,10 @@ class RgbdOdometry {
   // (OdometryParams::recheck_by_images).
   bool better_start(std::size_t target, Attempt& other, Attempt& best);
   double images_rmse_at(std::size_t target, Attempt& attempt) const;
+  // Grey-level RMSE of this frame's images moved by each motion onto `target`'s (intensity_rmse);
+  // empty where either frame has no colour.
+  std::vector<double> images_rmse(std::size_t target,
+                                  std::span<const Eigen::Isometry3d> motions) const;
   // Between two registrations of a degenerate pair: the challenger's verdict where the speed
   // bound admits one and not the other (and OdometryFrame::speed_bounded is set), else none.
   std::optional<bool> speed_decides(const Attempt& challenger, const Attempt& incumbent);
