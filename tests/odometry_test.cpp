@@ -408,6 +408,50 @@ TEST(GeometricInformation, FindsTheFreeDirectionOfAWallAndTheFloor) {
   EXPECT_LT(kept.translation().norm(), 2e-3);
 }
 
+// What a registration of two frames can match: the points one frame's motion maps into the
+// other's view, with depth there within the gap.
+TEST(GeometricInformation, IsJudgedOnThePointsTheOtherFrameSees) {
+  const compute::Context context = compute::Context::cpu();
+  const PinholeIntrinsics camera = testing::qvga_camera();
+  const PointImage points =
+      testing::render(testing::corner_scene(), camera, testing::reference_camera());
+  registration::PyramidParams params;
+  params.levels = 3;
+  const registration::FramePyramid pyramid =
+      registration::make_frame_pyramid(context, camera, points, nullptr, params);
+  const registration::CloudView view = pyramid.level(2).view();
+  const PinholeIntrinsics& level_camera = pyramid.level(2).camera;
+  const auto shared = [&](const Eigen::Isometry3d& motion) {
+    const std::vector<std::uint8_t> keep =
+        registration::overlapping_points(view, view, level_camera, motion, 0.3);
+    return static_cast<std::size_t>(std::count(keep.begin(), keep.end(), 1));
+  };
+  const compute::HostView<Point4f> host = compute::read_on_host(*view.points);
+  const auto valid = static_cast<std::size_t>(
+      std::count_if(host.begin(), host.end(), [](const Point4f& p) { return is_valid(p); }));
+  ASSERT_GT(valid, 1000u);
+  EXPECT_EQ(shared(Eigen::Isometry3d::Identity()), valid);
+  EXPECT_EQ(shared(Eigen::Isometry3d(Eigen::Translation3d(20, 0, 0))), 0u);  // out of view
+  // With no gap allowed, a motion off by a centimetre along the view keeps almost nothing.
+  const std::vector<std::uint8_t> off = registration::overlapping_points(
+      view, view, level_camera, Eigen::Isometry3d(Eigen::Translation3d(0, 0, 0.01)), 1e-4);
+  EXPECT_LT(static_cast<std::size_t>(std::count(off.begin(), off.end(), 1)), valid / 20);
+  const std::size_t turned =
+      shared(Eigen::Isometry3d(Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitY())));
+  EXPECT_GT(turned, valid / 10);
+  EXPECT_LT(turned, valid * 3 / 4);
+
+  // All points kept: the whole frame's information; none: nothing.
+  const std::vector<std::uint8_t> all(host.size(), 1), none(host.size(), 0);
+  const registration::GeometricInformation whole =
+      registration::geometric_information(view, 1.5, 0.01);
+  EXPECT_EQ(registration::geometric_information(view, 1.5, 0.01, all).information,
+            whole.information);
+  EXPECT_EQ(registration::geometric_information(view, 1.5, 0.01, none).points, 0u);
+  EXPECT_THROW(registration::geometric_information(view, 1.5, 0.01, std::vector<std::uint8_t>(3)),
+               Error);
+}
+
 class OdometryBackends : public testing::BackendTest {};
 
 TEST_P(OdometryBackends, AgreesWithTheCpuBackend) {

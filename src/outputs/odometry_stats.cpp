@@ -53,6 +53,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["retried"] = frame.retried;
   json["from_features"] = frame.from_features;
   json["degenerate"] = frame.degenerate;
+  json["degenerate_overlap"] = frame.degenerate_overlap;
   json["photometric"] = frame.photometric;
   json["heading_sigma_m"] = frame.heading_sigma_m;
   json["accelerated"] = frame.accelerated;
@@ -78,6 +79,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["retried_from_other_starts"] = counts.retried_from_other_starts;
   json["from_features"] = counts.from_features;
   json["degenerate_frames"] = counts.degenerate_frames;
+  json["degenerate_overlap_frames"] = counts.degenerate_overlap_frames;
   json["photometric_frames"] = counts.photometric_frames;
   json["heading_prior_frames"] = counts.heading_prior_frames;
   json["accelerated_frames"] = counts.accelerated_frames;
@@ -109,6 +111,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.from_features += f.from_features;
     counts.keyframes += f.keyframe;
     counts.degenerate_frames += f.degenerate;
+    counts.degenerate_overlap_frames += f.degenerate_overlap;
     counts.photometric_frames += f.photometric;
     counts.heading_prior_frames += f.heading_sigma_m > 0;
     counts.accelerated_frames += f.accelerated;
@@ -122,9 +125,13 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
 
 namespace {
 
-// Sparse sequences only (OdometryParams::acceleration_start, step_scan, speed_change_margin).
+// Sparse sequences only (OdometryParams::overlap_turn_deg, acceleration_start, step_scan,
+// speed_change_margin).
 std::string speed_changes_text(const OdometryFrameCounts& c) {
   std::string text;
+  if (c.degenerate_overlap_frames > 0) {
+    text += ", " + std::to_string(c.degenerate_overlap_frames) + " only where a turn overlapped";
+  }
   if (c.accelerated_frames > 0) {
     text += ", " + std::to_string(c.accelerated_frames) + " followed a change of speed";
   }

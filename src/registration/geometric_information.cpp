@@ -64,9 +64,15 @@ Eigen::Isometry3d centre_pose(const GeometricInformation& geometry) {
 }  // namespace
 
 GeometricInformation geometric_information(const CloudView& cloud, double reference_depth,
-                                           double min_eigenvalue_ratio) {
+                                           double min_eigenvalue_ratio,
+                                           std::span<const std::uint8_t> keep) {
   const HostCloud host = host_cloud(cloud);
+  require(keep.empty() || keep.size() == host.points.size(),
+          "geometric information: the mask needs one entry per point");
   GeometricInformation result;
+  const auto counts = [&](std::size_t i) {
+    return (keep.empty() || keep[i]) && is_valid(host.points[i]) && is_valid(host.normals[i]);
+  };
   const auto weight_of = [&](const Point4f& p) {
     return reference_depth > 0
                ? static_cast<double>(DepthWeightedFinder::weight(p.z(), reference_depth))
@@ -74,7 +80,7 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
   };
   Eigen::Vector3d weighted_sum = Eigen::Vector3d::Zero();
   for (std::size_t i = 0; i < host.points.size(); ++i) {
-    if (!is_valid(host.points[i]) || !is_valid(host.normals[i])) continue;
+    if (!counts(i)) continue;
     const double w = weight_of(host.points[i]);
     weighted_sum += w * host.points[i].head<3>().cast<double>();
     result.weight_sum += w;
@@ -83,7 +89,7 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
   if (!(result.weight_sum > 0)) return result;
   result.centre = weighted_sum / result.weight_sum;
   for (std::size_t i = 0; i < host.points.size(); ++i) {
-    if (!is_valid(host.points[i]) || !is_valid(host.normals[i])) continue;
+    if (!counts(i)) continue;
     const double w = weight_of(host.points[i]);
     const Eigen::Vector3d p = host.points[i].head<3>().cast<double>();
     const Eigen::Vector3d n = host.normals[i].head<3>().cast<double>();
@@ -97,6 +103,30 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
   result.about_centre /= result.weight_sum;
   result.degeneracy = analyse_degeneracy(result.about_centre, min_eigenvalue_ratio);
   return result;
+}
+
+std::vector<std::uint8_t> overlapping_points(const CloudView& source, const CloudView& target,
+                                             const PinholeIntrinsics& camera,
+                                             const Eigen::Isometry3d& source_to_target,
+                                             double max_gap_m) {
+  const compute::HostView<Point4f> from = compute::read_on_host(*source.points);
+  const compute::HostView<Point4f> onto = compute::read_on_host(*target.points);
+  require(onto.size() == static_cast<std::size_t>(camera.width) * camera.height,
+          "overlapping points: the target must be an image of the camera's size");
+  const Eigen::Isometry3f motion = source_to_target.cast<float>();
+  std::vector<std::uint8_t> keep(from.size(), 0);
+  for (std::size_t i = 0; i < from.size(); ++i) {
+    if (!is_valid(from[i])) continue;
+    const Eigen::Vector3f q = motion * from[i].head<3>();
+    if (!(q.z() > 0)) continue;
+    const double u = std::round(camera.fx * q.x() / q.z() + camera.cx);
+    const double v = std::round(camera.fy * q.y() / q.z() + camera.cy);
+    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
+    const Point4f& seen =
+        onto[static_cast<std::size_t>(v) * camera.width + static_cast<std::size_t>(u)];
+    keep[i] = is_valid(seen) && std::abs(seen.z() - q.z()) <= max_gap_m;
+  }
+  return keep;
 }
 
 namespace {

@@ -17,11 +17,13 @@
 // `about_centre` is the same sum with p taken relative to the weighted centroid; degeneracy is
 // analyse_degeneracy() of it.
 #include <cstddef>
+#include <cstdint>
 #include <span>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include "kartograf/core/intrinsics.hpp"
 #include "kartograf/core/se3.hpp"
 #include "kartograf/registration/correspondence_finder.hpp"
 #include "kartograf/registration/rigid_solvers.hpp"
@@ -39,8 +41,19 @@ struct GeometricInformation {
 
 // cloud needs points and normals (downloaded from a device). reference_depth > 0 applies the depth
 // weights of DepthWeightedFinder; 0 weighs every point 1.
+// `keep` (one entry per point; empty: all) restricts the sums to the points it marks.
 GeometricInformation geometric_information(const CloudView& cloud, double reference_depth,
-                                           double min_eigenvalue_ratio);
+                                           double min_eigenvalue_ratio,
+                                           std::span<const std::uint8_t> keep = {});
+
+// The points of `source` (a frame's pyramid level) that `source_to_target` maps into the view of
+// `target` (the same level of another frame, an image of `camera`'s size): they land inside the
+// image on a pixel with depth, within max_gap_m of it along the view axis. What a registration of
+// the two frames can match: at a wide turn only part of the frame.
+std::vector<std::uint8_t> overlapping_points(const CloudView& source, const CloudView& target,
+                                             const PinholeIntrinsics& camera,
+                                             const Eigen::Isometry3d& source_to_target,
+                                             double max_gap_m);
 
 // GeometricInformation::information without its weak directions (balanced eigenvalue below
 // min_eigenvalue_ratio x the largest, about the centroid): what a registration whose weak
