@@ -371,10 +371,7 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   } else {
     kept_color = RgbImage();
   }
-  geometry_ =
-      geometric_information(pyramid.level(information_level_).view(),
-                            params_.depth_weighting ? params_.depth_weights.reference_depth : 0.0,
-                            params_.icp.min_eigenvalue_ratio);
+  geometry_ = level_geometry(pyramid.level(information_level_).view());
   frame.degenerate = geometry_.degeneracy.degenerate;
   frame.eigenvalue_ratio = geometry_.degeneracy.eigenvalue_ratio;
   if (frame.index == 0) {
@@ -803,8 +800,13 @@ GeometricInformation RgbdOdometry::overlap_geometry(std::size_t current, std::si
   const PyramidLevel& onto = pyramid_of(target).level(information_level_);
   const std::vector<std::uint8_t> keep = overlapping_points(
       source.view(), onto.view(), onto.camera, motion, params_.icp.levels.back().max_distance);
+  return level_geometry(source.view(), keep);
+}
+
+GeometricInformation RgbdOdometry::level_geometry(const CloudView& level,
+                                                  std::span<const std::uint8_t> keep) const {
   return geometric_information(
-      source.view(), params_.depth_weighting ? params_.depth_weights.reference_depth : 0.0,
+      level, params_.depth_weighting ? params_.depth_weights.reference_depth : 0.0,
       params_.icp.min_eigenvalue_ratio, keep);
 }
 

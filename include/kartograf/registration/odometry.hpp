@@ -39,8 +39,10 @@
 // the last keyframe, or is max_interval frames after it, or is a fallback. SLAM uses them as
 // loop-closure nodes.
 #include <cstddef>
+#include <cstdint>
 #include <memory>
 #include <optional>
+#include <span>
 #include <string_view>
 #include <vector>
 
@@ -443,6 +445,10 @@ class RgbdOdometry {
   // frame `target` (both at the information level).
   GeometricInformation overlap_geometry(std::size_t current, std::size_t target,
                                         const Eigen::Isometry3d& motion);
+  // The geometric information of an information-level cloud (of the points `keep` marks; empty:
+  // all) with the odometry's depth weights and degeneracy threshold.
+  GeometricInformation level_geometry(const CloudView& level,
+                                      std::span<const std::uint8_t> keep = {}) const;
   // Grey-level RMSE of this frame's images moved by each motion onto `target`'s (intensity_rmse);
   // empty where either frame has no colour.
   std::vector<double> images_rmse(std::size_t target,
