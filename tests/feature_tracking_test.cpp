@@ -11,6 +11,7 @@
 
 #include "kartograf/features/orb_front_end.hpp"
 #include "kartograf/mapping/loop_closure.hpp"
+#include "kartograf/outputs/synthetic_dataset.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
 #include "kartograf/registration/odometry.hpp"
 #include "kartograf/synth/trajectory.hpp"
@@ -88,9 +89,15 @@ TEST(FeatureTracking, OdometryFollowsStepsBeyondIcpsBasin) {
 
 // `count` frames of the seed-1 survey (the demo's recipe) taken every 10th frame from `first`.
 testing::RenderedSequence every_10th_survey_frame(std::size_t first, std::size_t count,
-                                                  unsigned seed = 1) {
+                                                  unsigned seed = 1, bool as_synth_writes = false) {
   const synth::World world = synth::make_building(seed);
-  return testing::render_sequence(world, testing::survey_poses(world, first, count, 10), kKinect);
+  const std::vector<Eigen::Isometry3d> poses = testing::survey_poses(world, first, count, 10);
+  if (!as_synth_writes) return testing::render_sequence(world, poses, kKinect);
+  std::vector<std::uint64_t> noise_seeds;
+  for (std::size_t i = 0; i < count; ++i) {
+    noise_seeds.push_back(io::synthetic_frame_seed(seed, first + 10 * i));
+  }
+  return testing::render_sequence(world, poses, kKinect, noise_seeds);
 }
 
 // The start of the seed-1 survey taken every 10th frame: the robot sets off from rest at 20, 39
@@ -146,6 +153,9 @@ struct Counterfactual {
   double with_below_m, without_above_m;
   unsigned seed = 1;  // of the survey
   double with_below_deg = 0, without_above_deg = 0;
+  // The frames' noise as `kartograf synth` writes them, and the features of `kartograf slam
+  // --features` (pipeline::map_orb_params).
+  bool as_the_cli_runs = false;
 };
 
 const Counterfactual kCounterfactuals[] = {
@@ -237,17 +247,33 @@ const Counterfactual kCounterfactuals[] = {
     // prior (0.4 mm).
     {"AWideTurnIsJudgedOnWhatTheFramesShare", 880, 5, 3,
      [](registration::OdometryParams& p) { p.overlap_turn_deg = 0; }, 0.02, 0.04, 2},
+    // Seed 2's survey, frames 100-420 as `kartograf synth` writes them and with the map's
+    // features (the case hangs on both, and on the steps before: from frame 200 on, or with the
+    // other tests' frames, the tie does not arise): the robot speeds up along a corridor, 0.50,
+    // 0.68 and 0.91 m a frame into
+    // frame 400, over a floor whose tiles repeat along the step, in a view that leaves the forward
+    // slide free. ICP from the prediction finds the robot's step, ICP from the features' motion
+    // a tile short (0.26 m); the images, refined at both, fit them alike (grey-level RMSE 16.6
+    // and 15.7) and the speed bound admits both. The features' was taken on that tie, and the
+    // next step followed it (0.65 m short twice; 3.7 mm with the prediction kept).
+    {"AnImagesTieOnADriveKeepsThePrediction", 100, 33, 29,
+     [](registration::OdometryParams& p) { p.prediction_keeps_image_ties = false; }, 0.05, 0.3, 2,
+     0, 0, true},
 };
 
 class OdometryBehaviour : public ::testing::TestWithParam<Counterfactual> {};
 
 TEST_P(OdometryBehaviour, MendsTheStepsThatAreWrongWithoutIt) {
   const Counterfactual& c = GetParam();
-  const testing::RenderedSequence sequence = every_10th_survey_frame(c.first, c.count, c.seed);
+  const testing::RenderedSequence sequence =
+      every_10th_survey_frame(c.first, c.count, c.seed, c.as_the_cli_runs);
+  const auto features =
+      c.as_the_cli_runs ? std::make_shared<const features::OrbFrontEnd>(pipeline::map_orb_params())
+                        : orb();
   registration::OdometryParams without;
   c.switch_off(without);
-  const StepErrors with = track(sequence, orb(), {}, c.first_step);
-  const StepErrors without_it = track(sequence, orb(), without, c.first_step);
+  const StepErrors with = track(sequence, features, {}, c.first_step);
+  const StepErrors without_it = track(sequence, features, without, c.first_step);
   RecordProperty("worst_step_error_m", testing::scientific(with.worst_m));
   RecordProperty("worst_step_error_without_m", testing::scientific(without_it.worst_m));
   EXPECT_LT(with.worst_m, c.with_below_m);

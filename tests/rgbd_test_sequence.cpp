@@ -1,6 +1,7 @@
 #include "rgbd_test_sequence.hpp"
 
 #include <cmath>
+#include <numeric>
 
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/synth/render.hpp"
@@ -34,19 +35,38 @@ RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,
   return render_sequence(test_world(), poses, camera, noise);
 }
 
-RenderedSequence render_sequence(const synth::World& world,
-                                 const std::vector<Eigen::Isometry3d>& poses,
-                                 const PinholeIntrinsics& camera, bool noise) {
+namespace {
+
+RenderedSequence render_with(const synth::World& world, const std::vector<Eigen::Isometry3d>& poses,
+                             const PinholeIntrinsics& camera, const synth::NoiseModel& model,
+                             const std::vector<std::uint64_t>& noise_seeds) {
   RenderedSequence sequence;
   sequence.camera = camera;
   sequence.truth = poses;
-  const synth::NoiseModel model = noise ? synth::NoiseModel::kinect() : synth::NoiseModel::none();
   for (std::size_t i = 0; i < poses.size(); ++i) {
-    synth::SyntheticFrame frame = synth::render(world, camera, poses[i], model, 100 + i);
+    synth::SyntheticFrame frame = synth::render(world, camera, poses[i], model, noise_seeds.at(i));
     sequence.frames.push_back(
         {std::move(frame.depth), std::move(frame.color), static_cast<double>(i) / 30.0, poses[i]});
   }
   return sequence;
+}
+
+}  // namespace
+
+RenderedSequence render_sequence(const synth::World& world,
+                                 const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera, bool noise) {
+  std::vector<std::uint64_t> seeds(poses.size());
+  std::iota(seeds.begin(), seeds.end(), std::uint64_t{100});
+  return render_with(world, poses, camera,
+                     noise ? synth::NoiseModel::kinect() : synth::NoiseModel::none(), seeds);
+}
+
+RenderedSequence render_sequence(const synth::World& world,
+                                 const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera,
+                                 const std::vector<std::uint64_t>& noise_seeds) {
+  return render_with(world, poses, camera, synth::NoiseModel::kinect(), noise_seeds);
 }
 
 double ate_rmse(const std::vector<Eigen::Isometry3d>& estimate,

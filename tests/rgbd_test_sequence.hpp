@@ -38,6 +38,12 @@ RenderedSequence render_sequence(const std::vector<Eigen::Isometry3d>& poses,
 RenderedSequence render_sequence(const synth::World& world,
                                  const std::vector<Eigen::Isometry3d>& poses,
                                  const PinholeIntrinsics& camera, bool noise = true);
+// The same with each frame's noise seed given (io::synthetic_frame_seed: `kartograf synth`'s own
+// frames).
+RenderedSequence render_sequence(const synth::World& world,
+                                 const std::vector<Eigen::Isometry3d>& poses,
+                                 const PinholeIntrinsics& camera,
+                                 const std::vector<std::uint64_t>& noise_seeds);
 
 // 30 frames (1.3 m) of the 500-frame robot tour along a furnished room, then back the same way
 // (as a robot reversing): the return trip sees again what the way out saw, so SLAM closes loops.

@@ -13,6 +13,7 @@
 
 #include "formats/atomic_file.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/random.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
 #include "kartograf/formats/pcd.hpp"
@@ -20,7 +21,6 @@
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/synth/floor_plan.hpp"
 #include "kartograf/synth/preview.hpp"
-#include "kartograf/core/random.hpp"
 
 namespace kartograf::io {
 
@@ -270,9 +270,9 @@ void write_frames(const std::filesystem::path& dir, const synth::World& world,
   auto work = [&] {
     for (int k; !failed && (k = next++) < count;) {
       try {
-        const synth::SyntheticFrame frame = synth::render(
-            world, options.intrinsics, trajectory[k].pose, options.noise,
-            hash_key(options.seed, static_cast<std::uint64_t>(k), kFrameSalt), {1});
+        const synth::SyntheticFrame frame =
+            synth::render(world, options.intrinsics, trajectory[k].pose, options.noise,
+                          synthetic_frame_seed(options.seed, static_cast<std::size_t>(k)), {1});
         const std::string name = timestamp_name(trajectory[k].timestamp) + ".png";
         write_png(dir / "rgb" / name, frame.color);
         write_png(dir / "depth" / name, frame.depth);
@@ -346,8 +346,8 @@ CameraPath plan_handheld(const SyntheticDatasetParams& options, SyntheticDataset
   require(handheld_room >= 1 && handheld_room <= world.rooms.size(),
           "synthetic data set: no room " + std::to_string(handheld_room) + " (the world has " +
               std::to_string(world.rooms.size()) + ")");
-  summary.trajectory = synth::handheld(world, handheld_room, options.frames,
-                                       hash_key(options.seed, kHandheldSalt));
+  summary.trajectory =
+      synth::handheld(world, handheld_room, options.frames, hash_key(options.seed, kHandheldSalt));
   return {handheld_room, options.frames};
 }
 
@@ -433,6 +433,10 @@ Json dataset_json(const SyntheticDatasetParams& options, const SyntheticDatasetS
 }
 
 }  // namespace
+
+std::uint64_t synthetic_frame_seed(std::uint64_t dataset_seed, std::size_t frame) {
+  return hash_key(dataset_seed, static_cast<std::uint64_t>(frame), kFrameSalt);
+}
 
 std::string timestamp_name(double timestamp) {
   char text[64];

@@ -474,7 +474,7 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
     }
   }
   if (seeded) {
-    if (agrees_better(attempt, *seeded) || images_tell_apart(attempt, *seeded)) {
+    if (keeps_prediction(attempt, *seeded)) {
       if (params_.recheck_after_features && is_doubtful(attempt))
         return best_of_other_starts(previous, predicted, std::move(attempt), frame);
       return attempt;
@@ -582,6 +582,13 @@ bool RgbdOdometry::images_tell_apart(const Attempt& challenger, const Attempt& i
          challenger.photometric_rmse > 0 && incumbent.photometric_rmse > 0 &&
          challenger.photometric_rmse <
              params_.feature_arbitration_ratio * incumbent.photometric_rmse;
+}
+
+bool RgbdOdometry::keeps_prediction(const Attempt& predicted, const Attempt& seeded) {
+  if (agrees_better(predicted, seeded) || images_tell_apart(predicted, seeded)) return true;
+  return params_.prediction_keeps_image_ties && predicted.report.accepted() &&
+         predicted.photometric && seeded.photometric && !within_arbitration(predicted, seeded) &&
+         !agrees_better(seeded, predicted);
 }
 
 bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incumbent) {

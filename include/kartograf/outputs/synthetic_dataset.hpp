@@ -68,6 +68,10 @@ struct SyntheticDatasetSummary {
   int tour_frames_needed = 0;  // robot tours: frames below which the per-frame limits are exceeded
 };
 
+// The noise seed of frame `frame` of a data set written with seed `dataset_seed`: rendered with
+// it, a frame equals the one `write_synthetic_dataset` writes (tests re-render stretches).
+std::uint64_t synthetic_frame_seed(std::uint64_t dataset_seed, std::size_t frame);
+
 // Throws Error naming the folder when it exists and is not empty (unless options.force) or
 // cannot be created, and naming the file when a write fails.
 SyntheticDatasetSummary write_synthetic_dataset(const std::filesystem::path& dir,

@@ -261,6 +261,13 @@ struct OdometryParams {
   // features'. False: the features' always, as before 2026-12-01 (the survey every 10th frame,
   // frame 980: a turn on the spot taken with the features' 3 cm slide, RMSE 7.9 against 2.5).
   bool feature_ties_by_images = true;
+  // Where both registrations of a large predicted motion were refined by the images and end
+  // apart, but neither the speed bound nor the images tell them apart (RMSEs within
+  // feature_arbitration_ratio of each other), the prediction's is kept: features matched on a
+  // degenerate view's repeated pattern fit the images as well as the truth does. False: the
+  // features' (the survey of seed 2 every 10th frame, frame 40: a drive at 0.91 m a frame taken
+  // for 0.26 m, a floor tile over, at RMSE 15.7 against 16.6).
+  bool prediction_keeps_image_ties = true;
   // Grey levels; the synthetic camera's noise is about 1. Also: a photometric refinement whose
   // answer lies beyond the registration's correction limits (frame_limits, reestimate_limits) is
   // kept only at an RMSE within this (docs/slam.md, "An images' correction beyond the limits").
@@ -461,6 +468,10 @@ class RgbdOdometry {
   // Within that distance on a degenerate view: whether `challenger`'s images were refined to a
   // grey-level RMSE below feature_arbitration_ratio times `incumbent`'s.
   bool images_tell_apart(const Attempt& challenger, const Attempt& incumbent) const;
+  // A large predicted motion's registration from the prediction against ICP from the features'
+  // motion: whether the prediction's is kept (agrees better, told apart by the images within the
+  // arbitration distance, or beyond it a tie the refined images cannot break).
+  bool keeps_prediction(const Attempt& predicted, const Attempt& seeded);
   // Whether the attempt's step into the frame being tracked is one the robot's drive allows
   // (OdometryParams::speed_change_margin).
   bool speed_allows(const Attempt& attempt) const;
