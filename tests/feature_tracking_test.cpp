@@ -87,7 +87,9 @@ TEST(FeatureTracking, OdometryFollowsStepsBeyondIcpsBasin) {
       << without.worst_m << " m, " << without.worst_deg << " deg";
 }
 
-// `count` frames of the seed-1 survey (the demo's recipe) taken every 10th frame from `first`.
+// `count` frames of a survey (the demo's recipe; seed 1 unless `seed`) taken every 10th frame
+// from `first`, with the tests' noise seeds or, `as_synth_writes`, those `kartograf synth` writes
+// the frames with.
 testing::RenderedSequence every_10th_survey_frame(std::size_t first, std::size_t count,
                                                   unsigned seed = 1, bool as_synth_writes = false) {
   const synth::World world = synth::make_building(seed);
@@ -250,12 +252,12 @@ const Counterfactual kCounterfactuals[] = {
     // Seed 2's survey, frames 100-420 as `kartograf synth` writes them and with the map's
     // features (the case hangs on both, and on the steps before: from frame 200 on, or with the
     // other tests' frames, the tie does not arise): the robot speeds up along a corridor, 0.50,
-    // 0.68 and 0.91 m a frame into
-    // frame 400, over a floor whose tiles repeat along the step, in a view that leaves the forward
-    // slide free. ICP from the prediction finds the robot's step, ICP from the features' motion
-    // a tile short (0.26 m); the images, refined at both, fit them alike (grey-level RMSE 16.6
-    // and 15.7) and the speed bound admits both. The features' was taken on that tie, and the
-    // next step followed it (0.65 m short twice; 3.7 mm with the prediction kept).
+    // 0.68 and 0.91 m a frame into frame 400, over a floor whose tiles repeat along the step, in
+    // a view that leaves the forward slide free. ICP from the prediction finds the robot's step,
+    // ICP from the features' motion a tile short (0.26 m); the images, refined at both, fit them
+    // alike (grey-level RMSE 16.6 and 15.7) and the speed bound admits both. The features' was
+    // taken on that tie, and the next step followed it (0.65 m short twice; 3.7 mm with the
+    // prediction kept).
     {"AnImagesTieOnADriveKeepsThePrediction", 100, 33, 29,
      [](registration::OdometryParams& p) { p.prediction_keeps_image_ties = false; }, 0.05, 0.3, 2,
      0, 0, true},
