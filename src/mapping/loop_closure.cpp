@@ -8,6 +8,7 @@
 #include <span>
 #include <string>
 
+#include "kartograf/geometry/pixel_projection.hpp"
 #include "kartograf/registration/depth_weighted_finder.hpp"
 #include "kartograf/registration/geometric_information.hpp"
 #include "kartograf/registration/projective_association.hpp"
@@ -147,11 +148,9 @@ double LoopClosureDetector::view_overlap(std::size_t from, std::size_t to,
   std::size_t seen = 0;
   for (const Eigen::Vector3f& sample : source->samples) {
     const Eigen::Vector3d p = from_to_to * sample.cast<double>();
-    if (p.z() <= 0) continue;
-    const double u = std::floor(camera_.fx * p.x() / p.z() + camera_.cx + 0.5);
-    const double v = std::floor(camera_.fy * p.y() / p.z() + camera_.cy + 0.5);
-    if (u < 0 || v < 0 || u >= camera_.width || v >= camera_.height) continue;
-    const std::uint16_t d = target(static_cast<int>(u), static_cast<int>(v));
+    const std::optional<Eigen::Vector2i> pixel = geometry::nearest_pixel(camera_, p);
+    if (!pixel) continue;
+    const std::uint16_t d = target(pixel->x(), pixel->y());
     if (d != 0 && std::abs(d * metres_per_unit - p.z()) <= tolerance) ++seen;
   }
   return static_cast<double>(seen) / static_cast<double>(source->samples.size());

@@ -1,12 +1,14 @@
 #include "kartograf/registration/geometric_information.hpp"
 
 #include <cmath>
+#include <optional>
 #include <span>
 #include <vector>
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/QR>
 
+#include "kartograf/geometry/pixel_projection.hpp"
 #include "kartograf/registration/depth_weighted_finder.hpp"
 
 namespace kartograf::registration {
@@ -118,12 +120,10 @@ std::vector<std::uint8_t> overlapping_points(const CloudView& source, const Clou
   for (std::size_t i = 0; i < from.size(); ++i) {
     if (!is_valid(from[i])) continue;
     const Eigen::Vector3f q = motion * from[i].head<3>();
-    if (!(q.z() > 0)) continue;
-    const double u = std::round(camera.fx * q.x() / q.z() + camera.cx);
-    const double v = std::round(camera.fy * q.y() / q.z() + camera.cy);
-    if (u < 0 || v < 0 || u >= camera.width || v >= camera.height) continue;
-    const Point4f& seen =
-        onto[static_cast<std::size_t>(v) * camera.width + static_cast<std::size_t>(u)];
+    const std::optional<Eigen::Vector2i> pixel = geometry::nearest_pixel(camera, q.cast<double>());
+    if (!pixel) continue;
+    const Point4f& seen = onto[static_cast<std::size_t>(pixel->y()) * camera.width +
+                               static_cast<std::size_t>(pixel->x())];
     keep[i] = is_valid(seen) && std::abs(seen.z() - q.z()) <= max_gap_m;
   }
   return keep;
