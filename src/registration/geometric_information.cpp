@@ -107,16 +107,16 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
   return result;
 }
 
-std::vector<std::uint8_t> overlapping_points(const CloudView& source, const CloudView& target,
-                                             const PinholeIntrinsics& camera,
-                                             const Eigen::Isometry3d& source_to_target,
-                                             double max_gap_m) {
+std::vector<ViewRelation> view_relations(const CloudView& source, const CloudView& target,
+                                         const PinholeIntrinsics& camera,
+                                         const Eigen::Isometry3d& source_to_target,
+                                         double max_gap_m) {
   const compute::HostView<Point4f> from = compute::read_on_host(*source.points);
   const compute::HostView<Point4f> onto = compute::read_on_host(*target.points);
   require(onto.size() == static_cast<std::size_t>(camera.width) * camera.height,
-          "overlapping points: the target must be an image of the camera's size");
+          "view relations: the target must be an image of the camera's size");
   const Eigen::Isometry3f motion = source_to_target.cast<float>();
-  std::vector<std::uint8_t> keep(from.size(), 0);
+  std::vector<ViewRelation> relations(from.size(), ViewRelation::unseen);
   for (std::size_t i = 0; i < from.size(); ++i) {
     if (!is_valid(from[i])) continue;
     const Eigen::Vector3f q = motion * from[i].head<3>();
@@ -124,7 +124,24 @@ std::vector<std::uint8_t> overlapping_points(const CloudView& source, const Clou
     if (!pixel) continue;
     const Point4f& seen = onto[static_cast<std::size_t>(pixel->y()) * camera.width +
                                static_cast<std::size_t>(pixel->x())];
-    keep[i] = is_valid(seen) && std::abs(seen.z() - q.z()) <= max_gap_m;
+    if (!is_valid(seen)) continue;
+    const float gap = q.z() - seen.z();
+    relations[i] = std::abs(gap) <= max_gap_m ? ViewRelation::agrees
+                   : gap < 0                  ? ViewRelation::seen_through
+                                              : ViewRelation::hidden;
+  }
+  return relations;
+}
+
+std::vector<std::uint8_t> overlapping_points(const CloudView& source, const CloudView& target,
+                                             const PinholeIntrinsics& camera,
+                                             const Eigen::Isometry3d& source_to_target,
+                                             double max_gap_m) {
+  const std::vector<ViewRelation> relations =
+      view_relations(source, target, camera, source_to_target, max_gap_m);
+  std::vector<std::uint8_t> keep(relations.size(), 0);
+  for (std::size_t i = 0; i < relations.size(); ++i) {
+    keep[i] = relations[i] == ViewRelation::agrees;
   }
   return keep;
 }

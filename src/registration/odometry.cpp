@@ -601,7 +601,7 @@ bool RgbdOdometry::agrees_better(const Attempt& challenger, const Attempt& incum
            challenger.photometric_rmse <
                params_.feature_arbitration_ratio * incumbent.photometric_rmse;
   }
-  return challenger.report.fitness > incumbent.report.fitness;
+  return fits_better(frames_.size() - 1, challenger, incumbent);
 }
 
 std::optional<bool> RgbdOdometry::speed_decides(const Attempt& challenger,
@@ -706,7 +706,15 @@ bool RgbdOdometry::better_start(std::size_t target, Attempt& other, Attempt& bes
     }
     if (const std::optional<bool> decided = images_decide(target, other, best)) return *decided;
   }
-  return other.report.fitness > best.report.fitness;
+  return fits_better(target, other, best);
+}
+
+bool RgbdOdometry::fits_better(std::size_t target, const Attempt& challenger,
+                               const Attempt& incumbent) {
+  if (params_.fitness_weighed_by_view && !within_arbitration(challenger, incumbent)) {
+    return view_weighed_fitness(target, challenger) > view_weighed_fitness(target, incumbent);
+  }
+  return challenger.report.fitness > incumbent.report.fitness;
 }
 
 std::vector<Eigen::Isometry3d> RgbdOdometry::starts_from_turn(
@@ -799,6 +807,24 @@ RgbdOdometry::Attempt RgbdOdometry::judged_on_the_overlap(const Eigen::Isometry3
     return attempt;
   }
   return degenerate;
+}
+
+double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& attempt) {
+  // Shares of the points mapped onto the other frame's surfaces (information_level_): those
+  // within the coarsest ICP level's pair distance of them, against those where that camera saw
+  // past them to a surface behind.
+  const PyramidLevel& source = pyramid_of(frames_.size()).level(information_level_);
+  const PyramidLevel& onto = pyramid_of(target).level(information_level_);
+  const std::vector<ViewRelation> relations =
+      view_relations(source.view(), onto.view(), onto.camera, attempt.motion,
+                     params_.icp.levels.back().max_distance);
+  const auto count = [&](ViewRelation r) {
+    return static_cast<double>(std::count(relations.begin(), relations.end(), r));
+  };
+  const double agreeing = count(ViewRelation::agrees);
+  const double contradicting = count(ViewRelation::seen_through);
+  if (agreeing + contradicting == 0) return 0;
+  return attempt.report.fitness * agreeing / (agreeing + contradicting);
 }
 
 GeometricInformation RgbdOdometry::overlap_geometry(std::size_t current, std::size_t target,

@@ -46,6 +46,18 @@ GeometricInformation geometric_information(const CloudView& cloud, double refere
                                            double min_eigenvalue_ratio,
                                            std::span<const std::uint8_t> keep = {});
 
+// Where `source_to_target` puts a point of `source` (a frame's pyramid level) in the view of
+// `target` (the same level of another frame, an image of `camera`'s size): outside it or onto a
+// pixel without depth (unseen); within max_gap_m of the pixel's depth along the view axis
+// (agrees); nearer than that, where the target camera saw a surface behind it, which the point
+// would have hidden (seen_through: the motion contradicts the target's view); or farther (hidden
+// behind what the target saw: no contradiction).
+enum class ViewRelation : std::uint8_t { unseen, agrees, seen_through, hidden };
+std::vector<ViewRelation> view_relations(const CloudView& source, const CloudView& target,
+                                         const PinholeIntrinsics& camera,
+                                         const Eigen::Isometry3d& source_to_target,
+                                         double max_gap_m);
+
 // The points of `source` (a frame's pyramid level) that `source_to_target` maps into the view of
 // `target` (the same level of another frame, an image of `camera`'s size): they land inside the
 // image on a pixel with depth, within max_gap_m of it along the view axis. What a registration of
