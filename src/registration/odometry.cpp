@@ -810,14 +810,11 @@ RgbdOdometry::Attempt RgbdOdometry::judged_on_the_overlap(const Eigen::Isometry3
 }
 
 double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& attempt) {
-  // Shares of the points mapped onto the other frame's surfaces (information_level_): those
-  // within the coarsest ICP level's pair distance of them, against those where that camera saw
-  // past them to a surface behind.
-  const PyramidLevel& source = pyramid_of(frames_.size()).level(information_level_);
-  const PyramidLevel& onto = pyramid_of(target).level(information_level_);
+  // Shares of the points mapped onto the other frame's surfaces: those within the overlap's
+  // gap of them, against those where that camera saw past them to a surface behind.
+  const auto [source, onto] = information_levels(frames_.size(), target);
   const std::vector<ViewRelation> relations =
-      view_relations(source.view(), onto.view(), onto.camera, attempt.motion,
-                     params_.icp.levels.back().max_distance);
+      view_relations(source.view(), onto.view(), onto.camera, attempt.motion, overlap_gap_m());
   const auto count = [&](ViewRelation r) {
     return static_cast<double>(std::count(relations.begin(), relations.end(), r));
   };
@@ -829,11 +826,21 @@ double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& att
 
 GeometricInformation RgbdOdometry::overlap_geometry(std::size_t current, std::size_t target,
                                                     const Eigen::Isometry3d& motion) {
-  const PyramidLevel& source = pyramid_of(current).level(information_level_);
-  const PyramidLevel& onto = pyramid_of(target).level(information_level_);
-  const std::vector<std::uint8_t> keep = overlapping_points(
-      source.view(), onto.view(), onto.camera, motion, params_.icp.levels.back().max_distance);
+  const auto [source, onto] = information_levels(current, target);
+  const std::vector<std::uint8_t> keep =
+      overlapping_points(source.view(), onto.view(), onto.camera, motion, overlap_gap_m());
   return level_geometry(source.view(), keep);
+}
+
+std::pair<const PyramidLevel&, const PyramidLevel&> RgbdOdometry::information_levels(
+    std::size_t current, std::size_t target) {
+  return {pyramid_of(current).level(information_level_),
+          pyramid_of(target).level(information_level_)};
+}
+
+double RgbdOdometry::overlap_gap_m() const {
+  // The coarsest ICP level's pair distance: what a registration of the two frames can still match.
+  return params_.icp.levels.back().max_distance;
 }
 
 GeometricInformation RgbdOdometry::level_geometry(const CloudView& level,

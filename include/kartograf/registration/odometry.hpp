@@ -44,6 +44,7 @@
 #include <optional>
 #include <span>
 #include <string_view>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -462,6 +463,12 @@ class RgbdOdometry {
   // frame `target` (both at the information level).
   GeometricInformation overlap_geometry(std::size_t current, std::size_t target,
                                         const Eigen::Isometry3d& motion);
+  // Frames `current`'s and `target`'s pyramid levels of the geometric information, on which what
+  // the two frames share is judged (overlap_geometry, view_weighed_fitness), and the depth gap
+  // within which a point counts as on the other frame's surface there.
+  std::pair<const PyramidLevel&, const PyramidLevel&> information_levels(std::size_t current,
+                                                                         std::size_t target);
+  double overlap_gap_m() const;
   // The geometric information of an information-level cloud (of the points `keep` marks; empty:
   // all) with the odometry's depth weights and degeneracy threshold.
   GeometricInformation level_geometry(const CloudView& level,
