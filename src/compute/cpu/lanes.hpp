@@ -25,6 +25,33 @@ Vector select(LaneMask mask, Vector a, Vector b) {
                                   (~mask & reinterpret_cast<LaneMask>(b)));
 }
 
+// Per lane std::min(a, b) (b < a ? b : a) and std::max(a, b) (a < b ? b : a), NaN lanes
+// included: SSE's own instructions where there are (they choose the same way), else a select.
+inline Lanes min_of(Lanes a, Lanes b) {
+#if defined(__SSE__)
+  return __builtin_ia32_minps(b, a);  // b < a ? b : a
+#else
+  return select(b < a, b, a);
+#endif
+}
+inline Lanes max_of(Lanes a, Lanes b) {
+#if defined(__SSE__)
+  return __builtin_ia32_maxps(b, a);  // b > a ? b : a
+#else
+  return select(a < b, b, a);
+#endif
+}
+
+// The last lane of `previous` followed by the first three of `next`: each lane's left neighbour
+// along a row read four at a time.
+inline Lanes shift_in(Lanes previous, Lanes next) {
+#if defined(__clang__)
+  return __builtin_shufflevector(previous, next, 3, 4, 5, 6);
+#else
+  return __builtin_shuffle(previous, next, LaneMask{3, 4, 5, 6});
+#endif
+}
+
 // Four points of four floats each (x, y, z, w), as read from memory, turned into their x, y and z
 // lanes (w dropped): a 4 x 4 transpose in six shuffles instead of twelve lane inserts.
 struct XyzLanes {
