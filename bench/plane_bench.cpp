@@ -1,7 +1,8 @@
 // kartograf_plane_bench: Kartograf's plane extraction in both modes (regions: the M1 paper's Lab
 // growing; cells: planar cells first) on the plane benchmark's frames, with each mode's time, its
 // parts and its quality figures (docs/benchmarks.md "Planes"). The same frames, scoring and tables
-// as kartograf_peer_bench's plane part, without the peers (no Open3D or PCL needed).
+// as kartograf_peer_bench's plane part, without its peers (no Open3D or PCL needed); with CAPE
+// beside them when built with KARTOGRAF_CAPE_DIR (scripts/fetch-cape.sh).
 #include <chrono>
 #include <cstdlib>
 #include <exception>
@@ -14,6 +15,7 @@
 #include "peer/peer_methods.hpp"
 #include "peer/peer_timing.hpp"
 #include "peer/plane_bench.hpp"
+#include "peer/plane_methods.hpp"
 
 int main(int argc, char** argv) {
   using kartograf::peer::PlaneBenchOptions;
@@ -42,6 +44,9 @@ int main(int argc, char** argv) {
   app.add_flag("--details", options.details, "Every frame's time and scores on stderr");
   app.add_option("--only", options.only, "Only methods whose name contains this");
   CLI11_PARSE(app, argc, argv);
+#ifdef KARTOGRAF_WITH_CAPE
+  options.peers = kartograf::peer::cape_plane_methods();
+#endif
   try {
     const auto start = std::chrono::steady_clock::now();
     std::cout << "# Kartograf plane benchmark\n\n- machine: " << kartograf::peer::cpu_model()

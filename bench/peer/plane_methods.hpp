@@ -60,4 +60,8 @@ std::vector<PlaneMethod> pcl_plane_methods();
 // (DetectPlanarPatches appeared in Open3D 0.17; Debian bookworm ships 0.16.)
 std::vector<PlaneMethod> open3d_plane_methods(int max_planes);
 
+// CAPE (pedropro/CAPE) as its example runs it, planes only; only in builds with
+// KARTOGRAF_CAPE_DIR (bench/CMakeLists.txt), which define KARTOGRAF_WITH_CAPE.
+std::vector<PlaneMethod> cape_plane_methods();
+
 }  // namespace kartograf::peer
