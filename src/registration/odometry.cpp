@@ -648,22 +648,25 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
                                                          Attempt first, OdometryFrame& frame) {
   // The pair is the same for every start: the speed bound and the images where they are
   // decisive, else the fitness, choose (better_start); the first stays on a tie.
-  Attempt best = std::move(first);
+  Attempt best = held_on_its_overlap(previous, predicted, std::move(first));
   const auto consider = [&](Attempt other, bool seeded_by_features) {
     if (!better_start(previous, other, best)) return;
     best = std::move(other);
     frame.retried = !seeded_by_features;
     frame.from_features = seeded_by_features;
   };
+  const auto from = [&](const Eigen::Isometry3d& start) {
+    return held_on_its_overlap(previous, start,
+                               register_frames(previous, start, frame_limits_now()));
+  };
   for (const Eigen::Isometry3d& start : other_starts(predicted)) {
     if (is_identity(predicted.inverse() * start)) continue;  // where the first one started
-    consider(register_frames(previous, start, frame_limits_now()), false);
+    consider(from(start), false);
   }
   if (std::optional<Attempt> seeded = register_from_features()) consider(std::move(*seeded), true);
   if (params_.recheck_from_turn && best.report.accepted()) {
-    for (const Eigen::Isometry3d& start : starts_from_turn(best.motion)) {
-      consider(register_frames(previous, start, frame_limits_now()), false);
-    }
+    for (const Eigen::Isometry3d& start : starts_from_turn(best.motion))
+      consider(from(start), false);
   }
   return best;
 }
@@ -807,6 +810,27 @@ RgbdOdometry::Attempt RgbdOdometry::judged_on_the_overlap(const Eigen::Isometry3
     return attempt;
   }
   return degenerate;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::held_on_its_overlap(std::size_t previous,
+                                                        const Eigen::Isometry3d& start,
+                                                        Attempt attempt) {
+  if (!params_.overlap_every_start || params_.overlap_turn_deg <= 0 || !attempt.report.accepted() ||
+      geometry_.degeneracy.degenerate ||
+      se3::rotation_angle(attempt.motion) <= params_.overlap_turn_deg * kDegree) {
+    return attempt;
+  }
+  GeometricInformation overlap = overlap_geometry(frames_.size(), previous, attempt.motion);
+  if (!overlap.degeneracy.degenerate) return attempt;
+  // From the same start as a degenerate view: the prior holds what the shared part leaves free.
+  GeometricInformation whole_frame = std::exchange(geometry_, std::move(overlap));
+  Attempt held = register_frames(previous, start, frame_limits_now());
+  geometry_ = std::move(whole_frame);
+  // Unless the images side with ICP's own answer (judged_on_the_overlap's test).
+  if (!held.report.accepted() || images_decide(previous, attempt, held).value_or(false)) {
+    return attempt;
+  }
+  return held;
 }
 
 double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& attempt) {
