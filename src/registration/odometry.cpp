@@ -665,8 +665,9 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
   }
   if (std::optional<Attempt> seeded = register_from_features()) consider(std::move(*seeded), true);
   if (params_.recheck_from_turn && best.report.accepted()) {
-    for (const Eigen::Isometry3d& start : starts_from_turn(best.motion))
+    for (const Eigen::Isometry3d& start : starts_from_turn(best.motion)) {
       consider(from(start), false);
+    }
   }
   return best;
 }
@@ -780,13 +781,23 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   geometry_ = whole_frame;
 }
 
+bool RgbdOdometry::turns_wide_on_a_constrained_view(const Attempt& attempt) const {
+  return params_.overlap_turn_deg > 0 && attempt.report.accepted() &&
+         !geometry_.degeneracy.degenerate &&
+         se3::rotation_angle(attempt.motion) > params_.overlap_turn_deg * kDegree;
+}
+
+bool RgbdOdometry::overlap_answer_stands(std::size_t previous, Attempt& first,
+                                         Attempt& held) const {
+  // Unless the images side with the first answer: at seed 4's frame 920 (a turn on the spot)
+  // the images measured the degenerate view's free directions 3.5 cm and 1.1 degrees off, where
+  // the first answer, from the turn on the spot, fitted them at an RMSE of 1.2.
+  return held.report.accepted() && !images_decide(previous, first, held).value_or(false);
+}
+
 RgbdOdometry::Attempt RgbdOdometry::judged_on_the_overlap(const Eigen::Isometry3d& predicted,
                                                           OdometryFrame& frame, Attempt attempt) {
-  if (params_.overlap_turn_deg <= 0 || !attempt.report.accepted() ||
-      geometry_.degeneracy.degenerate ||
-      se3::rotation_angle(attempt.motion) <= params_.overlap_turn_deg * kDegree) {
-    return attempt;
-  }
+  if (!turns_wide_on_a_constrained_view(attempt)) return attempt;
   GeometricInformation overlap = overlap_geometry(frame.index, frame.index - 1, attempt.motion);
   if (!overlap.degeneracy.degenerate) return attempt;
   // Registered again as a degenerate view: its free directions from the prior and the images.
@@ -798,12 +809,7 @@ RgbdOdometry::Attempt RgbdOdometry::judged_on_the_overlap(const Eigen::Isometry3
   frame.retried = frame.from_features = false;
   speed_bound_decided_ = false;
   Attempt degenerate = attempt_previous(predicted, frame);
-  const std::size_t previous = frame.index - 1;
-  // Unless the images side with the first answer: at seed 4's frame 920 (a turn on the spot)
-  // the images measured the degenerate view's free directions 3.5 cm and 1.1 degrees off, where
-  // the first answer, from the turn on the spot, fitted them at an RMSE of 1.2.
-  if (!degenerate.report.accepted() ||
-      images_decide(previous, attempt, degenerate).value_or(false)) {
+  if (!overlap_answer_stands(frame.index - 1, attempt, degenerate)) {
     geometry_ = std::move(whole_frame);
     frame = as_constrained;
     speed_bound_decided_ = speed_decided;
@@ -815,22 +821,14 @@ RgbdOdometry::Attempt RgbdOdometry::judged_on_the_overlap(const Eigen::Isometry3
 RgbdOdometry::Attempt RgbdOdometry::held_on_its_overlap(std::size_t previous,
                                                         const Eigen::Isometry3d& start,
                                                         Attempt attempt) {
-  if (!params_.overlap_every_start || params_.overlap_turn_deg <= 0 || !attempt.report.accepted() ||
-      geometry_.degeneracy.degenerate ||
-      se3::rotation_angle(attempt.motion) <= params_.overlap_turn_deg * kDegree) {
-    return attempt;
-  }
+  if (!params_.overlap_every_start || !turns_wide_on_a_constrained_view(attempt)) return attempt;
   GeometricInformation overlap = overlap_geometry(frames_.size(), previous, attempt.motion);
   if (!overlap.degeneracy.degenerate) return attempt;
   // From the same start as a degenerate view: the prior holds what the shared part leaves free.
   GeometricInformation whole_frame = std::exchange(geometry_, std::move(overlap));
   Attempt held = register_frames(previous, start, frame_limits_now());
   geometry_ = std::move(whole_frame);
-  // Unless the images side with ICP's own answer (judged_on_the_overlap's test).
-  if (!held.report.accepted() || images_decide(previous, attempt, held).value_or(false)) {
-    return attempt;
-  }
-  return held;
+  return overlap_answer_stands(previous, attempt, held) ? held : attempt;
 }
 
 double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& attempt) {

@@ -466,6 +466,12 @@ class RgbdOdometry {
   // (OdometryParams::overlap_turn_deg), and registered again where that part is degenerate.
   Attempt judged_on_the_overlap(const Eigen::Isometry3d& predicted, OdometryFrame& frame,
                                 Attempt attempt);
+  // Whether `attempt` is judged on what the frames share: accepted, turning by more than
+  // overlap_turn_deg, on a view the whole frame constrains.
+  bool turns_wide_on_a_constrained_view(const Attempt& attempt) const;
+  // Whether `held`, registered again as a degenerate view, replaces `first`: accepted, and the
+  // images do not side with `first`.
+  bool overlap_answer_stands(std::size_t previous, Attempt& first, Attempt& held) const;
   // One of a doubtful registration's answers, ICP from `start`, held on its shared part
   // (OdometryParams::overlap_every_start).
   Attempt held_on_its_overlap(std::size_t previous, const Eigen::Isometry3d& start,
