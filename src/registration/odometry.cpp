@@ -473,16 +473,19 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
       attempt.scanned = true;
     }
   }
+  // A large motion on a constrained view: a settled answer may still be a neighbouring basin's.
+  const bool recheck_large =
+      params_.recheck_large_motions && is_large(predicted) && !geometry_.degeneracy.degenerate;
   if (seeded) {
     if (keeps_prediction(attempt, *seeded)) {
-      if (params_.recheck_after_features && is_doubtful(attempt))
+      if (params_.recheck_after_features && (is_doubtful(attempt) || recheck_large))
         return best_of_other_starts(previous, predicted, std::move(attempt), frame);
       return attempt;
     }
     frame.from_features = true;
     return std::move(*seeded);
   }
-  if (is_doubtful(attempt)) {
+  if (is_doubtful(attempt) || recheck_large) {
     return best_of_other_starts(previous, predicted, std::move(attempt), frame);
   }
   if (images_left_open(attempt)) {
