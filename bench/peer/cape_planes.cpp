@@ -101,12 +101,11 @@ std::vector<PlaneMethod> cape_plane_methods() {
       "50 mm, no cylinders; timed: organizePointCloudByCell + process";
   method.prepare = [detectors](const PlaneFrame& frame) {
     const int width = frame.points.width(), height = frame.points.height();
-    auto& detector = (*detectors)[{width, height}];
-    // Made untimed on first use; CAPE needs whole cells.
-    if (width % kCell != 0 || height % kCell != 0) {
+    if (width % kCell != 0 || height % kCell != 0) {  // CAPE needs whole cells
       throw std::invalid_argument("CAPE needs an image size that is a multiple of 20 pixels");
     }
-    if (!detector) detector = std::make_unique<Detector>(width, height);
+    auto& detector = (*detectors)[{width, height}];
+    if (!detector) detector = std::make_unique<Detector>(width, height);  // untimed, once
     auto prepared = std::make_shared<Prepared>();
     prepared->cloud = millimetre_cloud(frame);
     Detector* d = detector.get();
