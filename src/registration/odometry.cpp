@@ -464,6 +464,8 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   // weighed against the features: by fitness they picked wrong turns in rooms that look alike.
   std::optional<Attempt> seeded;
   if (is_large(predicted)) seeded = register_from_features();
+  // On a degenerate view their step may be a tile over where their turn is right.
+  if (seeded) seeded = features_turn_on_the_arc(predicted, std::move(*seeded));
   Attempt attempt = accelerating_if_better(
       frame.step_frame, predicted, register_frames(previous, predicted, frame_limits_now()));
   if (images_left_open(attempt)) {
@@ -980,6 +982,29 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::register_from_features() {
       register_frames(frames_.size() - 1, aligned->source_to_target, frame_limits_now());
   if (!attempt.report.accepted()) return {};
   return attempt;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::features_turn_on_the_arc(const Eigen::Isometry3d& predicted,
+                                                             Attempt seeded) {
+  if (!params_.features_turn_on_the_arc || !geometry_.degeneracy.degenerate) return seeded;
+  const Eigen::Vector3d travel = travel_on_arc(seeded.motion);
+  if (travel.squaredNorm() == 0) return seeded;
+  Eigen::Isometry3d start = seeded.motion;
+  start.translation() = predicted.translation().norm() * travel;
+  Attempt on_the_arc = register_frames(frames_.size() - 1, start, frame_limits_now());
+  return agrees_better(on_the_arc, seeded) ? on_the_arc : seeded;
+}
+
+Eigen::Vector3d RgbdOdometry::travel_on_arc(const Eigen::Isometry3d& step) const {
+  if (heading_prior_.ready()) return heading_prior_.travel_on(step);
+  const auto half_turn = [](const Eigen::Isometry3d& motion) {
+    const Eigen::AngleAxisd turn(motion.linear());
+    return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis());
+  };
+  const Eigen::Isometry3d last = predict(StepFrame::camera);
+  const Eigen::Vector3d heading = half_turn(last).inverse() * last.translation();
+  if (heading.norm() < 1e-3) return Eigen::Vector3d::Zero();  // a turn on the spot: no heading
+  return half_turn(step) * heading.normalized();
 }
 
 void RgbdOdometry::keep_images_for_features(const DepthImage& depth, const RgbImage* color) {
