@@ -302,6 +302,7 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
       attempt.photometric = true;
     }
     attempt.photometric_rmse = attempt.photometric ? refined.rmse_after : refined.rmse_before;
+    attempt.refined_rmse = refined.rmse_after;
   }
   return attempt;
 }
@@ -689,6 +690,9 @@ double RgbdOdometry::images_rmse_at(std::size_t target, Attempt& attempt) const 
   if (attempt.start_rmse < 0) {
     const std::vector<double> rmse = images_rmse(target, {&attempt.motion, 1});
     attempt.start_rmse = rmse.empty() ? 0 : rmse[0];
+    if (params_.recheck_images_refined && attempt.start_rmse > 0 && attempt.refined_rmse > 0) {
+      attempt.start_rmse = std::min(attempt.start_rmse, attempt.refined_rmse);
+    }
   }
   return attempt.start_rmse;
 }
