@@ -294,22 +294,22 @@ const Counterfactual kCounterfactuals[] = {
     {"ALargeMotionIsCheckedAgainstTheOtherStarts", 100, 32, 30,
      [](registration::OdometryParams& p) { p.recheck_large_motions = false; }, 0.05, 0.15, 4, 1, 5,
      true},
-    // Seed 8's survey, frames 0-70 as `kartograf synth` writes them and with the map's features:
-    // the robot drives at 0.84-0.89 m a frame over a tiled floor towards a wall beyond the depth
-    // range and sets off on a turn, 26 degrees and 0.72 m into frame 60. The features found the
-    // turn with a step of 0.42 m half sideways, which the speed bound refused, and ICP from the
-    // prediction went straight on. From the features' turn with the predicted step along its arc
-    // the turn is found; the step's length, which the view leaves free, stays the prediction's
-    // (17 cm long: the robot slowed down), so the turn's error is checked.
     // Seed 3's survey, frames 0-200 as `kartograf synth` writes them and with the map's features:
     // the robot turns on the spot, 36 degrees a frame, towards a striped wall. Into frame 190 ICP
     // from the prediction finds the turn at a fitness of 0.29 (a grey-level RMSE of 13.8 there,
     // 6.9 once refined; the refinement is refused for its spread, on the 500 pixels the frames
     // share) and rest wins at 0.495 (RMSE 22.0 however refined). Judged after their refinement,
-    // the images decide for the turn.
+    // the images decide for the turn. A turn on the spot: the turn's error is checked.
     {"ATurnIsJudgedByItsImagesAfterTheirRefinement", 0, 21, 18,
      [](registration::OdometryParams& p) { p.recheck_images_refined = false; }, 0.05, 0, 3, 1, 10,
      true},
+    // Seed 8's survey, frames 0-70 as `kartograf synth` writes them and with the map's features:
+    // the robot drives at 0.84-0.89 m a frame over a tiled floor, in a degenerate view, and sets
+    // off on a turn, 26 degrees and 0.72 m into frame 60. The features found the
+    // turn with a step of 0.42 m half sideways, which the speed bound refused, and ICP from the
+    // prediction went straight on. From the features' turn with the predicted step along its arc
+    // the turn is found; the step's length, which the view leaves free, stays the prediction's
+    // (17 cm long: the robot slowed down), so the turn's error is checked.
     {"TheFeaturesTurnIsTriedOnItsArc", 0, 8, 5,
      [](registration::OdometryParams& p) { p.features_turn_on_the_arc = false; }, 0.2, 0.2, 8, 1,
      10, true},
