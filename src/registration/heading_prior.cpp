@@ -9,16 +9,19 @@ namespace {
 
 constexpr double kKeep = 0.95;  // decay per learned step: about the last 20 steps
 
-// The step's translation with half its turn undone: on an arc of constant curvature, the
-// direction of travel at no turn.
+constexpr double kVarianceFloor = 1e-12;  // m^2: a spread of nothing is no reason to divide by 0
+
+}  // namespace
+
 Eigen::Vector3d untwisted(const Eigen::Isometry3d& step) {
   const Eigen::AngleAxisd turn(step.linear());
   return Eigen::AngleAxisd(-0.5 * turn.angle(), turn.axis()) * step.translation();
 }
 
-constexpr double kVarianceFloor = 1e-12;  // m^2: a spread of nothing is no reason to divide by 0
-
-}  // namespace
+Eigen::Vector3d travel_on_arc(const Eigen::Vector3d& heading, const Eigen::Isometry3d& step) {
+  const Eigen::AngleAxisd turn(step.linear());
+  return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()) * heading.normalized();
+}
 
 void HeadingPrior::learn(const Eigen::Isometry3d& step) {
   const Eigen::Vector3d travel = untwisted(step);
@@ -34,8 +37,7 @@ void HeadingPrior::learn(const Eigen::Isometry3d& step) {
 
 Eigen::Vector3d HeadingPrior::travel_on(const Eigen::Isometry3d& step) const {
   if (heading_.squaredNorm() == 0) return Eigen::Vector3d::Zero();
-  const Eigen::AngleAxisd turn(step.linear());
-  return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis()) * heading_.normalized();
+  return travel_on_arc(heading_, step);
 }
 
 bool HeadingPrior::ready() const {

@@ -1001,14 +1001,9 @@ RgbdOdometry::Attempt RgbdOdometry::features_turn_on_the_arc(const Eigen::Isomet
 
 Eigen::Vector3d RgbdOdometry::travel_on_arc(const Eigen::Isometry3d& step) const {
   if (heading_prior_.ready()) return heading_prior_.travel_on(step);
-  const auto half_turn = [](const Eigen::Isometry3d& motion) {
-    const Eigen::AngleAxisd turn(motion.linear());
-    return Eigen::AngleAxisd(0.5 * turn.angle(), turn.axis());
-  };
-  const Eigen::Isometry3d last = predict(StepFrame::camera);
-  const Eigen::Vector3d heading = half_turn(last).inverse() * last.translation();
+  const Eigen::Vector3d heading = untwisted(predict(StepFrame::camera));
   if (heading.norm() < 1e-3) return Eigen::Vector3d::Zero();  // a turn on the spot: no heading
-  return half_turn(step) * heading.normalized();
+  return registration::travel_on_arc(heading, step);
 }
 
 void RgbdOdometry::keep_images_for_features(const DepthImage& depth, const RgbImage* color) {

@@ -18,6 +18,14 @@
 
 namespace kartograf::registration {
 
+// A step's translation with half its turn undone: on an arc of constant curvature, the direction
+// of travel at no turn (camera frame of the step's start).
+Eigen::Vector3d untwisted(const Eigen::Isometry3d& step);
+
+// The unit direction of travel on `step`'s arc: `heading` (the direction at no turn) turned by
+// half the step's turn.
+Eigen::Vector3d travel_on_arc(const Eigen::Vector3d& heading, const Eigen::Isometry3d& step);
+
 class HeadingPrior {
  public:
   // One step (T_{n-1}^-1 T_n, camera frames) of a frame whose geometry measured every direction.
