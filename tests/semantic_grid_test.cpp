@@ -903,6 +903,47 @@ TEST(SemanticGrid, WallFacesMoveUnderFurnitureStandingAgainstThem) {
   EXPECT_EQ(behind, probes);
 }
 
+// Such a room with a door leaf standing open 1 cm in front of its south wall, 4 cm thick: its face
+// to the room lies 5 cm from the wall's, on a cell boundary once the lattice follows the wall, and
+// the face's noise (2 cm: seen from 3-4 m) puts its points in the cells on both sides of it, too
+// many of them beyond the spill's margin for the spill to free the cell in front. By each cell's
+// points the leaf is two cells thick; measured along the leaf, its face leaves the cell in front of
+// it on the floor and the leaf one cell, as it stands.
+TEST(SemanticGrid, DoorLeavesAreAsThickAsTheirFacesSay) {
+  using C = SemanticClass;
+  constexpr double kWest = 0.512, kEast = 4.012, kSouth = 0.512, kNorth = 3.012;
+  constexpr double kLeafX0 = 1.5, kLeafX1 = 2.4, kLeafFace = kSouth + 0.05;
+  LabelledPoints s = noisy_room({kWest, kSouth}, {kEast, kNorth}, 0.006, 5);
+  s.box_face({kWest, kSouth, 0}, {kEast, kNorth, 0}, C::floor, 0.01);  // the floor seen again
+  LabelledPoints leaf;
+  leaf.box_face({kLeafX0, kLeafFace, 0.02}, {kLeafX1, kLeafFace, 1.4}, C::door, 0.01);
+  std::mt19937 rng(9);
+  std::normal_distribution<double> noise(0.0, 0.02);
+  for (const Eigen::Vector3d& p : leaf.points)
+    s.add(p + Eigen::Vector3d(0, noise(rng), 0), C::door);
+  // Leaf cells at the wall (2.5 cm from its face) and in front of the leaf (7.5 cm), along the
+  // leaf away from its ends.
+  const auto count = [&](const SemanticGrid& grid) {
+    int at_wall = 0, in_front = 0, probes = 0;
+    for (double x = kLeafX0 + 0.1; x < kLeafX1 - 0.1; x += 0.05, ++probes) {
+      const Eigen::Vector2i a = grid.cell_of({x, kSouth + 0.025});
+      const Eigen::Vector2i b = grid.cell_of({x, kSouth + 0.075});
+      at_wall += grid.classes(a.x(), a.y()) == C::door;
+      in_front += grid.classes(b.x(), b.y()) == C::door;
+    }
+    return std::tuple{at_wall, in_front, probes};
+  };
+  const auto [at_wall, in_front, probes] = count(build_semantic_grid(s.points, s.labels));
+  EXPECT_EQ(at_wall, probes);
+  EXPECT_EQ(in_front, 0) << "of " << probes << " cells in front of the leaf";
+  SemanticGridParams off;
+  off.place_leaf_faces = false;
+  const auto [off_at_wall, off_in_front, off_probes] =
+      count(build_semantic_grid(s.points, s.labels, off));
+  EXPECT_EQ(off_at_wall, off_probes);
+  EXPECT_GT(off_in_front, off_probes / 2) << "of " << off_probes << " cells, without the faces";
+}
+
 // The doorways found across a 1.4 m corridor that two rooms' dividers meet at a T from either
 // side, the north one `offset` metres east of the south one; `ragged`: each corridor wall is unseen
 // for 0.1 m beside the divider that meets it (as mapped: a wall breaks up at a junction).

@@ -6,8 +6,8 @@
 #include <optional>
 #include <utility>
 
+#include "semantic/grid_band_points.hpp"
 #include "semantic/grid_cells.hpp"
-#include "semantic/grid_wall_points.hpp"
 #include "semantic/quantile.hpp"
 
 namespace kartograf::semantic::detail {
@@ -62,7 +62,7 @@ double reveal_distance(std::vector<double>& along) {
 // straddle the faces): the reveals bound it along the wall, the faces (and the reveals, which
 // span the wall) across it. Empty when either jamb has too few points or the result is no
 // plausible doorway.
-std::optional<Opening> measure_jambs(const SemanticGrid& grid, const WallPointIndex& walls,
+std::optional<Opening> measure_jambs(const SemanticGrid& grid, const BandPointIndex& walls,
                                      const Eigen::Vector2d& centre, const Eigen::Vector2d& u,
                                      double width, const SemanticGridParams& options) {
   constexpr double kInside = 0.1;  // jamb points may lie this far inside the cells' opening
@@ -322,7 +322,7 @@ std::optional<std::pair<double, double>> wall_rows_beside(
 }
 
 // The doorway of one (merged) gap: its cells become door cells and a doorway object.
-void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const WallPointIndex& walls,
+void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const BandPointIndex& walls,
                  const WallGap& gap, int& doorway_count, const AddObject& add_object) {
   const double res = grid.resolution;
   const Eigen::Vector2d centre = 0.5 * (gap.a + gap.b);
@@ -355,7 +355,7 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Wa
 }  // namespace
 
 void add_gap_doorways(SemanticGrid& grid, const SemanticGridParams& options,
-                      const WallPointIndex& walls, const std::vector<int>& wall_ids,
+                      const BandPointIndex& walls, const std::vector<int>& wall_ids,
                       const AddObject& add_object) {
   int doorway_count = 0;
   for (const WallGap& gap : merge_face_gaps(find_wall_gaps(grid, options, wall_ids), options))

@@ -9,7 +9,7 @@
 #include <Eigen/Core>
 
 #include "kartograf/semantic/semantic_grid.hpp"
-#include "semantic/grid_wall_points.hpp"
+#include "semantic/grid_band_points.hpp"
 
 namespace kartograf::semantic::detail {
 
@@ -23,7 +23,7 @@ using AddObject = std::function<SemanticObject&(ObjectKind, SemanticClass, const
 // cells; its opening is measured on the wall points in the height band (`walls`) where enough
 // are there.
 void add_gap_doorways(SemanticGrid& grid, const SemanticGridParams& options,
-                      const WallPointIndex& walls, const std::vector<int>& wall_ids,
+                      const BandPointIndex& walls, const std::vector<int>& wall_ids,
                       const AddObject& add_object);
 
 }  // namespace kartograf::semantic::detail

@@ -29,10 +29,10 @@ Boundary boundary_between(const SemanticGrid& grid, const Eigen::Vector2i& wall,
   return {0.5 * (a + b), out, Eigen::Vector2d(-out.y(), out.x())};
 }
 
-// The face's offset along `out` from the boundary [m]: the median of the nearby wall points'
+// The face's offset along `out` from the boundary [m]: the median of the nearby points'
 // offsets within a cell of it, twice (from the boundary, then from the first estimate), so that
 // the other face of a thin wall stays out. Empty with too few points.
-std::optional<double> face_offset(const SemanticGrid& grid, const WallPointIndex& walls,
+std::optional<double> face_offset(const SemanticGrid& grid, const BandPointIndex& surface,
                                   const Eigen::Vector2i& wall, const Eigen::Vector2i& step,
                                   const Boundary& b) {
   const double res = grid.resolution;
@@ -42,7 +42,7 @@ std::optional<double> face_offset(const SemanticGrid& grid, const WallPointIndex
     for (int row = -1; row <= 1; ++row) {
       const Eigen::Vector2i c = wall + k * across + row * step;
       if (!grid.contains(c)) continue;
-      for (const Eigen::Vector2d& p : walls.in_cell(c)) offsets.push_back(b.out.dot(p - b.point));
+      for (const Eigen::Vector2d& p : surface.in_cell(c)) offsets.push_back(b.out.dot(p - b.point));
     }
   }
   double face = 0;
@@ -76,7 +76,7 @@ std::optional<SemanticClass> room_in_front(const SemanticGrid& grid, const Eigen
 
 }  // namespace
 
-int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
+int place_wall_faces(SemanticGrid& grid, const BandPointIndex& walls,
                      const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
                      Image<std::uint8_t>& furniture) {
   const double res = grid.resolution;
@@ -103,6 +103,40 @@ int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
           grid.classes(behind.x(), behind.y()) = SemanticClass::wall;
           grid.weight(behind.x(), behind.y()) = weights.of(SemanticClass::wall);
         }
+        ++moved;
+        break;
+      }
+    }
+  }
+  return moved;
+}
+
+int place_leaf_faces(SemanticGrid& grid, const BandPointIndex& doors,
+                     const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
+                     Image<std::uint8_t>& leaf) {
+  const double res = grid.resolution;
+  const auto is_leaf = [&](const Eigen::Vector2i& c) {
+    return grid.contains(c) && leaf(c.x(), c.y()) &&
+           grid.classes(c.x(), c.y()) == SemanticClass::door;
+  };
+  int moved = 0;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      const Eigen::Vector2i c(col, row);
+      if (!is_leaf(c) || !floor_seen(col, row)) continue;
+      for (const Eigen::Vector2i& step : kFourNeighbours) {
+        // Across the leaf: two cells deep along the step, the leaf running on beside c (its end,
+        // judged along the leaf, would measure the end's points as a face and shorten it).
+        const Eigen::Vector2i across(-step.y(), step.x());
+        if (!seen_as(grid, c + step, SemanticClass::floor) || !is_leaf(c - step) ||
+            is_leaf(c - 2 * step) || !(is_leaf(c + across) || is_leaf(c - across)))
+          continue;
+        const std::optional<double> face =
+            face_offset(grid, doors, c, step, boundary_between(grid, c, c + step));
+        if (!face || *face >= -0.5 * res) continue;  // the cell's centre is inside the leaf
+        grid.classes(col, row) = SemanticClass::floor;
+        grid.weight(col, row) = weights.of(SemanticClass::floor);
+        leaf(col, row) = 0;
         ++moved;
         break;
       }

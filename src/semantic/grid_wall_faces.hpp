@@ -1,12 +1,13 @@
 #pragma once
-// The semantic grid's wall faces placed from the wall points (a step of build_semantic_grid): the
-// depth noise spreads a face's points over both cells beside it, so a cell's own points cannot
-// say on which side of it the face lies; the points along a stretch of the face can.
+// The semantic grid's wall faces placed from the wall points, and door leaves' faces from the door
+// points (steps of build_semantic_grid): the depth noise spreads a face's points over both cells
+// beside it, so a cell's own points cannot say on which side of it the face lies; the points along
+// a stretch of the face can.
 #include <cstdint>
 
 #include "kartograf/core/image.hpp"
 #include "kartograf/semantic/semantic_grid.hpp"
-#include "semantic/grid_wall_points.hpp"
+#include "semantic/grid_band_points.hpp"
 
 namespace kartograf::semantic::detail {
 
@@ -17,8 +18,18 @@ namespace kartograf::semantic::detail {
 // and an unseen cell behind it whose centre the wall then covers becomes wall. Two cells of wall
 // (or unseen) stay behind every moved cell. One pass, in scan order: a bulge of noise two cells
 // into the room is judged from its outer cell only. Returns the number of wall cells moved.
-int place_wall_faces(SemanticGrid& grid, const WallPointIndex& walls,
+int place_wall_faces(SemanticGrid& grid, const BandPointIndex& walls,
                      const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
                      Image<std::uint8_t>& furniture);
+
+// A door leaf (a few centimetres thick) whose room-side face lies near a cell boundary puts that
+// face's points in the cells on both sides of it, and comes out two cells thick. Each leaf cell
+// with seen floor in front of it, one more leaf cell behind it and the leaf running on beside it is
+// judged on the leaf's face as a wall cell is on the wall's: a cell whose centre lies on the room's
+// side of the face becomes floor (and leaves `leaf`). The cell behind stays, so a leaf keeps a
+// cell. Returns the cells moved.
+int place_leaf_faces(SemanticGrid& grid, const BandPointIndex& doors,
+                     const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
+                     Image<std::uint8_t>& leaf);
 
 }  // namespace kartograf::semantic::detail

@@ -1225,7 +1225,7 @@ void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& opti
 // The cells no view saw that the seen ones imply (walls' insides and hidden backs, furniture
 // pockets, floor shadows), and the wall faces placed on the wall points.
 void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                           const detail::WallPointIndex& wall_points,
+                           const detail::BandPointIndex& wall_points,
                            const SemanticGridParams& options, ObstacleMasks& masks) {
   const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
   const bool fronts = options.furniture_max_depth > 0 && options.furniture_max_extent > 0;
@@ -1300,6 +1300,17 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   complete_one_sided_walls(grid, options, thickness, max_wall, masks);
 }
 
+// Door leaves one cell thick where their faces say so (before they become objects).
+void place_leaf_faces(SemanticGrid& grid, const Image<CellEvidence>& evidence,
+                      std::span<const Eigen::Vector3d> points,
+                      std::span<const SemanticClass> labels, const SemanticGridParams& options,
+                      ObstacleMasks& masks) {
+  if (!options.place_leaf_faces) return;
+  const detail::BandPointIndex door_points(grid, points, labels, options, SemanticClass::door);
+  detail::place_leaf_faces(grid, door_points, floor_seen(evidence, options), options.weights,
+                           masks.leaf);
+}
+
 }  // namespace
 
 SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
@@ -1345,7 +1356,7 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   if (options.spill_margin > 0) remove_spill(grid, evidence, options, masks.leaf, masks.furniture);
   if (options.remove_isolated_obstacles)
     remove_isolated_obstacles(grid, evidence, options, masks.leaf, masks.furniture);
-  const detail::WallPointIndex wall_points(grid, points, labels, options);
+  const detail::BandPointIndex wall_points(grid, points, labels, options);
 
   const detail::AddObject add_object = [&](ObjectKind kind, SemanticClass label,
                                            const std::string& name,
@@ -1364,6 +1375,7 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
   complete_hidden_cells(grid, evidence, wall_points, options, masks);
+  place_leaf_faces(grid, evidence, points, labels, options, masks);
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);
   join_leftover_wall_cells(grid, evidence, walls);

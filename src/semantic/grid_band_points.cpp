@@ -1,14 +1,14 @@
-#include "semantic/grid_wall_points.hpp"
+#include "semantic/grid_band_points.hpp"
 
 namespace kartograf::semantic::detail {
 
-WallPointIndex::WallPointIndex(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
+BandPointIndex::BandPointIndex(const SemanticGrid& grid, std::span<const Eigen::Vector3d> points,
                                std::span<const SemanticClass> labels,
-                               const SemanticGridParams& options)
+                               const SemanticGridParams& options, SemanticClass indexed)
     : width_(grid.width()), start_(static_cast<std::size_t>(grid.width()) * grid.height() + 1, 0) {
   const auto in_band = [&](std::size_t i) {
     const double h = points[i].z() - grid.floor_z;
-    return labels[i] == SemanticClass::wall && points[i].allFinite() && h >= options.band_min &&
+    return labels[i] == indexed && points[i].allFinite() && h >= options.band_min &&
            h <= options.band_max;
   };
   const auto slot = [&](std::size_t i) {
@@ -26,7 +26,7 @@ WallPointIndex::WallPointIndex(const SemanticGrid& grid, std::span<const Eigen::
   }
 }
 
-std::span<const Eigen::Vector2d> WallPointIndex::in_cell(const Eigen::Vector2i& c) const {
+std::span<const Eigen::Vector2d> BandPointIndex::in_cell(const Eigen::Vector2i& c) const {
   const std::size_t k = static_cast<std::size_t>(c.y()) * width_ + c.x();
   return {points_.data() + start_[k], start_[k + 1] - start_[k]};
 }
