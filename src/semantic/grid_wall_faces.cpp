@@ -125,11 +125,12 @@ int place_leaf_faces(SemanticGrid& grid, const BandPointIndex& doors,
       const Eigen::Vector2i c(col, row);
       if (!is_leaf(c) || !floor_seen(col, row)) continue;
       for (const Eigen::Vector2i& step : kFourNeighbours) {
-        // Across the leaf: two cells deep along the step, the leaf running on beside c (its end,
-        // judged along the leaf, would measure the end's points as a face and shorten it).
+        // Across the leaf: two or three cells deep along the step (the third where the leaf's
+        // points reach into its wall's face cell), the leaf running on beside c (its end, judged
+        // along the leaf, would measure the end's points as a face and shorten it).
         const Eigen::Vector2i across(-step.y(), step.x());
         if (!seen_as(grid, c + step, SemanticClass::floor) || !is_leaf(c - step) ||
-            is_leaf(c - 2 * step) || !(is_leaf(c + across) || is_leaf(c - across)))
+            is_leaf(c - 3 * step) || !(is_leaf(c + across) || is_leaf(c - across)))
           continue;
         const std::optional<double> face =
             face_offset(grid, doors, c, step, boundary_between(grid, c, c + step));

@@ -24,7 +24,7 @@ int place_wall_faces(SemanticGrid& grid, const BandPointIndex& walls,
 
 // A door leaf (a few centimetres thick) whose room-side face lies near a cell boundary puts that
 // face's points in the cells on both sides of it, and comes out two cells thick. Each leaf cell
-// with seen floor in front of it, one more leaf cell behind it and the leaf running on beside it is
+// with seen floor in front of it, one or two more behind it and the leaf running on beside it is
 // judged on the leaf's face as a wall cell is on the wall's: a cell whose centre lies on the room's
 // side of the face becomes floor (and leaves `leaf`). The cell behind stays, so a leaf keeps a
 // cell. Returns the cells moved.

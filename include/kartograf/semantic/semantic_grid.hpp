@@ -87,8 +87,8 @@ struct SemanticGridParams {
   // Wall cells beside floor are judged on the wall's face, measured on the wall points along a
   // stretch of it: a cell whose centre lies on the room's side of the face is floor.
   bool place_wall_faces = true;
-  // Door leaf cells two deep are judged the same way on the leaf's face, measured on the door
-  // points: a leaf is a few centimetres thick, and its face on a cell boundary made it two cells.
+  // Door leaf cells two or three deep are judged the same way on the leaf's face, measured on the
+  // door points: a leaf is a few centimetres thick, and its face on a cell boundary made it two.
   bool place_leaf_faces = true;
   // Furniture outlines (legs, edges: a table top drops out at grazing views) are closed and
   // filled to their convex hull when that is at most this area [m^2]; 0: off.
