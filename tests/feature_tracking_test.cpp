@@ -498,5 +498,51 @@ TEST(FeatureTracking, ALargeLoopCorrectionNeedsTheFeaturesToAgree) {
   EXPECT_EQ(verdict(nullptr, views.frames[2].color), RegistrationVerdict::accepted);
 }
 
+// Where the features are silent (the match's image is plain: nothing to match) a large correction
+// stands on the odometry's uncertainty instead: accepted when the chain between the keyframes
+// could have drifted that far (a 25 cm correction under 30 cm of chain sigma), unconfirmed when
+// it could not (2 cm), and unconfirmed when the caller gives no uncertainty.
+TEST(FeatureTracking, WhereTheFeaturesAreSilentTheOdometrysUncertaintyDecides) {
+  const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
+  const testing::RenderedSequence views =
+      testing::render_sequence({tour[400].pose, tour[404].pose}, kKinect);
+  geometry::DepthRange range;
+  range.units_per_metre = testing::kSynthUnitsPerMetre;
+  mapping::LoopClosureParams params;
+  params.min_frame_gap = 1;
+  params.min_correction_m = 0.1;
+  std::vector<Eigen::Isometry3d> poses = {views.truth[0], views.truth[1]};
+  poses[1] = Eigen::Translation3d(0.2, 0.15, 0) * poses[1];
+  mapping::LoopCandidate candidate;
+  candidate.query = 1;
+  candidate.query_frame = 1;
+  candidate.drift_allowance_m = 0.5;
+  const compute::Context context = compute::Context::cpu();
+  mapping::LoopClosureDetector detector(context, kKinect, range, params, orb());
+  const RgbImage plain(views.frames[0].color.width(), views.frames[0].color.height(),
+                       Rgb8{128, 128, 128});
+  detector.add_keyframe(0, views.frames[0].depth, 0.0, &plain);
+  detector.add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
+  const auto chain_sigma = [](double metres) {
+    return [metres](const mapping::LoopCandidate&) {
+      se3::Matrix6d covariance = se3::Matrix6d::Identity() * 1e-6;
+      covariance.bottomRightCorner<3, 3>() *= metres * metres / 1e-6;
+      return covariance;
+    };
+  };
+  const mapping::LoopClosure drifted = detector.verify(candidate, poses, chain_sigma(0.3));
+  EXPECT_GT(drifted.report.correction_m, params.min_correction_m);
+  EXPECT_EQ(drifted.confirmation, mapping::FeatureConfirmation::silent);
+  EXPECT_EQ(drifted.report.verdict, registration::RegistrationVerdict::accepted);
+  EXPECT_GT(drifted.correction_chi2, 0.0);
+  EXPECT_LT(drifted.correction_chi2, params.max_correction_chi2);
+  const mapping::LoopClosure tight = detector.verify(candidate, poses, chain_sigma(0.02));
+  EXPECT_EQ(tight.report.verdict, registration::RegistrationVerdict::unconfirmed);
+  EXPECT_GT(tight.correction_chi2, params.max_correction_chi2);
+  const mapping::LoopClosure unknown = detector.verify(candidate, poses);
+  EXPECT_EQ(unknown.report.verdict, registration::RegistrationVerdict::unconfirmed);
+  EXPECT_LT(unknown.correction_chi2, 0.0);
+}
+
 }  // namespace
 }  // namespace kartograf

@@ -9,6 +9,7 @@
 #include <string>
 
 #include "kartograf/geometry/pixel_projection.hpp"
+#include "kartograf/mapping/chain_covariance.hpp"
 #include "kartograf/registration/depth_weighted_finder.hpp"
 #include "kartograf/registration/geometric_information.hpp"
 #include "kartograf/registration/projective_association.hpp"
@@ -52,6 +53,22 @@ double view_angle_deg(const Eigen::Isometry3d& a, const Eigen::Isometry3d& b) {
 }
 
 }  // namespace
+
+std::string_view to_string(FeatureConfirmation confirmation) {
+  switch (confirmation) {
+    case FeatureConfirmation::not_asked:
+      return "not_asked";
+    case FeatureConfirmation::agree:
+      return "agree";
+    case FeatureConfirmation::disagree:
+      return "disagree";
+    case FeatureConfirmation::silent:
+      return "silent";
+    case FeatureConfirmation::no_features:
+      return "no_features";
+  }
+  return "unknown";
+}
 
 registration::IcpParams loop_closure_icp_params() {
   registration::IcpParams params;
@@ -236,7 +253,8 @@ std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
 }
 
 LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
-                                        std::span<const Eigen::Isometry3d> poses) {
+                                        std::span<const Eigen::Isometry3d> poses,
+                                        const ExpectedUncertainty& expected_uncertainty) {
   const Keyframe& query = keyframes_.at(candidate.query);
   const Keyframe& match = keyframes_.at(candidate.match);
   require_pose(poses, query.frame);
@@ -259,9 +277,8 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   closure.candidate = candidate;
   closure.report = registration::judge_registration(result, expected, limits, geometry.degeneracy);
   if (closure.report.accepted() && !candidate.by_appearance &&
-      closure.report.correction_m > params_.min_correction_m &&
-      !features_agree(candidate.query, candidate.match, result.source_to_target)) {
-    closure.report.verdict = registration::RegistrationVerdict::unconfirmed;
+      closure.report.correction_m > params_.min_correction_m) {
+    confirm_large_correction(closure, expected, result.source_to_target, expected_uncertainty);
   }
   // Where the query's geometry barely constrains a direction (along a corridor, along the line
   // where a wall meets the floor), ICP slides to answers that fit as well as the right one (on
@@ -285,13 +302,40 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   return closure;
 }
 
-bool LoopClosureDetector::features_agree(std::size_t query, std::size_t match,
-                                         const Eigen::Isometry3d& motion) const {
-  if (!features_ || !archive_->has_features(query) || !archive_->has_features(match)) return true;
+FeatureConfirmation LoopClosureDetector::confirm_by_features(
+    std::size_t query, std::size_t match, const Eigen::Isometry3d& motion) const {
+  if (!features_ || !archive_->has_features(query) || !archive_->has_features(match))
+    return FeatureConfirmation::no_features;
   const std::optional<registration::FeatureAlignment> aligned =
       features_->align(*archive_->at(query)->features, *archive_->at(match)->features);
-  return aligned && (aligned->source_to_target.translation() - motion.translation()).norm() <=
-                        params_.feature_agreement_m;
+  if (!aligned) return FeatureConfirmation::silent;
+  const double apart = (aligned->source_to_target.translation() - motion.translation()).norm();
+  return apart <= params_.feature_agreement_m ? FeatureConfirmation::agree
+                                              : FeatureConfirmation::disagree;
+}
+
+void LoopClosureDetector::confirm_large_correction(
+    LoopClosure& closure, const Eigen::Isometry3d& expected, const Eigen::Isometry3d& motion,
+    const ExpectedUncertainty& expected_uncertainty) const {
+  const LoopCandidate& candidate = closure.candidate;
+  closure.confirmation = confirm_by_features(candidate.query, candidate.match, motion);
+  bool confirmed = closure.confirmation == FeatureConfirmation::agree ||
+                   closure.confirmation == FeatureConfirmation::no_features;
+  if (closure.confirmation == FeatureConfirmation::silent && expected_uncertainty) {
+    // The loop's own error grows with its baseline (baseline_error_fraction).
+    const double fraction = params_.baseline_error_fraction;
+    const double sigma_m =
+        std::max(params_.information.min_sigma, fraction * motion.translation().norm());
+    const double sigma_rad = fraction * se3::rotation_angle(motion);
+    se3::Matrix6d covariance = expected_uncertainty(candidate);
+    se3::Vector6d added;
+    added << Eigen::Vector3d::Constant(sigma_rad * sigma_rad),
+        Eigen::Vector3d::Constant(sigma_m * sigma_m);
+    covariance.diagonal() += added;
+    closure.correction_chi2 = mahalanobis_squared(expected.inverse() * motion, covariance);
+    confirmed = closure.correction_chi2 <= params_.max_correction_chi2;
+  }
+  if (!confirmed) closure.report.verdict = registration::RegistrationVerdict::unconfirmed;
 }
 
 registration::IcpResult LoopClosureDetector::align(const Eigen::Isometry3d& initial) {

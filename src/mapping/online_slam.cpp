@@ -7,6 +7,7 @@
 #include <string>
 
 #include "kartograf/core/error.hpp"
+#include "kartograf/mapping/chain_covariance.hpp"
 
 namespace kartograf::mapping {
 
@@ -244,7 +245,8 @@ class GraphState {
 // both ways is verified once, from the pose estimate), each verified; the accepted ones join the
 // graph. A keyframe the odometry lost (a fallback) is relocalised: any earlier keyframe may match
 // it by appearance. Returns whether any was accepted.
-bool close_loops(LoopClosureDetector& detector, GraphState& state, bool lost,
+bool close_loops(LoopClosureDetector& detector, GraphState& state,
+                 std::span<const registration::RelativePose> odometry_steps, bool lost,
                  const SlamObserver& observer, SlamResult& result) {
   const std::size_t query = detector.keyframe_count() - 1;
   std::vector<LoopCandidate> candidates = detector.find_candidates(query, state.estimate());
@@ -256,10 +258,14 @@ bool close_loops(LoopClosureDetector& detector, GraphState& state, bool lost,
                     [&](const LoopCandidate& other) { return other.match == c.match; });
     if (!known) candidates.push_back(c);
   }
+  // How far the estimate between the two keyframes could have drifted: the odometry chain's.
+  const LoopClosureDetector::ExpectedUncertainty uncertainty = [&](const LoopCandidate& c) {
+    return chain_covariance(odometry_steps, state.estimate(), c.match_frame, c.query_frame);
+  };
   bool closed = false;
   for (const LoopCandidate& candidate : candidates) {
     ++result.loop_candidates;
-    LoopClosure closure = detector.verify(candidate, state.estimate());
+    LoopClosure closure = detector.verify(candidate, state.estimate(), uncertainty);
     if (observer.on_loop_closure) observer.on_loop_closure(closure);
     if (closure.report.accepted()) {
       state.add_loop(closure, result.loop_closures.size());
@@ -352,7 +358,8 @@ SlamStep OnlineSlam::add(const registration::RgbdImages& images) {
   if (s.detector && frame.keyframe) {
     const auto start = Clock::now();
     s.detector->add_keyframe(i, images.depth, s.tracker.path_length(i), color_of(images));
-    step.optimised = close_loops(*s.detector, s.graph, frame.fallback, s.observer, s.result);
+    step.optimised = close_loops(*s.detector, s.graph, s.tracker.constraints(), frame.fallback,
+                                 s.observer, s.result);
     s.result.timing.loop_closure_seconds += seconds_since(start);
     if (step.optimised) s.optimise();
   }

@@ -26,6 +26,8 @@ RunJson loop_closure_json(const mapping::LoopClosureRecord& record) {
     json["appearance_score"] = c.appearance_score;
   }
   json["registration"] = detail::registration_report_json(record.closure.report);
+  json["feature_confirmation"] = mapping::to_string(record.closure.confirmation);
+  if (record.closure.correction_chi2 >= 0) json["correction_chi2"] = record.closure.correction_chi2;
   const Eigen::Isometry3d& motion = record.closure.constraint.motion;
   const Eigen::Quaterniond rotation(motion.linear());
   json["motion"] = {motion.translation().x(),

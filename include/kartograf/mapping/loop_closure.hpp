@@ -34,8 +34,10 @@
 // leaves nearly free (weak_direction_ratio) the edge keeps the expected motion and has no
 // information: ICP slides there to answers that fit as well as the right one.
 #include <cstddef>
+#include <functional>
 #include <memory>
 #include <span>
+#include <string_view>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -91,6 +93,11 @@ struct LoopClosureParams {
   // the drift allowance (5 % of a 40 m path is 2 m): with a feature front end, the features of
   // the two keyframes must then find the same motion within this (else: unconfirmed).
   double feature_agreement_m = 0.1;
+  // Where the features are silent (too few inliers to align the keyframes: a faint carpet, a
+  // plain wall) the correction must instead be one the chained odometry could have drifted by:
+  // its squared Mahalanobis distance under the chain's covariance (chain_covariance.hpp) plus the
+  // loop's baseline error within this (chi^2, 6 degrees of freedom, 99.9 %).
+  double max_correction_chi2 = 22.46;
   // Keyframe depth kept in memory, in bytes; beyond it the depth goes to a temporary file.
   std::size_t keyframe_depth_memory = std::size_t{32} << 20;
   // The newest keyframes' overlap samples and features kept in memory, in bytes (35-65 KB a
@@ -114,8 +121,23 @@ struct LoopCandidate {
   double appearance_score = 0;
 };
 
+// What the keyframes' features said of a verified loop (asked only of a candidate by pose whose
+// correction exceeds min_correction_m).
+enum class FeatureConfirmation {
+  not_asked,
+  agree,        // their motion is ICP's within feature_agreement_m
+  disagree,     // they align the keyframes elsewhere: another place that looks alike
+  silent,       // too few matched inliers to align them at all: the odometry's uncertainty decides
+  no_features,  // no front end, or a keyframe without features
+};
+std::string_view to_string(FeatureConfirmation confirmation);
+
 struct LoopClosure {
   LoopCandidate candidate;
+  FeatureConfirmation confirmation = FeatureConfirmation::not_asked;
+  // The correction's squared Mahalanobis distance under the expected motion's uncertainty (see
+  // max_correction_chi2), where it was needed; negative where not.
+  double correction_chi2 = -1;
   registration::RegistrationReport report;
   // From the match frame to the query frame (T_match^-1 T_query), for the pose graph; valid when
   // report.accepted().
@@ -161,7 +183,12 @@ class LoopClosureDetector {
   // camera of `from` is at from_to_to in the frame of `to`, with depth tolerance `tolerance`.
   double view_overlap(std::size_t from, std::size_t to, const Eigen::Isometry3d& from_to_to,
                       double tolerance) const;
-  LoopClosure verify(const LoopCandidate& candidate, std::span<const Eigen::Isometry3d> poses);
+  // expected_uncertainty (optional): the covariance of the pose estimate's relative motion from
+  // the match to the query (chain_covariance.hpp), asked for only where the features are silent;
+  // without it such a loop is unconfirmed.
+  using ExpectedUncertainty = std::function<se3::Matrix6d(const LoopCandidate&)>;
+  LoopClosure verify(const LoopCandidate& candidate, std::span<const Eigen::Isometry3d> poses,
+                     const ExpectedUncertainty& expected_uncertainty = {});
 
   const LoopClosureParams& params() const { return params_; }
   // The keyframes' depth, samples and features: bytes in memory and in the temporary files.
@@ -178,9 +205,13 @@ class LoopClosureDetector {
   static void require_pose(std::span<const Eigen::Isometry3d> poses, std::size_t frame);
   // ICP of the built source_ (query) against target_ (match) from `initial`.
   registration::IcpResult align(const Eigen::Isometry3d& initial);
-  // Whether the keyframes' features agree with `motion` (match <- query) within
-  // feature_agreement_m; true when either keyframe has none.
-  bool features_agree(std::size_t query, std::size_t match, const Eigen::Isometry3d& motion) const;
+  // What the keyframes' features say of `motion` (match <- query).
+  FeatureConfirmation confirm_by_features(std::size_t query, std::size_t match,
+                                          const Eigen::Isometry3d& motion) const;
+  // Features first; where they are silent, the correction against the expected uncertainty.
+  void confirm_large_correction(LoopClosure& closure, const Eigen::Isometry3d& expected,
+                                const Eigen::Isometry3d& motion,
+                                const ExpectedUncertainty& expected_uncertainty) const;
 
   PinholeIntrinsics camera_;
   geometry::DepthRange range_;
