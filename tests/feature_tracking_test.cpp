@@ -463,25 +463,37 @@ TEST(FeatureTracking, KeyframesReadBackFromDiskFindTheSameLoops) {
   EXPECT_TRUE(b.constraint.motion.matrix() == a.constraint.motion.matrix());
 }
 
+// Two views of the tour 4 frames apart (and a third from elsewhere) whose estimate is 25 cm off:
+// a loop candidate by pose whose correction exceeds the 10 cm a loop may move without drift.
+struct LargeLoopCorrection {
+  testing::RenderedSequence views;
+  geometry::DepthRange range;
+  mapping::LoopClosureParams params;
+  std::vector<Eigen::Isometry3d> poses;
+  mapping::LoopCandidate candidate;
+};
+
+LargeLoopCorrection large_loop_correction() {
+  const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
+  LargeLoopCorrection loop;
+  loop.views = testing::render_sequence({tour[400].pose, tour[404].pose, tour[100].pose}, kKinect);
+  loop.range.units_per_metre = testing::kSynthUnitsPerMetre;
+  loop.params.min_frame_gap = 1;
+  loop.params.min_correction_m = 0.1;
+  loop.poses = {loop.views.truth[0], Eigen::Translation3d(0.2, 0.15, 0) * loop.views.truth[1]};
+  loop.candidate.query = 1;
+  loop.candidate.query_frame = 1;
+  loop.candidate.drift_allowance_m = 0.5;
+  return loop;
+}
+
 // A loop found by pose whose ICP corrects the estimate by more than a loop may move without drift
 // (here 25 cm against 10 cm) must be seen by the features too: with matching views it is; with
 // the match's colour from elsewhere (features that see another place) it is unconfirmed; without
 // a feature front end it stands on ICP alone.
 TEST(FeatureTracking, ALargeLoopCorrectionNeedsTheFeaturesToAgree) {
-  const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
-  const testing::RenderedSequence views =
-      testing::render_sequence({tour[400].pose, tour[404].pose, tour[100].pose}, kKinect);
-  geometry::DepthRange range;
-  range.units_per_metre = testing::kSynthUnitsPerMetre;
-  mapping::LoopClosureParams params;
-  params.min_frame_gap = 1;
-  params.min_correction_m = 0.1;
-  std::vector<Eigen::Isometry3d> poses = {views.truth[0], views.truth[1]};
-  poses[1] = Eigen::Translation3d(0.2, 0.15, 0) * poses[1];
-  mapping::LoopCandidate candidate;
-  candidate.query = 1;
-  candidate.query_frame = 1;
-  candidate.drift_allowance_m = 0.5;
+  const LargeLoopCorrection loop = large_loop_correction();
+  const auto& [views, range, params, poses, candidate] = loop;
   const compute::Context context = compute::Context::cpu();
   const auto verdict = [&](std::shared_ptr<const features::OrbFrontEnd> front_end,
                            const RgbImage& match_color) {
@@ -503,20 +515,8 @@ TEST(FeatureTracking, ALargeLoopCorrectionNeedsTheFeaturesToAgree) {
 // could have drifted that far (a 25 cm correction under 30 cm of chain sigma), unconfirmed when
 // it could not (2 cm), and unconfirmed when the caller gives no uncertainty.
 TEST(FeatureTracking, WhereTheFeaturesAreSilentTheOdometrysUncertaintyDecides) {
-  const Trajectory tour = synth::robot_tour(testing::test_world(), 500);
-  const testing::RenderedSequence views =
-      testing::render_sequence({tour[400].pose, tour[404].pose}, kKinect);
-  geometry::DepthRange range;
-  range.units_per_metre = testing::kSynthUnitsPerMetre;
-  mapping::LoopClosureParams params;
-  params.min_frame_gap = 1;
-  params.min_correction_m = 0.1;
-  std::vector<Eigen::Isometry3d> poses = {views.truth[0], views.truth[1]};
-  poses[1] = Eigen::Translation3d(0.2, 0.15, 0) * poses[1];
-  mapping::LoopCandidate candidate;
-  candidate.query = 1;
-  candidate.query_frame = 1;
-  candidate.drift_allowance_m = 0.5;
+  const LargeLoopCorrection loop = large_loop_correction();
+  const auto& [views, range, params, poses, candidate] = loop;
   const compute::Context context = compute::Context::cpu();
   mapping::LoopClosureDetector detector(context, kKinect, range, params, orb());
   const RgbImage plain(views.frames[0].color.width(), views.frames[0].color.height(),
