@@ -35,6 +35,7 @@ nb::dict frame_dict(const registration::OdometryFrame& frame) {
   d["fallback"] = frame.fallback;
   d["degenerate"] = frame.degenerate;
   d["degenerate_overlap"] = frame.degenerate_overlap;
+  d["reestimate_degenerate_overlap"] = frame.reestimate_degenerate_overlap;
   d["photometric"] = frame.photometric;
   d["heading_sigma_m"] = frame.heading_sigma_m;
   d["accelerated"] = frame.accelerated;

@@ -54,6 +54,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["from_features"] = frame.from_features;
   json["degenerate"] = frame.degenerate;
   json["degenerate_overlap"] = frame.degenerate_overlap;
+  json["reestimate_degenerate_overlap"] = frame.reestimate_degenerate_overlap;
   json["photometric"] = frame.photometric;
   json["heading_sigma_m"] = frame.heading_sigma_m;
   json["accelerated"] = frame.accelerated;
@@ -87,6 +88,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["scanned_frames"] = counts.scanned_frames;
   json["reestimates"] = counts.reestimates;
   json["reestimates_rejected"] = counts.reestimates_rejected;
+  json["reestimates_on_degenerate_overlap"] = counts.reestimates_on_degenerate_overlap;
   return json;
 }
 
@@ -119,6 +121,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.scanned_frames += f.scanned;
     counts.reestimates += f.reestimate.has_value();
     counts.reestimates_rejected += f.reestimate && !f.reestimate->accepted();
+    counts.reestimates_on_degenerate_overlap += f.reestimate_degenerate_overlap;
   }
   return counts;
 }
@@ -144,6 +147,12 @@ std::string speed_changes_text(const OdometryFrameCounts& c) {
   return text;
 }
 
+std::string reestimates_on_overlap_text(const OdometryFrameCounts& c) {
+  if (c.reestimates_on_degenerate_overlap == 0) return "";
+  return ", " + std::to_string(c.reestimates_on_degenerate_overlap) +
+         " held where the anchor saw a degenerate view";
+}
+
 }  // namespace
 
 std::string frame_counts_line(const OdometryFrameCounts& c) {
@@ -152,9 +161,9 @@ std::string frame_counts_line(const OdometryFrameCounts& c) {
       c.from_features ? ", started from features " + count(c.from_features) : "";
   return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) + seeded +
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
-         "), degenerate frames " + count(c.degenerate_frames) + " (" + count(c.photometric_frames) +
-         " measured by image intensity, " + count(c.heading_prior_frames) + " held to the heading" +
-         speed_changes_text(c) + ")";
+         reestimates_on_overlap_text(c) + "), degenerate frames " + count(c.degenerate_frames) +
+         " (" + count(c.photometric_frames) + " measured by image intensity, " +
+         count(c.heading_prior_frames) + " held to the heading" + speed_changes_text(c) + ")";
 }
 
 OdometryThroughput odometry_throughput(const mapping::OdometryRun& run) {

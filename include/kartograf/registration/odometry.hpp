@@ -254,6 +254,14 @@ struct OdometryParams {
   // had the turn 1.7 degrees off but slid 0.33 m along a wall; another start's 18.2 degrees and
   // 0.55 m won, and its own shared part was not degenerate. False: the winner only.
   bool overlap_every_start = true;
+  // A re-estimate whose own view is constrained is judged on the part of it the anchor sees too,
+  // and registered again as a degenerate view where that part is degenerate; that answer is kept
+  // where the images side with it (survey seed 16, frames 790 -> 795: the anchor saw a blank
+  // wall, the re-estimate slid 2.6 cm along it from a chain right to 1 mm). Off by default: on,
+  // the surveys' odometry improves (seeds 1-10 mean 1.14 -> 0.93 cm) but seed 4's semantic grid
+  // loses an interior wall and two rooms merge (docs/benchmarks.md, session 53), a fragility of
+  // the grid to be mended before this is turned on.
+  bool reestimate_on_overlap = false;
   // A doubtful registration from the prediction that beat the features' (attempted on a large
   // predicted motion) is checked against the other starts too.
   bool recheck_after_features = true;
@@ -373,6 +381,9 @@ struct OdometryFrame {
   // Degenerate only in the part of the frame the frame before sees (a wide turn;
   // OdometryParams::overlap_turn_deg); eigenvalue_ratio is then that part's.
   bool degenerate_overlap = false;
+  // The re-estimate was registered again as a degenerate view: the part of this frame its anchor
+  // sees leaves directions free (OdometryParams::reestimate_on_overlap).
+  bool reestimate_degenerate_overlap = false;
   bool photometric = false;
   // The step's slide across the robot's heading was held by the heading prior
   // (OdometryParams::heading_prior) with this spread (metres; 0: it did not hold it).
@@ -555,6 +566,15 @@ class RgbdOdometry {
   Eigen::Vector3d travel_on_arc(const Eigen::Isometry3d& step) const;
   void keep_images_for_features(const DepthImage& depth, const RgbImage* color);
   void reestimate(OdometryFrame& frame);
+  // The re-estimate of the current frame against `anchor` from `chained`, with its pose-graph
+  // information, judged on what the anchor sees (OdometryParams::reestimate_on_overlap).
+  struct AnchoredAttempt {
+    Attempt attempt;
+    se3::Matrix6d information;
+    bool degenerate_overlap = false;  // registered again as a degenerate view
+  };
+  AnchoredAttempt register_against_anchor(std::size_t anchor, const Eigen::Isometry3d& chained,
+                                          const RegistrationLimits& limits);
   struct ReestimateLimits {
     RegistrationLimits limits;
     // After degenerate frames: a correction beyond reestimate_limits must be confirmed by the
