@@ -27,7 +27,6 @@
 #include <string>
 #include <utility>
 
-#include "kartograf/outputs/synthetic_dataset.hpp"
 #include "kartograf/registration/odometry.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "kartograf/synth/world.hpp"
@@ -43,8 +42,6 @@ struct DegenerateStretch {
   std::size_t first = 0;
   std::size_t count = 0;
   bool photometric = true;  // OdometryParams::photometric_refinement
-  // The frames' noise as `kartograf synth` writes them (else the tests' noise seeds).
-  bool as_synth_writes = false;
 };
 
 std::string stretch_name(const DegenerateStretch& s) {
@@ -81,15 +78,8 @@ struct TrackedFrames {
 TrackedFrames track_frames(const DegenerateStretch& stretch, registration::OdometryParams params) {
   const synth::World world = synth::make_building(stretch.seed);
   const PinholeIntrinsics kinect{640, 480, 525, 525, 319.5, 239.5};
-  std::vector<std::uint64_t> noise_seeds;
-  for (std::size_t i = 0; stretch.as_synth_writes && i < stretch.count; ++i) {
-    noise_seeds.push_back(io::synthetic_frame_seed(stretch.seed, stretch.first + i));
-  }
-  const std::vector<Eigen::Isometry3d> poses =
-      testing::survey_poses(world, stretch.first, stretch.count);
-  const testing::RenderedSequence sequence =
-      stretch.as_synth_writes ? testing::render_sequence(world, poses, kinect, noise_seeds)
-                              : testing::render_sequence(world, poses, kinect);
+  const testing::RenderedSequence sequence = testing::render_sequence(
+      world, testing::survey_poses(world, stretch.first, stretch.count), kinect);
   params.depth_range.units_per_metre = testing::kSynthUnitsPerMetre;
   params.photometric_refinement = stretch.photometric;
   registration::RgbdOdometry odometry(compute::Context::cpu(), sequence.camera, params);
@@ -325,9 +315,9 @@ TEST(Reestimation, AnImagesCorrectionBeyondTheLimitsNeedsTheImagesToFitIt) {
   EXPECT_GT(unlimited.degrees, 0.5);  // measured 1.25 degrees, 3.7 cm
 }
 
-// The re-estimate judged on what its anchor sees (the next test; OdometryParams::
-// reestimate_on_overlap) holds that slide too: the images' confirmation is checked without it,
-// then that rule alone.
+// The re-estimate judged on what its anchor sees (OdometryParams::reestimate_on_overlap;
+// FeatureTracking.AReestimateIsJudgedOnWhatItsAnchorSees) holds that slide too: the images'
+// confirmation is checked without it, then that rule alone.
 TEST(Reestimation, AfterADegenerateStretchTheImagesRefuseASlideAlongAWeakDirection) {
   const DegenerateStretch corridor{7, 1210, 30, true};
   const std::size_t frame = 1235 - corridor.first;
@@ -347,33 +337,6 @@ TEST(Reestimation, AfterADegenerateStretchTheImagesRefuseASlideAlongAWeakDirecti
   const TrackedFrames held = track_frames(corridor, on_overlap);
   EXPECT_TRUE(held.frames[frame].reestimate_degenerate_overlap);
   EXPECT_LT(held.error_at(frame).metres, 0.005);
-}
-
-// Seed 16, frames 770-800: the robot drives towards a blank wall (frames 771-791 degenerate),
-// then turns so that structure comes into view (frame 795: eigenvalue ratio 0.13). The
-// re-estimate of frame 795 against frame 790 was judged on 795's whole view, but what 790 saw
-// of it is the wall alone: ICP slid 2.6 cm along it from a chain right to 1 mm, within the
-// re-estimate's limits, and the slide was spread over frames 791-795. Judged on the part the
-// anchor sees, the re-estimate is a degenerate view's: the chain and the images hold the slide,
-// and the images side with that answer (grey-level RMSE 4.8 against 27.3).
-TEST(Reestimation, IsJudgedOnWhatTheAnchorSeesOfTheView) {
-  const DegenerateStretch towards_a_wall{16, 770, 30, true, true};
-  const std::size_t anchor = 790 - towards_a_wall.first, frame = 795 - towards_a_wall.first;
-  const auto slide = [&](const registration::OdometryParams& params) {
-    const TrackedFrames tracked = track_frames(towards_a_wall, params);
-    EXPECT_TRUE(tracked.frames[frame].reestimate.has_value());
-    const Eigen::Isometry3d truth = tracked.truth[anchor].inverse() * tracked.truth[frame];
-    const Eigen::Isometry3d estimate = tracked.poses[anchor].inverse() * tracked.poses[frame];
-    return (truth.inverse() * estimate).translation().norm();
-  };
-  registration::OdometryParams on_overlap, whole_view;
-  on_overlap.reestimate_on_overlap = true;
-  whole_view.reestimate_on_overlap = false;
-  const double held = slide(on_overlap), slid = slide(whole_view);
-  RecordProperty("frames_790_795_error_m", std::to_string(held));
-  RecordProperty("frames_790_795_error_whole_view_m", std::to_string(slid));
-  EXPECT_LT(held, 0.005);
-  EXPECT_GT(slid, 0.015);
 }
 
 // Seed 8, frames 650-720: 25 frames down a room that measure every direction, then a wall ahead
