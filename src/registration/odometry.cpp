@@ -831,13 +831,24 @@ RgbdOdometry::Attempt RgbdOdometry::held_on_its_overlap(std::size_t previous,
                                                         const Eigen::Isometry3d& start,
                                                         Attempt attempt) {
   if (!params_.overlap_every_start || !turns_wide_on_a_constrained_view(attempt)) return attempt;
-  GeometricInformation overlap = overlap_geometry(frames_.size(), previous, attempt.motion);
-  if (!overlap.degeneracy.degenerate) return attempt;
-  // From the same start as a degenerate view: the prior holds what the shared part leaves free.
+  std::optional<HeldOnOverlap> held =
+      held_where_degenerate(previous, attempt.motion, start, frame_limits_now());
+  if (!held) return attempt;
+  return overlap_answer_stands(previous, attempt, held->attempt) ? held->attempt : attempt;
+}
+
+std::optional<RgbdOdometry::HeldOnOverlap> RgbdOdometry::held_where_degenerate(
+    std::size_t target, const Eigen::Isometry3d& motion, const Eigen::Isometry3d& start,
+    const RegistrationLimits& limits) {
+  GeometricInformation overlap = overlap_geometry(frames_.size(), target, motion);
+  if (!overlap.degeneracy.degenerate) return std::nullopt;
+  // From `start` as a degenerate view: the prior holds what the shared part leaves free.
   GeometricInformation whole_frame = std::exchange(geometry_, std::move(overlap));
-  Attempt held = register_frames(previous, start, frame_limits_now());
+  HeldOnOverlap held;
+  held.attempt = register_frames(target, start, limits);
+  held.information = information_of(held.attempt);
   geometry_ = std::move(whole_frame);
-  return overlap_answer_stands(previous, attempt, held) ? held : attempt;
+  return held;
 }
 
 double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& attempt) {
@@ -962,22 +973,19 @@ RgbdOdometry::AnchoredAttempt RgbdOdometry::register_against_anchor(
       !attempt.report.accepted()) {
     return {attempt, information_of(attempt)};
   }
-  GeometricInformation overlap = overlap_geometry(frames_.size(), anchor, attempt.motion);
-  if (!overlap.degeneracy.degenerate) return {attempt, information_of(attempt)};
-  // What the two views share leaves directions free: registered again as a degenerate view, the
-  // chain (the motion prior) and the images hold them. That answer replaces the first where the
-  // images side with it (grey-level RMSE at most photometric_doubt_rmse and under
+  // Where what the two views share leaves directions free, registered again as a degenerate
+  // view the chain (the motion prior) and the images hold them. That answer replaces the first
+  // where the images side with it (grey-level RMSE at most photometric_doubt_rmse and under
   // recheck_images_ratio times the first's: seed 16 4.8 against 27.3), not otherwise: on survey
   // seed 4, frame 155, the chain had drifted 2.1 degrees in degenerate frames and the first
   // answer measured it (RMSE 31.6 against 24.3, neither decisive).
-  GeometricInformation whole_frame = std::exchange(geometry_, std::move(overlap));
-  Attempt held = register_frames(anchor, chained, limits);
-  const se3::Matrix6d information = information_of(held);
-  geometry_ = std::move(whole_frame);
-  if (!held.report.accepted() || !images_decide(anchor, held, attempt).value_or(false)) {
+  std::optional<HeldOnOverlap> held =
+      held_where_degenerate(anchor, attempt.motion, chained, limits);
+  if (!held || !held->attempt.report.accepted() ||
+      !images_decide(anchor, held->attempt, attempt).value_or(false)) {
     return {attempt, information_of(attempt)};
   }
-  return {held, information, true};
+  return {held->attempt, held->information, true};
 }
 
 bool RgbdOdometry::moves_anchor(std::size_t n) const {

@@ -513,6 +513,17 @@ class RgbdOdometry {
   // (OdometryParams::overlap_every_start).
   Attempt held_on_its_overlap(std::size_t previous, const Eigen::Isometry3d& start,
                               Attempt attempt);
+  // Where the part of the current frame that `motion` maps into frame `target`'s view is
+  // degenerate: ICP from `start` again as a degenerate view's on that part, with its pose-graph
+  // information (held_on_its_overlap, register_against_anchor).
+  struct HeldOnOverlap {
+    Attempt attempt;
+    se3::Matrix6d information;
+  };
+  std::optional<HeldOnOverlap> held_where_degenerate(std::size_t target,
+                                                     const Eigen::Isometry3d& motion,
+                                                     const Eigen::Isometry3d& start,
+                                                     const RegistrationLimits& limits);
   // The geometric information of frame `current`'s points that `motion` maps into the view of
   // frame `target` (both at the information level).
   GeometricInformation overlap_geometry(std::size_t current, std::size_t target,
