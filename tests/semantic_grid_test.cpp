@@ -672,6 +672,28 @@ TEST(SemanticGrid, APocketDeeperThanTheWallsInsidesIsACabinets) {
   EXPECT_EQ(grid.furniture_fronts, 1);
 }
 
+// A wall between two rooms, its line broken by 0.6 m that no view saw (nor the floor beside it): a
+// 2 m piece (furniture sized, with floor beside it) ends at the gap and a 3.4 m piece runs on
+// beyond it. The unseen run along the wall's own line between the two is no cabinet's pocket (one
+// cell wide), so the short piece stays a wall; it had become a cabinet's front (survey seed 4's
+// upper rooms merged).
+TEST(SemanticGrid, AGapInAWallsLineIsNoCabinetsPocket) {
+  using C = SemanticClass;
+  LabelledPoints s;
+  for (double x = 0.012; x <= 4.012; x += 0.02) {
+    for (double y = 0.012; y <= 6.012; y += 0.02) {
+      if (!(x > 1.92 && x < 2.16 && y > 2.0 && y < 2.6)) s.add({x, y, 0}, C::floor);
+    }
+  }
+  s.box_face({2.037, 0.012, 0.02}, {2.037, 2.0, 1.4}, C::wall);  // mid-cell: x 2.012-2.062
+  s.box_face({2.037, 2.6, 0.02}, {2.037, 6.012, 1.4}, C::wall);
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  for (const double y : {0.5, 1.0, 1.9, 3.0, 5.0})
+    EXPECT_EQ(class_at(grid, 2.037, y).first, C::wall) << "the wall at y " << y;
+  EXPECT_NE(class_at(grid, 2.037, 2.3).first, C::furniture);  // the gap
+  EXPECT_EQ(grid.furniture_fronts, 0);
+}
+
 // Walls 0.15 m thick, and a cabinet 0.4 m in front of the wall between two rooms, near the east
 // wall, its front taken for a wall. The wall's near face was seen only west of the cabinet (so no
 // wall line runs on past it: the east wall is 0.2 m beyond it): the unseen run behind the front

@@ -19,12 +19,30 @@ bool is_wall(const SemanticGrid& grid, int col, int row) {
   return seen_as(grid, {col, row}, SemanticClass::wall);
 }
 
+// Whether a seen floor cell lies within `cells` steps of `out` beyond c.
+bool floor_within(const SemanticGrid& grid, const Eigen::Vector2i& c, const Eigen::Vector2i& out,
+                  int cells) {
+  for (int k = 1; k <= cells; ++k)
+    if (seen_as(grid, c + k * out, SemanticClass::floor)) return true;
+  return false;
+}
+
 // Unseen cells on a row or column run of unseen cells with wall cells at both ends, longer than
-// min_cells (a wall's inside) and at most max_cells: what lies between two faces.
-cv::Mat pockets_between_walls(const SemanticGrid& grid, int min_cells, int max_cells) {
+// min_cells (a wall's inside) and at most max_cells: what lies between two faces. With
+// `facing_the_room`, only runs one of whose ends has floor within 3 cells beyond it: a front the
+// room saw, with the pocket it hid behind it. An unseen stretch of a wall's own line, between two
+// of its pieces, has the wall running on beyond both ends (survey seed 4: a 2.15 m piece of the
+// wall between two rooms had become a cabinet's front across such a gap, and the rooms merged).
+cv::Mat pockets_between_walls(const SemanticGrid& grid, int min_cells, int max_cells,
+                              bool facing_the_room) {
   cv::Mat pockets = cv::Mat::zeros(grid.height(), grid.width(), CV_8U);
   const auto wall_end = [&](const Eigen::Vector2i& c) { return is_wall(grid, c.x(), c.y()); };
-  for (const Eigen::Vector2i& k : unobserved_runs_between(grid, wall_end, min_cells, max_cells))
+  const auto accept = [&](const Eigen::Vector2i& a, const Eigen::Vector2i& b) {
+    const Eigen::Vector2i step = (b - a).cwiseSign();
+    return !facing_the_room || floor_within(grid, a, -step, 3) || floor_within(grid, b, step, 3);
+  };
+  for (const Eigen::Vector2i& k :
+       unobserved_runs_between(grid, wall_end, min_cells, max_cells, accept))
     pockets.at<std::uint8_t>(k.y(), k.x()) = 255;
   return pockets;
 }
@@ -107,14 +125,6 @@ bool beside_door(const SemanticGrid& grid, const std::vector<cv::Point>& cells) 
   at.reserve(cells.size());
   for (const cv::Point& c : cells) at.emplace_back(c.x, c.y);
   return detail::beside_door(grid, at);
-}
-
-// Whether a seen floor cell lies within `cells` steps of `out` beyond c.
-bool floor_within(const SemanticGrid& grid, const Eigen::Vector2i& c, const Eigen::Vector2i& out,
-                  int cells) {
-  for (int k = 1; k <= cells; ++k)
-    if (seen_as(grid, c + k * out, SemanticClass::floor)) return true;
-  return false;
 }
 
 // Cells of a joined front's pocket, each way (0.15 m at 5 cm cells).
@@ -298,7 +308,8 @@ FrontsFound fronts_against_walls(SemanticGrid& grid, double max_extent, double m
                                  const TraversabilityWeights& weights,
                                  Image<std::uint8_t>& furniture) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);
-  const Pieces pockets = pieces_of(pockets_between_walls(grid, min_depth_cells, max_depth_cells));
+  const Pieces pockets =
+      pieces_of(pockets_between_walls(grid, min_depth_cells, max_depth_cells, true));
   int fronts = 0;
   PocketSplit split;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {
@@ -323,7 +334,7 @@ FrontsFound joined_fronts_against_walls(SemanticGrid& grid, double max_extent, d
                                         const TraversabilityWeights& weights,
                                         Image<std::uint8_t>& furniture) {
   const WallPieces walls = wall_pieces(grid, max_extent, max_area);
-  const Pieces pockets = pieces_of(pockets_between_walls(grid, 1, max_depth_cells));
+  const Pieces pockets = pieces_of(pockets_between_walls(grid, 1, max_depth_cells, false));
   int fronts = 0;
   PocketSplit split;
   for (std::size_t p = 1; p < pockets.cells.size(); ++p) {

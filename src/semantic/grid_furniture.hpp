@@ -16,8 +16,9 @@ struct FrontsFound {
 // A cabinet or shelf against a wall, whose front the views took for a wall: a piece of wall cells
 // of furniture size (at most `max_extent` long, `max_area` in hull), most of them next to floor,
 // that stands in front of a longer wall with only unseen cells between them (rows or columns of
-// more than `min_depth_cells`, a wall's inside, and at most `max_depth_cells`: the pocket its top
-// and sides hid) and no door beside them. The front and the pocket become furniture (`furniture`
+// more than `min_depth_cells`, a wall's inside, and at most `max_depth_cells`, with floor within
+// 3 cells beyond one end: the pocket its top and sides hid, behind a face the room saw) and no
+// door beside them. The front and the pocket become furniture (`furniture`
 // marks them), but for the pocket's cells within `inside_cells` of a longer wall whose far side
 // the next room saw (floor within 2 cells beyond it; the line running on 0.4 m either way): the
 // inside of the wall the cabinet stands against, whose near face it hid, which become wall.

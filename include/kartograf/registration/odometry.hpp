@@ -257,11 +257,9 @@ struct OdometryParams {
   // A re-estimate whose own view is constrained is judged on the part of it the anchor sees too,
   // and registered again as a degenerate view where that part is degenerate; that answer is kept
   // where the images side with it (survey seed 16, frames 790 -> 795: the anchor saw a blank
-  // wall, the re-estimate slid 2.6 cm along it from a chain right to 1 mm). Off by default: on,
-  // the surveys' odometry improves (seeds 1-10 mean 1.14 -> 0.93 cm) but seed 4's semantic grid
-  // loses an interior wall and two rooms merge (docs/benchmarks.md, session 53), a fragility of
-  // the grid to be mended before this is turned on.
-  bool reestimate_on_overlap = false;
+  // wall, the re-estimate slid 2.6 cm along it from a chain right to 1 mm). False: judged on the
+  // whole view only.
+  bool reestimate_on_overlap = true;
   // A doubtful registration from the prediction that beat the features' (attempted on a large
   // predicted motion) is checked against the other starts too.
   bool recheck_after_features = true;
