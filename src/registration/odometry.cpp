@@ -733,14 +733,15 @@ bool RgbdOdometry::fits_better(std::size_t target, const Attempt& challenger,
 std::vector<Eigen::Isometry3d> RgbdOdometry::starts_from_turn(
     const Eigen::Isometry3d& motion) const {
   // A turn moves most points far more than the slide it can be traded for, so ICP's turn is
-  // better than its step: that turn again, on the spot and, once the heading is known, with the
-  // same step length along the heading on the turn's arc.
+  // better than its step: that turn again, on the spot and with the same step length along the
+  // heading (the prior's, or the predicted step's before it is ready) on the turn's arc.
   Eigen::Isometry3d on_the_spot = motion;
   on_the_spot.translation().setZero();
   std::vector<Eigen::Isometry3d> starts = {on_the_spot};
-  if (heading_prior_.ready()) {
+  if (!heading_prior_.ready() && !params_.arc_start_from_the_prediction) return starts;
+  if (const Eigen::Vector3d travel = travel_on_arc(motion); travel.squaredNorm() > 0) {
     Eigen::Isometry3d on_the_arc = motion;
-    on_the_arc.translation() = motion.translation().norm() * heading_prior_.travel_on(motion);
+    on_the_arc.translation() = motion.translation().norm() * travel;
     starts.push_back(on_the_arc);
   }
   return starts;
