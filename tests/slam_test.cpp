@@ -80,11 +80,14 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
 
 // With the paper's re-estimation (against frame n-5) the odometry drifts more, and the loops
 // closing the way back onto the way out take at least 40 % of it out (measured: 4.1 -> 2.0 mm).
+// Re-estimates judged on what their anchor sees hold this stretch to 0.6 mm even so, which leaves
+// the loops nothing to take out: off here.
 TEST(Slam, LoopClosuresTakeOutTheOdometrysDrift) {
   const testing::MemoryFrameSource source(testing::out_and_back());
   const compute::Context context = compute::Context::cpu();
   mapping::SlamParams params = loop_params();
   params.odometry.anchor = {0, 0, 0};
+  params.odometry.reestimate_on_overlap = false;
   const mapping::SlamResult result = mapping::run_slam(context, source, params);
   const double odometry_ate =
       testing::ate_rmse(result.odometry.poses, testing::out_and_back().truth);
