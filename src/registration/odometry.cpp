@@ -970,23 +970,20 @@ void RgbdOdometry::reestimate(OdometryFrame& frame) {
 RgbdOdometry::AnchoredAttempt RgbdOdometry::register_against_anchor(
     std::size_t anchor, const Eigen::Isometry3d& chained, const RegistrationLimits& limits) {
   Attempt attempt = register_frames(anchor, chained, limits);
-  if (!params_.reestimate_on_overlap || geometry_.degeneracy.degenerate ||
-      !attempt.report.accepted()) {
-    return {attempt, information_of(attempt)};
-  }
   // Where what the two views share leaves directions free, registered again as a degenerate
   // view the chain (the motion prior) and the images hold them. That answer replaces the first
   // where the images side with it (grey-level RMSE at most photometric_doubt_rmse and under
   // recheck_images_ratio times the first's: seed 16 4.8 against 27.3), not otherwise: on survey
   // seed 4, frame 155, the chain had drifted 2.1 degrees in degenerate frames and the first
   // answer measured it (RMSE 31.6 against 24.3, neither decisive).
-  std::optional<HeldOnOverlap> held =
-      held_where_degenerate(anchor, attempt.motion, chained, limits);
-  if (!held || !held->attempt.report.accepted() ||
-      !images_decide(anchor, held->attempt, attempt).value_or(false)) {
-    return {attempt, information_of(attempt)};
-  }
-  return {held->attempt, held->information, true};
+  std::optional<HeldOnOverlap> held;
+  if (params_.reestimate_on_overlap && !geometry_.degeneracy.degenerate &&
+      attempt.report.accepted())
+    held = held_where_degenerate(anchor, attempt.motion, chained, limits);
+  if (held && held->attempt.report.accepted() &&
+      images_decide(anchor, held->attempt, attempt).value_or(false))
+    return {held->attempt, held->information, true};
+  return {attempt, information_of(attempt)};
 }
 
 bool RgbdOdometry::moves_anchor(std::size_t n) const {

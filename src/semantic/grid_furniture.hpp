@@ -18,10 +18,10 @@ struct FrontsFound {
 // that stands in front of a longer wall with only unseen cells between them (rows or columns of
 // more than `min_depth_cells`, a wall's inside, and at most `max_depth_cells`, with floor within
 // 3 cells beyond one end: the pocket its top and sides hid, behind a face the room saw) and no
-// door beside them. The front and the pocket become furniture (`furniture`
-// marks them), but for the pocket's cells within `inside_cells` of a longer wall whose far side
-// the next room saw (floor within 2 cells beyond it; the line running on 0.4 m either way): the
-// inside of the wall the cabinet stands against, whose near face it hid, which become wall.
+// door beside them. The front and the pocket become furniture (`furniture` marks them), but for
+// the pocket's cells within `inside_cells` of a longer wall whose far side the next room saw
+// (floor within 2 cells beyond it; the line running on 0.4 m either way): the inside of the wall
+// the cabinet stands against, whose near face it hid, which become wall.
 FrontsFound fronts_against_walls(SemanticGrid& grid, double max_extent, double max_area,
                                  int min_depth_cells, int inside_cells, int max_depth_cells,
                                  const TraversabilityWeights& weights,
