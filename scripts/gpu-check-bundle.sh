@@ -5,7 +5,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 build_dir="$1" bundle="$2" frames="$3"
-limit_mib=64
+limit_mib=64  # the device tool's limit on what travels
 binaries=("$build_dir/tests/kartograf_device_tests" "$build_dir/bench/kartograf_gpu_check")
 for binary in "${binaries[@]}" "$build_dir/tests/kartograf_export_device_data"; do
   [ -x "$binary" ] || { echo "gpu-check: $binary is missing: build it (scripts/gpu-check.sh without --no-build)" >&2; exit 1; }
@@ -42,12 +42,17 @@ done
 data="$(mktemp -d)"
 trap 'rm -rf "$data"' EXIT
 "$build_dir/tests/kartograf_export_device_data" "$data/data" --sequence "$frames" >/dev/null
-tar czf "$bundle/data.tar.gz" -C "$data" data
+# xz, not gzip: the frames are a third smaller (34 vs 45 MiB at 60 frames), which keeps the bundle and
+# the tracked tree under the device tool's 64 MiB.
+XZ_OPT="-6 -T0" tar cJf "$bundle/data.tar.xz" -C "$data" data
 {
   echo "kartograf gpu-check bundle: git $(git rev-parse --short HEAD 2>/dev/null || echo unknown)$(git diff --quiet 2>/dev/null || echo ' + local changes'), built $(date -u +%Y-%m-%dT%H:%MZ) on $(uname -m)"
   echo "odometry frames: $frames"
   (cd "$bundle" && find . -type f -printf '%s %p\n' | sort -k2)
 } >"$bundle/MANIFEST"
+# The device tool sends the tracked tree with the bundle: both count towards its limit.
 size_kib="$(du -sk "$bundle" | cut -f1)"
-echo "gpu-check: bundle $bundle: $((size_kib / 1024)) MiB (limit $limit_mib MiB)"
-[ "$size_kib" -lt $((limit_mib * 1024)) ] || { echo "gpu-check: the bundle is over $limit_mib MiB" >&2; exit 1; }
+tree_kib="$(git ls-files -z 2>/dev/null | du -ck --files0-from=- 2>/dev/null | tail -1 | cut -f1)"
+tree_kib="${tree_kib:-0}"
+echo "gpu-check: bundle $bundle: $((size_kib / 1024)) MiB + tracked tree $((tree_kib / 1024)) MiB (limit $limit_mib MiB)"
+[ $((size_kib + tree_kib)) -lt $((limit_mib * 1024)) ] || { echo "gpu-check: the bundle and the tree are over $limit_mib MiB" >&2; exit 1; }

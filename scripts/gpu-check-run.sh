@@ -16,7 +16,8 @@ trap 'rm -rf "$work"' EXIT
 started=$SECONDS
 echo "== kartograf gpu-check ($mode) $(date -u +%Y-%m-%dT%H:%M:%SZ) on $(hostname)"
 head -2 "$bundle/MANIFEST"
-tar xzf "$bundle/data.tar.gz" -C "$work" || { echo "FAIL: cannot unpack the data"; exit 1; }
+# tar needs the xz program for .xz; Python's tarfile reads it where xz is not installed.
+{ tar xJf "$bundle/data.tar.xz" -C "$work" 2>/dev/null || python3 -m tarfile -e "$bundle/data.tar.xz" "$work"; } || { echo "FAIL: cannot unpack the data"; exit 1; }
 export POCL_CACHE_DIR="$work/pocl-cache" MESA_SHADER_CACHE_DIR="$work/mesa-cache" OMP_WAIT_POLICY=passive
 
 first_file() { for f in "$@"; do [ -f "$f" ] && { echo "$f"; return; }; done; }

@@ -13,7 +13,7 @@ variants_dir="$(cd "${1:?folder of variant folders}" && pwd)" rounds="${2:-2}"
 bundle="$PWD/.gpu-check" out="${OUT:-build/gpu-variants-out}" work="$(mktemp -d)"
 trap 'rm -rf "$work"' EXIT
 mkdir -p "$out"
-tar xzf "$bundle/data.tar.gz" -C "$work"
+tar xJf "$bundle/data.tar.xz" -C "$work" 2>/dev/null || python3 -m tarfile -e "$bundle/data.tar.xz" "$work"
 for deb in "$bundle"/debs/*.deb; do dpkg-deb -x "$deb" "$work/root"; done
 export LD_LIBRARY_PATH="$work/root/usr/lib/x86_64-linux-gnu"
 library="$( (ldconfig -p | grep -o '/[^ ]*libnvidia-opencl.so.1'; find /usr/local/nvidia -name libnvidia-opencl.so.1 2>/dev/null) | head -1)"
