@@ -115,6 +115,7 @@ TEST_F(SemanticGridRoom, CellsHoldTheirClassAndWeight) {
 struct DoorwayWall {
   bool ragged_ends = false;   // a 5 cm strip that no view saw 10-15 cm from each jamb
   bool far_face_seen = true;  // the hall's face of the wall (else only the room's was seen)
+  bool open_leaf = false;     // a door leaf swung open into the room, back past the wall's face
 };
 
 // A room and a hall with a wall `thickness` thick between them (faces at y = 3.012 and beyond),
@@ -137,6 +138,16 @@ LabelledPoints doorway_scene(double thickness, DoorwayWall wall = {}) {
   }
   for (const double x : {kDoorX0, kDoorX1})  // the reveals
     s.box_face({x, kFace0, 0.02}, {x, kFace1, 2.0}, C::wall, 0.01);
+  if (wall.open_leaf) {
+    // Hinged at the west jamb's room-side edge, 0.8 m wide, swung 120 degrees: it leans back
+    // over the wall's face, 60 degrees off it. A leaf is a plane like a wall's.
+    const Eigen::Vector2d hinge(kDoorX0, kFace0),
+        towards(-std::cos(std::numbers::pi / 3), -std::sin(std::numbers::pi / 3));
+    for (double t = 0.02; t <= 0.8; t += 0.01) {
+      const Eigen::Vector2d p = hinge + t * towards;
+      s.box_face({p.x(), p.y(), 0.02}, {p.x(), p.y(), 2.0}, C::wall, 0.01);
+    }
+  }
   s.box_face({kX0, kY0, 0.02}, {kX0, kHallY1, kHeight}, C::wall);  // west and east
   s.box_face({kX1, kY0, 0.02}, {kX1, kHallY1, kHeight}, C::wall);
   return s;
@@ -206,6 +217,32 @@ TEST(SemanticGrid, ADoorwayInAWallSeenFromOneSideKeepsToTheWallsRows) {
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   ASSERT_EQ(doorways(grid).size(), 1u);
   EXPECT_GE(expect_door_cells_fill_the_opening(grid, kFace0, kFace1 - 0.05), 3 * 16);
+}
+
+// A door leaf swung open into the room and back over the wall's face (as a door stands against
+// the wall beside its frame): its points lie beyond the reveal on the room's side, where the
+// jamb's faces are measured, and made them 0.2 m apart in a 0.1 m wall (0.19 on survey seed 4,
+// the doorway's cells three rows out on the floor). Faces more than a cell apart beyond the
+// walls' measured thickness are not the wall's: the doorway keeps to the wall's rows, of which
+// the leaf's hinge holds one more on its side.
+TEST(SemanticGrid, AnOpenDoorLeafBesideTheJambIsNoFaceOfTheWall) {
+  const double kFace0 = 3.012, kFace1 = kFace0 + 0.0995;
+  const LabelledPoints s = doorway_scene(kFace1 - kFace0, {.open_leaf = true});
+  const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
+  ASSERT_TRUE(grid.wall_thickness.has_value());
+  EXPECT_NEAR(*grid.wall_thickness, 0.1, 1e-9);
+  ASSERT_EQ(doorways(grid).size(), 1u);
+  int in_the_wall = 0, in_the_room = 0;
+  for (int row = 0; row < grid.height(); ++row) {
+    for (int col = 0; col < grid.width(); ++col) {
+      if (grid.classes(col, row) != SemanticClass::door) continue;
+      const double y = grid.cell_center({col, row}).y();
+      ++(y < kFace0 - 0.01 ? in_the_room : in_the_wall);
+      EXPECT_GT(y, kFace0 - grid.resolution - 0.01) << "more than the hinge's row out";
+    }
+  }
+  EXPECT_GE(in_the_wall, 2 * 16);
+  EXPECT_LE(in_the_room, 18);  // the hinge's row across the opening at most (three rows without)
 }
 
 // A doorway whose wall has a 5 cm strip that no view saw 10-15 cm from each jamb (as a wall's end
