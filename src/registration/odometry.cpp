@@ -496,8 +496,24 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
       frame.from_features = true;
       return std::move(*arbitrated);
     }
+    return straight_if_better(previous, predicted, std::move(attempt), frame);
   }
   return attempt;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::straight_if_better(std::size_t previous,
+                                                       const Eigen::Isometry3d& predicted,
+                                                       Attempt attempt, OdometryFrame& frame) {
+  if (!params_.straight_start_on_silent_images ||
+      se3::rotation_angle(predicted) <= params_.feature_seed_deg * kDegree) {
+    return attempt;
+  }
+  Eigen::Isometry3d straight = Eigen::Isometry3d::Identity();
+  straight.translation() = predicted.translation();
+  Attempt other = register_frames(previous, straight, frame_limits_now());
+  if (!better_start(previous, other, attempt)) return attempt;
+  frame.retried = true;
+  return other;
 }
 
 bool RgbdOdometry::images_left_open(const Attempt& attempt) const {
