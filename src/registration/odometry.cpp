@@ -606,7 +606,18 @@ bool RgbdOdometry::images_tell_apart(const Attempt& challenger, const Attempt& i
              params_.feature_arbitration_ratio * incumbent.photometric_rmse;
 }
 
+bool RgbdOdometry::neither_images_fit(const Attempt& predicted, const Attempt& seeded) const {
+  const auto misfit = [&](const Attempt& a) {
+    return a.report.accepted() && !a.photometric &&
+           a.photometric_rmse > params_.photometric_doubt_rmse;
+  };
+  return (predicted.report.degenerate || seeded.report.degenerate) && misfit(predicted) &&
+         misfit(seeded) && !within_arbitration(predicted, seeded) &&
+         speed_allows(predicted) == speed_allows(seeded);
+}
+
 bool RgbdOdometry::keeps_prediction(const Attempt& predicted, const Attempt& seeded) {
+  if (params_.features_over_misfit_images && neither_images_fit(predicted, seeded)) return false;
   if (agrees_better(predicted, seeded) || images_tell_apart(predicted, seeded)) return true;
   return params_.prediction_keeps_image_ties && predicted.report.accepted() &&
          predicted.photometric && seeded.photometric && !within_arbitration(predicted, seeded) &&

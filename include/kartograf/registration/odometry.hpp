@@ -321,6 +321,16 @@ struct OdometryParams {
   // features' (the survey of seed 2 every 10th frame, frame 40: a drive at 0.91 m a frame taken
   // for 0.26 m, a floor tile over, at RMSE 15.7 against 16.6).
   bool prediction_keeps_image_ties = true;
+  // Where the two registrations of a large predicted motion end apart on a degenerate view, the
+  // speed bound does not tell them apart, and neither's images were refined nor fit within
+  // photometric_doubt_rmse, the features' is kept: the images' RMSEs then compare two misfits,
+  // and the features measured their motion where the prediction only carried the last one on.
+  // Found on survey seed 6 every 10th frame, frame 25: the robot sets off from a turn (0.49 m and
+  // 2.0 degrees; predicted 0.30 m and 11.4). The features found 0.49 m and 3.9 degrees (RMSE
+  // 23.9), the prediction's registration stayed at its turn (16.5) and won on the ratio: 19.6 cm
+  // and 9.3 degrees off. Seed 10's tour, frame 25, the same (19.5 cm, 6.7 degrees). False: the
+  // images' ratio decides there too.
+  bool features_over_misfit_images = true;
   // Grey levels; the synthetic camera's noise is about 1. Also: a photometric refinement whose
   // answer lies beyond the registration's correction limits (frame_limits, reestimate_limits) is
   // kept only at an RMSE within this (docs/slam.md, "An images' correction beyond the limits").
@@ -572,6 +582,10 @@ class RgbdOdometry {
   // motion: whether the prediction's is kept (agrees better, told apart by the images within the
   // arbitration distance, or beyond it a tie the refined images cannot break).
   bool keeps_prediction(const Attempt& predicted, const Attempt& seeded);
+  // OdometryParams::features_over_misfit_images: the two registrations end apart on a degenerate
+  // view where neither the speed bound nor the images (neither refined, both above
+  // photometric_doubt_rmse) can tell them apart.
+  bool neither_images_fit(const Attempt& predicted, const Attempt& seeded) const;
   // Whether the attempt's step into the frame being tracked is one the robot's drive allows
   // (OdometryParams::speed_change_margin).
   bool speed_allows(const Attempt& attempt) const;
