@@ -89,6 +89,13 @@ Eigen::Isometry3d orthonormalized(const Eigen::Isometry3d& pose) {
   return result;
 }
 
+// The motion's step with no turn: a start for ICP where the turn may be wrong.
+Eigen::Isometry3d without_its_turn(const Eigen::Isometry3d& motion) {
+  Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
+  step.translation() = motion.translation();
+  return step;
+}
+
 bool is_identity(const Eigen::Isometry3d& pose) {
   return pose.matrix().isApprox(Eigen::Matrix4d::Identity(), 1e-12);
 }
@@ -508,9 +515,7 @@ RgbdOdometry::Attempt RgbdOdometry::straight_if_better(std::size_t previous,
       se3::rotation_angle(predicted) <= params_.feature_seed_deg * kDegree) {
     return attempt;
   }
-  Eigen::Isometry3d straight = Eigen::Isometry3d::Identity();
-  straight.translation() = predicted.translation();
-  Attempt other = register_frames(previous, straight, frame_limits_now());
+  Attempt other = register_frames(previous, without_its_turn(predicted), frame_limits_now());
   if (!better_start(previous, other, attempt)) return attempt;
   frame.retried = true;
   return other;
@@ -661,9 +666,8 @@ std::vector<Eigen::Isometry3d> RgbdOdometry::other_starts(
     const Eigen::Isometry3d& predicted) const {
   Eigen::Isometry3d turn_only = predicted;
   turn_only.translation().setZero();
-  Eigen::Isometry3d step_only = Eigen::Isometry3d::Identity();
-  step_only.translation() = predicted.translation();
-  std::vector<Eigen::Isometry3d> starts = {Eigen::Isometry3d::Identity(), turn_only, step_only};
+  std::vector<Eigen::Isometry3d> starts = {Eigen::Isometry3d::Identity(), turn_only,
+                                           without_its_turn(predicted)};
   // Turns about the camera's vertical axis beyond the prediction: a robot's or a person's turn is
   // the motion most often beyond ICP's basin.
   for (const double degrees : params_.recheck_turns_deg) {
