@@ -68,6 +68,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
   cells["unobserved"] = d.unobserved_cells;
   json["cells"] = std::move(cells);
   json["inferred"] = {{"wall_thickness_m", d.wall_thickness ? Json(*d.wall_thickness) : Json()},
+                      {"lattice_offset_m", json_array(d.lattice_offset)},
+                      {"wall_face_crispness", json_array(d.wall_face_crispness)},
                       {"furniture_fronts", d.furniture_fronts},
                       {"furniture_pockets", d.furniture_pockets},
                       {"wall_specks", d.wall_specks},

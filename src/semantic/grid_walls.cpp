@@ -4,8 +4,12 @@
 #include <array>
 #include <cmath>
 #include <complex>
+#include <map>
 #include <numbers>
+#include <utility>
 #include <vector>
+
+#include <Eigen/Eigenvalues>
 
 #include "semantic/grid_cells.hpp"
 
@@ -113,27 +117,108 @@ Image<int> wall_direction_bins(const Image<SemanticClass>& classes) {
   return bins;
 }
 
-Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
-                                std::span<const SemanticClass> labels, double floor_z,
-                                const SemanticGridParams& options, double min_agreement) {
-  const double res = options.resolution;
-  const double to_angle = 2 * std::numbers::pi / res;
-  std::array<std::complex<double>, 2> sum{};
-  std::size_t count = 0;
+namespace {
+
+constexpr double kPatchSize = 0.25;     // m: a stretch of face, short enough to be straight
+constexpr double kMinPatchPoints = 20;  // fewer say nothing of a face
+constexpr double kMaxFaceTilt = 20.0;   // deg between a patch's long axis and the lattice's
+// Variance along a patch over variance across it (3x the spread): a face, not a corner.
+constexpr double kMinElongation = 9.0;
+
+// The wall points of one patch of the floor plan: their moments, and per axis the sum of their
+// coordinates as angles on the cell period.
+struct WallPatch {
+  double count = 0;
+  Eigen::Vector2d sum = Eigen::Vector2d::Zero();
+  Eigen::Matrix2d sum_sq = Eigen::Matrix2d::Zero();
+  std::array<std::complex<double>, 2> resultant{};
+};
+
+using PatchMap = std::map<std::pair<long, long>, WallPatch>;
+
+// The band's wall points, by patch and all together (summed in their order, as the lattice's
+// offset has always been). Patches on two lattices half a patch apart: a face that one cuts, which
+// leaves each part tighter than the face, lies inside a patch of the other.
+struct WallBand {
+  std::array<PatchMap, 2> patches;
+  WallPatch all;
+};
+
+WallBand wall_band(std::span<const Eigen::Vector3d> points, std::span<const SemanticClass> labels,
+                   double floor_z, const SemanticGridParams& options) {
+  const double to_angle = 2 * std::numbers::pi / options.resolution;
+  WallBand band;
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d& p = points[i];
     const double h = p.z() - floor_z;
     if (labels[i] != SemanticClass::wall || !p.allFinite() || h < options.band_min ||
         h > options.band_max)
       continue;
-    for (int axis = 0; axis < 2; ++axis) sum[axis] += std::polar(1.0, to_angle * p[axis]);
-    ++count;
+    const Eigen::Vector2d xy = p.head<2>();
+    std::array<WallPatch*, 3> sums_of{&band.all};
+    for (std::size_t lattice = 0; lattice < 2; ++lattice) {
+      const Eigen::Vector2d at = xy / kPatchSize + Eigen::Vector2d::Constant(0.5 * lattice);
+      sums_of[lattice + 1] = &band.patches[lattice][{std::lround(std::floor(at.x())),
+                                                     std::lround(std::floor(at.y()))}];
+    }
+    for (WallPatch* sums : sums_of) {
+      sums->count += 1;
+      sums->sum += xy;
+      sums->sum_sq += xy * xy.transpose();
+      for (int axis = 0; axis < 2; ++axis)
+        sums->resultant[axis] += std::polar(1.0, to_angle * xy[axis]);
+    }
   }
-  Eigen::Vector2d phase = Eigen::Vector2d::Zero();
+  return band;
+}
+
+// Whether a patch's points lie along a face across `axis` (the wall runs along the other one).
+bool face_across(const WallPatch& patch, int axis) {
+  if (patch.count < kMinPatchPoints) return false;
+  const Eigen::Vector2d mean = patch.sum / patch.count;
+  const Eigen::Matrix2d covariance = patch.sum_sq / patch.count - mean * mean.transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> solver(covariance);
+  const Eigen::Vector2d spread = solver.eigenvalues();  // ascending
+  return std::abs(solver.eigenvectors()(1 - axis, 1)) >=
+             std::cos(kMaxFaceTilt * std::numbers::pi / 180) &&
+         spread[1] >= kMinElongation * spread[0];
+}
+
+// Of the patches along faces across `axis`: how their offsets agree with each other (however
+// crisp each one), and how crisp they are (each one's points about its own offset).
+std::pair<double, double> face_agreement_and_crispness(const PatchMap& patches, int axis) {
+  std::complex<double> faces{};
+  double face_lengths = 0, face_points = 0;
+  for (const auto& [key, patch] : patches) {
+    if (!face_across(patch, axis)) continue;
+    faces += patch.resultant[axis];
+    face_lengths += std::abs(patch.resultant[axis]);
+    face_points += patch.count;
+  }
+  if (face_points == 0) return {0.0, 0.0};
+  return {std::abs(faces) / face_lengths, face_lengths / face_points};
+}
+
+}  // namespace
+
+FacePhase wall_face_phase(std::span<const Eigen::Vector3d> points,
+                          std::span<const SemanticClass> labels, double floor_z,
+                          const SemanticGridParams& options, double min_crispness) {
+  const double res = options.resolution;
+  const double to_angle = 2 * std::numbers::pi / res;
+  const WallBand band = wall_band(points, labels, floor_z, options);
+  FacePhase phase;
   for (int axis = 0; axis < 2; ++axis) {
-    if (count == 0 || std::abs(sum[axis]) < min_agreement * static_cast<double>(count)) continue;
-    const double offset = std::arg(sum[axis]) / to_angle;  // (-res / 2, res / 2]
-    phase[axis] = offset < 0 ? offset + res : offset;
+    // A face that a patch boundary cuts reads tighter in each part than it is: the reading of
+    // the lattice of patches that finds the faces less crisp.
+    const auto [agreement0, crispness0] = face_agreement_and_crispness(band.patches[0], axis);
+    const auto [agreement1, crispness1] = face_agreement_and_crispness(band.patches[1], axis);
+    const bool first = crispness0 <= crispness1;
+    phase.agreement[axis] = first ? agreement0 : agreement1;
+    phase.crispness[axis] = first ? crispness0 : crispness1;
+    if (phase.crispness[axis] < min_crispness) continue;
+    const double offset = std::arg(band.all.resultant[axis]) / to_angle;  // (-res / 2, res / 2]
+    phase.offset[axis] = offset < 0 ? offset + res : offset;
   }
   return phase;
 }

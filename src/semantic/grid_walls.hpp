@@ -10,14 +10,24 @@
 
 namespace kartograf::semantic::detail {
 
-// Per axis, the offset in [0, resolution) of the cell boundaries that puts the wall faces on them:
-// the circular mean, modulo the resolution, of the wall points' coordinate in the height band
-// above `floor_z`. Faces across an axis share a phase there; faces along it spread uniformly and
-// cancel. 0 on an axis where the points agree less than `min_agreement` (the mean resultant
-// length, 0..1): faces at unrelated offsets, which no lattice can serve at once.
-Eigen::Vector2d wall_face_phase(std::span<const Eigen::Vector3d> points,
-                                std::span<const SemanticClass> labels, double floor_z,
-                                const SemanticGridParams& options, double min_agreement);
+// Per axis, the offset of the cell boundaries that puts the wall faces on them, and what it rests
+// on. Faces are 0.25 m patches of the band's wall points that lie along the other axis;
+// `agreement` is how their offsets (circular, modulo the resolution) agree with each other,
+// whatever each one's spread, and `crispness` how tightly each one's points keep to its own offset
+// (exp(-(2 pi sigma / resolution)^2 / 2) for a Gaussian spread sigma across the face; 0 without
+// faces). `offset`, in [0, resolution), is the circular mean of all the band's wall points (faces
+// along the axis spread uniformly and cancel): the best one lattice for the faces, however well
+// they agree (the default lattice serves unrelated faces no better). 0 on an axis whose faces are
+// less crisp than `min_crispness`: points spread over both cells at a face are read better off a
+// lattice that does not cut them at their face.
+struct FacePhase {
+  Eigen::Vector2d offset = Eigen::Vector2d::Zero();
+  Eigen::Vector2d agreement = Eigen::Vector2d::Zero();
+  Eigen::Vector2d crispness = Eigen::Vector2d::Zero();
+};
+FacePhase wall_face_phase(std::span<const Eigen::Vector3d> points,
+                          std::span<const SemanticClass> labels, double floor_z,
+                          const SemanticGridParams& options, double min_crispness);
 
 // Direction bin (8 bins over 180 degrees, bin b at angle b * pi / 8 in cell coordinates) of each
 // wall cell: the direction of the longest run of wall cells through it, when that run is at least

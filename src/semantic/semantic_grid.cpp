@@ -30,9 +30,11 @@
 namespace kartograf::semantic {
 namespace {
 
-// Wall points must agree this much (mean resultant length) on where faces cross an axis before the
-// lattice moves for them: faces at unrelated offsets leave the lattice where it is.
-constexpr double kMinFacePhaseAgreement = 0.1;
+// Wall faces must be this crisp before the lattice moves for them: exp(-pi^2 / 8), their points
+// spread at most a quarter of a cell across the face (1.25 cm at 5 cm cells; a depth camera's
+// noise at 3-4 m is more). A measure of the faces' own spread and not of how their offsets agree:
+// that one swung across its threshold with a millimetre of the poses.
+constexpr double kMinFaceCrispness = 0.29;
 // Face cells of walls seen from both sides needed to measure a wall's thickness (1 m of wall).
 constexpr int kMinTwoSidedWallCells = 40;
 // Furniture is judged seen through this far below its top: inside a table's 2-5 cm top.
@@ -825,10 +827,13 @@ SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
   require(std::isfinite(lo.x()),
           "build_semantic_grid: no finite point among " + std::to_string(points.size()));
   const double res = options.resolution;
-  const Eigen::Vector2d phase =
-      options.align_cells_to_walls
-          ? detail::wall_face_phase(points, labels, grid.floor_z, options, kMinFacePhaseAgreement)
-          : Eigen::Vector2d::Zero();
+  if (options.align_cells_to_walls) {
+    const detail::FacePhase faces =
+        detail::wall_face_phase(points, labels, grid.floor_z, options, kMinFaceCrispness);
+    grid.lattice_offset = faces.offset;
+    grid.wall_face_crispness = faces.crispness;
+  }
+  const Eigen::Vector2d& phase = grid.lattice_offset;
   grid.origin = (((lo - phase).array() - options.margin) / res).floor() * res + phase.array();
   const Eigen::Vector2i size =
       ((hi.array() + options.margin - grid.origin.array()) / res).ceil().cast<int>().max(1);
@@ -1398,6 +1403,8 @@ MapDescription describe(const SemanticGrid& grid) {
   d.floor_z = grid.floor_z;
   d.ceiling_z = grid.ceiling_z;
   d.wall_thickness = grid.wall_thickness;
+  d.lattice_offset = grid.lattice_offset;
+  d.wall_face_crispness = grid.wall_face_crispness;
   d.furniture_fronts = grid.furniture_fronts;
   d.furniture_pockets = grid.furniture_pockets;
   d.wall_specks = grid.wall_specks;

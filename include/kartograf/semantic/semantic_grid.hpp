@@ -123,7 +123,8 @@ struct SemanticGridParams {
   // doorway would have shown floor. 0: off.
   double max_unseen_wall_gap = 3.0;
   // The cell lattice is shifted (less than a cell) so that wall faces lie on cell boundaries where
-  // the wall points agree on such a shift: a face inside a cell makes it half wall, half room.
+  // the faces are crisp (SemanticGrid::wall_face_crispness): a face inside a cell makes it half
+  // wall, half room.
   bool align_cells_to_walls = true;
   // Unobserved cells between floor cells this close along a row or a column are floor: the thin
   // shadows behind corners that a camera turning in place leaves as a fan. 0: off.
@@ -218,6 +219,12 @@ struct SemanticGrid {
   // floor again, and the lone posts kept as obstacles (a leg inside one cell, no obstacle beside
   // it, which the speck removal would have dropped).
   std::optional<double> wall_thickness;  // m
+  // Where the cell lattice stands: the offset its boundaries moved by to lie on the wall faces (0
+  // on an axis where they did not), and how crisp the faces across each axis were (the mean
+  // resultant length of their points about each face's offset: 1 sharp, 0 spread over a cell or
+  // no face; align_cells_to_walls moves for 0.29 and more).
+  Eigen::Vector2d lattice_offset = Eigen::Vector2d::Zero();       // m
+  Eigen::Vector2d wall_face_crispness = Eigen::Vector2d::Zero();  // per axis, 0..1
   int furniture_fronts = 0;
   int furniture_pockets = 0;
   int wall_specks = 0;
@@ -280,7 +287,9 @@ struct MapDescription {
   std::vector<std::pair<std::string, float>> class_weights;  // class name -> weight (NaN: unknown)
   std::array<int, kSemanticClassCount> cells_per_class{};
   int unobserved_cells = 0;
-  std::optional<double> wall_thickness;  // as SemanticGrid's
+  std::optional<double> wall_thickness;                           // as SemanticGrid's
+  Eigen::Vector2d lattice_offset = Eigen::Vector2d::Zero();       // as SemanticGrid's
+  Eigen::Vector2d wall_face_crispness = Eigen::Vector2d::Zero();  // as SemanticGrid's
   int furniture_fronts = 0;
   int furniture_pockets = 0;
   int wall_specks = 0;
