@@ -148,6 +148,9 @@ WallBand wall_band(std::span<const Eigen::Vector3d> points, std::span<const Sema
                    double floor_z, const SemanticGridParams& options) {
   const double to_angle = 2 * std::numbers::pi / options.resolution;
   WallBand band;
+  // Consecutive points mostly come from neighbouring pixels, in one patch: the last one found
+  // spares most of the lookups.
+  std::array<std::pair<std::pair<long, long>, WallPatch*>, 2> last{};
   for (std::size_t i = 0; i < points.size(); ++i) {
     const Eigen::Vector3d& p = points[i];
     const double h = p.z() - floor_z;
@@ -158,8 +161,11 @@ WallBand wall_band(std::span<const Eigen::Vector3d> points, std::span<const Sema
     std::array<WallPatch*, 3> sums_of{&band.all};
     for (std::size_t lattice = 0; lattice < 2; ++lattice) {
       const Eigen::Vector2d at = xy / kPatchSize + Eigen::Vector2d::Constant(0.5 * lattice);
-      sums_of[lattice + 1] = &band.patches[lattice][{std::lround(std::floor(at.x())),
-                                                     std::lround(std::floor(at.y()))}];
+      const std::pair<long, long> key{std::lround(std::floor(at.x())),
+                                      std::lround(std::floor(at.y()))};
+      if (!last[lattice].second || last[lattice].first != key)
+        last[lattice] = {key, &band.patches[lattice][key]};
+      sums_of[lattice + 1] = last[lattice].second;
     }
     for (WallPatch* sums : sums_of) {
       sums->count += 1;
