@@ -511,8 +511,9 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
 RgbdOdometry::Attempt RgbdOdometry::straight_if_better(std::size_t previous,
                                                        const Eigen::Isometry3d& predicted,
                                                        Attempt attempt, OdometryFrame& frame) {
-  if (!params_.straight_start_on_silent_images ||
-      se3::rotation_angle(predicted) <= params_.feature_seed_deg * kDegree) {
+  // A large step (where the features are tried) that turns more than the arbitration tells apart.
+  if (!params_.straight_start_on_silent_images || !is_large(predicted) ||
+      se3::rotation_angle(predicted) <= params_.feature_arbitration_deg * kDegree) {
     return attempt;
   }
   Attempt other = register_frames(previous, without_its_turn(predicted), frame_limits_now());

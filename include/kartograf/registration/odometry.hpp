@@ -365,14 +365,20 @@ struct OdometryParams {
   // range (metres wide after long degenerate stretches) the images took wrong minima.
   bool step_scan = true;
   // A degenerate view whose images the registration left doubtful and whose features found no
-  // motion, while the prediction turns more than feature_seed_deg: ICP is also run from the
+  // motion, while the prediction is large (beyond feature_seed_m or feature_seed_deg, where the
+  // features are tried) and turns more than feature_arbitration_deg (a start apart from the
+  // prediction's, as the arbitration tells answers apart): ICP is also run from the
   // predicted step without its turn, kept where better_start prefers it (the speed bound, then
   // decisive images, then the fitness weighed by the view). A turn can end within one frame of a
   // sparse sequence; from the predicted turn the wall ahead lands beside its own points, ICP
   // pairs the floor alone, which no turn about the vertical moves, and the turn stays. Found on
   // survey seed 5 every 10th frame, frame 38: a 22 degree turn that ended as the robot drove
   // through a doorway, kept at a fitness of 0.36 (0.48 from the straight start, 0.07 degrees
-  // off). Frames 30 Hz apart never turn that far.
+  // off). The same on seed 10's, frame 93: the robot stopped turning (6.3 degrees the step
+  // before) and sped up straight towards a wall beyond the depth's range over a floor whose grain
+  // runs along the motion; the kept 6 degree turn set the next two frames wrong (from 15 degrees
+  // until 2026-12-04, which that turn was under). Frames 30 Hz apart never make such a step (with
+  // any turn over 2 degrees it had run on 3 of survey 5's 1319 frames and moved the odometry).
   bool straight_start_on_silent_images = true;
 };
 
