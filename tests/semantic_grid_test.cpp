@@ -938,9 +938,10 @@ TEST(SemanticGrid, NoisyWallFacesAreMeasuredAlongTheWall) {
 
 // Faces that agree poorly on where they cross x (the west face on a cell boundary, the east one
 // 2 cm past one: 144 degrees apart on the 5 cm period), crisp (6 mm noise): the lattice takes their
-// circular mean, and moving the east face by 2 mm moves it by a millimetre. Judged on how the
-// points agreed (0.12, then 0.07 of them, against a threshold of 0.1), the whole lattice had
-// jumped 1 cm between the two rooms: what a millimetre of the SLAM's poses did on survey seed 5.
+// circular mean, and moving the east face by 2 mm moves it by a millimetre. Judged on how all the
+// points agreed (their mean resultant length over the old threshold of 0.1 in the first room,
+// under it in the second), the lattice had moved in the first and not in the second: a 1 cm jump,
+// what a millimetre of the SLAM's poses did on survey seed 5.
 TEST(SemanticGrid, TheLatticeFollowsCrispFacesSmoothlyHoweverTheyAgree) {
   constexpr double kWest = 0.5, kSouth = 0.525, kNorth = 3.025;
   const auto lattice_x = [&](double east) {
