@@ -136,12 +136,12 @@ struct WallPatch {
 
 using PatchMap = std::map<std::pair<long, long>, WallPatch>;
 
-// The band's wall points, by patch and all together (summed in their order, as the lattice's
-// offset has always been). Patches on two lattices half a patch apart: a face that one cuts, which
-// leaves each part tighter than the face, lies inside a patch of the other.
+// The band's wall points, by patch, and the resultant of them all (summed in their order, as the
+// lattice's offset has always been). Patches on two lattices half a patch apart: a face that one
+// cuts, which leaves each part tighter than the face, lies inside a patch of the other.
 struct WallBand {
   std::array<PatchMap, 2> patches;
-  WallPatch all;
+  std::array<std::complex<double>, 2> resultant{};
 };
 
 WallBand wall_band(std::span<const Eigen::Vector3d> points, std::span<const SemanticClass> labels,
@@ -158,21 +158,24 @@ WallBand wall_band(std::span<const Eigen::Vector3d> points, std::span<const Sema
         h > options.band_max)
       continue;
     const Eigen::Vector2d xy = p.head<2>();
-    std::array<WallPatch*, 3> sums_of{&band.all};
+    std::array<WallPatch*, 2> sums_of{};
     for (std::size_t lattice = 0; lattice < 2; ++lattice) {
       const Eigen::Vector2d at = xy / kPatchSize + Eigen::Vector2d::Constant(0.5 * lattice);
       const std::pair<long, long> key{std::lround(std::floor(at.x())),
                                       std::lround(std::floor(at.y()))};
       if (!last[lattice].second || last[lattice].first != key)
         last[lattice] = {key, &band.patches[lattice][key]};
-      sums_of[lattice + 1] = last[lattice].second;
+      sums_of[lattice] = last[lattice].second;
+    }
+    for (int axis = 0; axis < 2; ++axis) {
+      const std::complex<double> angle = std::polar(1.0, to_angle * xy[axis]);
+      band.resultant[axis] += angle;
+      for (WallPatch* sums : sums_of) sums->resultant[axis] += angle;
     }
     for (WallPatch* sums : sums_of) {
       sums->count += 1;
       sums->sum += xy;
       sums->sum_sq += xy * xy.transpose();
-      for (int axis = 0; axis < 2; ++axis)
-        sums->resultant[axis] += std::polar(1.0, to_angle * xy[axis]);
     }
   }
   return band;
@@ -190,19 +193,15 @@ bool face_across(const WallPatch& patch, int axis) {
          spread[1] >= kMinElongation * spread[0];
 }
 
-// Of the patches along faces across `axis`: how their offsets agree with each other (however
-// crisp each one), and how crisp they are (each one's points about its own offset).
-std::pair<double, double> face_agreement_and_crispness(const PatchMap& patches, int axis) {
-  std::complex<double> faces{};
+// How crisp the patches along faces across `axis` are: each one's points about its own offset.
+double face_crispness(const PatchMap& patches, int axis) {
   double face_lengths = 0, face_points = 0;
   for (const auto& [key, patch] : patches) {
     if (!face_across(patch, axis)) continue;
-    faces += patch.resultant[axis];
     face_lengths += std::abs(patch.resultant[axis]);
     face_points += patch.count;
   }
-  if (face_points == 0) return {0.0, 0.0};
-  return {std::abs(faces) / face_lengths, face_lengths / face_points};
+  return face_points > 0 ? face_lengths / face_points : 0.0;
 }
 
 }  // namespace
@@ -217,13 +216,10 @@ FacePhase wall_face_phase(std::span<const Eigen::Vector3d> points,
   for (int axis = 0; axis < 2; ++axis) {
     // A face that a patch boundary cuts reads tighter in each part than it is: the reading of
     // the lattice of patches that finds the faces less crisp.
-    const auto [agreement0, crispness0] = face_agreement_and_crispness(band.patches[0], axis);
-    const auto [agreement1, crispness1] = face_agreement_and_crispness(band.patches[1], axis);
-    const bool first = crispness0 <= crispness1;
-    phase.agreement[axis] = first ? agreement0 : agreement1;
-    phase.crispness[axis] = first ? crispness0 : crispness1;
+    phase.crispness[axis] =
+        std::min(face_crispness(band.patches[0], axis), face_crispness(band.patches[1], axis));
     if (phase.crispness[axis] < min_crispness) continue;
-    const double offset = std::arg(band.all.resultant[axis]) / to_angle;  // (-res / 2, res / 2]
+    const double offset = std::arg(band.resultant[axis]) / to_angle;  // (-res / 2, res / 2]
     phase.offset[axis] = offset < 0 ? offset + res : offset;
   }
   return phase;

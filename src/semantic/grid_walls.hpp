@@ -12,8 +12,7 @@ namespace kartograf::semantic::detail {
 
 // Per axis, the offset of the cell boundaries that puts the wall faces on them, and what it rests
 // on. Faces are 0.25 m patches of the band's wall points that lie along the other axis;
-// `agreement` is how their offsets (circular, modulo the resolution) agree with each other,
-// whatever each one's spread, and `crispness` how tightly each one's points keep to its own offset
+// `crispness` is how tightly each one's points keep to its own offset, modulo the resolution
 // (exp(-(2 pi sigma / resolution)^2 / 2) for a Gaussian spread sigma across the face; 0 without
 // faces). `offset`, in [0, resolution), is the circular mean of all the band's wall points (faces
 // along the axis spread uniformly and cancel): the best one lattice for the faces, however well
@@ -22,7 +21,6 @@ namespace kartograf::semantic::detail {
 // lattice that does not cut them at their face.
 struct FacePhase {
   Eigen::Vector2d offset = Eigen::Vector2d::Zero();
-  Eigen::Vector2d agreement = Eigen::Vector2d::Zero();
   Eigen::Vector2d crispness = Eigen::Vector2d::Zero();
 };
 FacePhase wall_face_phase(std::span<const Eigen::Vector3d> points,
