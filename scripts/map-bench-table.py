@@ -29,6 +29,15 @@ def get(report, *path):
     return node
 
 
+def ate_text(r, value, at_measured):
+    """The ATE in cm, and where the ground truth interpolates between measured poses (SUN3D's every
+    5th frame) the ATE at those alone."""
+    measured = get(r, "evaluation", at_measured)
+    if value is None or not measured:
+        return cm(value)
+    return f"{cm(value)} ({cm(measured['ate_rmse_m'])} at the {measured['poses']} measured)"
+
+
 def loops_text(r):
     """Accepted loop closures, those found by appearance, and frames from features by features."""
     accepted = get(r, "slam", "loop_closures_accepted")
@@ -55,7 +64,9 @@ def row(runs, name):
     ious = " / ".join(number(get(r, "evaluation", "classes", "iou", c)) for c in CLASSES)
     rooms = get(r, "evaluation", "rooms")
     rooms_text = "-" if not rooms else f"{rooms['recall_mean']:.2f} / {rooms['precision_mean']:.2f}"
-    cells = [name, str(r.get("frames", "-")), cm(odometry), cm(slam), ratio,
+    cells = [name, str(r.get("frames", "-")),
+             ate_text(r, odometry, "odometry_at_measured_poses"),
+             ate_text(r, slam, "trajectory_at_measured_poses"), ratio,
              loops_text(r), views, ious, rooms_text,
              number(get(r, "timing_s", "odometry_ms_per_frame"), "{:.1f}"),
              number(get(r, "timing_s", "total"), "{:.0f}"), TUNED.get(name, "no")]

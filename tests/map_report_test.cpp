@@ -10,12 +10,12 @@
 
 #include <gtest/gtest.h>
 
+#include "kartograf/formats/top_view.hpp"
+#include "kartograf/outputs/map_outputs.hpp"
+#include "kartograf/pipeline/map_evaluation.hpp"
 #include "outputs/html_text.hpp"
 #include "outputs/map_report_html.hpp"
 #include "outputs/report_svg.hpp"
-#include "kartograf/outputs/map_outputs.hpp"
-#include "kartograf/formats/top_view.hpp"
-#include "kartograf/pipeline/map_evaluation.hpp"
 
 namespace kartograf {
 namespace {
@@ -108,6 +108,31 @@ TEST(MapEvaluation, ScoresTheOdometryBeforeLoopClosureOnItsOwn) {
   EXPECT_EQ(e.odometry_trajectory->ate.translation_m.count, 20u);
 }
 
+TEST(MapEvaluation, ScoresTheMeasuredPosesAloneWhereTheTruthInterpolatesBetweenThem) {
+  // A reference that measured every 5th pose of the run's wavy path and went straight between
+  // (SUN3D's ground truth): the run follows the waves, so it is off the reference between the
+  // measured poses and exact at them.
+  const pipeline::MapPipelineResult run = small_run(20);
+  pipeline::MapGroundTruth truth;
+  for (std::size_t k = 0; k < run.poses.size(); ++k) {
+    const std::size_t m = std::min<std::size_t>(5 * (k / 5), 10);  // after 15: the last run on
+    const Eigen::Vector3d from = run.poses[m].translation();
+    const Eigen::Vector3d step = (run.poses[m + 5].translation() - from) / 5;
+    Eigen::Isometry3d pose = run.poses[m];
+    pose.translation() = from + static_cast<double>(k - m) * step;
+    truth.poses.push_back(pose);
+  }
+  const pipeline::MapEvaluation e = pipeline::evaluate_map(run, truth);
+  ASSERT_TRUE(e.trajectory && e.trajectory_at_measured_poses);
+  EXPECT_GT(e.trajectory->ate.translation_m.rmse, 0.01);
+  EXPECT_EQ(e.trajectory_at_measured_poses->period, 5u);
+  EXPECT_EQ(e.trajectory_at_measured_poses->ate.translation_m.count, 4u);  // poses 0, 5, 10, 15
+  EXPECT_NEAR(e.trajectory_at_measured_poses->ate.translation_m.rmse, 0, 1e-9);
+  // A reference that measured every pose: nothing more to say.
+  EXPECT_FALSE(
+      pipeline::evaluate_map(run, moved_truth(run, 99, 99, 0)).trajectory_at_measured_poses);
+}
+
 int yellow_pixels(const RgbImage& image) {
   int count = 0;
   for (int y = 0; y < image.height(); ++y)
@@ -193,6 +218,7 @@ Json report_of(bool with_evaluation) {
       "odometry_trajectory": {"ate_rmse_m": 0.0246, "ate_max_m": 0.05,
                               "rpe_translation_rmse_m": 0.003, "rpe_rotation_rmse_deg": 0.2,
                               "poses": 19},
+      "trajectory_at_measured_poses": {"ate_rmse_m": 0.0111, "poses": 4, "ground_truth_period": 5},
       "rooms": {"ground_truth_rooms": 2, "segments": 2, "recall_mean": 0.95, "recall_total": 0.96,
                 "precision_mean": 0.85, "precision_total": 0.9, "mcc": 1.0},
       "classes": {"iou": {"unknown": null, "floor": 0.9, "wall": 0.3, "ceiling": null, "door": 0.81,
@@ -246,7 +272,9 @@ TEST(MapReportHtml, SummaryAndMetricsFirstThenPicturesPlotsConfusionAnd3dView) {
   EXPECT_NE(page.at("class=\"value missed\">1.23 cm"), std::string::npos);  // target 1 cm
   EXPECT_NE(page.at("odometry alone: ATE RMSE"), std::string::npos);        // before loop closure
   EXPECT_NE(page.at("the back end changes the ATE by -50 %"), std::string::npos);
-  EXPECT_NE(page.at("class=\"value met\">0.810"), std::string::npos);       // door IoU, target 0.8
+  EXPECT_NE(page.at("ATE RMSE at the measured poses</th><td class=\"value\">1.11 cm"),
+            std::string::npos);  // the truth interpolated between every 5th pose
+  EXPECT_NE(page.at("class=\"value met\">0.810"), std::string::npos);  // door IoU, target 0.8
   EXPECT_NE(page.at("Not scored: nothing"), std::string::npos);
   EXPECT_NE(page.at("<svg class=\"plot\""), std::string::npos);  // the error over time
   EXPECT_NE(page.at("<svg class=\"bars\""), std::string::npos);  // the stage times

@@ -257,6 +257,13 @@ std::optional<eval::AteResult> absolute_trajectory_error(
   return eval::compute_ate(matched, eval::Alignment::se3);
 }
 
+std::optional<eval::MeasuredPoseAte> ate_at_measured_poses(
+    const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses) {
+  const eval::MatchedPoses matched = eval::match_frames(source.ground_truth(), poses);
+  if (matched.size() < 3) return std::nullopt;
+  return eval::ate_at_measured_poses(matched);
+}
+
 // --poses: each frame's pose from the sequence's ground truth or from a TUM file, matched by
 // timestamp, or by frame number where the layout has no timestamps (as the trajectories Kartograf
 // writes for it are stamped); a frame without one stops the run with an Error naming it.

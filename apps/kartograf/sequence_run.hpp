@@ -19,6 +19,7 @@
 #include "commands.hpp"
 #include "kartograf/compute/context.hpp"
 #include "kartograf/core/trajectory.hpp"
+#include "kartograf/eval/ground_truth_sampling.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/mapping/slam.hpp"
@@ -93,6 +94,10 @@ Trajectory ground_truth_trajectory(const pipeline::SequenceFrameSource& source,
                                    const std::vector<double>& timestamps, bool has_timestamps);
 // ATE (SE(3) alignment) of the estimate's frames that have ground truth; empty without any.
 std::optional<eval::AteResult> absolute_trajectory_error(
+    const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
+// The same at the ground truth's measured poses alone, where it interpolates between them (SUN3D's
+// every 5th frame; eval/ground_truth_sampling.hpp); empty where it measured every pose.
+std::optional<eval::MeasuredPoseAte> ate_at_measured_poses(
     const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
 
 // --poses of `map` and `fuse`: each frame's pose from the sequence's ground truth ("groundtruth")

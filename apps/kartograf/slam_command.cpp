@@ -30,16 +30,31 @@ namespace {
 
 // What the summary and stats.json say beyond the result itself.
 struct SlamFigures {
-  std::optional<eval::AteResult> slam_ate, odometry_ate;
+  io::SlamAccuracy accuracy;
   io::LoopClosureCounts loops;
 };
 
 SlamFigures slam_figures(const OpenedRun& run, const mapping::SlamResult& result) {
   SlamFigures f;
-  f.slam_ate = absolute_trajectory_error(*run.source, result.poses);
-  f.odometry_ate = absolute_trajectory_error(*run.source, result.odometry.poses);
+  f.accuracy.slam = absolute_trajectory_error(*run.source, result.poses);
+  f.accuracy.odometry = absolute_trajectory_error(*run.source, result.odometry.poses);
+  f.accuracy.slam_at_measured = ate_at_measured_poses(*run.source, result.poses);
+  f.accuracy.odometry_at_measured = ate_at_measured_poses(*run.source, result.odometry.poses);
   f.loops = io::count_loop_closures(result);
   return f;
+}
+
+// Where the ground truth interpolates between measured poses, the ATEs at those alone.
+void print_measured_pose_line(std::ostream& out, const io::SlamAccuracy& a) {
+  if (!a.slam_at_measured || !a.odometry_at_measured) return;
+  char line[256];
+  std::snprintf(line, sizeof(line),
+                "  ground truth measured every %zu frames, interpolated between: at its %zu "
+                "measured poses odometry_ate_rmse_m %.6f slam_ate_rmse_m %.6f\n",
+                a.slam_at_measured->period, a.slam_at_measured->ate.translation_m.count,
+                a.odometry_at_measured->ate.translation_m.rmse,
+                a.slam_at_measured->ate.translation_m.rmse);
+  out << line;
 }
 
 // Writes the files into the staging folder; returns whether groundtruth.txt was among them.
@@ -78,10 +93,11 @@ void print_slam_summary(std::ostream& out, const SlamOptions& o, const OpenedRun
   std::snprintf(line, sizeof(line), "  map_points %zu (voxel %.3f m)\n", result.map.size(),
                 o.voxel_size);
   out << line;
-  if (f.odometry_ate && f.slam_ate) {
+  if (f.accuracy.odometry && f.accuracy.slam) {
     std::snprintf(line, sizeof(line), "  odometry_ate_rmse_m %.6f\n  slam_ate_rmse_m %.6f\n",
-                  f.odometry_ate->translation_m.rmse, f.slam_ate->translation_m.rmse);
+                  f.accuracy.odometry->translation_m.rmse, f.accuracy.slam->translation_m.rmse);
     out << line;
+    print_measured_pose_line(out, f.accuracy);
   }
   std::snprintf(line, sizeof(line),
                 "  seconds %.2f total: odometry %.2f, loop closure %.2f, pose graph %.2f, map "
@@ -138,8 +154,8 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
 
   const SlamFigures figures = slam_figures(run, result);
   const io::SequenceRunRecord record = run_record(o.run, context);
-  const std::string stats = io::slam_stats_json(record, run.opened, params, result,
-                                                figures.slam_ate, figures.odometry_ate);
+  const std::string stats =
+      io::slam_stats_json(record, run.opened, params, result, figures.accuracy);
   bool wrote_truth = false;
   {
     const InterruptsDeferred writing;  // a signal waits for the files, then drops them

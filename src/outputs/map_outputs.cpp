@@ -80,10 +80,20 @@ Json trajectory_json(const eval::TrajectoryEvaluation& t) {
           {"poses", t.ate.translation_m.count}};
 }
 
+Json measured_poses_json(const eval::MeasuredPoseAte& m) {
+  return {{"ate_rmse_m", m.ate.translation_m.rmse},
+          {"poses", m.ate.translation_m.count},
+          {"ground_truth_period", m.period}};
+}
+
 Json evaluation_json(const pipeline::MapEvaluation& e) {
   Json json = Json::object();
   if (e.trajectory) json["trajectory"] = trajectory_json(*e.trajectory);
   if (e.odometry_trajectory) json["odometry_trajectory"] = trajectory_json(*e.odometry_trajectory);
+  if (e.trajectory_at_measured_poses)
+    json["trajectory_at_measured_poses"] = measured_poses_json(*e.trajectory_at_measured_poses);
+  if (e.odometry_at_measured_poses)
+    json["odometry_at_measured_poses"] = measured_poses_json(*e.odometry_at_measured_poses);
   if (e.rooms) {
     const eval::RoomSegmentationScores& r = *e.rooms;
     json["rooms"] = {{"ground_truth_rooms", r.ground_truth_rooms},

@@ -63,6 +63,15 @@ RunJson ate_rmse_json(const std::optional<eval::AteResult>& ate) {
   return ate ? RunJson(ate->translation_m.rmse) : RunJson();
 }
 
+// Where the ground truth interpolates between measured poses: the ATEs at those alone.
+RunJson measured_poses_json(const eval::MeasuredPoseAte& slam,
+                            const eval::MeasuredPoseAte& odometry) {
+  return {{"ground_truth_period", slam.period},
+          {"poses", slam.ate.translation_m.count},
+          {"odometry_ate_rmse_m", odometry.ate.translation_m.rmse},
+          {"slam_ate_rmse_m", slam.ate.translation_m.rmse}};
+}
+
 // Frame-to-frame, or frame-to-model with what the model did.
 RunJson tracking_json(const mapping::SlamParams& params, const mapping::OdometryRun& run) {
   if (!run.model_tracking) return {{"kind", "frame"}};
@@ -86,8 +95,7 @@ LoopClosureCounts count_loop_closures(const mapping::SlamResult& result) {
 
 std::string slam_stats_json(const SequenceRunRecord& record, const OpenedSequence& opened,
                             const mapping::SlamParams& params, const mapping::SlamResult& result,
-                            const std::optional<eval::AteResult>& slam_ate,
-                            const std::optional<eval::AteResult>& odometry_ate) {
+                            const SlamAccuracy& accuracy) {
   const mapping::SlamTimings& t = result.timing;
   RunJson json;
   json["sequence"] = record.sequence;
@@ -99,8 +107,12 @@ std::string slam_stats_json(const SequenceRunRecord& record, const OpenedSequenc
   json["device"] = record.device;
   json["reestimate_interval"] = params.odometry.reestimate_interval;
   json["tracking"] = tracking_json(params, result.odometry);
-  json["odometry_ate_rmse_m"] = ate_rmse_json(odometry_ate);
-  json["slam_ate_rmse_m"] = ate_rmse_json(slam_ate);
+  json["odometry_ate_rmse_m"] = ate_rmse_json(accuracy.odometry);
+  json["slam_ate_rmse_m"] = ate_rmse_json(accuracy.slam);
+  if (accuracy.slam_at_measured && accuracy.odometry_at_measured) {
+    json["at_measured_poses"] =
+        measured_poses_json(*accuracy.slam_at_measured, *accuracy.odometry_at_measured);
+  }
   json["timing_s"] = {{"total", t.total_seconds},
                       {"odometry", t.odometry_seconds},
                       {"loop_closure", t.loop_closure_seconds},

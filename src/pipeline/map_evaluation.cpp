@@ -56,10 +56,12 @@ MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth
   }
   out.trajectory = eval::evaluate_trajectory(matched, eval::Alignment::se3, eval::RpeParams{});
   out.frame_errors = frame_errors(matched, out.trajectory->ate);
+  out.trajectory_at_measured_poses = eval::ate_at_measured_poses(matched);
   const eval::MatchedPoses odometry = eval::match_frames(truth.poses, result.slam.odometry.poses);
   if (odometry.size() >= kMinMatchedPoses) {
     out.odometry_trajectory =
         eval::evaluate_trajectory(odometry, eval::Alignment::se3, eval::RpeParams{});
+    out.odometry_at_measured_poses = eval::ate_at_measured_poses(odometry);
   }
   if (!truth.plan) {
     out.skipped.push_back("rooms, classes: no floor plan");

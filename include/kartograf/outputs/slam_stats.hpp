@@ -5,6 +5,7 @@
 #include <optional>
 #include <string>
 
+#include "kartograf/eval/ground_truth_sampling.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/mapping/slam.hpp"
@@ -18,10 +19,16 @@ struct LoopClosureCounts {
 };
 LoopClosureCounts count_loop_closures(const mapping::SlamResult& result);
 
+// The trajectories against the ground truth: none without it; the `_at_measured` ones only where
+// it interpolates between measured poses (eval/ground_truth_sampling.hpp).
+struct SlamAccuracy {
+  std::optional<eval::AteResult> slam, odometry;
+  std::optional<eval::MeasuredPoseAte> slam_at_measured, odometry_at_measured;
+};
+
 // The ATEs are null without ground truth; ends with a newline.
 std::string slam_stats_json(const SequenceRunRecord& record, const OpenedSequence& opened,
                             const mapping::SlamParams& params, const mapping::SlamResult& result,
-                            const std::optional<eval::AteResult>& slam_ate,
-                            const std::optional<eval::AteResult>& odometry_ate);
+                            const SlamAccuracy& accuracy);
 
 }  // namespace kartograf::io

@@ -12,6 +12,7 @@
 
 #include "kartograf/core/label_image.hpp"
 #include "kartograf/core/occupancy_grid.hpp"
+#include "kartograf/eval/ground_truth_sampling.hpp"
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/eval/semantic_metrics.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
@@ -40,6 +41,9 @@ struct MapEvaluation {
   // The odometry's own trajectory (before loop closure), scored the same way: what the back end
   // adds is the difference.
   std::optional<eval::TrajectoryEvaluation> odometry_trajectory;
+  // Both again at the ground truth's measured poses alone, where it interpolates the others
+  // (SUN3D's every 5th frame; eval/ground_truth_sampling.hpp).
+  std::optional<eval::MeasuredPoseAte> trajectory_at_measured_poses, odometry_at_measured_poses;
   std::vector<FrameTrajectoryError> frame_errors;  // in frame order; empty without a trajectory
   std::optional<eval::RoomSegmentationScores> rooms;
   std::optional<eval::SemanticScores> semantic;
