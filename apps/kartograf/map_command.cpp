@@ -51,13 +51,7 @@ void print_summary(std::ostream& out, const pipeline::MapPipelineResult& r,
                   e->trajectory->ate.translation_m.rmse, e->trajectory->rpe.translation_m.rmse);
     out << line;
   }
-  if (const auto& m = e->trajectory_at_measured_poses) {
-    std::snprintf(line, sizeof(line),
-                  "  ground truth measured every %zu frames, interpolated between: ate_rmse_m "
-                  "%.4f at its %zu measured poses\n",
-                  m->period, m->ate.translation_m.rmse, m->ate.translation_m.count);
-    out << line;
-  }
+  if (e->trajectory_at_measured_poses) out << measured_poses_line(*e->trajectory_at_measured_poses);
   if (e->rooms) {
     std::snprintf(line, sizeof(line), "  rooms recall %.3f precision %.3f mcc %.3f\n",
                   e->rooms->recall_mean, e->rooms->precision_mean, e->rooms->mcc);

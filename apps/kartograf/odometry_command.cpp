@@ -72,14 +72,8 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
                   ate->translation_m.rmse, ate->translation_m.max, ate->translation_m.count);
     out << line;
   }
-  if (const auto measured = ate_at_measured_poses(*run.source, result.poses)) {
-    std::snprintf(line, sizeof(line),
-                  "  ground truth measured every %zu frames, interpolated between: ate_rmse_m "
-                  "%.6f at its %zu measured poses\n",
-                  measured->period, measured->ate.translation_m.rmse,
-                  measured->ate.translation_m.count);
-    out << line;
-  }
+  if (const auto measured = ate_at_measured_poses(*run.source, result.poses))
+    out << measured_poses_line(*measured);
 
   if (!o.stats.empty()) {
     io::write_text_file(stats_file,

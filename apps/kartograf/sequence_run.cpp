@@ -264,6 +264,15 @@ std::optional<eval::MeasuredPoseAte> ate_at_measured_poses(
   return eval::ate_at_measured_poses(matched);
 }
 
+std::string measured_poses_line(const eval::MeasuredPoseAte& measured) {
+  char line[160];
+  std::snprintf(line, sizeof(line),
+                "  ground truth measured every %zu frames, interpolated between: ate_rmse_m %.6f "
+                "at its %zu measured poses\n",
+                measured.period, measured.ate.translation_m.rmse, measured.ate.translation_m.count);
+  return line;
+}
+
 // --poses: each frame's pose from the sequence's ground truth or from a TUM file, matched by
 // timestamp, or by frame number where the layout has no timestamps (as the trajectories Kartograf
 // writes for it are stamped); a frame without one stops the run with an Error naming it.

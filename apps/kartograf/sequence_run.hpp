@@ -99,6 +99,9 @@ std::optional<eval::AteResult> absolute_trajectory_error(
 // every 5th frame; eval/ground_truth_sampling.hpp); empty where it measured every pose.
 std::optional<eval::MeasuredPoseAte> ate_at_measured_poses(
     const pipeline::SequenceFrameSource& source, const std::vector<Eigen::Isometry3d>& poses);
+// "  ground truth measured every N frames, interpolated between: ate_rmse_m X at its M measured
+// poses" and a newline.
+std::string measured_poses_line(const eval::MeasuredPoseAte& measured);
 
 // --poses of `map` and `fuse`: each frame's pose from the sequence's ground truth ("groundtruth")
 // or from a TUM file, matched by timestamp, or by frame number where the layout has no
