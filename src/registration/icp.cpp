@@ -85,6 +85,15 @@ IcpEngine::IcpEngine(const compute::Context& context, IcpParams params,
   validate(params_);
 }
 
+void IcpEngine::set_max_distance(std::size_t level, double metres) {
+  require(level < params_.levels.size(), "icp: set_max_distance: no level " +
+                                             std::to_string(level) + " of " +
+                                             std::to_string(params_.levels.size()));
+  require(std::isfinite(metres) && metres > 0,
+          "icp: set_max_distance: the gate must be finite and > 0, got " + std::to_string(metres));
+  params_.levels[level].max_distance = metres;
+}
+
 AssociationParams IcpEngine::gates_of(int level) const {
   const IcpLevelParams& lp = params_.levels[static_cast<std::size_t>(level)];
   return {lp.max_distance, params_.max_normal_angle_deg, lp.subsample, lp.search_radius};

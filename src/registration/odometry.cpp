@@ -79,6 +79,7 @@ void validate(const OdometryParams& params) {
           "odometry: fallback standard deviations must be > 0");
   require(params.information.effective_pairs > 0 && params.information.min_sigma > 0,
           "odometry: information model values must be > 0");
+  params.depth_noise_gate.validate();
 }
 
 // Composing poses (and inverting them by transposition, as Isometry3d does) lets rounding errors
@@ -370,6 +371,13 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
     planar_->samples[slot_of(frame.index)] = geometry::DeviceCloud::from_host(
         *context_, segmentation::sample_plane_points(points, nullptr, planes,
                                                      {params_.points_per_plane, frame.index + 1}));
+  }
+  if (!planar_) {  // the planar method's one level pairs plane samples, not a frame's points
+    engine_.set_max_distance(
+        0, depth_noise_gate(params_.icp.levels[0].max_distance,
+                            median_depth_m(depth, params_.depth_range.units_per_metre,
+                                           params_.depth_noise_gate.stride),
+                            params_.depth_noise_gate));
   }
   depth_ = &depth;
   color_ = color;

@@ -95,6 +95,10 @@ class IcpEngine {
                   const IcpPrior& prior);
 
   const IcpParams& params() const { return params_; }
+  // The pair gate of `level` for the following alignments (the odometry widens the finest one
+  // for deep frames, depth_noise_gate.hpp). Throws Error on a level out of range or a gate not
+  // finite and > 0.
+  void set_max_distance(std::size_t level, double metres);
 
  private:
   struct LastSums;
