@@ -372,13 +372,6 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
         *context_, segmentation::sample_plane_points(points, nullptr, planes,
                                                      {params_.points_per_plane, frame.index + 1}));
   }
-  if (!planar_) {  // the planar method's one level pairs plane samples, not a frame's points
-    engine_.set_max_distance(
-        0, depth_noise_gate(params_.icp.levels[0].max_distance,
-                            median_depth_m(depth, params_.depth_range.units_per_metre,
-                                           params_.depth_noise_gate.stride),
-                            params_.depth_noise_gate));
-  }
   depth_ = &depth;
   color_ = color;
   RgbImage& kept_color = colors_[slot_of(frame.index)];
@@ -388,6 +381,7 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
     kept_color = RgbImage();
   }
   geometry_ = level_geometry(pyramid.level(information_level_).view());
+  set_finest_gate(depth);
   frame.degenerate = geometry_.degeneracy.degenerate;
   frame.eigenvalue_ratio = geometry_.degeneracy.eigenvalue_ratio;
   if (frame.index == 0) {
@@ -406,6 +400,21 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   color_ = nullptr;
   frames_.push_back(frame);
   return frames_.back();
+}
+
+void RgbdOdometry::set_finest_gate(const DepthImage& depth) {
+  // Not the planar method's one level (plane samples), nor a degenerate view: there the motion
+  // prior and the images decide the free directions, and a wider gate let ICP's floor slide
+  // along a robot's step (the speed bound's and the step scan's test frames, 9.6 cm).
+  if (planar_) return;
+  double gate = params_.icp.levels[0].max_distance;
+  if (!geometry_.degeneracy.degenerate) {
+    gate = depth_noise_gate(
+        gate,
+        median_depth_m(depth, params_.depth_range.units_per_metre, params_.depth_noise_gate.stride),
+        params_.depth_noise_gate);
+  }
+  engine_.set_max_distance(0, gate);
 }
 
 Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame) const {

@@ -6,8 +6,8 @@
 // A fixed gate of 3 cm keeps the pairs of a room seen from 1-2.5 m and drops those of a deeper
 // one where the noise alone moves them apart: on SUN3D's study room (median depth 3.3-3.6 m) the
 // odometry paired about half of each frame's points and drifted 7 cm in five frames. So the gate
-// is `sigmas` times the noise at the frame's median depth where that is wider than the fixed one
-// (docs/slam.md, "SUN3D's ground truth measures every 5th frame").
+// is `sigmas` times the noise at the frame's median depth where that is wider than the fixed one,
+// on views that are not degenerate (RgbdOdometry; docs/slam.md, "The gate from the depth noise").
 #include <cstdint>
 
 #include "kartograf/core/point_image.hpp"

@@ -176,9 +176,10 @@ struct OdometryParams {
   bool depth_weighting = true;  // weight pairs by depth noise
   DepthWeightParams depth_weights;
   // ICP's finest pair gate (icp.levels[0].max_distance) widens to `sigmas` times the depth noise
-  // at each frame's median depth where that is wider (depth_noise_gate.hpp): SUN3D's study room,
-  // 3.4 m deep, SLAM ATE 2.19 -> 1.83 cm. Rooms seen from 1-2.5 m (7-Scenes, the synthetic
-  // surveys' frames but a few) keep the fixed gate. sigmas 0: the fixed gate.
+  // at each frame's median depth where that is wider (depth_noise_gate.hpp), on views that are
+  // not degenerate: SUN3D's study room, 3.4 m deep, SLAM ATE 2.19 -> 1.83 cm. Rooms seen from
+  // 1-2.5 m (7-Scenes, the synthetic surveys' frames but a few) keep the fixed gate. sigmas 0:
+  // the fixed gate.
   DepthNoiseGateParams depth_noise_gate;
   geometry::DepthRange depth_range;
   // The paper's k: re-estimate every k-th frame against the anchor (frame n-k when the anchor
@@ -692,6 +693,8 @@ class RgbdOdometry {
   SpeedBound speed_bound_;
   bool speed_bound_decided_ = false;  // for the frame being tracked (OdometryFrame::speed_bounded)
   RegistrationLimits frame_limits_now() const;
+  // ICP's finest gate for this frame's registrations (OdometryParams::depth_noise_gate).
+  void set_finest_gate(const DepthImage& depth);
 };
 
 }  // namespace kartograf::registration
