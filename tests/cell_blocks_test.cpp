@@ -13,6 +13,7 @@
 #include <string>
 #include <vector>
 
+#include "compute/cpu/wide_lanes.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "real_data.hpp"
 #include "segmentation/cell_planes.hpp"
@@ -141,26 +142,35 @@ void expect_same_cells(const segmentation::detail::CellGrid& a,
   }
 }
 
-class CellBlocksTest : public BackendTest {};
+struct Frame {
+  PointImage points;
+  RgbImage rgb;
+};
 
 // A slanted surface with steps of 0.4 m along diagonal bands (jumps that cross some cells and
-// blocks and miss others), noise, a tenth of the pixels without depth, any colour; a size that
-// cuts the last cells.
+// blocks and miss others), noise, a tenth of the pixels without depth, any colour.
+Frame random_frame(int width, int height, std::mt19937_64& rng) {
+  Frame frame{PointImage(width, height, invalid_point()), RgbImage(width, height)};
+  std::uniform_real_distribution<float> noise(-0.004f, 0.004f);
+  std::uniform_int_distribution<int> byte(0, 255);
+  for (int y = 0; y < height; ++y) {
+    for (int x = 0; x < width; ++x) {
+      frame.rgb(x, y) = {std::uint8_t(byte(rng)), std::uint8_t(byte(rng)), std::uint8_t(byte(rng))};
+      if (byte(rng) < 26) continue;
+      const float step = (x / 37 + y / 29) % 3 == 0 ? 0.4f : 0.0f;
+      const float d = 1.0f + 0.002f * x + 0.003f * y + step + noise(rng);
+      frame.points(x, y) = Point4f((x - width / 2) * d / 200, (y - height / 2) * d / 200, d, 1);
+    }
+  }
+  return frame;
+}
+
+class CellBlocksTest : public BackendTest {};
+
+// Random frames of a size that cuts the last cells.
 TEST_P(CellBlocksTest, MatchesReferenceOnRandomFrames) {
   for (const auto& [width, height] : {std::pair{250, 187}, std::pair{64, 48}}) {
-    PointImage points(width, height, invalid_point());
-    RgbImage rgb(width, height);
-    std::uniform_real_distribution<float> noise(-0.004f, 0.004f);
-    std::uniform_int_distribution<int> byte(0, 255);
-    for (int y = 0; y < height; ++y) {
-      for (int x = 0; x < width; ++x) {
-        rgb(x, y) = {std::uint8_t(byte(rng)), std::uint8_t(byte(rng)), std::uint8_t(byte(rng))};
-        if (byte(rng) < 26) continue;
-        const float step = (x / 37 + y / 29) % 3 == 0 ? 0.4f : 0.0f;
-        const float d = 1.0f + 0.002f * x + 0.003f * y + step + noise(rng);
-        points(x, y) = Point4f((x - width / 2) * d / 200, (y - height / 2) * d / 200, d, 1);
-      }
-    }
+    const Frame frame = random_frame(width, height, rng);
     const Eigen::Vector3d origin(0.1, -0.2, 2.5);
     // 12: a block's rows of validity bits straddle 32-bit words; 4 and 64: the smallest and
     // largest cells.
@@ -168,11 +178,37 @@ TEST_P(CellBlocksTest, MatchesReferenceOnRandomFrames) {
       const std::string what = std::to_string(width) + "x" + std::to_string(height) + ", " +
                                std::to_string(cell_size) + " px cells";
       const segmentation::detail::CellGrid cells =
-          measure(context(), points, rgb, origin, cell_size);
-      const double worst = check_blocks(points, rgb, origin, cells, what);
+          measure(context(), frame.points, frame.rgb, origin, cell_size);
+      const double worst = check_blocks(frame.points, frame.rgb, origin, cells, what);
       RecordProperty("worst_over_bound_" + what, testing::scientific(worst));
-      expect_same_cells(cells, measure(compute::Context::cpu(), points, rgb, origin, cell_size));
+      expect_same_cells(
+          cells, measure(compute::Context::cpu(), frame.points, frame.rgb, origin, cell_size));
     }
+  }
+}
+
+// The CPU's two forms of the pass, AVX2's eight lanes (blocks eight pixels wide, where the
+// processor has it) and the four-lane code, each against the reference and each other.
+TEST(CellBlocksCpuCode, WideAndFourLaneCodeAgree) {
+  std::mt19937_64 rng(7);
+  const compute::Context cpu = compute::Context::cpu();
+  const auto frames = testing::data_dir() / "7scenes_redkitchen" / "frames";
+  const std::vector<std::pair<std::string, Frame>> inputs = {
+      {"random 250x187", random_frame(250, 187, rng)},
+      {"7-Scenes frame 10",
+       {geometry::backproject(cpu, testing::read_depth(frames / "frame-000010.depth.png"),
+                              PinholeIntrinsics::kinect_7scenes()),
+        testing::read_color(frames / "frame-000010.color.jpg")}}};
+  RecordProperty("wide_code", compute::detail::wide_lanes_enabled() ? "AVX2" : "not available");
+  const Eigen::Vector3d origin(0.0, 0.0, 2.0);
+  for (const auto& [what, frame] : inputs) {
+    compute::detail::allow_wide_lanes(false);
+    const segmentation::detail::CellGrid four = measure(cpu, frame.points, frame.rgb, origin);
+    compute::detail::allow_wide_lanes(true);
+    const segmentation::detail::CellGrid wide = measure(cpu, frame.points, frame.rgb, origin);
+    check_blocks(frame.points, frame.rgb, origin, four, what + ", four lanes");
+    check_blocks(frame.points, frame.rgb, origin, wide, what + ", wide");
+    expect_same_cells(four, wide);
   }
 }
 
