@@ -15,6 +15,7 @@
 
 #include <Eigen/Geometry>
 
+#include "compute/cpu/wide_lanes.hpp"
 #include "kartograf/eval/plane_metrics.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/segmentation/plane_extraction.hpp"
@@ -450,6 +451,26 @@ TEST_P(PlaneExtractionBackendTest, CellsModeAgreesWithTheCpuBackend) {
 }
 
 KARTOGRAF_INSTANTIATE_BACKEND_TESTS(PlaneExtractionBackendTest);
+
+// The CPU's two forms of the cells mode's loops over pixels, AVX2's eight lanes (where the
+// processor has it) and four lanes: the same planes (the block sums differ by rounding only, the
+// pixels' scores not at all).
+TEST(PlaneExtraction, CellsModeWideAndFourLaneCodeAgree) {
+  RecordProperty("wide_code", compute::detail::wide_lanes_enabled() ? "AVX2" : "not available");
+  const PinholeIntrinsics camera{320, 240, 262.5, 262.5, 159.5, 119.5};
+  segmentation::PlaneExtractionParams params;
+  params.mode = segmentation::PlaneExtractionMode::cells;
+  const compute::Context context = compute::Context::cpu();
+  segmentation::PlaneExtractor extractor(context, camera, params);
+  for (const int frame : {40, 130}) {
+    const SyntheticView view = synthetic_view(camera, frame);
+    compute::detail::allow_wide_lanes(false);
+    const segmentation::PlaneSet four = extractor.extract(view.points, view.color);
+    compute::detail::allow_wide_lanes(true);
+    EXPECT_GE(four.planes.size(), 2u) << frame;
+    expect_same_planes(four, extractor.extract(view.points, view.color), 1e-6);
+  }
+}
 
 // The cells mode on the CPU: deterministic, planes by decreasing size with their records filled,
 // labelled pixels within their plane's distance allowance (planar cells and blocks with no other

@@ -8,7 +8,9 @@
 #include <numeric>
 #include <optional>
 
+#include "cell_scores_wide.hpp"
 #include "compute/cpu/lanes.hpp"
+#include "compute/cpu/wide_lanes.hpp"
 #include "compute/cpu_parallel.hpp"
 #include "kartograf/compute/kernel.hpp"
 #include "kartograf/core/error.hpp"
@@ -517,6 +519,67 @@ LaneMask device_choices(const ScoringJobs& scores, std::size_t job, const PixelR
   return choices;
 }
 
+// The choices of a rectangle's pixels, row by row: the device's (off the CPU backend), else the
+// rule's on the host, eight pixels at a time (cell_scores_wide.hpp, the same choices) where the
+// processor has AVX2 and the width is a multiple of eight, four at a time otherwise.
+class RectChoices {
+ public:
+  RectChoices(const AssignInputs& in, const PixelRect& rect, const CellCandidates& candidates,
+              std::size_t job)
+      : in_(in), rect_(rect), job_(job) {
+    const int width = rect.x1 - rect.x0;
+    wide_ =
+        !in.device && width % 8 == 0 && width <= kMaxWidth && compute::detail::wide_lanes_enabled();
+    if (in.device) return;
+    if (!wide_) {
+      lanes_ = candidate_lanes(in, candidates);
+      return;
+    }
+    for (int k = 0; k < candidates.count; ++k) {
+      const ScoredPlane& plane = in.scored[candidates.planes[k]];
+      nx_[k] = plane.normal.x(), ny_[k] = plane.normal.y(), nz_[k] = plane.normal.z();
+      offset_[k] = plane.offset;
+    }
+    wide_in_ = {in.rule.distance_base,
+                in.rule.distance_per_z2,
+                in.rule.min_facing,
+                nx_.data(),
+                ny_.data(),
+                nz_.data(),
+                offset_.data(),
+                candidates.count};
+  }
+
+  // Row `row` (the image row's first point) is next.
+  void start_row(const Point4f* row) {
+    if (wide_)
+      wide_row_choices(wide_in_, row, rect_.x0, rect_.x1, choices_.data(), distances_.data());
+  }
+
+  // The pixels x .. x + 3 of row y (`row` its first point): their choices (-1: none) and squared
+  // distances.
+  LaneMask at(const Point4f* row, int x, int y, Lanes& distance2) const {
+    if (in_.device) return device_choices(*in_.device, job_, rect_, x, y, distance2);
+    if (!wide_) return in_.rule.best(lanes_, pixel_lanes(row, x, rect_.x1), distance2);
+    LaneMask choices;
+    std::memcpy(&choices, choices_.data() + (x - rect_.x0), sizeof choices);
+    std::memcpy(&distance2, distances_.data() + (x - rect_.x0), sizeof distance2);
+    return choices;
+  }
+
+ private:
+  static constexpr int kMaxWidth = 64;  // a cell's largest side
+  const AssignInputs& in_;
+  PixelRect rect_;
+  std::size_t job_;
+  bool wide_ = false;
+  CandidateLanes lanes_;
+  std::array<float, 36> nx_, ny_, nz_, offset_;
+  WideScoreInputs wide_in_{};
+  std::array<std::int32_t, kMaxWidth> choices_;
+  std::array<float, kMaxWidth> distances_;
+};
+
 // A cell's pixels taken per candidate while it is scored: counts and squared distances for the
 // cell, and per row the first and last pixel (x) that took each candidate.
 struct CellTally {
@@ -560,7 +623,7 @@ std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRe
   const Point4f* points = in.points.data();
   const auto [x0, y0, x1, y1] = rect;
   const int count = candidates.count;
-  const CandidateLanes lanes = in.device ? CandidateLanes{} : candidate_lanes(in, candidates);
+  RectChoices source(in, rect, candidates, job);
   CellTally tally;
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * in.points.width();
@@ -570,11 +633,10 @@ std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRe
       compute::detail::prefetch_lines(next + x0, next + x1);
     }
     std::fill_n(tally.first.begin(), count, -1);
+    source.start_row(points + row);
     for (int x = x0; x < x1; x += 4) {
       Lanes distance2;
-      const LaneMask choices =
-          in.device ? device_choices(*in.device, job, rect, x, y, distance2)
-                    : in.rule.best(lanes, pixel_lanes(points + row, x, x1), distance2);
+      const LaneMask choices = source.at(points + row, x, y, distance2);
       for (int j = 0; j < 4; ++j) {
         if (choices[j] >= 0) pixel_plane[row + x + j] = candidates.planes[choices[j]];
       }

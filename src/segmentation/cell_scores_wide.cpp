@@ -1,0 +1,63 @@
+#include "cell_scores_wide.hpp"
+
+#include <cstring>
+#include <stdexcept>
+
+#include "compute/cpu/wide_lanes.hpp"
+
+namespace kartograf::segmentation::detail {
+
+#if KARTOGRAF_WIDE_LANES
+
+namespace {
+
+using compute::detail::WideLanes;
+using compute::detail::WideMask;
+
+// ScoreRule::best (cell_planes.cpp) on eight pixels: see its comment for the rule.
+KG_WIDE_TARGET void eight_choices(const WideScoreInputs& in, const compute::detail::WideXyz& p,
+                                  std::int32_t* choices, float* distance2) {
+  const WideLanes range2 = p.x * p.x + p.y * p.y + p.z * p.z;
+  const WideLanes floor2 = (in.min_facing * in.min_facing) * range2;
+  WideLanes best_d2 = WideLanes{} + 1.0f, best_s2 = WideLanes{};  // no candidate yet: 1 / 0
+  WideMask choice = WideMask{} - 1;
+  for (int k = 0; k < in.count; ++k) {
+    const WideLanes along = in.nx[k] * p.x + in.ny[k] * p.y + in.nz[k] * p.z;
+    const WideLanes d = along + in.offset[k];
+    const WideLanes d2 = d * d, a2 = along * along;
+    const WideLanes s2 = a2 > floor2 ? a2 : floor2;
+    const WideMask better = d2 * best_s2 < best_d2 * s2;
+    best_d2 = better ? d2 : best_d2;
+    best_s2 = better ? s2 : best_s2;
+    choice = better ? WideMask{} + k : choice;
+  }
+  const WideLanes base = in.distance_base + in.distance_per_z2 * p.z * p.z;
+  const WideMask chosen = best_d2 * range2 < base * base * best_s2 ? choice : WideMask{} - 1;
+  std::memcpy(choices, &chosen, sizeof chosen);
+  std::memcpy(distance2, &best_d2, sizeof best_d2);
+}
+
+KG_WIDE_TARGET void row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
+                                std::int32_t* choices, float* distance2) {
+  for (int x = x0; x < x1; x += 8) {
+    eight_choices(in, compute::detail::load_eight_xyz(row[x].data()), choices + (x - x0),
+                  distance2 + (x - x0));
+  }
+}
+
+}  // namespace
+
+void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
+                      std::int32_t* choices, float* distance2) {
+  row_choices(in, row, x0, x1, choices, distance2);
+}
+
+#else
+
+void wide_row_choices(const WideScoreInputs&, const Point4f*, int, int, std::int32_t*, float*) {
+  throw std::logic_error("wide_row_choices: no AVX2 code in this build");
+}
+
+#endif
+
+}  // namespace kartograf::segmentation::detail

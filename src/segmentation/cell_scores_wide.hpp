@@ -1,0 +1,24 @@
+#pragma once
+// The cells mode's pixel scoring (cell_planes.cpp's ScoreRule::best) eight pixels at a time in
+// AVX2 (compute/cpu/wide_lanes.hpp): the same float operations per lane, so the same choices and
+// squared distances, bit for bit, as the four-lane code and the devices' rule. Call only where
+// compute::detail::wide_lanes_enabled().
+#include <cstdint>
+
+#include "kartograf/core/point_image.hpp"
+
+namespace kartograf::segmentation::detail {
+
+// A rectangle's candidate planes (count of them) and the rule's constants.
+struct WideScoreInputs {
+  float distance_base, distance_per_z2, min_facing;
+  const float *nx, *ny, *nz, *offset;
+  int count;
+};
+
+// Pixels row[x0 .. x1) ((x1 - x0) a multiple of 8): per pixel the index of the candidate it takes
+// (-1: none) and its squared distance to it (1 where none), from choices[0] and distance2[0] on.
+void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
+                      std::int32_t* choices, float* distance2);
+
+}  // namespace kartograf::segmentation::detail
