@@ -556,6 +556,22 @@ class RectChoices {
       wide_row_choices(wide_in_, row, rect_.x0, rect_.x1, choices_.data(), distances_.data());
   }
 
+  bool wide() const { return wide_; }
+
+  // The wide path's row (after start_row): per candidate k, the pixels that took it as bits from
+  // the rectangle's first column, and their squared distances' sum; each pixel's plane written
+  // to `pixel_row` (the rectangle's first pixel of the row in pixel_plane, none taken before).
+  void tally_row(const CellCandidates& candidates, std::array<std::uint64_t, 36>& bits,
+                 std::array<float, 36>& squared, std::uint32_t* pixel_row) const {
+    const int width = rect_.x1 - rect_.x0;
+    wide_row_tally(choices_.data(), distances_.data(), width, candidates.count, bits.data(),
+                   squared.data());
+    std::array<std::uint32_t, 37> plane_of;  // of a choice + 1 (0: none)
+    plane_of[0] = geometry::kNoLabel;
+    std::copy_n(candidates.planes.begin(), candidates.count, plane_of.begin() + 1);
+    for (int j = 0; j < width; ++j) pixel_row[j] = plane_of[choices_[j] + 1];
+  }
+
   // The pixels x .. x + 3 of row y (`row` its first point): their choices (-1: none) and squared
   // distances.
   LaneMask at(const Point4f* row, int x, int y, Lanes& distance2) const {
@@ -607,6 +623,21 @@ struct CellTally {
       last[choice] = x + j;
     }
   }
+
+  // A whole row from the wide path (RectChoices::tally_row), its first column at x0.
+  void add_row(const RectChoices& source, const CellCandidates& candidates, int x0,
+               std::uint32_t* pixel_row) {
+    std::array<std::uint64_t, 36> bits;
+    std::array<float, 36> row_squared;
+    source.tally_row(candidates, bits, row_squared, pixel_row);
+    for (int k = 0; k < candidates.count; ++k) {
+      if (bits[k] == 0) continue;
+      taken[k] += static_cast<std::uint32_t>(std::popcount(bits[k]));
+      squared[k] += row_squared[k];
+      first[k] = x0 + std::countr_zero(bits[k]);
+      last[k] = x0 + 63 - std::countl_zero(bits[k]);
+    }
+  }
 };
 
 // Each valid pixel of the rectangle (a cell or a block) takes the candidate it scores best
@@ -634,13 +665,17 @@ std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRe
     }
     std::fill_n(tally.first.begin(), count, -1);
     source.start_row(points + row);
-    for (int x = x0; x < x1; x += 4) {
-      Lanes distance2;
-      const LaneMask choices = source.at(points + row, x, y, distance2);
-      for (int j = 0; j < 4; ++j) {
-        if (choices[j] >= 0) pixel_plane[row + x + j] = candidates.planes[choices[j]];
+    if (source.wide()) {
+      tally.add_row(source, candidates, x0, pixel_plane.data() + row + x0);
+    } else {
+      for (int x = x0; x < x1; x += 4) {
+        Lanes distance2;
+        const LaneMask choices = source.at(points + row, x, y, distance2);
+        for (int j = 0; j < 4; ++j) {
+          if (choices[j] >= 0) pixel_plane[row + x + j] = candidates.planes[choices[j]];
+        }
+        tally.add(choices, distance2, x);
       }
-      tally.add(choices, distance2, x);
     }
     for (int k = 0; k < count; ++k) {
       if (tally.first[k] < 0) continue;

@@ -45,7 +45,30 @@ KG_WIDE_TARGET void row_choices(const WideScoreInputs& in, const Point4f* row, i
   }
 }
 
+KG_WIDE_TARGET void row_tally(const std::int32_t* choices, const float* distance2, int width,
+                              int count, std::uint64_t* bits, float* squared) {
+  for (int k = 0; k < count; ++k) {
+    WideLanes sum{};
+    std::uint64_t taken = 0;
+    for (int x = 0; x < width; x += 8) {
+      WideMask c;
+      WideLanes d2;
+      std::memcpy(&c, choices + x, sizeof c), std::memcpy(&d2, distance2 + x, sizeof d2);
+      const WideMask mine = c == k;
+      taken |= std::uint64_t{compute::detail::wide_mask_bits(mine)} << x;
+      sum += mine ? d2 : WideLanes{};
+    }
+    bits[k] = taken;
+    squared[k] = compute::detail::wide_sum(sum);
+  }
+}
+
 }  // namespace
+
+void wide_row_tally(const std::int32_t* choices, const float* distance2, int width, int count,
+                    std::uint64_t* bits, float* squared) {
+  row_tally(choices, distance2, width, count, bits, squared);
+}
 
 void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
                       std::int32_t* choices, float* distance2) {
@@ -56,6 +79,10 @@ void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int
 
 void wide_row_choices(const WideScoreInputs&, const Point4f*, int, int, std::int32_t*, float*) {
   throw std::logic_error("wide_row_choices: no AVX2 code in this build");
+}
+
+void wide_row_tally(const std::int32_t*, const float*, int, int, std::uint64_t*, float*) {
+  throw std::logic_error("wide_row_tally: no AVX2 code in this build");
 }
 
 #endif

@@ -21,4 +21,11 @@ struct WideScoreInputs {
 void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
                       std::int32_t* choices, float* distance2);
 
+// The row's choices (width a multiple of 8, at most 64) per candidate k < count: bit j of bits[k]
+// is set where pixel j took k, and squared[k] sums those pixels' squared distances (in float,
+// eight lanes then across them: another order than the four-lane tally's, which only the
+// planes' output RMS sees).
+void wide_row_tally(const std::int32_t* choices, const float* distance2, int width, int count,
+                    std::uint64_t* bits, float* squared);
+
 }  // namespace kartograf::segmentation::detail
