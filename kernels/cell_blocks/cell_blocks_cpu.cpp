@@ -233,7 +233,7 @@ KG_WIDE_TARGET void measure_blocks_wide(const float4* points, const std::uint8_t
 #endif
 
 // The wide code where the processor has it and the blocks are eight pixels a side.
-BlockRange block_range_code(const CellBlocksParams& p) {
+BlockRange block_range_code([[maybe_unused]] const CellBlocksParams& p) {
 #if KARTOGRAF_WIDE_LANES
   if (p.block_size == 8u && compute::detail::wide_lanes_enabled()) return measure_blocks_wide;
 #endif

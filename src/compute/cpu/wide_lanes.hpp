@@ -3,10 +3,11 @@
 // of lanes.hpp's four (a block row of eight pixels in one step). Only code compiled for AVX2
 // (KG_WIDE_TARGET) may use these types, and only after wide_lanes_enabled() said yes: the same
 // binary runs on x86-64 processors without AVX2 and on other architectures, where
-// kKartografWideLanes is 0 and the four-lane code runs.
+// KARTOGRAF_WIDE_LANES is 0 and the four-lane code runs. GCC only for now (its __builtin_shuffle
+// and vector conditionals); a Clang build runs the four-lane code.
 #include <cstdint>
 
-#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+#if defined(__x86_64__) && defined(__GNUC__) && !defined(__clang__)
 #define KARTOGRAF_WIDE_LANES 1
 #define KG_WIDE_TARGET __attribute__((target("avx2")))
 #else
