@@ -63,19 +63,18 @@ void write_planes(const std::vector<SegmentPlane>& fits, const std::vector<Plane
   std::stable_sort(kept.begin(), kept.end(),
                    [&](std::uint32_t a, std::uint32_t b) { return sums[a].count > sums[b].count; });
   kept.resize(std::min<std::size_t>(kept.size(), std::numeric_limits<Label>::max()));
-  std::vector<Label> plane_label(fits.size(), kUnlabeled);
+  // Indexed by a pixel's plane + 1: kNoLabel + 1 wraps to 0, unlabelled (no branch per pixel).
+  static_assert(geometry::kNoLabel + 1u == 0u);
+  std::vector<Label> plane_label(fits.size() + 1, kUnlabeled);
   for (std::size_t k = 0; k < kept.size(); ++k) {
     result.planes.push_back(
         plane_with_sums(static_cast<Label>(k + 1), fits[kept[k]], sums[kept[k]]));
-    plane_label[kept[k]] = result.planes.back().id;
+    plane_label[kept[k] + 1] = result.planes.back().id;
   }
   Label* out = result.labels.data();
   compute::detail::for_each_chunk(
       pixel_plane.size(), pixel_plane.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
-        for (std::size_t i = begin; i < end; ++i) {
-          const std::uint32_t m = pixel_plane[i];
-          out[i] = m == geometry::kNoLabel ? kUnlabeled : plane_label[m];
-        }
+        for (std::size_t i = begin; i < end; ++i) out[i] = plane_label[pixel_plane[i] + 1u];
       });
 }
 
