@@ -72,10 +72,11 @@ void write_planes(const std::vector<SegmentPlane>& fits, const std::vector<Plane
     plane_label[kept[k] + 1] = result.planes.back().id;
   }
   Label* out = result.labels.data();
-  compute::detail::for_each_chunk(
-      pixel_plane.size(), pixel_plane.size(), [&](std::size_t begin, std::size_t end, std::size_t) {
-        for (std::size_t i = begin; i < end; ++i) out[i] = plane_label[pixel_plane[i] + 1u];
-      });
+  compute::detail::for_each_chunk(pixel_plane.size(), pixel_plane.size(),
+                                  [&](std::size_t begin, std::size_t end, std::size_t) {
+                                    for (std::size_t i = begin; i < end; ++i)
+                                      out[i] = plane_label[pixel_plane[i] + 1u];
+                                  });
 }
 
 }  // namespace kartograf::segmentation::detail
