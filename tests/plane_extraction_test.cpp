@@ -458,17 +458,22 @@ KARTOGRAF_INSTANTIATE_BACKEND_TESTS(PlaneExtractionBackendTest);
 TEST(PlaneExtraction, CellsModeWideAndFourLaneCodeAgree) {
   RecordProperty("wide_code", compute::detail::wide_lanes_enabled() ? "AVX2" : "not available");
   const PinholeIntrinsics camera{320, 240, 262.5, 262.5, 159.5, 119.5};
-  segmentation::PlaneExtractionParams params;
-  params.mode = segmentation::PlaneExtractionMode::cells;
   const compute::Context context = compute::Context::cpu();
-  segmentation::PlaneExtractor extractor(context, camera, params);
-  for (const int frame : {40, 130}) {
-    const SyntheticView view = synthetic_view(camera, frame);
-    compute::detail::allow_wide_lanes(false);
-    const segmentation::PlaneSet four = extractor.extract(view.points, view.color);
-    compute::detail::allow_wide_lanes(true);
-    EXPECT_GE(four.planes.size(), 2u) << frame;
-    expect_same_planes(four, extractor.extract(view.points, view.color), 1e-6);
+  // 16: the default (blocks of 8, the wide block pass); 40: rows of 40 and 20 pixels scored in
+  // groups of eight (the block pass in four lanes); 64: the widest rows, 64 bits of a row's mask.
+  for (const int cell_size : {16, 40, 64}) {
+    segmentation::PlaneExtractionParams params;
+    params.mode = segmentation::PlaneExtractionMode::cells;
+    params.cells.cell_size = cell_size;
+    segmentation::PlaneExtractor extractor(context, camera, params);
+    for (const int frame : {40, 130}) {
+      const SyntheticView view = synthetic_view(camera, frame);
+      compute::detail::allow_wide_lanes(false);
+      const segmentation::PlaneSet four = extractor.extract(view.points, view.color);
+      compute::detail::allow_wide_lanes(true);
+      EXPECT_GE(four.planes.size(), 2u) << cell_size << " px cells, frame " << frame;
+      expect_same_planes(four, extractor.extract(view.points, view.color), 1e-6);
+    }
   }
 }
 
