@@ -572,15 +572,11 @@ class RectChoices {
     for (int j = 0; j < width; ++j) pixel_row[j] = plane_of[choices_[j] + 1];
   }
 
-  // The pixels x .. x + 3 of row y (`row` its first point): their choices (-1: none) and squared
-  // distances.
+  // The four-lane path (not wide()): the pixels x .. x + 3 of row y (`row` its first point),
+  // their choices (-1: none) and squared distances.
   LaneMask at(const Point4f* row, int x, int y, Lanes& distance2) const {
     if (in_.device) return device_choices(*in_.device, job_, rect_, x, y, distance2);
-    if (!wide_) return in_.rule.best(lanes_, pixel_lanes(row, x, rect_.x1), distance2);
-    LaneMask choices;
-    std::memcpy(&choices, choices_.data() + (x - rect_.x0), sizeof choices);
-    std::memcpy(&distance2, distances_.data() + (x - rect_.x0), sizeof distance2);
-    return choices;
+    return in_.rule.best(lanes_, pixel_lanes(row, x, rect_.x1), distance2);
   }
 
  private:
