@@ -241,6 +241,31 @@ fails_with --regex "$1/err" "frame-000000.depth.png'.*at a depth scale of 1 unit
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
+# A depth camera without colour: planes of a depth PNG alone or an organized PCD without colour
+# in the cells mode (fy = fx when only --fx is given); the regions mode, which grows colour
+# regions, refuses them naming the cells mode.
+add_test(NAME Cli.input_planes_from_depth_alone
+  COMMAND sh -c [=[
+DATA=$2; . "$3"
+rm -rf "$1" && mkdir -p "$1" || exit 1
+depth="$DATA/7scenes_redkitchen/frames/frame-000000.depth.png"
+scan="$DATA/dlut_laser_scans/A601.pcd"
+fails_with "$1/err" "is a depth image: give its colour image with --color" "--mode cells for depth alone" \
+  -- "$0" planes "$depth" --fx 585 --out "$1/regions" || exit 1
+fails_with "$1/err" "A601.pcd' has no colour (rgb/rgba field)" "--mode cells works on depth alone" \
+  -- "$0" planes "$scan" --out "$1/regions" || exit 1
+test ! -e "$1/regions" || { echo "FAIL: a refused run left its folder"; exit 1; }
+"$0" planes "$depth" --fx 585 --mode cells --out "$1/depth" > "$1/depth.log" 2>&1 || { cat "$1/depth.log"; echo "FAIL: cells mode on depth alone"; exit 1; }
+grep -q '"fy": 585' "$1/depth/planes.json" || { echo "FAIL: fy is not fx"; exit 1; }
+planes=$(grep -c '"normal"' "$1/depth/planes.json")
+[ "$planes" -ge 20 ] && test -s "$1/depth/segmentation.png" && test -s "$1/depth/labels.png" || { cat "$1/depth.log"; echo "FAIL: $planes planes from depth alone"; exit 1; }
+"$0" planes "$scan" --mode cells --out "$1/scan" > "$1/scan.log" 2>&1 || { cat "$1/scan.log"; echo "FAIL: cells mode on a colourless scan"; exit 1; }
+grep -q "A601.pcd: [1-9][0-9]* planes" "$1/scan.log" || { cat "$1/scan.log"; echo "FAIL: no plane in the scan"; exit 1; }
+exit 0
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth-alone ${KARTOGRAF_DATA_DIR}
+  ${fails_with_helper})
+
 set_tests_properties(Cli.input_colour_and_depth_sizes_and_truncated_images
+  Cli.input_planes_from_depth_alone
   Cli.input_missing_frames_bad_poses_and_short_trajectories
   Cli.input_unusable_depth_is_named_before_the_run PROPERTIES ENVIRONMENT "${KARTOGRAF_TEST_ENV}")

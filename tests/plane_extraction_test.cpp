@@ -447,6 +447,9 @@ TEST_P(PlaneExtractionBackendTest, CellsModeAgreesWithTheCpuBackend) {
     EXPECT_GE(set.planes.size(), 2u) << frame;
     expect_same_planes(set, cpu.extract(view.points, view.color), 1e-6);
     expect_same_planes(set, mine.extract(view.points, view.color), 0.0);
+    // Without colour (a depth camera alone).
+    expect_same_planes(mine.extract(view.points, RgbImage()), cpu.extract(view.points, RgbImage()),
+                       1e-6);
   }
 }
 
@@ -617,6 +620,45 @@ TEST(PlaneExtraction, CellsModeMakesPlanesOfStripsNarrowerThanACell) {
   }
 }
 
+// A depth camera without colour (cells mode): the view's surfaces are found on depth alone, with
+// the normals the coloured run finds where both label a pixel. Colour only tells coplanar
+// surfaces apart (a door flush with its wall), so depth alone labels about as much of the view.
+// The extractor keeps no trace of the colourless frame: the next coloured one comes out as a
+// fresh extractor's.
+TEST(PlaneExtraction, CellsModeWorksOnDepthAlone) {
+  const compute::Context context = compute::Context::cpu();
+  const PinholeIntrinsics camera{320, 240, 262.5, 262.5, 159.5, 119.5};
+  const SyntheticView view = synthetic_view(camera, 120);
+  segmentation::PlaneExtractionParams params;
+  params.mode = segmentation::PlaneExtractionMode::cells;
+  segmentation::PlaneExtractor extractor(context, camera, params);
+  const segmentation::PlaneSet coloured = extractor.extract(view.points, view.color);
+  const segmentation::PlaneSet depth_only = extractor.extract(view.points, RgbImage());
+  std::size_t valid = 0, in_coloured = 0, in_depth_only = 0, in_both = 0, agreeing = 0;
+  for (std::size_t i = 0; i < view.points.size(); ++i) {
+    if (!is_valid(view.points.data()[i])) continue;
+    ++valid;
+    const Label a = coloured.labels.data()[i], b = depth_only.labels.data()[i];
+    in_coloured += a != kUnlabeled;
+    in_depth_only += b != kUnlabeled;
+    if (a == kUnlabeled || b == kUnlabeled) continue;
+    ++in_both;
+    agreeing += angle_deg(coloured.planes[a - 1].normal, depth_only.planes[b - 1].normal) < 2.0;
+  }
+  std::printf(
+      "depth alone: %zu planes, %.1f %% of valid pixels (with colour %zu, %.1f %%); "
+      "normals within 2 deg on %.1f %% of the pixels both label\n",
+      depth_only.planes.size(), 100.0 * double(in_depth_only) / double(valid),
+      coloured.planes.size(), 100.0 * double(in_coloured) / double(valid),
+      100.0 * double(agreeing) / double(in_both));
+  EXPECT_GE(depth_only.planes.size(), 2u);
+  EXPECT_GE(double(in_depth_only), 0.95 * double(in_coloured));
+  EXPECT_GE(double(agreeing), 0.98 * double(in_both));
+  segmentation::PlaneExtractor fresh(context, camera, params);
+  expect_same_planes(extractor.extract(view.points, view.color),
+                     fresh.extract(view.points, view.color), 0.0);
+}
+
 TEST(PlaneExtraction, CellsModeTakesFramesOfAnySize) {
   using segmentation::PlaneExtractionMode;
   const auto [odd, odd_planes] = view_coverage(250, 187, PlaneExtractionMode::cells);
@@ -637,6 +679,16 @@ TEST(PlaneExtraction, RejectsBadInput) {
   EXPECT_ERROR_MENTIONS(extractor.extract(PointImage(8, 5), RgbImage(8, 6)), "point image is 8x5",
                         "8x6");
   EXPECT_ERROR_MENTIONS(extractor.extract(PointImage(), RgbImage(8, 6)), "empty input");
+  // No colour: the regions mode grows colour regions; the cells mode takes depth alone.
+  EXPECT_ERROR_MENTIONS(extractor.extract(PointImage(8, 6), RgbImage()), "no colour image",
+                        "cells mode");
+  segmentation::PlaneExtractionParams cells_mode;
+  cells_mode.mode = segmentation::PlaneExtractionMode::cells;
+  segmentation::PlaneExtractor cells_extractor(context, camera, cells_mode);
+  EXPECT_ERROR_MENTIONS(cells_extractor.extract(PointImage(8, 5), RgbImage()), "point image is 8x5",
+                        "8x6");
+  EXPECT_ERROR_MENTIONS(cells_extractor.extract(PointImage(8, 6), RgbImage(7, 6)),
+                        "colour image is 7x6", "8x6");
   segmentation::PlaneExtractionParams bad;
   bad.merge.max_normal_angle_deg = -1;
   EXPECT_ERROR_MENTIONS(segmentation::PlaneExtractor(context, camera, bad), "max_normal_angle_deg");

@@ -1,9 +1,9 @@
 // `kartograf planes INPUT --out DIR`: plane extraction (segmentation::PlaneExtractor) of an
-// organized PCD with colour, an RGB-D frame (depth PNG + --color), or the frames of a sequence
-// folder. Per frame: labels.png (16-bit plane id, 0 = none), segmentation.png (planes over the
-// dimmed image, for people), planes.json and planes.ply (the plane points in their colours); one
-// summary line per frame on stdout. A sequence writes each frame to DIR/<frame number>/ and
-// DIR/summary.json. Wiring only.
+// organized PCD, an RGB-D frame (depth PNG + --color; in the cells mode colour is optional), or
+// the frames of a sequence folder. Per frame: labels.png (16-bit plane id, 0 = none),
+// segmentation.png (planes over the dimmed image, for people), planes.json and planes.ply (the
+// plane points in their colours); one summary line per frame on stdout. A sequence writes each
+// frame to DIR/<frame number>/ and DIR/summary.json. Wiring only.
 #include <algorithm>
 #include <cstdio>
 #include <filesystem>
@@ -73,18 +73,24 @@ io::PlaneRunRecord run_record(const PlanesOptions& o, const compute::Context& co
           .device = context.device_info().name};
 }
 
-// An organized PCD with colour: its pixels are the camera's; intrinsics are not needed for the
-// extraction (only recorded), so they are estimated as a Kinect's at the cloud's size.
-PlaneInput pcd_input(const fs::path& path) {
+// An organized PCD: its pixels are the camera's; intrinsics are not needed for the extraction
+// (only recorded), so they are estimated as a Kinect's at the cloud's size. Without colour only
+// the cells mode takes it.
+PlaneInput pcd_input(const fs::path& path, const PlanesOptions& o) {
   const io::PcdCloud cloud = io::read_pcd(path);
   const std::string name = "'" + path.string() + "'";
   require(cloud.organized(), "planes: " + name + " is not organized (height " +
                                  std::to_string(cloud.height) +
                                  "): region growing needs the pixel grid of a depth camera");
-  require(!cloud.colors.empty(), "planes: " + name + " has no colour (rgb/rgba field)");
-  PlaneInput input{path.string(), cloud.to_point_image(), RgbImage(cloud.width, cloud.height),
-                   PinholeIntrinsics{}};
-  std::copy(cloud.colors.begin(), cloud.colors.end(), input.color.data());
+  require(!cloud.colors.empty() || o.mode == "cells",
+          "planes: " + name +
+              " has no colour (rgb/rgba field): the regions mode grows colour regions; "
+              "--mode cells works on depth alone");
+  PlaneInput input{path.string(), cloud.to_point_image(), RgbImage(), PinholeIntrinsics{}};
+  if (!cloud.colors.empty()) {
+    input.color = RgbImage(cloud.width, cloud.height);
+    std::copy(cloud.colors.begin(), cloud.colors.end(), input.color.data());
+  }
   const double f = 525.0 * cloud.width / 640.0;
   input.intrinsics = {
       cloud.width, cloud.height, f, f, (cloud.width - 1) / 2.0, (cloud.height - 1) / 2.0};
@@ -101,20 +107,23 @@ PinholeIntrinsics frame_intrinsics(const PlanesOptions& o, const DepthImage& dep
     return intrinsics;
   }
   const double scale = depth.width() / 640.0;
+  const double fx = o.fx > 0 ? o.fx : 525.0 * scale;
   return {depth.width(),
           depth.height(),
-          o.fx > 0 ? o.fx : 525.0 * scale,
-          o.fy > 0 ? o.fy : 525.0 * scale,
+          fx,
+          o.fy > 0 ? o.fy : fx,  // square pixels unless told otherwise
           o.cx >= 0 ? o.cx : (depth.width() - 1) / 2.0,
           o.cy >= 0 ? o.cy : (depth.height() - 1) / 2.0};
 }
 
 PlaneInput rgbd_input(const PlanesOptions& o, const compute::Context& context) {
-  require(!o.color.empty(),
-          "planes: " + o.input.string() + " is a depth image: give its colour image with --color");
+  require(!o.color.empty() || o.mode == "cells",
+          "planes: " + o.input.string() +
+              " is a depth image: give its colour image with --color (the regions mode grows "
+              "colour regions), or --mode cells for depth alone");
   const DepthImage depth = io::read_depth_png(o.input);
-  RgbImage color = io::read_color_image(o.color);
-  require(color.width() == depth.width() && color.height() == depth.height(),
+  RgbImage color = o.color.empty() ? RgbImage() : io::read_color_image(o.color);
+  require(color.empty() || (color.width() == depth.width() && color.height() == depth.height()),
           "planes: the colour image " + o.color.string() + " is " + std::to_string(color.width()) +
               "x" + std::to_string(color.height()) + ", the depth image " + o.input.string() +
               " is " + std::to_string(depth.width()) + "x" + std::to_string(depth.height()));
@@ -143,7 +152,8 @@ io::PlaneFrameRecord extract_frame(segmentation::PlaneExtractor& extractor, cons
     const InterruptsDeferred writing;  // a signal waits for the frame's files, then drops them
     fs::create_directories(dir);
     io::write_label_png(dir / "labels.png", set.labels);
-    io::write_png(dir / "segmentation.png", io::plane_overlay(input.color, set.labels));
+    const RgbImage background = input.color.empty() ? io::depth_shading(input.points) : input.color;
+    io::write_png(dir / "segmentation.png", io::plane_overlay(background, set.labels));
     io::write_ply(dir / "planes.ply", io::plane_points(input.points, set.labels));
     io::write_planes_json(dir / "planes.json", set, {input.name, input.intrinsics, run_json});
   }
@@ -169,18 +179,23 @@ io::PlaneFrameRecord extract_frame(segmentation::PlaneExtractor& extractor, cons
 CLI::App* add_planes_command(CLI::App& app, PlanesOptions& o) {
   CLI::App* command = app.add_subcommand(
       "planes",
-      "Planes of an organized PCD, an RGB-D frame (depth PNG + --color) or a sequence folder "
-      "(docs/methods.md M1: Lab region growing, plane fits, merging)");
-  command->add_option("INPUT", o.input, "Organized PCD with colour, depth PNG, or sequence folder")
+      "Planes of an organized PCD, an RGB-D frame (depth PNG + --color; --mode cells: colour "
+      "optional) or a sequence folder (docs/methods.md M1: Lab region growing, plane fits, "
+      "merging)");
+  command
+      ->add_option("INPUT", o.input,
+                   "Organized PCD, depth PNG, or sequence folder (without colour: --mode cells)")
       ->required();
   command->add_option("--out", o.out_dir, "Output folder")->required();
-  command->add_option("--color", o.color, "Colour image of a depth PNG input");
+  command->add_option("--color", o.color,
+                      "Colour image of a depth PNG input (the regions mode needs it)");
   command->add_option("--intrinsics", o.intrinsics,
                       "Depth PNG input: camera_intrinsics.json (Open3D format)");
   // Checked when given: 0 and -1 are the defaults' "not given", never a value to fall back from.
   command->add_option("--fx", o.fx, "Depth PNG input: focal length [px] (default 525 at 640 wide)")
       ->check(finite_positive());
-  command->add_option("--fy", o.fy, "Depth PNG input: focal length [px]")->check(finite_positive());
+  command->add_option("--fy", o.fy, "Depth PNG input: focal length [px] (default: fx)")
+      ->check(finite_positive());
   command->add_option("--cx", o.cx, "Depth PNG input: principal point [px] (default: centre)")
       ->check(finite_in(0, 1e6));
   command->add_option("--cy", o.cy, "Depth PNG input: principal point [px]")
@@ -242,7 +257,7 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
     std::string extension = o.input.extension().string();
     std::transform(extension.begin(), extension.end(), extension.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    const PlaneInput input = extension == ".pcd" ? pcd_input(o.input) : rgbd_input(o, context);
+    const PlaneInput input = extension == ".pcd" ? pcd_input(o.input, o) : rgbd_input(o, context);
     segmentation::PlaneExtractor extractor(context, input.intrinsics, params);
     extract_frame(extractor, input, folder.dir(), o.out_dir, run_json, out);
     folder.commit();

@@ -37,8 +37,9 @@ std::string settings_text(const segmentation::PlaneExtractionParams& p) {
   return settings.str();
 }
 
+// depth_only: the frames' colour is not handed over (a depth camera alone; cells mode).
 PlaneMethod extractor_method(std::string name, std::string threads, ContextPtr context,
-                             segmentation::PlaneExtractionMode mode) {
+                             segmentation::PlaneExtractionMode mode, bool depth_only = false) {
   using CameraKey = std::tuple<int, int, double, double, double, double>;
   struct State {
     std::map<CameraKey, std::unique_ptr<segmentation::PlaneExtractor>> extractors;
@@ -51,16 +52,19 @@ PlaneMethod extractor_method(std::string name, std::string threads, ContextPtr c
   method.name = std::move(name);
   method.library = "kartograf";
   method.threads = std::move(threads);
-  method.settings = settings_text(params);
-  method.prepare = [state, context, params](const PlaneFrame& frame) {
+  method.settings =
+      settings_text(params) + (depth_only ? "; given no colour (depth only): planes apart "
+                                            "joined on geometry and the see-through test"
+                                          : "");
+  method.prepare = [state, context, params, depth_only](const PlaneFrame& frame) {
     const PinholeIntrinsics& c = frame.camera;
     auto& extractor = state->extractors[{c.width, c.height, c.fx, c.fy, c.cx, c.cy}];
     // Made untimed on first use (device buffers, scratch); every frame reuses it.
     if (!extractor) extractor = std::make_unique<segmentation::PlaneExtractor>(*context, c, params);
     segmentation::PlaneExtractor* planes = extractor.get();
     return PlaneRun{
-        [state, planes, &frame] {
-          state->last = planes->extract(frame.points, frame.color);
+        [state, planes, &frame, depth_only] {
+          state->last = planes->extract(frame.points, depth_only ? RgbImage() : frame.color);
           const segmentation::PlaneExtractionTimings& t = state->last.timings;
           return TimeParts{
               {"lab", t.lab},         {"growing", t.growing},       {"moments", t.moments},
@@ -86,6 +90,8 @@ std::vector<PlaneMethod> kartograf_plane_methods(bool device_backends) {
       extractor_method(kKartografPlanes, kartograf_threads(), cpu, PlaneExtractionMode::regions));
   methods.push_back(
       extractor_method(kKartografCellPlanes, kartograf_threads(), cpu, PlaneExtractionMode::cells));
+  methods.push_back(extractor_method("kartograf PlaneExtractor cells, depth only (cpu)",
+                                     kartograf_threads(), cpu, PlaneExtractionMode::cells, true));
   if (device_backends) {
     // CPU-hosted drivers here (lavapipe, PoCL): for the record, not a speed claim.
     for (const DeviceContext& device : device_contexts()) {

@@ -31,10 +31,11 @@ class PlaneSet:
 
 
 def extract_planes(context: _kartograf.Context, camera: _kartograf.PinholeIntrinsics,
-                   depth: np.ndarray, color: np.ndarray, depth_units: float = 1000.0,
+                   depth: np.ndarray, color: np.ndarray | None, depth_units: float = 1000.0,
                    mode: str = "regions") -> PlaneSet:
     """The planes of one frame, as `kartograf planes --mode MODE`: "regions" (the M1 paper's Lab
-    region growing, fits, merging) or "cells" (planar cells first, about 3x faster)."""
+    region growing, fits, merging) or "cells" (planar cells first, about 3x faster). The cells
+    mode also takes color=None (a depth camera alone); the regions mode raises kartograf.Error."""
     d = _kartograf.extract_planes(context, camera, depth, color, depth_units, mode)
     return PlaneSet(planes=[Plane(**p) for p in d["planes"]], labels=d["labels"],
                     milliseconds=d["milliseconds"])

@@ -1,12 +1,14 @@
 // Planes of RGB-D frames (M1) and rooms of 2-D maps (M4).
 #include <nanobind/stl/array.h>
 #include <nanobind/stl/filesystem.h>
+#include <nanobind/stl/optional.h>
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
 #include <array>
 #include <cmath>
 #include <filesystem>
+#include <optional>
 #include <string>
 
 #include "bindings.hpp"
@@ -49,10 +51,11 @@ PointImage points_of(const compute::Context& context, const PinholeIntrinsics& c
   return geometry::backproject(context, borrow_depth(depth), camera, range);
 }
 
-// The planes of one frame: depth (in depth_units per metre) back-projected, then extracted.
+// The planes of one frame: depth (in depth_units per metre) back-projected, then extracted;
+// without colour (None) in the cells mode only (PlaneExtractor::extract).
 nb::dict extract_planes(const compute::Context& context, const PinholeIntrinsics& camera,
-                        const DepthArray& depth, const ColorArray& color, double depth_units,
-                        const std::string& mode) {
+                        const DepthArray& depth, const std::optional<ColorArray>& color,
+                        double depth_units, const std::string& mode) {
   require(mode == "regions" || mode == "cells",
           "planes: mode is 'regions' or 'cells', not '" + mode + "'");
   const PointImage points = points_of(context, camera, depth, depth_units);
@@ -60,7 +63,7 @@ nb::dict extract_planes(const compute::Context& context, const PinholeIntrinsics
   params.mode = mode == "cells" ? segmentation::PlaneExtractionMode::cells
                                 : segmentation::PlaneExtractionMode::regions;
   segmentation::PlaneExtractor extractor(context, camera, params);
-  segmentation::PlaneSet set = extractor.extract(points, borrow_color(color));
+  segmentation::PlaneSet set = extractor.extract(points, color ? borrow_color(*color) : RgbImage());
   nb::list planes;
   for (const segmentation::Plane& p : set.planes) planes.append(plane_dict(p));
   nb::dict d;
@@ -156,7 +159,7 @@ std::vector<std::string> method_names() {
 
 void bind_scene(nb::module_& m) {
   m.def("extract_planes", &extract_planes, nb::arg("context"), nb::arg("camera"), nb::arg("depth"),
-        nb::arg("color"), nb::arg("depth_units") = 1000.0, nb::arg("mode") = "regions");
+        nb::arg("color").none(), nb::arg("depth_units") = 1000.0, nb::arg("mode") = "regions");
   m.def(
       "read_map",
       [](const std::filesystem::path& path, double resolution) {

@@ -42,6 +42,17 @@ def test_planes_of_a_real_frame_equal_the_clis(cpu, data_dir, tmp_path):
     assert np.array_equal(labels, cells.labels)
     with pytest.raises(kg.Error, match="mode"):
         kg.extract_planes(cpu, sequence.camera, frame["depth"], frame["color"], mode="fast")
+    # Depth alone: the cells mode, through both; the regions mode names what is missing.
+    alone = kg.extract_planes(cpu, sequence.camera, frame["depth"], None,
+                              sequence.depth_units_per_metre, mode="cells")
+    assert len(alone.planes) >= 3
+    cli("planes", frames / "frame-000000.depth.png",
+        "--fx", camera.fx, "--fy", camera.fy, "--cx", camera.cx, "--cy", camera.cy,
+        "--backend", "cpu", "--mode", "cells", "--out", tmp_path / "alone")
+    labels = kg.read_room_ground_truth(tmp_path / "alone" / "labels.png")
+    assert np.array_equal(labels, alone.labels)
+    with pytest.raises(kg.Error, match="no colour image"):
+        kg.extract_planes(cpu, sequence.camera, frame["depth"], None)
 
 
 def test_rooms_of_a_real_map_equal_the_clis_and_score(cpu, data_dir, tmp_path):

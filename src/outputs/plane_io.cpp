@@ -1,15 +1,17 @@
 #include "kartograf/outputs/plane_io.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 #include <string>
 
 #include <nlohmann/json.hpp>
 
 #include "formats/atomic_file.hpp"
 #include "formats/input_file.hpp"
-#include "outputs/json_array.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/formats/occupancy_map_io.hpp"
+#include "outputs/json_array.hpp"
 
 namespace kartograf::io {
 
@@ -128,6 +130,25 @@ std::vector<segmentation::Plane> read_planes_json(const std::filesystem::path& p
     planes.push_back(plane);
   }
   return planes;
+}
+
+RgbImage depth_shading(const PointImage& points) {
+  float nearest = std::numeric_limits<float>::infinity(), farthest = 0.0f;
+  for (const Point4f& p : points.pixels()) {
+    if (!is_valid(p)) continue;
+    nearest = std::min(nearest, p.z());
+    farthest = std::max(farthest, p.z());
+  }
+  RgbImage out(points.width(), points.height(), Rgb8{0, 0, 0});
+  const float range = std::max(farthest - nearest, 1e-3f);
+  for (std::size_t i = 0; i < points.size(); ++i) {
+    const Point4f& p = points.data()[i];
+    if (!is_valid(p)) continue;
+    const auto grey =
+        static_cast<std::uint8_t>(std::lround(230.0f - 180.0f * (p.z() - nearest) / range));
+    out.data()[i] = {grey, grey, grey};
+  }
+  return out;
 }
 
 RgbImage plane_overlay(const RgbImage& rgb, const LabelImage& labels) {

@@ -276,13 +276,19 @@ PlaneExtractor::PlaneExtractor(const compute::Context& context, const PinholeInt
 
 namespace {
 
-void check_frame(const PointImage& points, const RgbImage& rgb, int width, int height) {
-  require(!points.empty() && !rgb.empty(),
-          "plane extraction: empty input (points " + size_text(points.width(), points.height()) +
-              ", colour " + size_text(rgb.width(), rgb.height()) + ")");
+void check_frame(const PointImage& points, const RgbImage& rgb, int width, int height,
+                 PlaneExtractionMode mode) {
+  require(!points.empty(), "plane extraction: empty input (points " +
+                               size_text(points.width(), points.height()) + ")");
   require(points.width() == width && points.height() == height,
           "plane extraction: point image is " + size_text(points.width(), points.height()) +
               " but the camera is " + size_text(width, height));
+  if (rgb.empty()) {
+    require(mode == PlaneExtractionMode::cells,
+            "plane extraction: the frame has no colour image, and the regions mode (the M1 "
+            "paper's Lab region growing) needs one; the cells mode works on depth alone");
+    return;
+  }
   require(rgb.width() == width && rgb.height() == height,
           "plane extraction: colour image is " + size_text(rgb.width(), rgb.height()) +
               " but the camera is " + size_text(width, height));
@@ -343,7 +349,7 @@ void PlaneExtractor::assign_pixels(const PointImage& points, MergedPlanes& merge
 }
 
 PlaneSet PlaneExtractor::extract(const PointImage& points, const RgbImage& rgb) {
-  check_frame(points, rgb, intrinsics_.width, intrinsics_.height);
+  check_frame(points, rgb, intrinsics_.width, intrinsics_.height, params_.mode);
   return params_.mode == PlaneExtractionMode::cells ? extract_cells(points, rgb)
                                                     : extract_regions(points, rgb);
 }
@@ -385,7 +391,11 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
   cell_params.jump_per_z2 *= focal_scale;
   detail::CellGrid cells;
   points_.refer_or_upload(*context_, points.pixels());  // no copy on the CPU backend
-  detail::measure_cells(*context_, points_, rgb, cell_params.cell_size,
+  // Without colour the cells' pass reads black; the merge then sees no colours at all.
+  const bool coloured = !rgb.empty();
+  if (!coloured && (no_colour_.width() != points.width() || no_colour_.height() != points.height()))
+    no_colour_ = RgbImage(points.width(), points.height(), Rgb8{0, 0, 0});
+  detail::measure_cells(*context_, points_, coloured ? rgb : no_colour_, cell_params.cell_size,
                         params_.growing.max_depth_jump, static_cast<float>(cell_params.jump_per_z2),
                         origin.cast<double>(), cell_buffers_, cells);
   detail::CellSegments pieces;
@@ -399,7 +409,9 @@ PlaneSet PlaneExtractor::extract_cells(const PointImage& points, const RgbImage&
   // No label image: a pixel's segment is its cell's or block's.
   MergedPlanes merged =
       merge_segments(SegmentLabelImage(), pieces.moments, params_.merge,
-                     {pieces.lab_colours, &points, &graph, pieces.fits, pieces.pixel_sums,
+                     {coloured ? std::span<const Eigen::Vector3f>(pieces.lab_colours)
+                               : std::span<const Eigen::Vector3f>(),
+                      &points, &graph, pieces.fits, pieces.pixel_sums,
                       [&cells](int x, int y) { return cells.segment_at(x, y); }});
   result.merged_count = static_cast<std::uint32_t>(merged.planes.size());
   result.timings.merging = elapsed_ms(clock);

@@ -40,6 +40,10 @@ std::vector<segmentation::Plane> read_planes_json(const std::filesystem::path& p
 // blended over it, plane borders drawn dark. rgb and labels have the same size.
 RgbImage plane_overlay(const RgbImage& rgb, const LabelImage& labels);
 
+// A frame without colour seen as grey by depth, near bright and far dark (no depth: black), as
+// plane_overlay's background.
+RgbImage depth_shading(const PointImage& points);
+
 // The pixels with a plane as a cloud, each in its plane's colour (colorize_labels).
 PointCloud plane_points(const PointImage& points, const LabelImage& labels);
 

@@ -147,7 +147,10 @@ class PlaneExtractor {
                  const PlaneExtractionParams& params = {});
 
   // points (camera frame, NaN where invalid) and rgb have the intrinsics' size. Deterministic.
-  // Throws Error on a size mismatch or an empty image.
+  // Throws Error on a size mismatch or an empty point image. The cells mode also takes a depth
+  // camera's frame without colour (rgb empty): planes apart are then joined on their geometry
+  // alone, where the view between them shows no surface in front (see-through test); the
+  // regions mode grows colour regions and throws Error naming the missing colour.
   PlaneSet extract(const PointImage& points, const RgbImage& rgb);
 
   const PlaneExtractionParams& params() const { return params_; }
@@ -178,6 +181,7 @@ class PlaneExtractor {
   std::vector<std::uint32_t> open_cells_;       // scratch: cells with pixels no plane took
   SegmentStatistics statistics_;                // scratch: colours and moments per segment
   CellBuffers cell_buffers_;                    // the cells mode's pass on the context
+  RgbImage no_colour_;  // what the cells' pass reads for a frame without colour (black)
 };
 
 }  // namespace kartograf::segmentation
