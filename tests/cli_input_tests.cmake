@@ -265,7 +265,36 @@ exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth-alone ${KARTOGRAF_DATA_DIR}
   ${fails_with_helper})
 
+# A depth camera's sequence (the kitchen's frames 0-29 without their colour images): odometry,
+# slam without features, fuse and planes --mode cells run on depth alone; what needs colour
+# (--features, --method color and planar, map, semantic, the regions mode) is refused before any
+# work, naming the folder.
+add_test(NAME Cli.input_sequence_from_depth_alone
+  COMMAND sh -c [=[
+DATA=$2; . "$3"; . "$4"
+rm -rf "$1" && mkdir -p "$1" || exit 1
+kitchen_copy "$1/seq" 0 29
+rm "$1"/seq/frame-*.color.jpg
+"$0" odometry "$1/seq" --out "$1/odometry.txt" > "$1/odometry.log" 2> "$1/odometry.err" || { cat "$1/odometry.err"; echo "FAIL: odometry on depth alone"; exit 1; }
+grep -q "has no colour images: depth alone" "$1/odometry.err" || { cat "$1/odometry.err"; echo "FAIL: depth alone not said"; exit 1; }
+ate=$(sed -n 's/.*ate_rmse_m \([0-9.]*\).*//p' "$1/odometry.log")
+awk -v a="$ate" 'BEGIN { exit !(a != "" && a < 0.05) }' || { cat "$1/odometry.log"; echo "FAIL: ATE '$ate'"; exit 1; }
+"$0" slam "$1/seq" --no-map --out "$1/slam" --no-progress > /dev/null 2> "$1/slam.err" || { cat "$1/slam.err"; echo "FAIL: slam on depth alone"; exit 1; }
+"$0" fuse "$1/seq" --poses groundtruth --out "$1/fuse" --no-progress > /dev/null 2> "$1/fuse.err" && test -s "$1/fuse/mesh.ply" || { cat "$1/fuse.err"; echo "FAIL: fuse on depth alone"; exit 1; }
+"$0" planes "$1/seq" --mode cells --frames 2 --out "$1/planes" --no-progress > /dev/null 2> "$1/planes.err" && test -s "$1/planes/000001/labels.png" || { cat "$1/planes.err"; echo "FAIL: planes --mode cells on depth alone"; exit 1; }
+fails_with "$1/err" "--features (ORB on the colour images) needs colour images" "seq' has none" -- "$0" slam "$1/seq" --features --out "$1/x" || exit 1
+fails_with "$1/err" "--method color" "needs colour images" -- "$0" odometry "$1/seq" --method color --out "$1/x.txt" || exit 1
+fails_with "$1/err" "--method planar" "needs colour images" -- "$0" slam "$1/seq" --method planar --out "$1/x" || exit 1
+fails_with "$1/err" "map (its views' planes and semantic labels use the colour images) needs colour images" -- "$0" map "$1/seq" --out "$1/x" || exit 1
+fails_with "$1/err" "semantic" "needs colour images" -- "$0" semantic "$1/seq" --out "$1/x" || exit 1
+fails_with "$1/err" "the regions mode" "--mode cells works on depth alone" -- "$0" planes "$1/seq" --out "$1/x" || exit 1
+test ! -e "$1/x" && test ! -e "$1/x.txt" || { echo "FAIL: a refused run left output"; exit 1; }
+exit 0
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth-alone-sequence ${KARTOGRAF_DATA_DIR}
+  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
+
 set_tests_properties(Cli.input_colour_and_depth_sizes_and_truncated_images
+  Cli.input_sequence_from_depth_alone
   Cli.input_planes_from_depth_alone
   Cli.input_missing_frames_bad_poses_and_short_trajectories
   Cli.input_unusable_depth_is_named_before_the_run PROPERTIES ENVIRONMENT "${KARTOGRAF_TEST_ENV}")

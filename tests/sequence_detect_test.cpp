@@ -9,8 +9,8 @@
 #include "kartograf/core/error.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
-#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/outputs/synthetic_dataset.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "test_support_core.hpp"
 
 namespace kartograf {
@@ -44,6 +44,9 @@ TEST_F(SequenceDetect, NamesEachLayout) {
   EXPECT_FALSE(scenes.has_timestamps);
   touch(dir() / "flat" / "frame-000000.depth.png");
   EXPECT_EQ(io::detect_sequence(dir() / "flat").layout, io::SequenceLayout::seven_scenes);
+  fs::create_directories(dir() / "depth_alone" / "depth");  // a depth camera's frames
+  EXPECT_EQ(io::detect_sequence(dir() / "depth_alone").layout,
+            io::SequenceLayout::rgb_depth_folders);
 
   EXPECT_EQ(io::to_string(io::SequenceLayout::seven_scenes), "7scenes");
   EXPECT_EQ(io::to_string(io::SequenceLayout::synthetic), "synthetic");

@@ -16,8 +16,8 @@
 #include "kartograf/formats/camera_intrinsics.hpp"
 #include "kartograf/formats/image_io.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
-#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/mapping/slam.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/synth/trajectory.hpp"
 #include "rgbd_test_sequence.hpp"
 #include "test_support.hpp"
@@ -427,6 +427,41 @@ TEST_F(SequenceInput, RgbAndDepthFoldersPairedByNameWithTheAssumptionsSaid) {
   EXPECT_FALSE(opened.warnings.empty());
   fs::remove(folder / "rgb" / "11.png");
   EXPECT_ERROR_MENTIONS(io::open_sequence(folder), "rgb/ holds 2 images, depth/ 3");
+}
+
+// A depth camera alone: a numbered folder without any colour image, or depth/ without rgb/, opens
+// with empty colour in every frame (said so); a folder with some colour images needs them all.
+TEST_F(SequenceInput, FoldersWithoutAnyColourImageAreADepthCameraAlone) {
+  const fs::path numbered = kitchen_copy("depth_alone", 0, 4);
+  for (int n = 0; n <= 4; ++n) fs::remove(numbered / frame_name(n, ".color.jpg"));
+  const io::OpenedSequence opened = io::open_sequence(numbered);
+  EXPECT_FALSE(opened.has_color);
+  ASSERT_EQ(opened.sequence->size(), 5u);
+  const io::RgbdFrame frame = opened.sequence->frame(3);
+  EXPECT_TRUE(frame.color.empty());
+  EXPECT_TRUE(frame.color_file.empty());
+  EXPECT_EQ(frame.depth.width(), 640);
+  ASSERT_TRUE(frame.pose.has_value());  // the poses still come with the frames
+  ASSERT_FALSE(opened.warnings.empty());
+  EXPECT_NE(opened.warnings[0].find("has no colour images: depth alone"), std::string::npos);
+  EXPECT_TRUE(io::open_sequence(kitchen_copy("coloured", 0, 1)).has_color);
+
+  const fs::path some = kitchen_copy("some_colour", 0, 4);
+  fs::remove(some / frame_name(2, ".color.jpg"));
+  EXPECT_ERROR_MENTIONS(io::open_sequence(some), "frame-000002.color.jpg", "no such file");
+
+  const fs::path plain = dir() / "depth_folder";
+  fs::create_directories(plain / "depth");
+  for (const char* name : {"1", "2"}) {
+    io::write_png(plain / "depth" / (std::string(name) + ".png"),
+                  DepthImage(64, 48, std::uint16_t(900)));
+  }
+  const io::OpenedSequence folders = io::open_sequence(plain);
+  EXPECT_EQ(folders.detected.layout, io::SequenceLayout::rgb_depth_folders);
+  EXPECT_FALSE(folders.has_color);
+  ASSERT_EQ(folders.sequence->size(), 2u);
+  EXPECT_TRUE(folders.sequence->frame(1).color.empty());
+  EXPECT_EQ(folders.sequence->frame(1).depth_file.filename(), "2.png");
 }
 
 }  // namespace

@@ -121,6 +121,8 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   known_files.push_back("evaluation.png");
   OutputFolder folder("map", o.out_dir, o.force, known_files);
   const OpenedRun run = open_run(o.run, err);
+  require_colour(run.opened, o.run.sequence,
+                 "map (its views' planes and semantic labels use the colour images)");
   const compute::Context context = make_run_context(o.run);
   pipeline::MapperParams params;
   pipeline::MapPipelineParams& stages = params.pipeline;

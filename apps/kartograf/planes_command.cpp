@@ -270,6 +270,10 @@ int run_planes_command(const PlanesOptions& o, std::ostream& out, std::ostream& 
   reading.frames = o.frames;
   reading.step = o.step;
   const io::OpenedSequence opened = open_input(o.input, reading, err);
+  if (o.mode != "cells") {
+    require_colour(opened, o.input,
+                   "the regions mode (Lab region growing; --mode cells works on depth alone)");
+  }
   const io::Sequence& sequence = *opened.sequence;
   segmentation::PlaneExtractor extractor(context, sequence.intrinsics(), params);
   geometry::DepthRange range;

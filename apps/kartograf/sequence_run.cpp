@@ -145,9 +145,20 @@ io::SequenceRunRecord run_record(const SequenceRunOptions& options,
           std::string(compute::to_string(context.backend())), context.device_info().name};
 }
 
+void require_colour(const io::OpenedSequence& opened, const std::filesystem::path& folder,
+                    const std::string& what) {
+  require(opened.has_color, what + " needs colour images, and '" + folder.string() +
+                                "' has none (a depth camera alone)");
+}
+
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
   OpenedRun run;
   run.opened = open_input(options.sequence, options.input, err);
+  if (options.method == "color") {
+    require_colour(run.opened, options.sequence, "--method color (colour-checked ICP)");
+  } else if (options.method == "planar") {
+    require_colour(run.opened, options.sequence, "--method planar (planes of Lab regions)");
+  }
   geometry::DepthRange range = odometry_params(options).depth_range;
   range.units_per_metre = run.opened.sequence->depth_units_per_metre();
   pipeline::check_depth_usable(*run.opened.sequence, range);

@@ -60,8 +60,14 @@ struct OpenedRun {
   io::OpenedSequence opened;
   std::unique_ptr<pipeline::SequenceFrameSource> source;
 };
-// open_input, then the first frames' depth checked against the odometry's depth range.
+// open_input, then the first frames' depth checked against the odometry's depth range, and
+// --method color or planar refused on a sequence without colour.
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err);
+
+// Error naming `what` and the folder when the sequence has no colour images (a depth camera
+// alone), before any work.
+void require_colour(const io::OpenedSequence& opened, const std::filesystem::path& folder,
+                    const std::string& what);
 
 // A bar on a terminal (redrawn in place), else a line every 10 %.
 class ProgressBar {

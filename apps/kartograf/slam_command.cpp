@@ -143,6 +143,7 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   params.map.voxel_size = o.voxel_size;
   params.model = model_tracking_params(o.run);
   if (o.features) {
+    require_colour(run.opened, o.run.sequence, "--features (ORB on the colour images)");
     params.features = std::make_shared<const features::OrbFrontEnd>(pipeline::map_orb_params());
     params.odometry.features = params.features;
   }

@@ -69,6 +69,20 @@ Eigen::Isometry3d rotation_pose(const Eigen::Matrix4d& matrix, const std::string
 
 namespace detail {
 
+namespace {
+
+// The frame with its ground-truth pose, from the list or its pose file.
+RgbdFrame with_pose(const FrameFiles& files, RgbdFrame frame) {
+  frame.pose = files.pose;
+  if (!files.pose_file.empty()) {
+    frame.pose =
+        rotation_pose(matrix_from(read_numbers(files.pose_file, 16), 0), quoted(files.pose_file));
+  }
+  return frame;
+}
+
+}  // namespace
+
 ListedSequence::ListedSequence(std::vector<FrameFiles> frames, const PinholeIntrinsics& camera,
                                double depth_units_per_metre)
     : frames_(std::move(frames)), camera_(camera), depth_units_per_metre_(depth_units_per_metre) {
@@ -94,18 +108,14 @@ RgbdFrame ListedSequence::frame(std::size_t i) const {
           "depth image " + quoted(files.depth) + " is " + size_text(frame.depth) +
               ", the sequence's frames are " + std::to_string(camera_.width) + "x" +
               std::to_string(camera_.height));
+  if (files.color.empty()) return with_pose(files, std::move(frame));  // a depth camera alone
   frame.color = read_color_image(files.color);
   require(
       frame.color.width() == frame.depth.width() && frame.color.height() == frame.depth.height(),
       "colour image " + quoted(files.color) + " is " + size_text(frame.color) +
           ", its depth image " + quoted(files.depth) + " is " + size_text(frame.depth) +
           " (colour must be on the depth image's pixel grid)");
-  frame.pose = files.pose;
-  if (!files.pose_file.empty()) {
-    frame.pose =
-        rotation_pose(matrix_from(read_numbers(files.pose_file, 16), 0), quoted(files.pose_file));
-  }
-  return frame;
+  return with_pose(files, std::move(frame));
 }
 
 }  // namespace detail

@@ -33,12 +33,12 @@ DetectedSequence detect_sequence(const fs::path& folder) {
     return {synthetic ? SequenceLayout::synthetic : SequenceLayout::tum, true};
   }
   if (detail::numbered_frames_folder(folder)) return {SequenceLayout::seven_scenes, false};
-  if (fs::is_directory(folder / "rgb") && fs::is_directory(folder / "depth"))
-    return {SequenceLayout::rgb_depth_folders, false};
+  if (fs::is_directory(folder / "depth")) return {SequenceLayout::rgb_depth_folders, false};
   throw Error(detail::quoted(folder) +
               ": not a known RGB-D sequence layout (looked for rgb.txt and depth.txt: TUM or "
               "kartograf synth; frame-N.depth.png (e.g. frame-000000.depth.png), in the folder "
-              "or in frames/: 7-Scenes, 3DMatch, SUN3D; rgb/ and depth/ folders of images)");
+              "or in frames/: 7-Scenes, 3DMatch, SUN3D; rgb/ and depth/ folders of images, or "
+              "depth/ alone)");
 }
 
 OpenedSequence open_sequence(const fs::path& folder, const SequenceParams& options) {

@@ -43,8 +43,16 @@ Camera assumed_camera(const std::string& preset, const fs::path& folder, FrameLi
 void note_missing(FrameFiles& frame) {
   if (!fs::is_regular_file(frame.depth))
     frame.missing = frame.depth;
-  else if (!fs::is_regular_file(frame.color))
+  else if (!frame.color.empty() && !fs::is_regular_file(frame.color))  // empty: depth alone
     frame.missing = frame.color;
+}
+
+// A folder without any colour image is a depth camera's: its frames have no colour, and the user
+// is told which commands need it.
+void note_depth_alone(const fs::path& folder, FrameList& list) {
+  list.warnings.push_back(quoted(folder) +
+                          " has no colour images: depth alone (the commands and methods that "
+                          "need colour refuse it)");
 }
 
 // "frame-<digits><suffix>" -> the number and the suffix.
@@ -102,6 +110,16 @@ std::vector<fs::path> images_in(const fs::path& folder) {
   std::sort(images.begin(), images.end(),
             [&](const fs::path& a, const fs::path& b) { return key(a) < key(b); });
   return images;
+}
+
+// The rgb/ + depth/ layout's camera and depth scale: the folder's camera file, else a Kinect's
+// (said so), in millimetres.
+FrameList with_folder_camera(const fs::path& folder, FrameList list) {
+  const auto camera = folder_camera({folder});
+  list.camera = camera ? *camera : assumed_camera("kinect", folder, list);
+  list.depth_units_per_metre = 1000;
+  list.depth_scale_source = "assumed millimetres (1000 units per metre; --depth-scale to change)";
+  return list;
 }
 
 }  // namespace
@@ -167,7 +185,11 @@ FrameList list_numbered_frames(const fs::path& folder) {
   }
   step = std::max(step, 1LL);
   const bool png_colour = found.begin()->second.png && !found.begin()->second.jpg;
+  const bool any_colour = std::any_of(found.begin(), found.end(), [](const auto& entry) {
+    return entry.second.png || entry.second.jpg;
+  });
   FrameList list;
+  if (!any_colour) note_depth_alone(*frames_folder, list);
   for (long long n = found.begin()->first; n <= found.rbegin()->first; n += step) {
     const auto it = found.find(n);
     NumberedFiles files = it != found.end() ? it->second : NumberedFiles{};
@@ -177,7 +199,7 @@ FrameList list_numbered_frames(const fs::path& folder) {
     const fs::path base = *frames_folder / stem;
     const bool png = files.png || (!files.jpg && png_colour);
     FrameFiles frame{static_cast<double>(n) / 30.0,
-                     base.string() + (png ? ".color.png" : ".color.jpg"),
+                     any_colour ? base.string() + (png ? ".color.png" : ".color.jpg") : "",
                      base.string() + ".depth.png",
                      files.pose ? base.string() + ".pose.txt" : "",
                      {},
@@ -194,7 +216,8 @@ FrameList list_numbered_frames(const fs::path& folder) {
 }
 
 FrameList list_rgb_depth_frames(const fs::path& folder) {
-  const std::vector<fs::path> colour = images_in(folder / "rgb");
+  const std::vector<fs::path> colour =
+      fs::is_directory(folder / "rgb") ? images_in(folder / "rgb") : std::vector<fs::path>{};
   const std::vector<fs::path> depth = images_in(folder / "depth");
   std::map<std::string, fs::path> colour_by_stem;
   for (const fs::path& c : colour) colour_by_stem[c.stem().string()] = c;
@@ -202,21 +225,23 @@ FrameList list_rgb_depth_frames(const fs::path& folder) {
     return colour_by_stem.count(d.stem().string()) > 0;
   });
   require(!depth.empty(), quoted(folder / "depth") + ": no PNG depth images");
+  FrameList list;
+  if (colour.empty()) {  // depth/ alone
+    note_depth_alone(folder, list);
+    for (std::size_t i = 0; i < depth.size(); ++i)
+      list.frames.push_back({static_cast<double>(i) / 30.0, {}, depth[i], {}, {}, {}, 0});
+    return with_folder_camera(folder, std::move(list));
+  }
   require(same_names || colour.size() == depth.size(),
           quoted(folder) + ": rgb/ holds " + std::to_string(colour.size()) + " images, depth/ " +
               std::to_string(depth.size()) +
               " and their names differ: cannot pair colour with depth (same names, or as many "
               "of each in the same order)");
-  FrameList list;
   for (std::size_t i = 0; i < depth.size(); ++i) {
     const fs::path& c = same_names ? colour_by_stem.at(depth[i].stem().string()) : colour[i];
     list.frames.push_back({static_cast<double>(i) / 30.0, c, depth[i], {}, {}, {}, 0});
   }
-  const auto camera = folder_camera({folder});
-  list.camera = camera ? *camera : assumed_camera("kinect", folder, list);
-  list.depth_units_per_metre = 1000;
-  list.depth_scale_source = "assumed millimetres (1000 units per metre; --depth-scale to change)";
-  return list;
+  return with_folder_camera(folder, std::move(list));
 }
 
 }  // namespace kartograf::io::detail

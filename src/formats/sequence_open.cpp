@@ -121,6 +121,8 @@ OpenedSequence open_listed(FrameList list, const SequenceParams& o) {
     });
     sequence = std::make_unique<ListedSequence>(files_of(frames), opened.camera.intrinsics, scale);
   }
+  opened.has_color = std::any_of(frames.begin(), frames.end(),
+                                 [](const auto& frame) { return !frame.second.color.empty(); });
   opened.sequence = std::move(sequence);
   return opened;
 }

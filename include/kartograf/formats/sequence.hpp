@@ -2,7 +2,9 @@
 // RGB-D sequences on disk, read lazily one frame at a time through one interface:
 // TUM RGB-D folders (rgb.txt, depth.txt, optional groundtruth.txt), 7-Scenes / 3DMatch / SUN3D
 // folders (frame-N.color.jpg or .color.png, frame-N.depth.png, frame-N.pose.txt, any first N) and
-// rgb/ + depth/ folders. Also Redwood/Open3D .log trajectories. Opening a folder of any layout with
+// rgb/ + depth/ folders; a folder with no colour image at all (depth/ alone, or numbered depth
+// frames without colour) is a depth camera's: its frames' colour is empty. Also Redwood/Open3D
+// .log trajectories. Opening a folder of any layout with
 // a camera, depth scale, frame range and skipping of bad frames: io/sequence_detect.hpp.
 #include <cstddef>
 #include <filesystem>
@@ -21,7 +23,7 @@ namespace kartograf::io {
 struct RgbdFrame {
   std::size_t index = 0;  // position in the folder's order (before a frame range or skipping)
   double timestamp = 0;   // seconds
-  RgbImage color;
+  RgbImage color;         // empty for a depth camera alone (OpenedSequence::has_color)
   DepthImage depth;
   std::optional<Eigen::Isometry3d> pose;  // camera-to-world ground truth, when the data set has it
   std::filesystem::path color_file, depth_file;  // where the images came from, for messages

@@ -64,6 +64,9 @@ struct OpenedSequence {
   std::string depth_scale_source;     // e.g. "--depth-scale", "TUM default"
   std::vector<std::string> warnings;  // e.g. a default camera assumed: for the user
   std::vector<SkippedFrame> skipped;
+  // False for a depth camera alone (no colour image in the folder at all: its frames' colour is
+  // empty); a folder with some colour images needs them all.
+  bool has_color = true;
 };
 // Throws Error naming the folder, an option or a file when the folder cannot be read as asked.
 OpenedSequence open_sequence(const std::filesystem::path& folder,
