@@ -462,6 +462,15 @@ TEST_F(SequenceInput, FoldersWithoutAnyColourImageAreADepthCameraAlone) {
   ASSERT_EQ(folders.sequence->size(), 2u);
   EXPECT_TRUE(folders.sequence->frame(1).color.empty());
   EXPECT_EQ(folders.sequence->frame(1).depth_file.filename(), "2.png");
+
+  const fs::path tum = tum_folder("tum_depth");  // depth.txt without rgb.txt: TUM's timestamps
+  fs::remove(tum / "rgb.txt");
+  const io::OpenedSequence timed = io::open_sequence(tum);
+  EXPECT_EQ(timed.detected.layout, io::SequenceLayout::tum);
+  EXPECT_FALSE(timed.has_color);
+  ASSERT_EQ(timed.sequence->size(), 3u);
+  EXPECT_NEAR(timed.sequence->frame(2).timestamp, 1.0 + 2 / 30.0, 1e-4);  // as written: 6 digits
+  EXPECT_TRUE(timed.sequence->frame(2).color.empty());
 }
 
 }  // namespace

@@ -28,15 +28,17 @@ DetectedSequence detect_sequence(const fs::path& folder) {
   require(fs::is_directory(folder), detail::quoted(folder) +
                                         ": not a folder (expected an RGB-D "
                                         "sequence folder)");
-  if (fs::is_regular_file(folder / "rgb.txt") && fs::is_regular_file(folder / "depth.txt")) {
+  // TUM: rgb.txt and depth.txt, or depth.txt alone (a depth camera's).
+  if (fs::is_regular_file(folder / "depth.txt")) {
     const bool synthetic = fs::is_regular_file(folder / "world.json");
     return {synthetic ? SequenceLayout::synthetic : SequenceLayout::tum, true};
   }
   if (detail::numbered_frames_folder(folder)) return {SequenceLayout::seven_scenes, false};
   if (fs::is_directory(folder / "depth")) return {SequenceLayout::rgb_depth_folders, false};
   throw Error(detail::quoted(folder) +
-              ": not a known RGB-D sequence layout (looked for rgb.txt and depth.txt: TUM or "
-              "kartograf synth; frame-N.depth.png (e.g. frame-000000.depth.png), in the folder "
+              ": not a known RGB-D sequence layout (looked for rgb.txt and depth.txt, or "
+              "depth.txt alone: TUM or kartograf synth; frame-N.depth.png (e.g. "
+              "frame-000000.depth.png), in the folder "
               "or in frames/: 7-Scenes, 3DMatch, SUN3D; rgb/ and depth/ folders of images, or "
               "depth/ alone)");
 }

@@ -134,18 +134,25 @@ std::optional<fs::path> numbered_frames_folder(const fs::path& folder) {
   return std::nullopt;
 }
 
-FrameList list_tum_frames(const fs::path& folder, double max_difference) {
-  FrameList list;
-  const auto rgb = read_tum_file_list(folder / "rgb.txt");
+namespace {
+
+// TUM's frames: rgb.txt and depth.txt associated by time, or depth.txt alone (a depth camera).
+void list_tum_images(const fs::path& folder, double max_difference, FrameList& list) {
   const auto depth = read_tum_file_list(folder / "depth.txt");
-  std::vector<double> rgb_times, depth_times, gt_times;
-  for (const auto& f : rgb) rgb_times.push_back(f.timestamp);
+  std::vector<double> rgb_times, depth_times;
   for (const auto& f : depth) depth_times.push_back(f.timestamp);
-  Trajectory ground_truth;
-  if (fs::exists(folder / "groundtruth.txt")) {
-    ground_truth = read_tum_trajectory(folder / "groundtruth.txt");
-    for (const auto& p : ground_truth) gt_times.push_back(p.timestamp);
+  if (!fs::exists(folder / "rgb.txt")) {
+    note_depth_alone(folder, list);
+    for (std::size_t j = 0; j < depth.size(); ++j) {
+      FrameFiles frame{depth_times[j], {}, folder / depth[j].file, {}, {}, {}, 0};
+      note_missing(frame);
+      list.frames.push_back(std::move(frame));
+    }
+    require(!list.frames.empty(), quoted(folder / "depth.txt") + ": no depth image listed");
+    return;
   }
+  const auto rgb = read_tum_file_list(folder / "rgb.txt");
+  for (const auto& f : rgb) rgb_times.push_back(f.timestamp);
   for (const auto& [i, j] : associate_timestamps(rgb_times, depth_times, max_difference)) {
     FrameFiles frame{depth_times[j], folder / rgb[i].file, folder / depth[j].file, {}, {}, {}, 0};
     note_missing(frame);
@@ -154,6 +161,19 @@ FrameList list_tum_frames(const fs::path& folder, double max_difference) {
   require(!list.frames.empty(), quoted(folder) + ": no rgb/depth pair within " +
                                     std::to_string(max_difference) +
                                     " s (empty or mismatched rgb.txt / depth.txt)");
+}
+
+}  // namespace
+
+FrameList list_tum_frames(const fs::path& folder, double max_difference) {
+  FrameList list;
+  list_tum_images(folder, max_difference, list);
+  std::vector<double> gt_times;
+  Trajectory ground_truth;
+  if (fs::exists(folder / "groundtruth.txt")) {
+    ground_truth = read_tum_trajectory(folder / "groundtruth.txt");
+    for (const auto& p : ground_truth) gt_times.push_back(p.timestamp);
+  }
   std::vector<double> frame_times;
   for (const FrameFiles& f : list.frames) frame_times.push_back(f.timestamp);
   for (const auto& [f, g] : associate_timestamps(frame_times, gt_times, max_difference))

@@ -2,8 +2,9 @@
 // RGB-D sequences on disk, read lazily one frame at a time through one interface:
 // TUM RGB-D folders (rgb.txt, depth.txt, optional groundtruth.txt), 7-Scenes / 3DMatch / SUN3D
 // folders (frame-N.color.jpg or .color.png, frame-N.depth.png, frame-N.pose.txt, any first N) and
-// rgb/ + depth/ folders; a folder with no colour image at all (depth/ alone, or numbered depth
-// frames without colour) is a depth camera's: its frames' colour is empty. Also Redwood/Open3D
+// rgb/ + depth/ folders; a folder with no colour image at all (depth/ alone, numbered depth
+// frames without colour, TUM's depth.txt without rgb.txt) is a depth camera's: its frames'
+// colour is empty. Also Redwood/Open3D
 // .log trajectories. Opening a folder of any layout with
 // a camera, depth scale, frame range and skipping of bad frames: io/sequence_detect.hpp.
 #include <cstddef>
