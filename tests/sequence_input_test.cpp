@@ -444,6 +444,10 @@ TEST_F(SequenceInput, FoldersWithoutAnyColourImageAreADepthCameraAlone) {
   ASSERT_TRUE(frame.pose.has_value());  // the poses still come with the frames
   ASSERT_FALSE(opened.warnings.empty());
   EXPECT_NE(opened.warnings[0].find("has no colour images: depth alone"), std::string::npos);
+  io::SequenceParams camera;
+  camera.camera = "kinect";  // the user's camera drops the camera warning, not this one
+  EXPECT_NE(io::open_sequence(numbered, camera).warnings.at(0).find("depth alone"),
+            std::string::npos);
   EXPECT_TRUE(io::open_sequence(kitchen_copy("coloured", 0, 1)).has_color);
 
   const fs::path some = kitchen_copy("some_colour", 0, 4);

@@ -32,7 +32,8 @@ struct FrameList {
   Camera camera;  // the layout's own, may lack the image size
   double depth_units_per_metre = 1000;
   std::string depth_scale_source;
-  std::vector<std::string> warnings;
+  // A default camera assumed (dropped when the user gives one), and the other warnings.
+  std::vector<std::string> camera_warnings, warnings;
 };
 
 // TUM (and kartograf synth) folders: rgb.txt and depth.txt associated within max_difference s.

@@ -34,9 +34,9 @@ std::optional<Camera> folder_camera(const std::vector<fs::path>& folders) {
 
 // A preset assumed because nothing says which camera took the frames; the user is told.
 Camera assumed_camera(const std::string& preset, const fs::path& folder, FrameList& list) {
-  list.warnings.push_back(quoted(folder) + " has no camera file: assuming the " + preset +
-                          " camera; give the real one with --camera (a preset " +
-                          "tum-fr1|tum-fr2|tum-fr3|kinect|7scenes, fx,fy,cx,cy or a file)");
+  list.camera_warnings.push_back(quoted(folder) + " has no camera file: assuming the " + preset +
+                                 " camera; give the real one with --camera (a preset " +
+                                 "tum-fr1|tum-fr2|tum-fr3|kinect|7scenes, fx,fy,cx,cy or a file)");
   return {*camera_preset(preset), "default", "default " + preset + ", no camera file"};
 }
 

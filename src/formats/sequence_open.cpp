@@ -86,12 +86,13 @@ Camera camera_for_frames(std::vector<std::pair<std::size_t, FrameFiles>>& frames
 
 OpenedSequence open_listed(FrameList list, const SequenceParams& o) {
   OpenedSequence opened;
-  opened.warnings = list.warnings;
   Camera camera = list.camera;
-  if (!o.camera.empty()) {
-    camera = parse_camera_argument(o.camera);
-    opened.warnings.clear();  // the camera is the user's: no default assumed
+  if (o.camera.empty()) {
+    opened.warnings = list.camera_warnings;
+  } else {
+    camera = parse_camera_argument(o.camera);  // the user's: no default assumed
   }
+  opened.warnings.insert(opened.warnings.end(), list.warnings.begin(), list.warnings.end());
   double scale = list.depth_units_per_metre;
   opened.depth_scale_source = list.depth_scale_source;
   if (o.depth_units_per_metre) {
