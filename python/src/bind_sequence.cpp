@@ -109,6 +109,9 @@ void bind_sequence(nb::module_& m) {
                      return std::string(io::to_string(s.opened.detected.layout));
                    })
       .def_prop_ro("warnings", [](const SequenceHandle& s) { return s.opened.warnings; })
+      .def_prop_ro(
+          "has_color", [](const SequenceHandle& s) { return s.opened.has_color; },
+          "False for a depth camera alone (every frame's color is None)")
       .def_prop_ro("description",
                    [](const SequenceHandle& s) { return io::describe_input(s.opened); })
       .def("frame", &frame_dict, nb::arg("i"),

@@ -61,3 +61,19 @@ def test_real_seven_scenes_frames(data_dir):
     assert frame["depth"].shape == (480, 640)
     assert frame["pose"] is not None
     assert sequence.camera.fx == 585.0
+    assert sequence.has_color
+
+
+def test_a_depth_camera_alone(synthetic, tmp_path):
+    """A TUM folder with depth.txt and no rgb.txt: frames without colour, said so."""
+    folder = tmp_path / "depth_alone"
+    folder.mkdir()
+    for name in ("depth.txt", "groundtruth.txt", "camera_intrinsics.json"):
+        (folder / name).write_bytes((synthetic / name).read_bytes())
+    (folder / "depth").symlink_to(synthetic / "depth")
+    sequence = kg.open_sequence(folder, frames=3)
+    assert not sequence.has_color
+    assert any("depth alone" in w for w in sequence.warnings)
+    frame = sequence.frame(2)
+    assert frame["color"] is None and frame["depth"].shape == (240, 320)
+    assert frame["pose"] is not None
