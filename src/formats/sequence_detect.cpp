@@ -38,9 +38,8 @@ DetectedSequence detect_sequence(const fs::path& folder) {
   throw Error(detail::quoted(folder) +
               ": not a known RGB-D sequence layout (looked for rgb.txt and depth.txt, or "
               "depth.txt alone: TUM or kartograf synth; frame-N.depth.png (e.g. "
-              "frame-000000.depth.png), in the folder "
-              "or in frames/: 7-Scenes, 3DMatch, SUN3D; rgb/ and depth/ folders of images, or "
-              "depth/ alone)");
+              "frame-000000.depth.png), in the folder or in frames/: 7-Scenes, 3DMatch, SUN3D; "
+              "rgb/ and depth/ folders of images, or depth/ alone)");
 }
 
 OpenedSequence open_sequence(const fs::path& folder, const SequenceParams& options) {
