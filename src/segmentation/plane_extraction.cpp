@@ -114,16 +114,40 @@ constexpr int kFloodRadius = 2;
 // The cells mode's leftover regions are 8-connected: its passes already reached across gaps.
 constexpr int kCellLeftoverRadius = 1;
 
-// Calls visit(j) for every pixel j within `radius` (Chebyshev) of pixel i, i itself included.
-template <class Visit>
-void for_each_pixel_near(std::uint32_t i, int width, int height, int radius, Visit&& visit) {
-  const int x = static_cast<int>(i % static_cast<std::uint32_t>(width));
-  const int y = static_cast<int>(i / static_cast<std::uint32_t>(width));
-  for (int ny = std::max(0, y - radius); ny <= std::min(height - 1, y + radius); ++ny) {
-    for (int nx = std::max(0, x - radius); nx <= std::min(width - 1, x + radius); ++nx)
-      visit(static_cast<std::uint32_t>(ny * width + nx));
+// Calls visit(j) for every pixel j within `radius` (Chebyshev) of pixel i, i itself included, row
+// by row. A pixel away from the image's edge takes its neighbours from a table of offsets (no
+// bounds per neighbour: the growths below visit each of their pixels' neighbourhoods).
+class PixelNeighbourhood {
+ public:
+  PixelNeighbourhood(int width, int height, int radius)
+      : width_(width), height_(height), radius_(radius) {
+    require(radius >= 0 && radius <= kMaxRadius,
+            "plane extraction: neighbourhood radius too large");
+    for (int dy = -radius; dy <= radius; ++dy) {
+      for (int dx = -radius; dx <= radius; ++dx) offsets_[count_++] = dy * width + dx;
+    }
   }
-}
+
+  template <class Visit>
+  void for_each(std::uint32_t i, Visit&& visit) const {
+    const int x = static_cast<int>(i % static_cast<std::uint32_t>(width_));
+    const int y = static_cast<int>(i / static_cast<std::uint32_t>(width_));
+    if (x >= radius_ && y >= radius_ && x < width_ - radius_ && y < height_ - radius_) {
+      for (int k = 0; k < count_; ++k) visit(static_cast<std::uint32_t>(int(i) + offsets_[k]));
+      return;
+    }
+    for (int ny = std::max(0, y - radius_); ny <= std::min(height_ - 1, y + radius_); ++ny) {
+      for (int nx = std::max(0, x - radius_); nx <= std::min(width_ - 1, x + radius_); ++nx)
+        visit(static_cast<std::uint32_t>(ny * width_ + nx));
+    }
+  }
+
+ private:
+  static constexpr int kMaxRadius = 2;
+  int width_, height_, radius_;
+  std::array<int, (2 * kMaxRadius + 1) * (2 * kMaxRadius + 1)> offsets_{};
+  int count_ = 0;
+};
 
 // Planes grow pixel by pixel (breadth first) into valid pixels that no plane took, while a pixel
 // lies within the distance allowance of the plane it is reached from and its depth continues that
@@ -135,7 +159,7 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
                              std::vector<std::uint32_t>& pixel_plane,
                              std::vector<std::uint32_t>& queue,
                              std::vector<std::uint8_t>& source_mask) {
-  const int width = points.width(), height = points.height();
+  const PixelNeighbourhood near(points.width(), points.height(), kFloodRadius);
   const Point4f* point = points.data();
   const auto open = [&](std::size_t j) {
     return pixel_plane[j] == geometry::kNoLabel && is_valid(point[j]);
@@ -145,10 +169,9 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
   source.assign(pixel_plane.size(), 0);
   for (std::size_t i = 0; i < pixel_plane.size(); ++i) {
     if (!open(i)) continue;
-    for_each_pixel_near(static_cast<std::uint32_t>(i), width, height, kFloodRadius,
-                        [&](std::uint32_t j) {
-                          if (pixel_plane[j] != geometry::kNoLabel) source[j] = 1;
-                        });
+    near.for_each(static_cast<std::uint32_t>(i), [&](std::uint32_t j) {
+      if (pixel_plane[j] != geometry::kNoLabel) source[j] = 1;
+    });
   }
   queue.clear();
   for (std::size_t i = 0; i < pixel_plane.size(); ++i) {
@@ -158,7 +181,7 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
     const std::uint32_t i = queue[head];
     const SegmentPlane& plane = planes[pixel_plane[i]];
     const float depth = point[i].z();
-    for_each_pixel_near(i, width, height, kFloodRadius, [&](std::uint32_t j) {
+    near.for_each(i, [&](std::uint32_t j) {
       if (!open(j)) return;
       if (max_depth_jump > 0.0f && std::fabs(point[j].z() - depth) > max_depth_jump * depth) return;
       if (plane_score(plane, PixelPoint(point[j], params), params) >= 1.0) return;
@@ -170,13 +193,36 @@ void flood_unassigned_pixels(const PointImage& points, const std::vector<Segment
 
 constexpr std::uint32_t kVisited = geometry::kNoLabel - 1;  // in no plane, checked
 
+// The moments of the region's points about `origin`: the six distinct products summed apart (the
+// same sums as the outer products', a third fewer operations).
+geometry::SegmentMoments region_moments(const Point4f* point,
+                                        const std::vector<std::uint32_t>& region,
+                                        const Eigen::Vector3d& origin) {
+  std::array<double, 3> sum{};
+  std::array<double, 6> outer{};  // xx, xy, xz, yy, yz, zz
+  for (const std::uint32_t i : region) {
+    const double x = static_cast<double>(point[i].x()) - origin.x();
+    const double y = static_cast<double>(point[i].y()) - origin.y();
+    const double z = static_cast<double>(point[i].z()) - origin.z();
+    sum[0] += x, sum[1] += y, sum[2] += z;
+    outer[0] += x * x, outer[1] += x * y, outer[2] += x * z;
+    outer[3] += y * y, outer[4] += y * z, outer[5] += z * z;
+  }
+  geometry::SegmentMoments moments;
+  moments.count = region.size();
+  moments.sum = {sum[0], sum[1], sum[2]};
+  moments.sum_outer << outer[0], outer[1], outer[2], outer[1], outer[3], outer[4], outer[2],
+      outer[4], outer[5];
+  return moments;
+}
+
 // The connected region of valid pixels that no plane took around `seed` (up to `radius` pixels
 // apart, with continuous depth), marked kVisited; if it is planar it becomes a plane of its own
 // (appended to `planes`), and its pixels within the plane's allowance take it.
-void leftover_region(const PointImage& points, const PlaneExtractionParams& params, int radius,
-                     std::uint32_t seed, std::vector<std::uint32_t>& pixel_plane,
-                     std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region) {
-  const int width = points.width(), height = points.height();
+void leftover_region(const PointImage& points, const PlaneExtractionParams& params,
+                     const PixelNeighbourhood& near, std::uint32_t seed,
+                     std::vector<std::uint32_t>& pixel_plane, std::vector<SegmentPlane>& planes,
+                     std::vector<std::uint32_t>& region) {
   const Point4f* point = points.data();
   const float jump = params.growing.max_depth_jump;
   region.assign(1, seed);
@@ -184,7 +230,7 @@ void leftover_region(const PointImage& points, const PlaneExtractionParams& para
   for (std::size_t head = 0; head < region.size(); ++head) {
     const std::uint32_t i = region[head];
     const float depth = point[i].z();
-    for_each_pixel_near(i, width, height, radius, [&](std::uint32_t j) {
+    near.for_each(i, [&](std::uint32_t j) {
       if (pixel_plane[j] != geometry::kNoLabel || !is_valid(point[j])) return;
       if (jump > 0.0f && std::fabs(point[j].z() - depth) > jump * depth) return;
       pixel_plane[j] = kVisited;
@@ -193,15 +239,9 @@ void leftover_region(const PointImage& points, const PlaneExtractionParams& para
   }
   // Most regions are crumbs: their moments are summed only when they are large enough.
   if (region.size() < params.min_plane_pixels) return;
-  geometry::SegmentMoments moments;
   const Eigen::Vector3d origin = point[seed].head<3>().cast<double>();
-  for (const std::uint32_t i : region) {
-    const Eigen::Vector3d d = point[i].head<3>().cast<double>() - origin;
-    ++moments.count;
-    moments.sum += d;
-    moments.sum_outer += d * d.transpose();
-  }
-  const SegmentPlane plane = fit_plane(moments, origin, params.merge.fit);
+  const SegmentPlane plane =
+      fit_plane(region_moments(point, region, origin), origin, params.merge.fit);
   const double min_facing = std::cos(params.merge.max_incidence_deg * M_PI / 180.0);
   if (!plane.valid ||
       plane.rms_error > distance_allowance(params.merge, plane.centroid, plane.normal) ||
@@ -227,10 +267,11 @@ void plane_leftover_regions(const PointImage& points, const PlaneExtractionParam
                             std::vector<std::uint32_t>& pixel_plane,
                             std::vector<SegmentPlane>& planes, std::vector<std::uint32_t>& region,
                             std::vector<std::uint32_t>& visited) {
+  const PixelNeighbourhood near(points.width(), points.height(), radius);
   visited.clear();
   for_each_seed([&](std::uint32_t seed) {
     if (pixel_plane[seed] != geometry::kNoLabel || !is_valid(points.data()[seed])) return;
-    leftover_region(points, params, radius, seed, pixel_plane, planes, region);
+    leftover_region(points, params, near, seed, pixel_plane, planes, region);
     visited.insert(visited.end(), region.begin(), region.end());
   });
   for (const std::uint32_t i : visited) {
