@@ -266,9 +266,10 @@ exit 0
   ${fails_with_helper})
 
 # A depth camera's sequence (the kitchen's frames 0-29 without their colour images): odometry,
-# slam without features, fuse and planes --mode cells run on depth alone; what needs colour
-# (--features, --method color and planar, map, semantic, the regions mode) is refused before any
-# work, naming the folder.
+# slam without features, fuse, map (without features, said; a mesh without colour), semantic (the
+# same labels as with colour: it reads the depth alone) and planes --mode cells run on depth
+# alone; what needs colour (--features, --method color and planar, the regions mode) is refused
+# before any work, naming the folder.
 add_test(NAME Cli.input_sequence_from_depth_alone
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
@@ -277,7 +278,7 @@ kitchen_copy "$1/seq" 0 29
 rm "$1"/seq/frame-*.color.jpg
 "$0" odometry "$1/seq" --out "$1/odometry.txt" > "$1/odometry.log" 2> "$1/odometry.err" || { cat "$1/odometry.err"; echo "FAIL: odometry on depth alone"; exit 1; }
 grep -q "has no colour images: depth alone" "$1/odometry.err" || { cat "$1/odometry.err"; echo "FAIL: depth alone not said"; exit 1; }
-ate=$(sed -n 's/.*ate_rmse_m \([0-9.]*\).*//p' "$1/odometry.log")
+ate=$(sed -n 's/^  ate_rmse_m \([0-9.]*\).*/\1/p' "$1/odometry.log")
 awk -v a="$ate" 'BEGIN { exit !(a != "" && a < 0.05) }' || { cat "$1/odometry.log"; echo "FAIL: ATE '$ate'"; exit 1; }
 "$0" slam "$1/seq" --no-map --out "$1/slam" --no-progress > /dev/null 2> "$1/slam.err" || { cat "$1/slam.err"; echo "FAIL: slam on depth alone"; exit 1; }
 "$0" fuse "$1/seq" --poses groundtruth --out "$1/fuse" --no-progress > /dev/null 2> "$1/fuse.err" && test -s "$1/fuse/mesh.ply" || { cat "$1/fuse.err"; echo "FAIL: fuse on depth alone"; exit 1; }
@@ -285,10 +286,21 @@ awk -v a="$ate" 'BEGIN { exit !(a != "" && a < 0.05) }' || { cat "$1/odometry.lo
 fails_with "$1/err" "--features (ORB on the colour images) needs colour images" "seq' has none" -- "$0" slam "$1/seq" --features --out "$1/x" || exit 1
 fails_with "$1/err" "--method color" "needs colour images" -- "$0" odometry "$1/seq" --method color --out "$1/x.txt" || exit 1
 fails_with "$1/err" "--method planar" "needs colour images" -- "$0" slam "$1/seq" --method planar --out "$1/x" || exit 1
-fails_with "$1/err" "map (its views' planes and semantic labels use the colour images) needs colour images" -- "$0" map "$1/seq" --out "$1/x" || exit 1
-fails_with "$1/err" "semantic" "needs colour images" -- "$0" semantic "$1/seq" --out "$1/x" || exit 1
 fails_with "$1/err" "the regions mode" "--mode cells works on depth alone" -- "$0" planes "$1/seq" --out "$1/x" || exit 1
 test ! -e "$1/x" && test ! -e "$1/x.txt" || { echo "FAIL: a refused run left output"; exit 1; }
+"$0" map "$1/seq" --out "$1/map" --no-progress > "$1/map.log" 2> "$1/map.err" || { cat "$1/map.err"; echo "FAIL: map on depth alone"; exit 1; }
+grep -q "no colour images: no local image features" "$1/map.err" || { cat "$1/map.err"; echo "FAIL: features not said"; exit 1; }
+grep -q '"colour": false' "$1/map/report.json" && grep -q '"features": false' "$1/map/report.json" || { echo "FAIL: report.json"; exit 1; }
+grep -q "none: a depth camera alone" "$1/map/report.html" || { echo "FAIL: report.html does not say so"; exit 1; }
+! grep -a -q "property uchar red" "$1/map/mesh.ply" && ! grep -a -q "property uchar red" "$1/map/map.ply" || { echo "FAIL: a mesh of black colours"; exit 1; }
+ate=$(sed -n 's/^  ate_rmse_m \([0-9.]*\).*/\1/p' "$1/map.log")
+awk -v a="$ate" 'BEGIN { exit !(a != "" && a < 0.05) }' || { cat "$1/map.log"; echo "FAIL: map ATE '$ate'"; exit 1; }
+kitchen_copy "$1/coloured" 0 29
+"$0" semantic "$1/coloured" --out "$1/sem-colour" > /dev/null 2>&1 || { echo "FAIL: semantic with colour"; exit 1; }
+"$0" semantic "$1/seq" --out "$1/sem-depth" > /dev/null 2> "$1/sem.err" || { cat "$1/sem.err"; echo "FAIL: semantic on depth alone"; exit 1; }
+for f in labels.png semantic.png occupancy.pgm; do
+  cmp -s "$1/sem-colour/$f" "$1/sem-depth/$f" || { echo "FAIL: semantic $f differs without colour"; exit 1; }
+done
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth-alone-sequence ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})

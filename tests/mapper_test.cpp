@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <memory>
 
 #include "kartograf/core/error.hpp"
 #include "kartograf/mapping/esdf_volume.hpp"
@@ -223,6 +224,38 @@ TEST(Mapper, MeshFromGivenPosesLiesOnTheTrueSurfaces) {
   EXPECT_EQ(mapper.volume_stats().evictions, 0u);
   EXPECT_TRUE(mapper.volume_stats().covers_all_frames);
   expect_distance_field_measures_the_surfaces(mapper.distance_field(), mesh, world_from_first);
+}
+
+// A depth camera alone (frames without colour): the same surface as with colour, and no colour
+// on it (the voxels' colours would all be black), in mesh() and in the finished map.
+TEST(Mapper, FramesWithoutColourGiveTheSameSurfaceWithoutColours) {
+  const compute::Context cpu = compute::Context::cpu();
+  const testing::RenderedSequence& walk = survey_walk();
+  const auto first_frames = [&](bool colour) {
+    pipeline::MapperParams params;
+    params.pipeline.features = false;
+    auto mapper =
+        std::make_unique<pipeline::Mapper>(cpu, walk.camera, testing::kSynthUnitsPerMetre, params);
+    for (std::size_t i = 0; i < 30; ++i) {
+      registration::RgbdImages frame = walk.frames[i];
+      if (!colour) frame.color = RgbImage();
+      mapper->add_frame(frame, walk.truth[i]);
+    }
+    return mapper;
+  };
+  const auto coloured = first_frames(true);
+  const auto depth_alone = first_frames(false);
+  const TriangleMesh with = coloured->mesh(), without = depth_alone->mesh();
+  ASSERT_GT(with.vertices.size(), 1000u);
+  EXPECT_EQ(with.colors.size(), with.vertices.size());
+  EXPECT_TRUE(without.colors.empty());
+  ASSERT_EQ(without.vertices.size(), with.vertices.size());
+  for (std::size_t i = 0; i < with.vertices.size(); ++i)
+    ASSERT_LT((without.vertices[i] - with.vertices[i]).norm(), 1e-6f) << "vertex " << i;
+  const pipeline::MapPipelineResult result = depth_alone->finish();
+  EXPECT_TRUE(result.mesh.colors.empty());
+  EXPECT_FALSE(result.map.has_colors());
+  EXPECT_GT(result.map.size(), 1000u);
 }
 
 // max_views bounds the views stage: 100 frames, every 5th would be 20 views; 7 are allowed, so

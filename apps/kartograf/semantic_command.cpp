@@ -166,7 +166,6 @@ LabelledPoints sequence_points(const SemanticOptions& o, const Views& views, std
   SequenceInputOptions reading = o.sequence;
   reading.frames = o.frames;
   const io::OpenedSequence opened = open_input(o.input, reading, err);
-  require_colour(opened, o.input, "semantic (its regions and objects use the colour images)");
   const io::Sequence& sequence = *opened.sequence;
   const std::size_t count = sequence.size();
   std::optional<Trajectory> trajectory;

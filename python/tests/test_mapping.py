@@ -20,12 +20,12 @@ def test_slam_runs_and_pickles(cpu, synthetic):
     assert copy.map.points.shape == slam.map.points.shape
 
 
-def mapped(cpu, synthetic):
+def mapped(cpu, synthetic, colour=True):
     sequence = kg.open_sequence(synthetic)
     mapper = kg.Mapper(cpu, sequence.camera, sequence.depth_units_per_metre, features=False)
     for i in range(len(sequence)):
         frame = sequence.frame(i)
-        step = mapper.add_frame(frame["depth"], frame["color"], frame["pose"])
+        step = mapper.add_frame(frame["depth"], frame["color"] if colour else None, frame["pose"])
         assert step["status"] == "given"
     return mapper
 
@@ -44,6 +44,13 @@ def test_the_mappers_mesh_and_distance_field_agree(cpu, synthetic):
     assert field.distance((1e3, 1e3, 1e3)) == field.max_distance
     copy = pickle.loads(pickle.dumps(field))
     assert np.array_equal(copy.distances, field.distances)
+
+
+def test_a_depth_camera_alone_gives_the_same_surface_without_colours(cpu, synthetic):
+    coloured, depth_alone = mapped(cpu, synthetic).mesh(), mapped(cpu, synthetic, False).mesh()
+    assert coloured.colors.shape == coloured.vertices.shape
+    assert depth_alone.colors.shape == (0, 3)
+    assert np.allclose(depth_alone.vertices, coloured.vertices, atol=1e-6)
 
 
 def test_the_mappers_finished_map_has_rooms_and_a_semantic_grid(cpu, synthetic):

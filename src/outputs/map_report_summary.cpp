@@ -37,6 +37,8 @@ void input_facts(std::ostringstream& html, const Json& r) {
   if (const Json* skipped = report_member(r, {"input", "frames_skipped"}); skipped && *skipped != 0)
     frames += ", " + text_of(*skipped) + " unreadable frames skipped";
   fact(html, "frames", frames);
+  if (const Json* colour = report_member(r, {"input", "colour"}); colour && *colour == false)
+    fact(html, "colour", "none: a depth camera alone (no local image features; a grey map)");
   const Json* camera = report_member(r, {"input", "camera"});
   if (!camera) camera = report_member(r, {"camera"});
   if (camera && camera->contains("fx")) fact(html, "camera", camera_text(*camera));

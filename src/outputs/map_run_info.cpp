@@ -14,6 +14,7 @@ detail::RunJson parameters_json(const std::string& method, const pipeline::Mappe
   return {{"method", method},
           {"reestimate_interval", p.slam.odometry.reestimate_interval},
           {"tracking", p.slam.model.enabled ? "model" : "frame"},
+          {"features", p.features},
           {"model_voxel_m", p.slam.model.volume.voxel_size},
           {"label_step", p.label_step},
           {"max_views", p.max_views},

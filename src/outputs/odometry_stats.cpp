@@ -22,6 +22,7 @@ RunJson input_json(const OpenedSequence& opened) {
             {"height", k.height},
             {"source", opened.camera.source},
             {"description", opened.camera.description}}},
+          {"colour", opened.has_color},  // false: a depth camera alone
           {"depth_units_per_metre", opened.sequence->depth_units_per_metre()},
           {"depth_scale_source", opened.depth_scale_source},
           {"frames_skipped", opened.skipped.size()},

@@ -235,6 +235,14 @@ struct Mapper::State {
     return stats;
   }
 
+  // The volume's surface; without colour when no frame brought any (a depth camera alone: the
+  // voxels' colours are then all black, no colour of the scene).
+  TriangleMesh surface(const mapping::TsdfBlocks& blocks) const {
+    TriangleMesh mesh = mapping::extract_mesh(blocks, params.mesh);
+    if (!coloured) mesh.colors.clear();
+    return mesh;
+  }
+
   // The pose of the next frame: tracked, or given (relative to the first given one).
   Eigen::Isometry3d locate(const registration::RgbdImages& frame,
                            const std::optional<Eigen::Isometry3d>& pose, MapperStep& step);
@@ -255,6 +263,7 @@ struct Mapper::State {
   std::optional<mapping::EsdfVolume> distance_field;  // made when first asked for
   mapping::EsdfGrid distance_grid;
   double adding_seconds = 0;
+  bool coloured = false;  // some frame brought colour
   bool finished = false;
 };
 
@@ -299,7 +308,7 @@ MapPipelineResult Mapper::State::complete(mapping::SlamResult slam_result) {
   if (stale) volume.refuse(result.slam.poses);
   stale = false;
   const mapping::TsdfBlocks blocks = volume.volume().download();
-  result.mesh = transformed(mapping::extract_mesh(blocks, params.mesh), result.map_from_slam);
+  result.mesh = transformed(surface(blocks), result.map_from_slam);
   result.map = mesh_points(result.mesh);
   mapping::TsdfSliceParams slice = params.slice;
   slice.world_to_level = result.map_from_slam;
@@ -332,6 +341,7 @@ MapperStep Mapper::add_frame(const registration::RgbdImages& frame,
   s.store.check(frame);
   step.pose = s.locate(frame, pose, step);
   s.stale = s.stale || step.poses_moved;
+  s.coloured = s.coloured || !frame.color.empty();
   const registration::RgbdImages kept = s.store.add(frame);
   if (s.params.live_fusion) {
     step.evicted = s.volume.fuse(kept, step.pose, s.poses());
@@ -358,7 +368,7 @@ VolumeStats Mapper::volume_stats() const {
 
 TriangleMesh Mapper::mesh() {
   State& s = *state_;
-  return mapping::extract_mesh(s.current_volume().download(), s.params.mesh);
+  return s.surface(s.current_volume().download());
 }
 
 const mapping::EsdfGrid& Mapper::distance_field() {
