@@ -45,9 +45,10 @@ def _convert_bags(args, scratch):
     for i, arg in enumerate(args[1:], start=1):
         if not arg.startswith("-") and not args[i - 1].startswith("--") and rosbag.is_bag(arg):
             converted = rosbag.bag_to_folder(arg, Path(scratch) / "frames", **topics)
-            print(f"bag: {arg}: {converted.depth_frames} depth and {converted.color_frames} colour "
-                  f"images from {converted.topics.depth} and {converted.topics.color}",
-                  file=sys.stderr)
+            colour = (f"{converted.color_frames} colour images from {converted.topics.color}"
+                      if converted.topics.color else "no colour topic (a depth camera alone)")
+            print(f"bag: {arg}: {converted.depth_frames} depth images from "
+                  f"{converted.topics.depth}; {colour}", file=sys.stderr)
             poses = ["--poses", str(converted.prior)] if converted.prior else []
             return [*args[:i], str(converted.folder), *args[i + 1:], *poses]
     return args

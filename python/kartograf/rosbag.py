@@ -3,7 +3,9 @@
 
 A bag becomes a TUM RGB-D folder (rgb/, depth/, rgb.txt, depth.txt, camera_intrinsics.json),
 which every Kartograf reader, pipeline and CLI command takes; colour and depth are paired by their
-header stamps as TUM's tools pair them (within 0.02 s).
+header stamps as TUM's tools pair them (within 0.02 s). A bag with no image topic but the depth's
+(a depth camera alone) becomes depth/ and depth.txt only: what needs no colour runs on it
+(odometry, slam without features, map, semantic, fuse, planes in the cells mode).
 
     folder = kg.rosbag.bag_to_folder("run.bag", "run_frames")   # topics chosen automatically
     run = kg.run_odometry(context, kg.open_sequence(folder))
@@ -44,7 +46,7 @@ TUM_UNITS = 5000.0  # depth units per metre in the folder
 
 @dataclass
 class BagTopics:
-    color: str
+    color: Optional[str]  # None: a depth camera alone (the folder then has no rgb/)
     depth: str
     camera_info: Optional[str]
     odometry: Optional[str] = None  # the pose prior's (nav_msgs/Odometry), when asked for
@@ -86,7 +88,8 @@ def _image_topics(topics: dict) -> list:
 def choose_topics(topics: dict, color: Optional[str] = None, depth: Optional[str] = None,
                   camera_info: Optional[str] = None) -> BagTopics:
     """The colour, depth and camera_info topics: given, else by name ('depth' for depth; 'color',
-    'rgb' or 'image' for colour; the camera_info in the depth topic's namespace, else any)."""
+    'rgb' or 'image' for colour, None when the bag has no other image topic: a depth camera
+    alone; the camera_info in the depth topic's namespace, else any)."""
     images = _image_topics(topics)
     listing = ", ".join(f"{t} ({i.msgtype})" for t, i in sorted(topics.items()))
     if depth is None:
@@ -97,11 +100,9 @@ def choose_topics(topics: dict, color: Optional[str] = None, depth: Optional[str
     if color is None:
         candidates = [t for t in images if t != depth and "depth" not in t.lower()]
         ranked = sorted(candidates, key=lambda t: (not any(k in t.lower() for k in ("color", "rgb")), t))
-        if not ranked:
-            raise _kartograf.Error(f"bag: no colour image topic; topics: {listing}")
-        color = ranked[0]
+        color = ranked[0] if ranked else None
     for topic in (color, depth):
-        if topic not in topics:
+        if topic is not None and topic not in topics:
             raise _kartograf.Error(f"bag: no topic {topic}; topics: {listing}")
     if camera_info is None:
         infos = [t for t, i in topics.items() if i.msgtype == CAMERA_INFO]
@@ -234,23 +235,24 @@ def bag_to_folder(bag: str | os.PathLike, folder: str | os.PathLike,
                   camera: Optional[_kartograf.PinholeIntrinsics] = None,
                   pose_prior: bool = False, odometry_topic: Optional[str] = None,
                   tf_world: Optional[str] = None) -> BagConversion:
-    """Writes the bag's colour and depth frames as a TUM folder; returns what it used. With
+    """Writes the bag's colour and depth frames as a TUM folder (depth alone when the bag has no
+    colour topic: every command that needs no colour takes it); returns what it used. With
     pose_prior: also prior.txt, the camera's pose at each depth image (a TUM trajectory for
     `--poses`) from the odometry topic or /tf (from tf_world, default the topmost frame)."""
     bag, folder = Path(bag), Path(folder)
     if folder.exists() and any(folder.iterdir()):
         raise _kartograf.Error(f"bag: {folder} exists and is not empty")
-    (folder / "rgb").mkdir(parents=True, exist_ok=True)
-    (folder / "depth").mkdir(exist_ok=True)
     camera_frame, records = None, None
     with _reader(bag) as reader, tempfile.TemporaryDirectory() as scratch:
         topics = choose_topics(reader.topics, color_topic, depth_topic, camera_info_topic)
+        lists = {"rgb": [], "depth": []} if topics.color else {"depth": []}
+        for name in lists:
+            (folder / name).mkdir(parents=True, exist_ok=True)
         if pose_prior:
             records = _PoseRecords(reader.topics, odometry_topic)
             topics.odometry = records.odometry_topic
         pose_topics = {records.odometry_topic, *records.tf_topics} if records else set()
-        wanted = {topics.color, topics.depth, topics.camera_info, *pose_topics}
-        lists = {"rgb": [], "depth": []}
+        wanted = {topics.color, topics.depth, topics.camera_info, *pose_topics} - {None}
         for connection, _, raw in reader.messages(
                 connections=[c for c in reader.connections if c.topic in wanted]):
             msg = reader.deserialize(raw, connection.msgtype)
@@ -269,13 +271,14 @@ def bag_to_folder(bag: str | os.PathLike, folder: str | os.PathLike,
         lines = [f"# {name} images of {bag.name}", "# timestamp filename"]
         lines += [f"{t:.6f} {name}/{t:.6f}.png" for t in entries]
         (folder / f"{name}.txt").write_text("\n".join(lines) + "\n")
-    if not lists["rgb"] or not lists["depth"]:
-        raise _kartograf.Error(f"bag: {bag} holds no {'colour' if not lists['rgb'] else 'depth'} "
-                               "images on the chosen topics")
+    for name, entries in lists.items():
+        if not entries:
+            raise _kartograf.Error(f"bag: {bag} holds no {'colour' if name == 'rgb' else 'depth'} "
+                                   "images on the chosen topics")
     prior = folder / "prior.txt" if records else None
     if records:
         topics.world = records.write(prior, camera_frame, lists["depth"], tf_world)
-    return BagConversion(folder=folder, topics=topics, color_frames=len(lists["rgb"]),
+    return BagConversion(folder=folder, topics=topics, color_frames=len(lists.get("rgb", [])),
                          depth_frames=len(lists["depth"]), camera=camera, prior=prior)
 
 

@@ -121,8 +121,9 @@ def _odometry(types, ros1, t, camera_pose):
         twist=types["geometry_msgs/msg/TwistWithCovariance"](twist=twist, covariance=zeros))
 
 
-def write_bag(sequence, folder, path, ros1, odometry=False, tf_every=0):
-    """The sequence's frames into a bag at path; colour from the folder's PNGs for ROS 1. With
+def write_bag(sequence, folder, path, ros1, odometry=False, tf_every=0, colour=True):
+    """The sequence's frames into a bag at path; colour from the folder's PNGs for ROS 1 (none
+    without colour: a depth camera alone). With
     odometry: /odom (the base's ground-truth pose) and /tf_static (base to camera). With tf_every
     k: /tf's odom -> base_link (the true pose) at every k-th frame and the last, and /tf_static."""
     store = get_typestore(Stores.ROS1_NOETIC if ros1 else Stores.ROS2_HUMBLE)
@@ -137,7 +138,9 @@ def write_bag(sequence, folder, path, ros1, odometry=False, tf_every=0):
         info = add("/camera/color/camera_info", "sensor_msgs/msg/CameraInfo")
         depth_topic = add("/camera/aligned_depth_to_color/image_raw", "sensor_msgs/msg/Image")
         color_type = "sensor_msgs/msg/CompressedImage" if ros1 else "sensor_msgs/msg/Image"
-        color_topic = add("/camera/color/image_raw" + ("/compressed" if ros1 else ""), color_type)
+        if colour:
+            color_topic = add("/camera/color/image_raw" + ("/compressed" if ros1 else ""),
+                              color_type)
         rgb_files = sorted((Path(folder) / "rgb").glob("*.png"))
         if odometry:
             odom = add("/odom", "nav_msgs/msg/Odometry")
@@ -154,8 +157,9 @@ def write_bag(sequence, folder, path, ros1, odometry=False, tf_every=0):
             ns = int(round(t * 1e9))
             writer.write(depth_topic, ns, serialize(_depth(types, ros1, t, frame["depth"]),
                                                     "sensor_msgs/msg/Image"))
-            color = _color(types, ros1, t, frame["color"], rgb_files[i] if ros1 else None)
-            writer.write(color_topic, ns, serialize(color, color_type))
+            if colour:
+                color = _color(types, ros1, t, frame["color"], rgb_files[i] if ros1 else None)
+                writer.write(color_topic, ns, serialize(color, color_type))
             if odometry:
                 writer.write(odom, ns, serialize(_odometry(types, ros1, t, frame["pose"]),
                                                  "nav_msgs/msg/Odometry"))

@@ -54,6 +54,32 @@ def test_the_cli_reads_a_bag(cpu, synthetic, tmp_path):
                           read_tum(tmp_path / "map_folder" / "trajectory.txt"))
 
 
+def test_a_bag_from_a_depth_camera_alone(cpu, synthetic, tmp_path):
+    sequence = kg.open_sequence(synthetic)
+    bag = tmp_path / "depth_bag"
+    write_bag(sequence, synthetic, bag, ros1=False, colour=False)
+    converted = kg.rosbag.bag_to_folder(bag, tmp_path / "frames")
+    assert converted.topics.color is None and converted.color_frames == 0
+    assert converted.depth_frames == len(sequence)
+    assert not (converted.folder / "rgb").exists() and not (converted.folder / "rgb.txt").exists()
+    from_bag = kg.open_sequence(converted.folder)
+    assert not from_bag.has_color
+    assert np.array_equal(from_bag.frame(3)["depth"], sequence.frame(3)["depth"])
+    run = kg.run_odometry(cpu, from_bag)
+    truth = [sequence.frame(i)["pose"] for i in range(len(sequence))]
+    assert kg.ate(run.poses, truth).rmse_m < 0.05
+    # A colour topic asked for by name must exist.
+    with pytest.raises(kg.Error, match="no topic /camera/color/image_raw"):
+        kg.rosbag.bag_to_folder(bag, tmp_path / "out", color_topic="/camera/color/image_raw")
+    # The CLI maps it (without features, said) as it maps the folder.
+    done = subprocess.run([sys.executable, "-m", "kartograf._cli", "map", str(bag), "--out",
+                           str(tmp_path / "map"), "--backend", "cpu", "--no-progress"],
+                          check=True, capture_output=True, text=True)
+    assert "no colour topic (a depth camera alone)" in done.stderr
+    assert "no local image features" in done.stderr
+    assert (tmp_path / "map" / "mesh.ply").is_file()
+
+
 def test_missing_topics_are_named(tmp_path, synthetic):
 
     sequence = kg.open_sequence(synthetic, frames=2)
