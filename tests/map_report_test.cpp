@@ -202,11 +202,13 @@ Json report_of(bool with_evaluation) {
     "sequence": "/data/a<b>&c", "layout": "synthetic", "backend": "cpu", "device": "cpu", "frames": 20,
     "input": {"camera": {"fx": 535.4, "fy": 539.2, "cx": 320.1, "cy": 247.6, "width": 640,
               "height": 480, "source": "preset", "description": "tum-fr3"},
-              "depth_units_per_metre": 5000, "depth_scale_source": "TUM: 5000 units per metre", "frames_skipped": 2},
+              "depth_units_per_metre": 5000, "depth_scale_source": "TUM: 5000 units per metre", "frames_skipped": 2,
+              "colour": false},
     "timing_s": {"total": 2.0, "stages": [{"stage": "slam", "seconds": 1.5},
                                           {"stage": "rooms", "seconds": 0.5}]},
     "slam": {"loop_candidates": 3, "loop_closures_accepted": 1, "loop_closures_pruned": 0,
-             "pose_graph_converged": true, "map_points": 1000},
+             "pose_graph_converged": true, "map_points": 1000, "degenerate_frames": 7,
+             "degenerate_frames_unmeasured": 4, "fallback_frames": 1},
     "views": {"labelled": 3, "unlabelled": 1, "first_unlabelled_reason": "no floor"},
     "planes": {"count": 3, "by_class": {"floor": 1, "wall": 2}},
     "grid": {"width": 10, "height": 20, "resolution_m": 0.05, "objects": {}},
@@ -268,6 +270,11 @@ TEST(MapReportHtml, SummaryAndMetricsFirstThenPicturesPlotsConfusionAnd3dView) {
   EXPECT_NE(page.at("480 <span class=\"note\">(tum-fr3)</span>"), std::string::npos);
   EXPECT_NE(page.at("5000 depth units per metre (TUM)<"), std::string::npos);
   EXPECT_NE(page.at("2 unreadable frames skipped"), std::string::npos);
+  EXPECT_NE(page.at("none: a depth camera alone"), std::string::npos);
+  // Where the trajectory is the motion model's: degenerate views no image or feature measured.
+  EXPECT_NE(page.at("7 degenerate views <span class=\"note\">(4 with no image or feature"),
+            std::string::npos);
+  EXPECT_NE(page.at(", 1 fallbacks"), std::string::npos);
   EXPECT_NE(page.at("1.23 cm"), std::string::npos);                         // the ATE
   EXPECT_NE(page.at("class=\"value missed\">1.23 cm"), std::string::npos);  // target 1 cm
   EXPECT_NE(page.at("odometry alone: ATE RMSE"), std::string::npos);        // before loop closure

@@ -126,6 +126,37 @@ Json evaluation_json(const pipeline::MapEvaluation& e) {
   return json;
 }
 
+// What the loops and the tracking did, and where the trajectory is the motion model's: degenerate
+// views whose free directions neither the images nor the features measured (a depth camera
+// alone, a plain wall in the dark) and fallbacks.
+Json slam_json(const pipeline::MapPipelineResult& r) {
+  std::size_t accepted = 0, pruned = 0, by_appearance = 0;
+  for (const mapping::LoopClosureRecord& l : r.slam.loop_closures) {
+    accepted += l.closure.report.accepted();
+    pruned += l.pruned;
+    by_appearance += l.closure.report.accepted() && l.closure.candidate.by_appearance;
+  }
+  std::size_t from_features = 0, degenerate = 0, unmeasured = 0, fallbacks = 0;
+  for (const registration::OdometryFrame& f : r.slam.odometry.frames) {
+    from_features += f.from_features;
+    degenerate += f.degenerate;
+    unmeasured += f.degenerate && !f.photometric && !f.scanned && !f.from_features;
+    fallbacks += f.fallback;
+  }
+  return {{"poses_given", r.slam.poses_given},
+          {"loop_candidates", r.slam.loop_candidates},
+          {"appearance_candidates", r.slam.appearance_candidates},
+          {"loop_closures_accepted", accepted},
+          {"loop_closures_by_appearance", by_appearance},
+          {"frames_from_features", from_features},
+          {"degenerate_frames", degenerate},
+          {"degenerate_frames_unmeasured", unmeasured},
+          {"fallback_frames", fallbacks},
+          {"loop_closures_pruned", pruned},
+          {"pose_graph_converged", r.slam.final_graph.converged},
+          {"map_points", r.map.size()}};
+}
+
 Json report_json(const pipeline::MapPipelineResult& r,
                  const std::optional<pipeline::MapEvaluation>& evaluation, const MapRunInfo& info) {
   Json json;
@@ -147,24 +178,7 @@ Json report_json(const pipeline::MapPipelineResult& r,
   json["timing_s"] = {{"total", r.total_seconds()},
                       {"stages", std::move(stages)},
                       {"odometry_ms_per_frame", odometry_ms}};
-  std::size_t accepted = 0, pruned = 0, by_appearance = 0;
-  for (const mapping::LoopClosureRecord& l : r.slam.loop_closures) {
-    accepted += l.closure.report.accepted();
-    pruned += l.pruned;
-    by_appearance += l.closure.report.accepted() && l.closure.candidate.by_appearance;
-  }
-  std::size_t from_features = 0;
-  for (const registration::OdometryFrame& f : r.slam.odometry.frames)
-    from_features += f.from_features;
-  json["slam"] = {{"poses_given", r.slam.poses_given},
-                  {"loop_candidates", r.slam.loop_candidates},
-                  {"appearance_candidates", r.slam.appearance_candidates},
-                  {"loop_closures_accepted", accepted},
-                  {"loop_closures_by_appearance", by_appearance},
-                  {"frames_from_features", from_features},
-                  {"loop_closures_pruned", pruned},
-                  {"pose_graph_converged", r.slam.final_graph.converged},
-                  {"map_points", r.map.size()}};
+  json["slam"] = slam_json(r);
   const pipeline::VolumeStats& v = r.volume;
   json["volume"] = {{"blocks", v.blocks},
                     {"peak_blocks", v.peak_blocks},

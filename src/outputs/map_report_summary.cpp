@@ -87,6 +87,14 @@ void result_facts(std::ostringstream& html, const Json& r) {
            text_of(slam["loop_candidates"]) + " candidates, " +
            text_of(slam["loop_closures_pruned"]) + " pruned; pose graph " +
            (slam["pose_graph_converged"].get<bool>() ? "converged" : "did not converge"));
+  if (slam.contains("degenerate_frames")) {
+    std::string tracking = text_of(slam["degenerate_frames"]) + " degenerate views";
+    if (slam["degenerate_frames_unmeasured"] != 0)
+      tracking += " <span class=\"note\">(" + text_of(slam["degenerate_frames_unmeasured"]) +
+                  " with no image or feature to measure what their geometry leaves free: there "
+                  "the trajectory is the motion model's)</span>";
+    fact(html, "tracking", tracking + ", " + text_of(slam["fallback_frames"]) + " fallbacks");
+  }
 }
 
 std::string headline(const MapReportInput& in) {
