@@ -306,7 +306,36 @@ exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth-alone-sequence ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
 
+# --motion-prior: another sensor's camera poses predict each step (the kitchen's frames 0-29
+# without colour): its ground truth, and a TUM file (the odometry's own trajectory, stamped by
+# frame number as Kartograf stamps layouts without timestamps), each frame predicted by it (in
+# --stats); a file that lacks frames and a missing file are Errors naming it, before any output.
+add_test(NAME Cli.input_motion_prior
+  COMMAND sh -c [=[
+DATA=$2; . "$3"; . "$4"
+rm -rf "$1" && mkdir -p "$1" || exit 1
+kitchen_copy "$1/seq" 0 29
+rm "$1"/seq/frame-*.color.jpg
+"$0" odometry "$1/seq" --out "$1/plain.txt" > "$1/plain.log" 2>&1 || { cat "$1/plain.log"; exit 1; }
+"$0" odometry "$1/seq" --motion-prior groundtruth --out "$1/truth.txt" --stats "$1/truth.json" > "$1/truth.log" 2>&1 || { cat "$1/truth.log"; echo "FAIL: groundtruth prior"; exit 1; }
+grep -q "predicted by the motion prior 29" "$1/truth.log" || { cat "$1/truth.log"; echo "FAIL: frames predicted by the prior not counted"; exit 1; }
+test "$(grep -o '"from_motion_prior": true' "$1/truth.json" | wc -l)" -eq 29 || { echo "FAIL: --stats"; exit 1; }
+"$0" odometry "$1/seq" --motion-prior "$1/plain.txt" --out "$1/file.txt" > "$1/file.log" 2>&1 || { cat "$1/file.log"; echo "FAIL: file prior"; exit 1; }
+grep -q "predicted by the motion prior 29" "$1/file.log" || { cat "$1/file.log"; echo "FAIL: file prior not used"; exit 1; }
+for log in plain truth file; do
+  ate=$(sed -n 's/^  ate_rmse_m \([0-9.]*\).*/\1/p' "$1/$log.log")
+  awk -v a="$ate" 'BEGIN { exit !(a != "" && a < 0.05) }' || { cat "$1/$log.log"; echo "FAIL: $log ATE '$ate'"; exit 1; }
+done
+head -7 "$1/plain.txt" > "$1/short.txt"
+fails_with "$1/err" "--motion-prior: '$1/short.txt' has no pose within 20 ms of frame" -- "$0" odometry "$1/seq" --motion-prior "$1/short.txt" --out "$1/x.txt" || exit 1
+fails_with "$1/err" "none.txt" -- "$0" slam "$1/seq" --motion-prior "$1/none.txt" --out "$1/x" || exit 1
+test ! -e "$1/x" && test ! -e "$1/x.txt" || { echo "FAIL: a refused run left output"; exit 1; }
+exit 0
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-motion-prior ${KARTOGRAF_DATA_DIR}
+  ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
+
 set_tests_properties(Cli.input_colour_and_depth_sizes_and_truncated_images
+  Cli.input_motion_prior
   Cli.input_sequence_from_depth_alone
   Cli.input_planes_from_depth_alone
   Cli.input_missing_frames_bad_poses_and_short_trajectories

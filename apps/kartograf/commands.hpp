@@ -98,6 +98,7 @@ struct SequenceRunOptions {
   }();
   std::string tracking = pipeline::TrackingChoices{}.tracking;
   double model_voxel = pipeline::TrackingChoices{}.model_voxel;
+  std::string motion_prior;  // --motion-prior: another sensor's camera poses (empty: none)
   bool progress = true;
 };
 

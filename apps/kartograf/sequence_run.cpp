@@ -81,6 +81,13 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
       ->delimiter(',')
       ->check(CLI::Range(0.0, 1e6))
       ->capture_default_str();
+  command.add_option(
+      "--motion-prior", o.motion_prior,
+      "Another sensor's camera poses (a TUM trajectory, e.g. a wheeled robot's "
+      "odometry through the camera mount; matched by timestamp within 20 ms; "
+      "'groundtruth': the sequence's own, an ideal one): each step is predicted from "
+      "them instead of the motion model, and views that leave a direction free "
+      "(a plain wall, a corridor) take their motion there");
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
 }
 
@@ -163,6 +170,10 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
   range.units_per_metre = run.opened.sequence->depth_units_per_metre();
   pipeline::check_depth_usable(*run.opened.sequence, range);
   run.source = std::make_unique<pipeline::SequenceFrameSource>(*run.opened.sequence);
+  if (!options.motion_prior.empty()) {
+    run.source->set_motion_prior(known_pose_lookup(
+        "odometry", options.motion_prior, !run.opened.detected.has_timestamps, "--motion-prior"));
+  }
   return run;
 }
 
@@ -288,22 +299,22 @@ std::string measured_poses_line(const eval::MeasuredPoseAte& measured) {
 // timestamp, or by frame number where the layout has no timestamps (as the trajectories Kartograf
 // writes for it are stamped); a frame without one stops the run with an Error naming it.
 mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
-                                           bool by_frame_number) {
+                                           bool by_frame_number, const std::string& option) {
   if (poses.empty()) return {};
+  const std::string named = command + " " + option;
   if (poses == "groundtruth") {
-    return [command](std::size_t i, const registration::RgbdImages& images) {
-      require(images.ground_truth.has_value(), command + " --poses groundtruth: frame " +
-                                                   std::to_string(i) +
+    return [named](std::size_t i, const registration::RgbdImages& images) {
+      require(images.ground_truth.has_value(), named + " groundtruth: frame " + std::to_string(i) +
                                                    " has no ground-truth pose in the sequence");
       return *images.ground_truth;
     };
   }
   auto trajectory = std::make_shared<Trajectory>(io::read_tum_trajectory(poses));
-  require(!trajectory->empty(), command + " --poses: '" + poses + "' holds no pose");
+  require(!trajectory->empty(), named + ": '" + poses + "' holds no pose");
   std::sort(trajectory->begin(), trajectory->end(),
             [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
-  return [command, trajectory, poses, by_frame_number](std::size_t i,
-                                                       const registration::RgbdImages& images) {
+  return [named, trajectory, poses, by_frame_number](std::size_t i,
+                                                     const registration::RgbdImages& images) {
     constexpr double kMaxDifference = 0.02;  // seconds
     const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp;
     const auto after =
@@ -316,9 +327,9 @@ mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std
         best = &*it;
     }
     require(best && std::fabs(best->timestamp - stamp) <= kMaxDifference,
-            command + " --poses: '" + poses + "' has no pose within 20 ms of frame " +
-                std::to_string(i) + " (" + (by_frame_number ? "frame number " : "timestamp ") +
-                std::to_string(stamp) + ")");
+            named + ": '" + poses + "' has no pose within 20 ms of frame " + std::to_string(i) +
+                " (" + (by_frame_number ? "frame number " : "timestamp ") + std::to_string(stamp) +
+                ")");
     return best->pose;
   };
 }

@@ -109,10 +109,12 @@ std::optional<eval::MeasuredPoseAte> ate_at_measured_poses(
 // poses" and a newline.
 std::string measured_poses_line(const eval::MeasuredPoseAte& measured);
 
-// --poses of `map` and `fuse`: each frame's pose from the sequence's ground truth ("groundtruth")
-// or from a TUM file, matched by timestamp, or by frame number where the layout has no
-// timestamps; a frame without one stops the run with an Error naming `command` and the frame.
+// --poses of `map` and `fuse` (and --motion-prior, `option`): each frame's pose from the
+// sequence's ground truth ("groundtruth") or from a TUM file, matched by timestamp, or by frame
+// number where the layout has no timestamps; a frame without one stops the run with an Error
+// naming `command`, `option` and the frame.
 mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
-                                           bool by_frame_number);
+                                           bool by_frame_number,
+                                           const std::string& option = "--poses");
 
 }  // namespace kartograf::cli

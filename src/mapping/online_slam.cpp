@@ -48,7 +48,8 @@ class Tracker {
 
   const registration::OdometryFrame& track(const registration::RgbdImages& images) {
     run_.timestamps.push_back(images.timestamp);
-    const registration::OdometryFrame& frame = odometry_.track(images.depth, color_of(images));
+    const registration::OdometryFrame& frame =
+        odometry_.track(images.depth, color_of(images), images.motion_prior);
     run_.compute_seconds += frame.seconds;
     if (model_) track_model(images);
     const std::size_t n = poses().size() - 1;

@@ -136,11 +136,13 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
     pruned += l.pruned;
     by_appearance += l.closure.report.accepted() && l.closure.candidate.by_appearance;
   }
-  std::size_t from_features = 0, degenerate = 0, unmeasured = 0, fallbacks = 0;
+  std::size_t from_features = 0, from_prior = 0, degenerate = 0, unmeasured = 0, fallbacks = 0;
   for (const registration::OdometryFrame& f : r.slam.odometry.frames) {
     from_features += f.from_features;
+    from_prior += f.from_motion_prior;
     degenerate += f.degenerate;
-    unmeasured += f.degenerate && !f.photometric && !f.scanned && !f.from_features;
+    unmeasured +=
+        f.degenerate && !f.photometric && !f.scanned && !f.from_features && !f.from_motion_prior;
     fallbacks += f.fallback;
   }
   return {{"poses_given", r.slam.poses_given},
@@ -149,6 +151,7 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
           {"loop_closures_accepted", accepted},
           {"loop_closures_by_appearance", by_appearance},
           {"frames_from_features", from_features},
+          {"frames_from_motion_prior", from_prior},
           {"degenerate_frames", degenerate},
           {"degenerate_frames_unmeasured", unmeasured},
           {"fallback_frames", fallbacks},

@@ -53,6 +53,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["fallback"] = frame.fallback;
   json["retried"] = frame.retried;
   json["from_features"] = frame.from_features;
+  json["from_motion_prior"] = frame.from_motion_prior;
   json["degenerate"] = frame.degenerate;
   json["degenerate_overlap"] = frame.degenerate_overlap;
   json["reestimate_degenerate_overlap"] = frame.reestimate_degenerate_overlap;
@@ -80,6 +81,7 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["fallbacks"] = counts.fallbacks;
   json["retried_from_other_starts"] = counts.retried_from_other_starts;
   json["from_features"] = counts.from_features;
+  json["motion_prior_frames"] = counts.motion_prior_frames;
   json["degenerate_frames"] = counts.degenerate_frames;
   json["degenerate_overlap_frames"] = counts.degenerate_overlap_frames;
   json["photometric_frames"] = counts.photometric_frames;
@@ -112,6 +114,7 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.fallbacks += f.fallback;
     counts.retried_from_other_starts += f.retried;
     counts.from_features += f.from_features;
+    counts.motion_prior_frames += f.from_motion_prior;
     counts.keyframes += f.keyframe;
     counts.degenerate_frames += f.degenerate;
     counts.degenerate_overlap_frames += f.degenerate_overlap;
@@ -158,8 +161,9 @@ std::string reestimates_on_overlap_text(const OdometryFrameCounts& c) {
 
 std::string frame_counts_line(const OdometryFrameCounts& c) {
   const auto count = [](std::size_t n) { return std::to_string(n); };
-  const std::string seeded =
-      c.from_features ? ", started from features " + count(c.from_features) : "";
+  std::string seeded = c.from_features ? ", started from features " + count(c.from_features) : "";
+  if (c.motion_prior_frames > 0)
+    seeded += ", predicted by the motion prior " + count(c.motion_prior_frames);
   return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) + seeded +
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
          reestimates_on_overlap_text(c) + "), degenerate frames " + count(c.degenerate_frames) +

@@ -24,7 +24,10 @@ registration::RgbdImages SequenceFrameSource::frame(std::size_t i) const {
   io::RgbdFrame frame = sequence_->frame(i);
   if (ground_truth_.size() <= i) ground_truth_.resize(i + 1);
   ground_truth_[i] = frame.pose;
-  return {std::move(frame.depth), std::move(frame.color), frame.timestamp, frame.pose};
+  registration::RgbdImages images{std::move(frame.depth), std::move(frame.color), frame.timestamp,
+                                  frame.pose};
+  if (prior_of_) images.motion_prior = prior_of_(i, images);
+  return images;
 }
 
 void check_depth_usable(const io::Sequence& sequence, const geometry::DepthRange& range) {

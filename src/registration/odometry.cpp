@@ -10,6 +10,7 @@
 #include <utility>
 
 #include "kartograf/core/memory_budget.hpp"
+#include "kartograf/core/pose.hpp"
 #include "kartograf/geometry/subsample.hpp"
 #include "kartograf/registration/depth_weighted_finder.hpp"
 #include "kartograf/registration/kdtree_correspondences.hpp"
@@ -349,10 +350,17 @@ void RgbdOdometry::hold_across_heading(Attempt& attempt) const {
   attempt.heading_sigma_m = std::sqrt(heading_prior_.across_variance());
 }
 
-const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage* color) {
+const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage* color,
+                                         const std::optional<Eigen::Isometry3d>& motion_prior) {
   const auto start = std::chrono::steady_clock::now();
   OdometryFrame frame;
   frame.index = poses_.size();
+  require(!motion_prior || is_rigid(*motion_prior),
+          "odometry: frame " + std::to_string(frame.index) +
+              ": its motion prior is not a finite rigid motion");
+  prior_before_ = frame.index > 0 ? prior_now_ : std::nullopt;
+  prior_now_ = motion_prior;
+  frame.from_motion_prior = prior_motion().has_value();
   // Colour is read on the depth image's pixel grid (photometric refinement, planes).
   require(color == nullptr || color->empty() ||
               (color->width() == depth.width() && color->height() == depth.height()),
@@ -421,9 +429,18 @@ Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame) const {
   return predict(step_frame, params_.motion_model);
 }
 
+std::optional<Eigen::Isometry3d> RgbdOdometry::prior_motion() const {
+  // Only while the frame that came with prior_now_ is being tracked (afterwards poses_ has it).
+  if (poses_.size() != frames_.size() || !prior_before_ || !prior_now_) return std::nullopt;
+  return orthonormalized(prior_before_->inverse() * *prior_now_);
+}
+
 Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame, MotionModel model) const {
   const std::size_t n = poses_.size();  // the frame to predict
-  if (model == MotionModel::still || n < 2) return Eigen::Isometry3d::Identity();
+  if (model == MotionModel::still) return Eigen::Isometry3d::Identity();
+  // Another sensor's motion wins over every model (they are guesses from the frames before).
+  if (const std::optional<Eigen::Isometry3d> prior = prior_motion()) return *prior;
+  if (n < 2) return Eigen::Isometry3d::Identity();
   // Rotation: the last turn again, in the camera frame. Translation: the camera centre's last
   // step (with `acceleration`, changed as it changed before), in the world or the camera frame.
   const auto step_of = [&](std::size_t to) -> Eigen::Vector3d {

@@ -31,7 +31,7 @@ struct OdometryFrameCounts {
               from_features = 0, degenerate_frames = 0, photometric_frames = 0, reestimates = 0,
               reestimates_rejected = 0, heading_prior_frames = 0, accelerated_frames = 0,
               speed_bounded_frames = 0, scanned_frames = 0, degenerate_overlap_frames = 0,
-              reestimates_on_degenerate_overlap = 0;
+              reestimates_on_degenerate_overlap = 0, motion_prior_frames = 0;
 };
 OdometryFrameCounts count_odometry_frames(const std::vector<registration::OdometryFrame>& frames);
 // Those counts in one line, for the summaries on stdout.

@@ -3,6 +3,7 @@
 // pipeline's FrameSource, and the check before a run that its depth is usable at all.
 #include <cstddef>
 #include <optional>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -10,6 +11,7 @@
 #include "kartograf/formats/sequence.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/mapping/frame_source.hpp"
+#include "kartograf/mapping/slam.hpp"
 
 namespace kartograf::pipeline {
 
@@ -36,9 +38,14 @@ class SequenceFrameSource final : public mapping::FrameSource {
     return ground_truth_;
   }
 
+  // Every frame read from now on carries prior_of's pose as its motion prior
+  // (RgbdImages::motion_prior: another sensor's camera poses); prior_of's Error stops the run.
+  void set_motion_prior(mapping::KnownPoseLookup prior_of) { prior_of_ = std::move(prior_of); }
+
  private:
   const io::Sequence* sequence_;
   std::size_t count_;
+  mapping::KnownPoseLookup prior_of_;
   // Written by frame(), which the pipeline calls from its prefetch thread one call at a time;
   // read after the run.
   mutable std::vector<std::optional<Eigen::Isometry3d>> ground_truth_;

@@ -438,6 +438,8 @@ struct OdometryFrame {
   // The frame the prediction kept the camera centre's step in (OdometryParams::step_frame).
   StepFrame step_frame = StepFrame::world;
   bool keyframe = false;
+  // The prediction was the motion prior's (this frame and the one before had one).
+  bool from_motion_prior = false;
   double seconds = 0;  // processing time of track() (no file I/O)
 };
 
@@ -452,8 +454,13 @@ class RgbdOdometry {
 
   // Registers the next frame (depth in params.depth_range's units; colour on the depth camera's
   // pixel grid, required by OdometryMethod::color and ::planar). Returns its report; poses()
-  // grows by one. Throws Error when the method needs colour and there is none.
-  const OdometryFrame& track(const DepthImage& depth, const RgbImage* color = nullptr);
+  // grows by one. Throws Error when the method needs colour and there is none. motion_prior: the
+  // camera-to-world pose another sensor gives this frame (RgbdImages::motion_prior); where this
+  // frame and the one before both have one, their relative motion is the prediction (the start
+  // of ICP and what a degenerate view's free directions take) instead of the motion model's.
+  // Throws Error on a prior that is not a finite rigid motion.
+  const OdometryFrame& track(const DepthImage& depth, const RgbImage* color = nullptr,
+                             const std::optional<Eigen::Isometry3d>& motion_prior = std::nullopt);
 
   std::size_t frame_count() const { return poses_.size(); }
   // Camera-to-world; frame 0 is the identity. A re-estimate updates the last k poses.
@@ -669,6 +676,11 @@ class RgbdOdometry {
   std::shared_ptr<const FeatureDescription> previous_features_;
   const RgbImage* color_ = nullptr;
   std::vector<Eigen::Isometry3d> poses_;
+  // The motion priors given to track() with the frame being tracked and the one before.
+  std::optional<Eigen::Isometry3d> prior_before_, prior_now_;
+  // The relative motion of the frame to predict from the motion priors, when it and the frame
+  // before have one.
+  std::optional<Eigen::Isometry3d> prior_motion() const;
   std::vector<OdometryFrame> frames_;
   std::vector<RelativePose> constraints_;
   std::vector<std::size_t> keyframes_;

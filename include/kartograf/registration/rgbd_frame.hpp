@@ -23,6 +23,10 @@ struct RgbdImages {
   // The camera-to-world pose the data set gives with the frame (ground truth), if any: never
   // used to estimate, only to run on a known trajectory or to score.
   std::optional<Eigen::Isometry3d> ground_truth = std::nullopt;
+  // The camera-to-world pose another sensor gives (a wheeled robot's odometry through its camera
+  // mount), if any: the odometry predicts the step from it instead of its motion model
+  // (RgbdOdometry::track), so a view that leaves a direction free takes the sensor's motion there.
+  std::optional<Eigen::Isometry3d> motion_prior = std::nullopt;
 };
 
 // The first pyramid level (level l is about width / 2^l wide) at most max_width pixels wide: where
