@@ -39,10 +39,12 @@ class Mapper:
         self._mapper = _kartograf.Mapper(context, camera, depth_units, features, voxel)
 
     def add_frame(self, depth: np.ndarray, color: Optional[np.ndarray] = None,
-                  pose: Optional[np.ndarray] = None) -> dict:
+                  pose: Optional[np.ndarray] = None,
+                  motion_prior: Optional[np.ndarray] = None) -> dict:
         """Tracks the frame (or takes its camera-to-world pose: give one with every frame or
-        with none); returns frame, pose, status, keyframe, poses_moved, evicted, fitness."""
-        return self._mapper.add_frame(depth, color, pose)
+        with none); returns frame, pose, status, keyframe, poses_moved, evicted, fitness.
+        motion_prior: another sensor's camera pose of the frame, which predicts the step."""
+        return self._mapper.add_frame(depth, color, pose, motion_prior)
 
     @property
     def poses(self) -> np.ndarray:

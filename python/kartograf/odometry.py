@@ -30,9 +30,13 @@ class Odometry:
                                              reestimate_every, tuple(anchor_bounds), min_depth,
                                              max_depth)
 
-    def track(self, depth: np.ndarray, color: Optional[np.ndarray] = None) -> FrameReport:
-        """Registers the next frame; its report carries its pose (4 x 4, camera-to-world)."""
-        return FrameReport.from_dict(self._odometry.track(depth, color))
+    def track(self, depth: np.ndarray, color: Optional[np.ndarray] = None,
+              motion_prior: Optional[np.ndarray] = None) -> FrameReport:
+        """Registers the next frame; its report carries its pose (4 x 4, camera-to-world).
+        motion_prior: another sensor's camera-to-world pose of this frame (a wheeled robot's
+        odometry through the camera mount); with the previous frame's it predicts the step, and
+        a view that leaves a direction free takes its motion there."""
+        return FrameReport.from_dict(self._odometry.track(depth, color, motion_prior))
 
     @property
     def poses(self) -> np.ndarray:

@@ -80,16 +80,20 @@ void bind_mapper(nb::module_& m) {
       .def(
           "add_frame",
           [](pipeline::Mapper& mapper, const DepthArray& depth,
-             const std::optional<ColorArray>& color, const std::optional<PoseArray>& pose) {
+             const std::optional<ColorArray>& color, const std::optional<PoseArray>& pose,
+             const std::optional<PoseArray>& motion_prior) {
             registration::RgbdImages frame;
             frame.depth = borrow_depth(depth);
             frame.color = borrow_color(color);
+            if (motion_prior) frame.motion_prior = to_pose(*motion_prior, "Mapper.add_frame");
             const auto given =
                 pose ? std::optional(to_pose(*pose, "Mapper.add_frame")) : std::nullopt;
             return step_dict(mapper.add_frame(frame, given));
           },
           nb::arg("depth"), nb::arg("color") = nb::none(), nb::arg("pose") = nb::none(),
-          "Tracks (or takes the given camera-to-world pose of) the next frame and fuses it")
+          nb::arg("motion_prior") = nb::none(),
+          "Tracks (or takes the given camera-to-world pose of) the next frame and fuses it; "
+          "motion_prior: another sensor's camera pose, which predicts the step")
       .def_prop_ro("poses",
                    [](const pipeline::Mapper& mapper) { return pose_stack(mapper.poses()); })
       .def("__len__", &pipeline::Mapper::frame_count)

@@ -25,12 +25,15 @@ class Odometry {
       : odometry_(context, camera, params(choices, depth_units, min_depth, max_depth)) {}
 
   // The depth array is read in place (no copy when it is C-contiguous uint16).
-  nb::dict track(const DepthArray& depth, const std::optional<ColorArray>& color) {
+  nb::dict track(const DepthArray& depth, const std::optional<ColorArray>& color,
+                 const std::optional<PoseArray>& motion_prior) {
     const DepthImage depth_image = borrow_depth(depth);
     const RgbImage color_image = borrow_color(color);
     last_depth_address_ = reinterpret_cast<std::uintptr_t>(depth_image.data());
+    const auto prior = motion_prior ? std::optional(to_pose(*motion_prior, "Odometry.track"))
+                                    : std::nullopt;
     const registration::OdometryFrame& frame =
-        odometry_.track(depth_image, color ? &color_image : nullptr);
+        odometry_.track(depth_image, color ? &color_image : nullptr, prior);
     nb::dict d = frame_dict(frame);
     d["pose"] = pose_array(odometry_.poses().back());
     return d;
@@ -116,7 +119,9 @@ void bind_odometry(nb::module_& m) {
           nb::arg("min_depth") = geometry::DepthRange{}.min_metres,
           nb::arg("max_depth") = geometry::DepthRange{}.max_metres, nb::keep_alive<1, 2>())
       .def("track", &Odometry::track, nb::arg("depth"), nb::arg("color") = nb::none(),
-           "Registers the next frame; returns its report with its pose (4 x 4)")
+           nb::arg("motion_prior") = nb::none(),
+           "Registers the next frame (motion_prior: another sensor's camera-to-world pose, which "
+           "predicts the step with the previous frame's); returns its report with its pose")
       .def_prop_ro("poses", &Odometry::poses, nb::rv_policy::move)
       .def("__len__", &Odometry::size)
       .def_prop_ro("last_depth_address", &Odometry::last_depth_address,

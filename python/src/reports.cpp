@@ -32,6 +32,7 @@ nb::dict frame_dict(const registration::OdometryFrame& frame) {
       frame.reestimate ? nb::object(registration_dict(*frame.reestimate)) : nb::none();
   d["retried"] = frame.retried;
   d["from_features"] = frame.from_features;
+  d["from_motion_prior"] = frame.from_motion_prior;
   d["fallback"] = frame.fallback;
   d["degenerate"] = frame.degenerate;
   d["degenerate_overlap"] = frame.degenerate_overlap;

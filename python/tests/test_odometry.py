@@ -45,6 +45,22 @@ def test_frame_by_frame_equals_the_sequence_run(cpu, synthetic):
     assert ate.rmse_m < 0.05, ate
 
 
+def test_a_motion_prior_predicts_each_step(cpu, synthetic):
+    """Another sensor's poses (here the sequence's own, an ideal wheel odometry, moved 1 m away:
+    only their relative motion counts) predict every step after the first; a pose that is no
+    rigid motion is an Error."""
+    sequence = kg.open_sequence(synthetic)
+    odometry = kg.Odometry(cpu, sequence.camera, sequence.depth_units_per_metre)
+    offset = np.eye(4)
+    offset[:3, 3] = (1.0, 0.0, 0.0)
+    reports = [odometry.track(f["depth"], None, offset @ f["pose"]) for f in frames_of(sequence)]
+    assert [r.extra["from_motion_prior"] for r in reports] == [False] + [True] * 29
+    truth = [f["pose"] for f in frames_of(sequence)]
+    assert kg.ate(odometry.poses, truth).rmse_m < 0.05
+    with pytest.raises(kg.Error, match="Odometry.track"):
+        odometry.track(sequence.frame(0)["depth"], None, np.zeros((4, 4)))
+
+
 def test_worst_steps_are_the_largest_and_agree_with_the_ate(cpu, synthetic):
     run = kg.run_odometry(cpu, kg.open_sequence(synthetic))
     worst = run.worst_steps(count=5)
