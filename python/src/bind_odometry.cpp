@@ -30,8 +30,8 @@ class Odometry {
     const DepthImage depth_image = borrow_depth(depth);
     const RgbImage color_image = borrow_color(color);
     last_depth_address_ = reinterpret_cast<std::uintptr_t>(depth_image.data());
-    const auto prior = motion_prior ? std::optional(to_pose(*motion_prior, "Odometry.track"))
-                                    : std::nullopt;
+    const auto prior =
+        motion_prior ? std::optional(to_pose(*motion_prior, "Odometry.track")) : std::nullopt;
     const registration::OdometryFrame& frame =
         odometry_.track(depth_image, color ? &color_image : nullptr, prior);
     nb::dict d = frame_dict(frame);
