@@ -274,8 +274,7 @@ add_test(NAME Cli.input_sequence_from_depth_alone
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
 rm -rf "$1" && mkdir -p "$1" || exit 1
-kitchen_copy "$1/seq" 0 29
-rm "$1"/seq/frame-*.color.jpg
+kitchen_depth_alone "$1/seq" 0 29
 "$0" odometry "$1/seq" --out "$1/odometry.txt" > "$1/odometry.log" 2> "$1/odometry.err" || { cat "$1/odometry.err"; echo "FAIL: odometry on depth alone"; exit 1; }
 grep -q "has no colour images: depth alone" "$1/odometry.err" || { cat "$1/odometry.err"; echo "FAIL: depth alone not said"; exit 1; }
 ate=$(sed -n 's/^  ate_rmse_m \([0-9.]*\).*/\1/p' "$1/odometry.log")
@@ -314,8 +313,7 @@ add_test(NAME Cli.input_motion_prior
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
 rm -rf "$1" && mkdir -p "$1" || exit 1
-kitchen_copy "$1/seq" 0 29
-rm "$1"/seq/frame-*.color.jpg
+kitchen_depth_alone "$1/seq" 0 29
 "$0" odometry "$1/seq" --out "$1/plain.txt" > "$1/plain.log" 2>&1 || { cat "$1/plain.log"; exit 1; }
 "$0" odometry "$1/seq" --motion-prior groundtruth --out "$1/truth.txt" --stats "$1/truth.json" > "$1/truth.log" 2>&1 || { cat "$1/truth.log"; echo "FAIL: groundtruth prior"; exit 1; }
 grep -q "predicted by the motion prior 29" "$1/truth.log" || { cat "$1/truth.log"; echo "FAIL: frames predicted by the prior not counted"; exit 1; }

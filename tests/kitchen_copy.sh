@@ -10,3 +10,10 @@ kitchen_copy() {
     done
   done
 }
+
+# kitchen_depth_alone DIR FIRST LAST: the same frames without their colour images (a depth camera
+# alone).
+kitchen_depth_alone() {
+  kitchen_copy "$1" "$2" "$3"
+  rm "$1"/frame-*.color.jpg || exit 1
+}
