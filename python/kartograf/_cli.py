@@ -1,8 +1,10 @@
 """The `kartograf` command the package installs: the C++ CLI carried inside the package. A ROS
 bag given where a command takes a sequence folder is converted first (kartograf.rosbag), with
 --color-topic, --depth-topic and --camera-info-topic to choose the topics, and --bag-poses (with
---odometry-topic or --tf-world) to take the camera's poses from the bag's odometry or /tf;
-`kartograf batch` maps many sequences on Ray (kartograf.batch)."""
+--odometry-topic or --tf-world) to take the camera's poses from the bag's odometry or /tf, or
+--bag-prior to take them as the odometry's motion prior (`--motion-prior`: each step predicted
+from them, the depth still registered); `kartograf batch` maps many sequences on Ray
+(kartograf.batch)."""
 
 import os
 import sys
@@ -13,8 +15,10 @@ SEQUENCE_COMMANDS = {"odometry", "slam", "map", "fuse", "planes"}
 TOPIC_OPTIONS = {"--color-topic": "color_topic", "--depth-topic": "depth_topic",
                  "--camera-info-topic": "camera_info_topic", "--odometry-topic": "odometry_topic",
                  "--tf-world": "tf_world"}
-# Use the bag's odometry or /tf as the camera's poses: `--poses` of the converted prior.
+# Use the bag's odometry or /tf as the camera's poses: `--poses` of the converted prior; or as
+# the odometry's motion prior: `--motion-prior` of it.
 POSES_FLAG = "--bag-poses"
+PRIOR_FLAG = "--bag-prior"
 
 
 def _take_topic_options(args):
@@ -22,8 +26,11 @@ def _take_topic_options(args):
     rest, topics, i = [], {}, 0
     while i < len(args):
         name, _, value = args[i].partition("=")
-        if name == POSES_FLAG:
+        if name in (POSES_FLAG, PRIOR_FLAG):
+            if topics.get("pose_prior"):
+                sys.exit(f"kartograf: give {POSES_FLAG} or {PRIOR_FLAG}, not both")
             topics["pose_prior"] = True
+            topics["_prior_option"] = "--poses" if name == POSES_FLAG else "--motion-prior"
         elif name in TOPIC_OPTIONS:
             if not value:
                 i += 1
@@ -42,6 +49,7 @@ def _convert_bags(args, scratch):
     from . import rosbag
 
     args, topics = _take_topic_options(args)
+    prior_option = topics.pop("_prior_option", "--poses")
     for i, arg in enumerate(args[1:], start=1):
         if not arg.startswith("-") and not args[i - 1].startswith("--") and rosbag.is_bag(arg):
             converted = rosbag.bag_to_folder(arg, Path(scratch) / "frames", **topics)
@@ -49,7 +57,7 @@ def _convert_bags(args, scratch):
                       if converted.topics.color else "no colour topic (a depth camera alone)")
             print(f"bag: {arg}: {converted.depth_frames} depth images from "
                   f"{converted.topics.depth}; {colour}", file=sys.stderr)
-            poses = ["--poses", str(converted.prior)] if converted.prior else []
+            poses = [prior_option, str(converted.prior)] if converted.prior else []
             return [*args[:i], str(converted.folder), *args[i + 1:], *poses]
     return args
 

@@ -108,6 +108,15 @@ def test_the_bags_odometry_and_tf_give_the_cameras_poses(cpu, synthetic, tmp_pat
                     *common], check=True, capture_output=True)
     assert np.allclose(read_tum(tmp_path / "a" / "trajectory.txt"),
                        read_tum(tmp_path / "b" / "trajectory.txt"), atol=1e-5)
+    # --bag-prior: the same poses as the odometry's motion prior (every step after the first).
+    done = subprocess.run([sys.executable, "-m", "kartograf._cli", "odometry",
+                           str(tmp_path / "ros2_odom"), "--bag-prior", "--out",
+                           str(tmp_path / "prior.txt"), *common], check=True, capture_output=True,
+                          text=True)
+    assert f"predicted by the motion prior {len(sequence) - 1}" in done.stdout
+    both = subprocess.run([*run, str(tmp_path / "ros2_odom"), "--bag-poses", "--bag-prior",
+                           "--out", str(tmp_path / "c"), *common], capture_output=True, text=True)
+    assert both.returncode != 0 and "not both" in both.stderr
 
 
 def test_tf_alone_gives_the_cameras_poses_between_its_samples(cpu, synthetic, tmp_path):
