@@ -123,8 +123,8 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   const OpenedRun run = open_run(o.run, err);
   // A depth camera alone: the features (ORB) have no image to work on; the views' planes and
   // labels come from the depth (docs/user-guide.md, "A depth camera alone").
-  const bool features = !o.no_features && o.poses.empty() && run.opened.has_color;
-  if (!o.no_features && o.poses.empty() && !run.opened.has_color)
+  const bool wants_features = !o.no_features && o.poses.empty();
+  if (wants_features && !run.opened.has_color)
     err << "map: no colour images: no local image features (as --no-features)\n";
   const compute::Context context = make_run_context(o.run);
   pipeline::MapperParams params;
@@ -133,7 +133,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   stages.slam.model = model_tracking_params(o.run);
   stages.label_step = o.label_step;
   stages.max_views = o.max_views;
-  stages.features = features;
+  stages.features = wants_features && run.opened.has_color;
   stages.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps);
   stages.label_width = o.label_width;
   stages.grid.resolution = o.resolution;
