@@ -52,12 +52,6 @@ geometry::SegmentMoments block_moments(const float* sums, std::uint32_t count,
   return m;
 }
 
-void add_moments(geometry::SegmentMoments& into, const geometry::SegmentMoments& m) {
-  into.count += m.count;
-  into.sum += m.sum;
-  into.sum_outer += m.sum_outer;
-}
-
 // The colour image as the kernel reads it: bytes on the CPU (the image itself), 32-bit words on
 // a device (a copy padded to whole words).
 void colours_to_backend(const compute::Context& context, const RgbImage& rgb,
@@ -95,7 +89,7 @@ void cells_from_blocks(const compute::HostView<float>& sums,
             const std::uint32_t inside = n[KG_CELL_BLOCK_INSIDE_JUMPS];
             cells.block_continuous[k] = 2 * inside <= static_cast<std::uint32_t>(half);
             cell_jumps += inside + n[KG_CELL_BLOCK_EDGE_JUMPS];
-            add_moments(cells.moments[c], cells.block_moments[k]);
+            cells.moments[c] += cells.block_moments[k];
           }
           cells.continuous[c] = 2 * cell_jumps <= static_cast<std::uint32_t>(cells.cell_size);
         }

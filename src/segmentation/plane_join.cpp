@@ -308,7 +308,7 @@ double PlaneJoiner::cost_before_see_through(std::uint32_t p, std::uint32_t q, Re
   if (!pair_within(p, q, adjacent_pair)) return kNoJoin;
   if (!adjacent_pair && !each_near_other_plane(p, q)) return kNoJoin;
   geometry::SegmentMoments both = merged_.moments[p];
-  add_moments(both, merged_.moments[q]);
+  both += merged_.moments[q];
   joint = fit_plane(both, origin_, params_.fit);
   // Two parallel pieces with a step between them fit a plane tilted to both: the joint plane
   // itself must keep within the angle of each.
@@ -396,7 +396,7 @@ void PlaneJoiner::update_row(std::uint32_t p) {
 
 // q joins p: moments, colour, fit and pixel sums.
 void PlaneJoiner::absorb(std::uint32_t p, std::uint32_t q) {
-  add_moments(merged_.moments[p], merged_.moments[q]);
+  merged_.moments[p] += merged_.moments[q];
   merged_.moments[q] = {};
   if (!merged_.colour_sums.empty()) merged_.colour_sums[p] += merged_.colour_sums[q];
   merged_.planes[p] = fit_plane(merged_.moments[p], origin_, params_.fit);

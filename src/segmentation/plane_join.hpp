@@ -16,13 +16,6 @@ inline double allowance(const PlaneMergeParams& params, const Eigen::Vector3d& a
   return distance_allowance(params, at, plane.normal);
 }
 
-// Moments are additive: those of the union of two pieces.
-inline void add_moments(geometry::SegmentMoments& into, const geometry::SegmentMoments& m) {
-  into.count += m.count;
-  into.sum += m.sum;
-  into.sum_outer += m.sum_outer;
-}
-
 // Second pass: joins adjacent merged planes, lowest cost first (cost: RMS of the joint fit over the
 // allowance at its depth; joins only below 1 and within the angle), then drops the absorbed planes
 // and renumbers the rest in order. From `inputs`: `points` (may be null) enables the see-through

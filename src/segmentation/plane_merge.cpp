@@ -12,7 +12,6 @@ namespace kartograf::segmentation {
 
 namespace {
 
-using detail::add_moments;
 using detail::allowance;
 using geometry::kNoLabel;
 
@@ -178,7 +177,7 @@ void PlaneGrower::grow_from(std::uint32_t seed) {
     if (result_.segment_plane[s] != kNoLabel || segments_[s].count == 0) continue;
     if (!may_join(s, plane)) continue;
     result_.segment_plane[s] = plane_index;
-    add_moments(merged, segments_[s]);
+    merged += segments_[s];
     // Re-fit as the plane grows by a quarter: deterministic, and few eigen solves.
     if (merged.count * 4 >= fitted_count * 5) {
       const SegmentPlane refit = fit_plane(merged, origin_, params_.fit);

@@ -37,6 +37,14 @@ struct SegmentMoments {
   Eigen::Matrix3d sum_outer = Eigen::Matrix3d::Zero();  // sum (p - origin)(p - origin)^T
 };
 
+// The moments of two disjoint point sets together (both about the same origin).
+inline SegmentMoments& operator+=(SegmentMoments& into, const SegmentMoments& m) {
+  into.count += m.count;
+  into.sum += m.sum;
+  into.sum_outer += m.sum_outer;
+  return into;
+}
+
 struct SegmentMomentSet {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();
   std::vector<SegmentMoments> segments;  // indexed by label
