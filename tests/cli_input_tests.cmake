@@ -308,7 +308,8 @@ exit 0
 # --motion-prior: another sensor's camera poses predict each step (the kitchen's frames 0-29
 # without colour): its ground truth, and a TUM file (the odometry's own trajectory, stamped by
 # frame number as Kartograf stamps layouts without timestamps), each frame predicted by it (in
-# --stats); a file that lacks frames and a missing file are Errors naming it, before any output.
+# --stats); a file that lacks frames and a missing file are Errors naming it, before any output;
+# on a timestamped layout a prior sampled slower than the frames is interpolated between its poses.
 add_test(NAME Cli.input_motion_prior
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
@@ -328,6 +329,15 @@ head -7 "$1/plain.txt" > "$1/short.txt"
 fails_with "$1/err" "--motion-prior: '$1/short.txt' has no pose within 20 ms of frame" -- "$0" odometry "$1/seq" --motion-prior "$1/short.txt" --out "$1/x.txt" || exit 1
 fails_with "$1/err" "none.txt" -- "$0" slam "$1/seq" --motion-prior "$1/none.txt" --out "$1/x" || exit 1
 test ! -e "$1/x" && test ! -e "$1/x.txt" || { echo "FAIL: a refused run left output"; exit 1; }
+# A timestamped layout (30 Hz) and a prior at 10 Hz: interpolated at the frames between its poses;
+# a gap over 0.5 s (frames 1-12 between poses 0.9 s apart) is an Error naming the frame.
+"$0" synth --out "$1/syn" --frames 13 --width 320 --height 240 --trajectory handheld > /dev/null 2>&1 || { echo "FAIL: synth"; exit 1; }
+grep -v '^#' "$1/syn/groundtruth.txt" | awk 'NR % 3 == 1' > "$1/ten_hz.txt"
+test "$(wc -l < "$1/ten_hz.txt")" -eq 5 || { echo "FAIL: the 10 Hz prior"; exit 1; }
+"$0" odometry "$1/syn" --motion-prior "$1/ten_hz.txt" --out "$1/syn.txt" > "$1/syn.log" 2>&1 || { cat "$1/syn.log"; echo "FAIL: 10 Hz prior"; exit 1; }
+grep -q "predicted by the motion prior 12" "$1/syn.log" || { cat "$1/syn.log"; echo "FAIL: 10 Hz prior not used at every frame"; exit 1; }
+grep -v '^#' "$1/syn/groundtruth.txt" | awk 'NR == 1 { print } NR == 13 { $1 = "0.9"; print }' > "$1/gap.txt"
+fails_with "$1/err" "no pose within 20 ms of frame 1 (timestamp 0.033333), nor two at most 0.5 s apart around it" -- "$0" odometry "$1/syn" --motion-prior "$1/gap.txt" --out "$1/x.txt" || exit 1
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-motion-prior ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})

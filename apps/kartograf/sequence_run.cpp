@@ -12,6 +12,7 @@
 
 #include "backend_option.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/core/trajectory.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/pipeline/tracking_choices.hpp"
@@ -295,9 +296,10 @@ std::string measured_poses_line(const eval::MeasuredPoseAte& measured) {
   return line;
 }
 
-// --poses: each frame's pose from the sequence's ground truth or from a TUM file, matched by
-// timestamp, or by frame number where the layout has no timestamps (as the trajectories Kartograf
-// writes for it are stamped); a frame without one stops the run with an Error naming it.
+// --poses: each frame's pose from the sequence's ground truth or from a TUM file at the frame's
+// timestamp (interpolated between the file's poses: pose_at), or at its frame number where the
+// layout has no timestamps (as the trajectories Kartograf writes for it are stamped); a frame
+// without one stops the run with an Error naming it.
 mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
                                            bool by_frame_number, const std::string& option) {
   if (poses.empty()) return {};
@@ -315,22 +317,13 @@ mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std
             [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
   return [named, trajectory, poses, by_frame_number](std::size_t i,
                                                      const registration::RgbdImages& images) {
-    constexpr double kMaxDifference = 0.02;  // seconds
     const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp;
-    const auto after =
-        std::lower_bound(trajectory->begin(), trajectory->end(), stamp,
-                         [](const StampedPose& p, double t) { return p.timestamp < t; });
-    const StampedPose* best = nullptr;
-    for (auto it : {after, after == trajectory->begin() ? after : std::prev(after)}) {
-      if (it == trajectory->end()) continue;
-      if (!best || std::fabs(it->timestamp - stamp) < std::fabs(best->timestamp - stamp))
-        best = &*it;
-    }
-    require(best && std::fabs(best->timestamp - stamp) <= kMaxDifference,
+    const std::optional<Eigen::Isometry3d> pose = pose_at(*trajectory, stamp);
+    require(pose.has_value(),
             named + ": '" + poses + "' has no pose within 20 ms of frame " + std::to_string(i) +
                 " (" + (by_frame_number ? "frame number " : "timestamp ") + std::to_string(stamp) +
-                ")");
-    return best->pose;
+                "), nor two at most 0.5 s apart around it");
+    return *pose;
   };
 }
 

@@ -1,5 +1,7 @@
 #pragma once
-// Camera trajectories: timestamped rigid poses (camera-to-world).
+// Camera trajectories: timestamped rigid poses (camera-to-world), and the pose at a time between
+// two of them.
+#include <optional>
 #include <vector>
 
 #include <Eigen/Geometry>
@@ -12,5 +14,19 @@ struct StampedPose {
 };
 
 using Trajectory = std::vector<StampedPose>;
+
+// How far a time may be from a trajectory's poses for pose_at to answer.
+struct PoseAtTolerance {
+  double max_gap = 0.5;  // seconds between the two poses an answer interpolates between
+  // Seconds to the nearest pose, where no two close enough lie on both sides.
+  double max_offset = 0.02;
+};
+
+// The pose at time `t` from a trajectory sorted by time: between two poses at most `max_gap` apart,
+// interpolated (translation linearly, rotation along the shorter arc), as a sensor sampled at
+// another rate than the camera needs; else the nearest pose within `max_offset` (a time just
+// outside the trajectory's ends); else none.
+std::optional<Eigen::Isometry3d> pose_at(const Trajectory& by_time, double t,
+                                         const PoseAtTolerance& tolerance = {});
 
 }  // namespace kartograf
