@@ -372,8 +372,8 @@ TEST(SemanticGridFreeSpace, ATableSeenOnlyByItsLegsIsFurniture) {
   EXPECT_EQ(class_at(grid, 3.0, 2.3), C::furniture);
   EXPECT_EQ(class_at(grid, 2.5, 1.3), C::floor);  // 0.25 m beside it
   EXPECT_EQ(class_at(grid, 1.4, 2.0), C::floor);
-  EXPECT_EQ(grid.tables_on_legs, 1);
-  EXPECT_EQ(grid.fill_cells_trimmed_at_tables, 0);  // no fill joined to it
+  EXPECT_EQ(grid.inferred.tables_on_legs, 1);
+  EXPECT_EQ(grid.inferred.fill_cells_trimmed_at_tables, 0);  // no fill joined to it
 }
 
 // The same four posts with no top: the rays crossed the floor between them at the posts' height
@@ -385,7 +385,7 @@ TEST(SemanticGridFreeSpace, FourPostsWithNoTopLeaveTheFloorBetweenThemFree) {
   const SemanticGrid grid = build_semantic_grid(v.points, v.labels, params, {}, v.ids, v.origins);
   EXPECT_EQ(class_at(grid, 2.5, 2.0), C::floor);
   EXPECT_EQ(class_at(grid, 2.5, 1.7), C::floor);
-  EXPECT_EQ(grid.tables_on_legs, 0);
+  EXPECT_EQ(grid.inferred.tables_on_legs, 0);
 }
 
 // Points as three views pooled them, view after view, without the views' origins: dense for
@@ -460,7 +460,7 @@ TEST(SemanticGridFreeSpace, ALonePostInsideOneCellStaysAnObstacle) {
   EXPECT_EQ(grid.weight(grid.cell_of({1.525, 1.525}).x(), grid.cell_of({1.525, 1.525}).y()), 0.0f);
   EXPECT_EQ(class_at(grid, 2.025, 1.025), C::floor);
   EXPECT_EQ(class_at(grid, 1.575, 1.525), C::floor);  // beside the post
-  EXPECT_EQ(grid.lone_posts_kept, 1);
+  EXPECT_EQ(grid.inferred.lone_posts_kept, 1);
 }
 
 // Two views 4.4 m from the room's east wall (x = 5) read it 8 cm short, as a depth step does: a

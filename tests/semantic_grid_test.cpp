@@ -229,8 +229,8 @@ TEST(SemanticGrid, AnOpenDoorLeafBesideTheJambIsNoFaceOfTheWall) {
   const double kFace0 = 3.012, kFace1 = kFace0 + 0.0995;
   const LabelledPoints s = doorway_scene(kFace1 - kFace0, {.open_leaf = true});
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
-  ASSERT_TRUE(grid.wall_thickness.has_value());
-  EXPECT_NEAR(*grid.wall_thickness, 0.1, 1e-9);
+  ASSERT_TRUE(grid.inferred.wall_thickness.has_value());
+  EXPECT_NEAR(*grid.inferred.wall_thickness, 0.1, 1e-9);
   ASSERT_EQ(doorways(grid).size(), 1u);
   int in_the_wall = 0, in_the_room = 0;
   for (int row = 0; row < grid.height(); ++row) {
@@ -354,7 +354,7 @@ void expect_cabinet_found(const LabelledPoints& s, std::optional<Eigen::Vector2d
   }
   EXPECT_EQ(at(grid, 0.5, 3.02), C::wall);
   EXPECT_EQ(at(grid, 1.5, 3.02), C::wall);
-  EXPECT_EQ(grid.furniture_fronts, 1);
+  EXPECT_EQ(grid.inferred.furniture_fronts, 1);
   SemanticGridParams off;
   off.furniture_max_depth = 0;
   EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 1.5, 2.57), C::wall);
@@ -381,12 +381,12 @@ TEST(SemanticGrid, TheUnseenPocketBehindAFurnitureFaceIsFurniture) {
   for (const double y : {2.65, 2.8, 2.95})
     EXPECT_EQ(class_at(grid, 1.5, y), std::pair(C::furniture, false)) << "behind it, y " << y;
   EXPECT_EQ(class_at(grid, 1.5, 3.02).first, C::wall);
-  EXPECT_EQ(grid.furniture_pockets, 1);
+  EXPECT_EQ(grid.inferred.furniture_pockets, 1);
   SemanticGridParams off;
   off.furniture_max_depth = 0;
   const SemanticGrid without = build_semantic_grid(s.points, s.labels, off);
   EXPECT_EQ(class_at(without, 1.5, 2.8), std::pair(C::unknown, true));
-  EXPECT_EQ(without.furniture_pockets, 0);
+  EXPECT_EQ(without.inferred.furniture_pockets, 0);
 }
 
 // A cabinet 0.45 m in front of the wall between two rooms hides that wall's near face: the first
@@ -408,7 +408,7 @@ TEST(SemanticGrid, NoPocketReachesAcrossAWallToItsFarFace) {
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   for (const double y : {1.6, 1.8, 2.06})
     EXPECT_NE(class_at(grid, 1.5, y).first, C::furniture) << "y " << y;
-  EXPECT_EQ(grid.furniture_pockets, 0);
+  EXPECT_EQ(grid.inferred.furniture_pockets, 0);
 }
 
 // A wall 0.2 m thick seen from both rooms: its inside, which no view sees, is wall; two walls
@@ -458,8 +458,8 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
   EXPECT_EQ(at(grid, 2.0, 4.012 + 0.12), std::pair(C::wall, false));
   EXPECT_EQ(at(grid, 2.0, 4.012 + 0.23), std::pair(C::unknown, true));  // beyond 0.2 m
-  ASSERT_TRUE(grid.wall_thickness.has_value());
-  EXPECT_NEAR(*grid.wall_thickness, 0.2, 0.051);
+  ASSERT_TRUE(grid.inferred.wall_thickness.has_value());
+  EXPECT_NEAR(*grid.inferred.wall_thickness, 0.2, 0.051);
   SemanticGridParams off;
   off.back_one_sided_walls = false;
   EXPECT_EQ(at(build_semantic_grid(s.points, s.labels, off), 2.0, 4.012 + 0.12),
@@ -471,7 +471,7 @@ TEST(SemanticGrid, AWallSeenFromOneSideIsAsThickAsOneSeenFromBoth) {
   }
   const SemanticGrid alone = build_semantic_grid(one_room.points, one_room.labels);
   EXPECT_EQ(at(alone, 2.0, 4.012 + 0.12), std::pair(C::unknown, true));
-  EXPECT_FALSE(alone.wall_thickness.has_value());
+  EXPECT_FALSE(alone.inferred.wall_thickness.has_value());
 }
 
 // Points the views took for an object inside the wall between the rooms (across its inside) and
@@ -486,7 +486,7 @@ TEST(SemanticGrid, FurnitureSpecksInsideAWallAreWall) {
   EXPECT_EQ(class_at(grid, 1.112, 2.062), std::pair(C::wall, false));
   EXPECT_EQ(class_at(grid, 1.5, 4.062), std::pair(C::wall, false));
   EXPECT_EQ(class_at(grid, 1.5, 4.012 + 0.12), std::pair(C::wall, false));
-  EXPECT_GE(grid.wall_specks, 2);
+  EXPECT_GE(grid.inferred.wall_specks, 2);
   // Where floor was seen beside them, such points are furniture against the wall.
   LabelledPoints against = two_rooms_with_a_wall_between();
   against.box_face({1.012, 3.912, 0.02}, {2.012, 3.912, 0.9}, C::furniture);
@@ -561,7 +561,7 @@ TEST(SemanticGrid, FurnitureInTheLineOfAWallHiddenBehindItIsWall) {
     EXPECT_EQ(class_at(grid, x, 4.012 + 0.12), std::pair(C::wall, false)) << "x " << x;
     EXPECT_EQ(class_at(grid, x, 3.952).first, C::furniture) << "x " << x;
   }
-  EXPECT_GE(grid.furniture_in_wall_lines, 15);
+  EXPECT_GE(grid.inferred.furniture_in_wall_lines, 15);
 }
 
 // The same, with a few floor points seen in the wall's back 0.25 m west of the cabinet (noise
@@ -601,7 +601,7 @@ TEST(SemanticGrid, ARoomsCornerHiddenBehindACabinetIsWall) {
   EXPECT_EQ(class_at(grid, 3.8, 4.012 + 0.02), std::pair(C::wall, false));  // the north wall
   EXPECT_EQ(class_at(grid, 4.012 + 0.02, 3.8), std::pair(C::wall, false));  // the east wall
   EXPECT_EQ(class_at(grid, 4.012 + 0.02, 4.012 + 0.02), std::pair(C::wall, false));
-  EXPECT_GT(grid.wall_corners_behind_furniture, 0);
+  EXPECT_GT(grid.inferred.wall_corners_behind_furniture, 0);
 }
 
 // The north room's outer north wall seen only at its ends (x < 1 m and x > 3 m): the views never
@@ -633,12 +633,12 @@ TEST(SemanticGrid, AWallLineRunsOnAcrossWhatNoViewSaw) {
   }
   EXPECT_EQ(class_at(grid, 2.0, 3.8), std::pair(C::unknown, true));           // in front: unseen
   EXPECT_EQ(class_at(grid, 2.0, 4.012 + 0.23), std::pair(C::unknown, true));  // beyond its back
-  EXPECT_GE(grid.wall_cells_across_unseen, 2 * 38);
+  EXPECT_GE(grid.inferred.wall_cells_across_unseen, 2 * 38);
   SemanticGridParams off;
   off.max_unseen_wall_gap = 0;
   const SemanticGrid without = build_semantic_grid(s.points, s.labels, off);
   EXPECT_EQ(class_at(without, 2.0, 4.012 + 0.02), std::pair(C::unknown, true));
-  EXPECT_EQ(without.wall_cells_across_unseen, 0);
+  EXPECT_EQ(without.inferred.wall_cells_across_unseen, 0);
   SemanticGridParams short_gap;
   short_gap.max_unseen_wall_gap = 1.5;  // less than the 2 m unseen
   EXPECT_EQ(class_at(build_semantic_grid(s.points, s.labels, short_gap), 2.0, 4.012 + 0.02),
@@ -706,7 +706,7 @@ TEST(SemanticGrid, APocketDeeperThanTheWallsInsidesIsACabinets) {
   EXPECT_EQ(class_at(grid, 1.5, 3.62).first, C::furniture);  // the front
   EXPECT_EQ(class_at(grid, 2.0, 2.04).first, C::wall);       // the inside of the wall between
   EXPECT_EQ(class_at(grid, 0.5, 4.02).first, C::wall);
-  EXPECT_EQ(grid.furniture_fronts, 1);
+  EXPECT_EQ(grid.inferred.furniture_fronts, 1);
 }
 
 // A wall between two rooms, its line broken by 0.6 m that no view saw (nor the floor beside it): a
@@ -728,7 +728,7 @@ TEST(SemanticGrid, AGapInAWallsLineIsNoCabinetsPocket) {
   for (const double y : {0.5, 1.0, 1.9, 3.0, 5.0})
     EXPECT_EQ(class_at(grid, 2.037, y).first, C::wall) << "the wall at y " << y;
   EXPECT_NE(class_at(grid, 2.037, 2.3).first, C::furniture);  // the gap
-  EXPECT_EQ(grid.furniture_fronts, 0);
+  EXPECT_EQ(grid.inferred.furniture_fronts, 0);
 }
 
 // Walls 0.15 m thick, and a cabinet 0.4 m in front of the wall between two rooms, near the east
@@ -754,10 +754,10 @@ TEST(SemanticGrid, AFrontsPocketStopsAtTheInsideOfAWallSeenFromBeyond) {
     EXPECT_EQ(class_at(grid, x, 1.8).first, C::furniture) << "the pocket at x " << x;
     EXPECT_EQ(class_at(grid, x, 2.04), std::pair(C::wall, false)) << "the wall's inside at x " << x;
   }
-  EXPECT_EQ(grid.furniture_fronts, 1);
+  EXPECT_EQ(grid.inferred.furniture_fronts, 1);
   // Two rows along most of the cabinet's 20 cells: near the east wall the far face's line runs on
   // for less than 0.4 m.
-  EXPECT_GE(grid.wall_insides_behind_fronts, 2 * 15);
+  EXPECT_GE(grid.inferred.wall_insides_behind_fronts, 2 * 15);
 }
 
 // A cabinet 1 m wide and 0.6 m deep against the outer north wall, taller than the views look over:
@@ -800,7 +800,7 @@ TEST(SemanticGrid, ACabinetStandsAgainstTheWallLineSeenBeyondItsEnds) {
     EXPECT_EQ(class_at(grid, x, 4.02), std::pair(C::wall, false)) << "the wall at x " << x;
   }
   EXPECT_EQ(class_at(grid, 0.5, 3.7).first, C::floor);
-  EXPECT_GE(grid.furniture_fronts, 1);
+  EXPECT_GE(grid.inferred.furniture_fronts, 1);
 
   for (const auto variant : {BehindTheFront::kNoLine, BehindTheFront::kLongerWall}) {
     const LabelledPoints other = front_before_a_hidden_wall(variant);
@@ -808,7 +808,7 @@ TEST(SemanticGrid, ACabinetStandsAgainstTheWallLineSeenBeyondItsEnds) {
     const int name = static_cast<int>(variant);
     EXPECT_EQ(class_at(alone, 1.5, 3.42).first, C::wall) << name;
     EXPECT_EQ(class_at(alone, 1.5, 3.7), std::pair(C::unknown, true)) << name;
-    EXPECT_EQ(alone.furniture_fronts, 0) << name;
+    EXPECT_EQ(alone.inferred.furniture_fronts, 0) << name;
   }
 }
 
@@ -821,8 +821,8 @@ TEST(SemanticGrid, StrayRowsOfWallCellsDoNotThinTheWalls) {
   LabelledPoints s = two_rooms_with_a_wall_between();
   for (double y : {0.512, 1.012, 1.512}) s.box_face({0.212, y, 0.02}, {3.812, y, 1.4}, C::wall);
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
-  ASSERT_TRUE(grid.wall_thickness.has_value());
-  EXPECT_NEAR(*grid.wall_thickness, 0.2, 0.051);
+  ASSERT_TRUE(grid.inferred.wall_thickness.has_value());
+  EXPECT_NEAR(*grid.inferred.wall_thickness, 0.2, 0.051);
   EXPECT_EQ(class_at(grid, 2.0, 4.012 + 0.12), std::pair(C::wall, false));
   EXPECT_EQ(class_at(grid, 2.0, 1.012), std::pair(C::wall, false));  // the rows stay walls
 }
@@ -846,8 +846,8 @@ TEST(SemanticGrid, AWallThinnedByDriftAlongPartOfItDoesNotThinTheWalls) {
   s.box_face({0.012, 1.962, 0.02}, {4.012, 1.962, 1.4}, C::wall);  // the south face
   s.box_face({0.012, 4.012, 0.02}, {4.012, 4.012, 1.4}, C::wall);  // the outer north wall
   const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
-  ASSERT_TRUE(grid.wall_thickness.has_value());
-  EXPECT_NEAR(*grid.wall_thickness, 0.15, 0.01);
+  ASSERT_TRUE(grid.inferred.wall_thickness.has_value());
+  EXPECT_NEAR(*grid.inferred.wall_thickness, 0.15, 0.01);
   EXPECT_EQ(class_at(grid, 2.0, 4.012 + 0.12), std::pair(C::wall, false));  // its back
 }
 
@@ -947,8 +947,8 @@ TEST(SemanticGrid, TheLatticeFollowsCrispFacesSmoothlyHoweverTheyAgree) {
   const auto lattice_x = [&](double east) {
     const LabelledPoints s = noisy_room({kWest, kSouth}, {east, kNorth}, 0.006, 7);
     const SemanticGrid grid = build_semantic_grid(s.points, s.labels);
-    EXPECT_GT(grid.wall_face_crispness.x(), 0.6) << east;
-    return grid.lattice_offset.x();
+    EXPECT_GT(grid.inferred.wall_face_crispness.x(), 0.6) << east;
+    return grid.inferred.lattice_offset.x();
   };
   const double before = lattice_x(4.02), after = lattice_x(4.022);
   EXPECT_NEAR(before, 0.01, 0.002);  // midway between the faces' offsets, 0 and 0.02
@@ -957,8 +957,8 @@ TEST(SemanticGrid, TheLatticeFollowsCrispFacesSmoothlyHoweverTheyAgree) {
   const LabelledPoints noisy = noisy_room({0.512, 0.512}, {4.012, 3.012}, 0.02, 11);
   const SemanticGrid grid = build_semantic_grid(noisy.points, noisy.labels);
   for (int axis = 0; axis < 2; ++axis) {
-    EXPECT_LT(grid.wall_face_crispness[axis], 0.15) << axis;
-    EXPECT_EQ(grid.lattice_offset[axis], 0.0) << axis;
+    EXPECT_LT(grid.inferred.wall_face_crispness[axis], 0.15) << axis;
+    EXPECT_EQ(grid.inferred.lattice_offset[axis], 0.0) << axis;
   }
 }
 

@@ -67,19 +67,20 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
     cells[std::string(to_string(static_cast<SemanticClass>(c)))] = d.cells_per_class[c];
   cells["unobserved"] = d.unobserved_cells;
   json["cells"] = std::move(cells);
-  json["inferred"] = {{"wall_thickness_m", d.wall_thickness ? Json(*d.wall_thickness) : Json()},
-                      {"lattice_offset_m", json_array(d.lattice_offset)},
-                      {"wall_face_crispness", json_array(d.wall_face_crispness)},
-                      {"furniture_fronts", d.furniture_fronts},
-                      {"furniture_pockets", d.furniture_pockets},
-                      {"wall_specks", d.wall_specks},
-                      {"furniture_in_wall_lines", d.furniture_in_wall_lines},
-                      {"wall_insides_behind_fronts", d.wall_insides_behind_fronts},
-                      {"wall_corners_behind_furniture", d.wall_corners_behind_furniture},
-                      {"wall_cells_across_unseen", d.wall_cells_across_unseen},
-                      {"tables_on_legs", d.tables_on_legs},
-                      {"fill_cells_trimmed_at_tables", d.fill_cells_trimmed_at_tables},
-                      {"lone_posts_kept", d.lone_posts_kept}};
+  json["inferred"] = {
+      {"wall_thickness_m", d.inferred.wall_thickness ? Json(*d.inferred.wall_thickness) : Json()},
+      {"lattice_offset_m", json_array(d.inferred.lattice_offset)},
+      {"wall_face_crispness", json_array(d.inferred.wall_face_crispness)},
+      {"furniture_fronts", d.inferred.furniture_fronts},
+      {"furniture_pockets", d.inferred.furniture_pockets},
+      {"wall_specks", d.inferred.wall_specks},
+      {"furniture_in_wall_lines", d.inferred.furniture_in_wall_lines},
+      {"wall_insides_behind_fronts", d.inferred.wall_insides_behind_fronts},
+      {"wall_corners_behind_furniture", d.inferred.wall_corners_behind_furniture},
+      {"wall_cells_across_unseen", d.inferred.wall_cells_across_unseen},
+      {"tables_on_legs", d.inferred.tables_on_legs},
+      {"fill_cells_trimmed_at_tables", d.inferred.fill_cells_trimmed_at_tables},
+      {"lone_posts_kept", d.inferred.lone_posts_kept}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

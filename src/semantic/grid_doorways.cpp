@@ -117,9 +117,10 @@ std::optional<Opening> measure_jambs(const SemanticGrid& grid, const BandPointIn
   // Faces more than a cell apart beyond the walls' own thickness (measured where both faces of a
   // wall were seen) are not this wall's: an open door leaf standing against it beside the jamb
   // lies beyond the reveal like a face. The doorway then keeps to the wall's rows.
-  const double max_thickness = grid.wall_thickness
-                                   ? std::min(kMaxWallThickness, *grid.wall_thickness + res)
-                                   : kMaxWallThickness;
+  const double max_thickness =
+      grid.inferred.wall_thickness
+          ? std::min(kMaxWallThickness, *grid.inferred.wall_thickness + res)
+          : kMaxWallThickness;
   const double measured_width = o.along_max - o.along_min;
   const bool plausible = measured_width >= 0.75 * options.min_door_width &&
                          measured_width <= 1.25 * options.max_door_width &&

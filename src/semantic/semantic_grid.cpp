@@ -575,8 +575,8 @@ void tables_on_legs(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   const std::vector<detail::LegTable> tables =
       detail::fill_tables_on_legs(grid, table_legs(grid, evidence, options), limits, free_space,
                                   options.weights.of(SemanticClass::furniture), furniture);
-  grid.tables_on_legs = static_cast<int>(tables.size());
-  grid.fill_cells_trimmed_at_tables = detail::trim_fills_around_tables(
+  grid.inferred.tables_on_legs = static_cast<int>(tables.size());
+  grid.inferred.fill_cells_trimmed_at_tables = detail::trim_fills_around_tables(
       grid, tables, marked, options.weights.of(SemanticClass::floor), furniture);
 }
 
@@ -779,7 +779,7 @@ void remove_isolated_obstacles(SemanticGrid& grid, const Image<CellEvidence>& ev
       }
       if (!alone) continue;
       if (leg_cell(grid, evidence(col, row), {col, row}, options))
-        ++grid.lone_posts_kept;
+        ++grid.inferred.lone_posts_kept;
       else
         specks.push_back({col, row});
     }
@@ -830,10 +830,10 @@ SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
   if (options.align_cells_to_walls) {
     const detail::FacePhase faces =
         detail::wall_face_phase(points, labels, grid.floor_z, options, kMinFaceCrispness);
-    grid.lattice_offset = faces.offset;
-    grid.wall_face_crispness = faces.crispness;
+    grid.inferred.lattice_offset = faces.offset;
+    grid.inferred.wall_face_crispness = faces.crispness;
   }
-  const Eigen::Vector2d& phase = grid.lattice_offset;
+  const Eigen::Vector2d& phase = grid.inferred.lattice_offset;
   grid.origin = (((lo - phase).array() - options.margin) / res).floor() * res + phase.array();
   const Eigen::Vector2i size =
       ((hi.array() + options.margin - grid.origin.array()) / res).ceil().cast<int>().max(1);
@@ -1211,20 +1211,20 @@ void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& opti
   if (options.back_one_sided_walls && max_wall > 0 && options.furniture_max_extent > 0) {
     const int gap = cells(options.furniture_max_extent);
     const float wall = options.weights.of(SemanticClass::wall);
-    grid.furniture_in_wall_lines =
+    grid.inferred.furniture_in_wall_lines =
         detail::wall_lines_behind_furniture(grid, gap, max_wall + 1, wall, masks.furniture);
-    grid.wall_corners_behind_furniture =
+    grid.inferred.wall_corners_behind_furniture =
         detail::wall_corners_behind_furniture(grid, gap, max_wall + 1, wall);
   }
   if (options.back_one_sided_walls && max_wall > 0 && options.max_unseen_wall_gap > 0) {
-    grid.wall_cells_across_unseen =
+    grid.inferred.wall_cells_across_unseen =
         detail::wall_lines_across_unseen(grid, cells(options.max_unseen_wall_gap), max_wall + 1,
                                          options.weights.of(SemanticClass::wall));
   }
   // The lines' faces have their backs too, where the backs beside them were too short to bridge
   // (a cell no view saw, or a speck seen, ends a back's row).
   detail::back_one_sided_walls(grid, thickness, max_wall, options.weights.of(SemanticClass::wall));
-  if (thickness > 0) grid.wall_thickness = thickness * options.resolution;
+  if (thickness > 0) grid.inferred.wall_thickness = thickness * options.resolution;
 }
 
 // The cells no view saw that the seen ones imply (walls' insides and hidden backs, furniture
@@ -1240,7 +1240,7 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   const int max_wall = cells(options.max_wall_thickness);
   // First: a speck inside a wall would stop every fill across the wall below.
   if (max_wall > 0) {
-    grid.wall_specks = detail::furniture_specks_in_walls(
+    grid.inferred.wall_specks = detail::furniture_specks_in_walls(
         grid, max_wall, options.weights.of(SemanticClass::wall), masks.furniture);
   }
   const int across =
@@ -1275,10 +1275,10 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         {cells(options.furniture_max_extent), min_pocket, cells(options.furniture_max_depth),
          options.max_furniture_fill_area},
         options.weights, masks.furniture);
-    grid.furniture_fronts = apart.fronts + joined.fronts + cabinets;
-    grid.wall_insides_behind_fronts = apart.wall_inside_cells + joined.wall_inside_cells;
+    grid.inferred.furniture_fronts = apart.fronts + joined.fronts + cabinets;
+    grid.inferred.wall_insides_behind_fronts = apart.wall_inside_cells + joined.wall_inside_cells;
     // Last: the fronts above are among the faces whose hidden backs it fills.
-    grid.furniture_pockets = detail::pockets_behind_furniture(
+    grid.inferred.furniture_pockets = detail::pockets_behind_furniture(
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
         cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
         masks.furniture);
@@ -1402,19 +1402,7 @@ MapDescription describe(const SemanticGrid& grid) {
   d.width = grid.width(), d.height = grid.height();
   d.floor_z = grid.floor_z;
   d.ceiling_z = grid.ceiling_z;
-  d.wall_thickness = grid.wall_thickness;
-  d.lattice_offset = grid.lattice_offset;
-  d.wall_face_crispness = grid.wall_face_crispness;
-  d.furniture_fronts = grid.furniture_fronts;
-  d.furniture_pockets = grid.furniture_pockets;
-  d.wall_specks = grid.wall_specks;
-  d.furniture_in_wall_lines = grid.furniture_in_wall_lines;
-  d.wall_insides_behind_fronts = grid.wall_insides_behind_fronts;
-  d.wall_corners_behind_furniture = grid.wall_corners_behind_furniture;
-  d.wall_cells_across_unseen = grid.wall_cells_across_unseen;
-  d.tables_on_legs = grid.tables_on_legs;
-  d.fill_cells_trimmed_at_tables = grid.fill_cells_trimmed_at_tables;
-  d.lone_posts_kept = grid.lone_posts_kept;
+  d.inferred = grid.inferred;
   for (int c = 0; c < kSemanticClassCount; ++c)
     d.class_weights.emplace_back(std::string(kSemanticClassNames[c]), grid.weights.by_class[c]);
   d.class_weights.emplace_back("unclassified obstacle", grid.weights.unclassified_obstacle);

@@ -198,26 +198,17 @@ struct SemanticObject {
   std::vector<Eigen::Vector2i> cells;  // (col, row)
 };
 
-struct SemanticGrid {
-  double resolution = 0.05;
-  Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // lower-left corner [m]
-  double floor_z = 0;
-  std::optional<double> ceiling_z;
-  Image<SemanticClass> classes;
-  Image<float> weight;                   // [0, 1], NaN = unobserved
-  Image<std::vector<int>> cell_objects;  // object ids over each cell
-  std::vector<SemanticObject> objects;
-  TraversabilityWeights weights;  // the table the cells were weighted with
-  // What the grid inferred beyond the views: the wall thickness measured on walls seen from both
-  // sides and given to walls seen from one side (none: too few two-sided walls, none backed), and
-  // the cabinet fronts the views had taken for walls, the unseen pockets behind furniture faces
-  // filled as furniture, the furniture specks inside walls or on their faces made wall, the
-  // furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
-  // pockets made wall as the inside of a wall seen from its far side, the cells of room
-  // corners hidden behind furniture made wall, the cells of wall lines run on across what no
-  // view saw, the tables found by their legs, the cells a fill had joined to such a table made
-  // floor again, and the lone posts kept as obstacles (a leg inside one cell, no obstacle beside
-  // it, which the speck removal would have dropped).
+// What a semantic grid inferred beyond the views: the wall thickness measured on walls seen from
+// both sides and given to walls seen from one side (none: too few two-sided walls, none backed),
+// and the cabinet fronts the views had taken for walls, the unseen pockets behind furniture faces
+// filled as furniture, the furniture specks inside walls or on their faces made wall, the
+// furniture cells in a wall's line behind furniture made wall, and the cells of the fronts'
+// pockets made wall as the inside of a wall seen from its far side, the cells of room
+// corners hidden behind furniture made wall, the cells of wall lines run on across what no
+// view saw, the tables found by their legs, the cells a fill had joined to such a table made
+// floor again, and the lone posts kept as obstacles (a leg inside one cell, no obstacle beside
+// it, which the speck removal would have dropped).
+struct GridInferences {
   std::optional<double> wall_thickness;  // m
   // Where the cell lattice stands: the offset its boundaries moved by to lie on the wall faces (0
   // on an axis where they did not), and how crisp the faces across each axis were (the mean
@@ -235,6 +226,19 @@ struct SemanticGrid {
   int tables_on_legs = 0;
   int fill_cells_trimmed_at_tables = 0;
   int lone_posts_kept = 0;
+};
+
+struct SemanticGrid {
+  double resolution = 0.05;
+  Eigen::Vector2d origin = Eigen::Vector2d::Zero();  // lower-left corner [m]
+  double floor_z = 0;
+  std::optional<double> ceiling_z;
+  Image<SemanticClass> classes;
+  Image<float> weight;                   // [0, 1], NaN = unobserved
+  Image<std::vector<int>> cell_objects;  // object ids over each cell
+  std::vector<SemanticObject> objects;
+  TraversabilityWeights weights;  // the table the cells were weighted with
+  GridInferences inferred;
 
   int width() const { return classes.width(); }
   int height() const { return classes.height(); }
@@ -287,19 +291,7 @@ struct MapDescription {
   std::vector<std::pair<std::string, float>> class_weights;  // class name -> weight (NaN: unknown)
   std::array<int, kSemanticClassCount> cells_per_class{};
   int unobserved_cells = 0;
-  std::optional<double> wall_thickness;                           // as SemanticGrid's
-  Eigen::Vector2d lattice_offset = Eigen::Vector2d::Zero();       // as SemanticGrid's
-  Eigen::Vector2d wall_face_crispness = Eigen::Vector2d::Zero();  // as SemanticGrid's
-  int furniture_fronts = 0;
-  int furniture_pockets = 0;
-  int wall_specks = 0;
-  int furniture_in_wall_lines = 0;
-  int wall_insides_behind_fronts = 0;
-  int wall_corners_behind_furniture = 0;
-  int wall_cells_across_unseen = 0;
-  int tables_on_legs = 0;
-  int fill_cells_trimmed_at_tables = 0;
-  int lone_posts_kept = 0;
+  GridInferences inferred;  // as SemanticGrid's
   std::vector<ObjectRecord> objects;
 };
 MapDescription describe(const SemanticGrid& grid);
