@@ -102,7 +102,8 @@ CLI::App* add_map_command(CLI::App& app, MapOptions& o) {
                     "from features");
   command->add_option("--poses", o.poses,
                       "Known camera poses instead of SLAM: 'groundtruth' (the sequence's own) or "
-                      "a TUM trajectory file (matched by timestamp within 20 ms)");
+                      "a TUM trajectory file (at each frame's timestamp, interpolated between two "
+                      "poses at most 0.5 s apart, else the nearest within 20 ms)");
   command->add_option("--voxel", o.voxel, "TSDF voxel size [m] (truncation: 3 voxels)")
       ->check(finite_in(0.005, 0.2))
       ->capture_default_str();

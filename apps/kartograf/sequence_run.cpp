@@ -85,7 +85,8 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   command.add_option(
       "--motion-prior", o.motion_prior,
       "Another sensor's camera poses (a TUM trajectory, e.g. a wheeled robot's "
-      "odometry through the camera mount; matched by timestamp within 20 ms; "
+      "odometry through the camera mount; at each frame's timestamp, interpolated "
+      "between two poses at most 0.5 s apart, else the nearest within 20 ms; "
       "'groundtruth': the sequence's own, an ideal one): each step is predicted from "
       "them instead of the motion model, and views that leave a direction free "
       "(a plain wall, a corridor) take their motion there");
