@@ -309,7 +309,8 @@ exit 0
 # without colour): its ground truth, and a TUM file (the odometry's own trajectory, stamped by
 # frame number as Kartograf stamps layouts without timestamps), each frame predicted by it (in
 # --stats); a file that lacks frames and a missing file are Errors naming it, before any output;
-# on a timestamped layout a prior sampled slower than the frames is interpolated between its poses.
+# on a timestamped layout a prior sampled slower than the frames is interpolated between its poses;
+# --pose-mount turns a body's poses into the camera's.
 add_test(NAME Cli.input_motion_prior
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
@@ -338,6 +339,37 @@ test "$(wc -l < "$1/ten_hz.txt")" -eq 5 || { echo "FAIL: the 10 Hz prior"; exit 
 grep -q "predicted by the motion prior 12" "$1/syn.log" || { cat "$1/syn.log"; echo "FAIL: 10 Hz prior not used at every frame"; exit 1; }
 grep -v '^#' "$1/syn/groundtruth.txt" | awk 'NR == 1 { print } NR == 13 { $1 = "0.9"; print }' > "$1/gap.txt"
 fails_with "$1/err" "no pose within 20 ms of frame 1 (timestamp 0.033333), nor two at most 0.5 s apart around it" -- "$0" odometry "$1/syn" --motion-prior "$1/gap.txt" --out "$1/x.txt" || exit 1
+# --pose-mount: a file of a body's poses (base = camera x mount^-1) and the camera's pose on it give
+# the camera's poses (map --poses: its steps are the ground truth's, RPE < 1e-6 m; without the
+# mount over 1 mm); a quaternion that is not a unit one, and a mount with no file to apply it to,
+# are Errors.
+python3 - "$1/syn/groundtruth.txt" "$1/base.txt" <<'PY' || exit 1
+import sys
+def mul(a, b):  # quaternions (x, y, z, w)
+    ax, ay, az, aw = a; bx, by, bz, bw = b
+    return (aw*bx + ax*bw + ay*bz - az*by, aw*by - ax*bz + ay*bw + az*bx,
+            aw*bz + ax*by - ay*bx + az*bw, aw*bw - ax*bx - ay*by - az*bz)
+def rotate(q, v):
+    x, y, z, w = mul(mul(q, (v[0], v[1], v[2], 0.0)), (-q[0], -q[1], -q[2], q[3]))
+    return (x, y, z)
+mount_t, mount_q = (0.1, -0.05, 0.3), (0.5, 0.5, 0.5, 0.5)
+inverse_q = (-0.5, -0.5, -0.5, 0.5)
+inverse_t = tuple(-c for c in rotate(inverse_q, mount_t))
+with open(sys.argv[2], "w") as out:
+    for line in open(sys.argv[1]):
+        if line.startswith("#"): continue
+        v = [float(x) for x in line.split()]
+        q = tuple(v[4:8]); step = rotate(q, inverse_t)
+        t = [v[1 + k] + step[k] for k in range(3)]
+        out.write("%.6f %.9f %.9f %.9f %.9f %.9f %.9f %.9f\n" % (v[0], *t, *mul(q, inverse_q)))
+PY
+"$0" map "$1/syn" --poses "$1/base.txt" --pose-mount 0.1,-0.05,0.3,0.5,0.5,0.5,0.5 --out "$1/mount" --no-progress > "$1/mount.log" 2>&1 || { cat "$1/mount.log"; echo "FAIL: map --poses with --pose-mount"; exit 1; }
+"$0" map "$1/syn" --poses "$1/base.txt" --out "$1/body" --no-progress > "$1/body.log" 2>&1 || { cat "$1/body.log"; echo "FAIL: map --poses of the body"; exit 1; }
+rpe() { python3 -c 'import json, sys; print(json.load(open(sys.argv[1]))["evaluation"]["trajectory"]["rpe_translation_rmse_m"])' "$1/report.json"; }
+awk -v a="$(rpe "$1/mount")" -v b="$(rpe "$1/body")" 'BEGIN { exit !(a != "" && a < 1e-6 && b > 1e-3) }' || { echo "FAIL: RPE with the mount '$(rpe "$1/mount")' (< 1e-6 m), without '$(rpe "$1/body")' (> 1 mm)"; exit 1; }
+fails_with "$1/err" "--pose-mount: quaternion (0.000000, 0.000000, 0.000000, 2.000000) has norm 2.000000, not 1" -- "$0" map "$1/syn" --poses "$1/base.txt" --pose-mount 0,0,0,0,0,0,2 --out "$1/x" || exit 1
+fails_with "$1/err" "--pose-mount: no --poses or --motion-prior FILE to apply it to" -- "$0" odometry "$1/syn" --pose-mount 0,0,0,0,0,0,1 --out "$1/x.txt" || exit 1
+test ! -e "$1/x" && test ! -e "$1/x.txt" || { echo "FAIL: a refused run left output"; exit 1; }
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-motion-prior ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})

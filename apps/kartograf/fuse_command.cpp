@@ -55,6 +55,7 @@ CLI::App* add_fuse_command(CLI::App& app, FuseOptions& o) {
                    "Also write the 2-D maps of the robot's height band (0.05-1.5 m above this "
                    "floor height, world z up): occupancy.pgm/.yaml and esdf.png")
       ->check(CLI::Range(-1000.0, 1000.0));
+  add_pose_mount_option(*command, o.run.pose_mount);
   command->add_flag(
       "--no-progress", [&o](std::int64_t) { o.run.progress = false; }, "No progress bar on stderr");
   command->add_flag("--force", o.force, "Replace the files of an earlier run");
@@ -79,15 +80,15 @@ void write_band_maps(const std::filesystem::path& dir, const mapping::TsdfBlocks
 int run_fuse_command(const FuseOptions& o, std::ostream& out, std::ostream& err) {
   OutputFolder folder("fuse", o.out_dir, o.force,
                       {"mesh.ply", "fuse.json", "occupancy.pgm", "occupancy.yaml", "esdf.png"});
-  const OpenedRun run = open_run(o.run, err);
+  const OpenedRun run = open_run(o.run, err, o.poses);
   const compute::Context context = make_run_context(o.run);
   mapping::TsdfVolumeParams params;
   params.voxel_size = o.voxel;
   params.truncation = o.truncation > 0 ? o.truncation : 4 * o.voxel;
   params.max_blocks = o.max_blocks;
   mapping::TsdfVolume volume(context, params);
-  const mapping::KnownPoseLookup pose_of =
-      known_pose_lookup("fuse", o.poses, !run.opened.detected.has_timestamps);
+  const mapping::KnownPoseLookup pose_of = known_pose_lookup(
+      "fuse", o.poses, !run.opened.detected.has_timestamps, "--poses", run.pose_mount);
   const PinholeIntrinsics camera = run.source->camera();
   const geometry::DepthRange range{run.source->depth_units_per_metre(), 0.1, o.max_depth};
 

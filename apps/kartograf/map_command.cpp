@@ -121,7 +121,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<std::string> known_files = io::map_output_files();
   known_files.push_back("evaluation.png");
   OutputFolder folder("map", o.out_dir, o.force, known_files);
-  const OpenedRun run = open_run(o.run, err);
+  const OpenedRun run = open_run(o.run, err, o.poses);
   // A depth camera alone: the features (ORB) have no image to work on; the views' planes and
   // labels come from the depth (docs/user-guide.md, "A depth camera alone").
   const bool wants_features = !o.no_features && o.poses.empty();
@@ -135,7 +135,8 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   stages.label_step = o.label_step;
   stages.max_views = o.max_views;
   stages.features = wants_features && run.opened.has_color;
-  stages.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps);
+  stages.known_poses = known_pose_lookup("map", o.poses, !run.opened.detected.has_timestamps,
+                                         "--poses", run.pose_mount);
   stages.label_width = o.label_width;
   stages.grid.resolution = o.resolution;
   stages.room_method = rooms::parse_room_method(o.room_method);

@@ -90,6 +90,7 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
       "'groundtruth': the sequence's own, an ideal one): each step is predicted from "
       "them instead of the motion model, and views that leave a direction free "
       "(a plain wall, a corridor) take their motion there");
+  add_pose_mount_option(command, o.pose_mount);
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
 }
 
@@ -160,8 +161,9 @@ void require_colour(const io::OpenedSequence& opened, const std::filesystem::pat
                                 "' has none (a depth camera alone)");
 }
 
-OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
+OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const std::string& poses) {
   OpenedRun run;
+  run.pose_mount = pose_mount(options, poses);
   run.opened = open_input(options.sequence, options.input, err);
   if (options.method == "color") {
     require_colour(run.opened, options.sequence, "--method color (colour-checked ICP)");
@@ -173,8 +175,9 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err) {
   pipeline::check_depth_usable(*run.opened.sequence, range);
   run.source = std::make_unique<pipeline::SequenceFrameSource>(*run.opened.sequence);
   if (!options.motion_prior.empty()) {
-    run.source->set_motion_prior(known_pose_lookup(
-        "odometry", options.motion_prior, !run.opened.detected.has_timestamps, "--motion-prior"));
+    run.source->set_motion_prior(known_pose_lookup("odometry", options.motion_prior,
+                                                   !run.opened.detected.has_timestamps,
+                                                   "--motion-prior", run.pose_mount));
   }
   return run;
 }
@@ -301,8 +304,39 @@ std::string measured_poses_line(const eval::MeasuredPoseAte& measured) {
 // timestamp (interpolated between the file's poses: pose_at), or at its frame number where the
 // layout has no timestamps (as the trajectories Kartograf writes for it are stamped); a frame
 // without one stops the run with an Error naming it.
+void add_pose_mount_option(CLI::App& command, std::vector<double>& mount) {
+  command
+      .add_option("--pose-mount", mount,
+                  "x,y,z,qx,qy,qz,qw: the camera's pose in the body whose poses a --poses or "
+                  "--motion-prior FILE gives (e.g. a robot base's odometry: base to camera "
+                  "optical frame); default: the file gives the camera's own poses")
+      ->expected(7)
+      ->delimiter(',')
+      ->check(finite_number());
+}
+
+Eigen::Isometry3d pose_mount(const SequenceRunOptions& options, const std::string& poses) {
+  const std::vector<double>& m = options.pose_mount;
+  if (m.empty()) return Eigen::Isometry3d::Identity();
+  const bool file_given = (!poses.empty() && poses != "groundtruth") ||
+                          (!options.motion_prior.empty() && options.motion_prior != "groundtruth");
+  require(file_given,
+          "--pose-mount: no --poses or --motion-prior FILE to apply it to (a sequence's own "
+          "ground truth is the camera's)");
+  const Eigen::Quaterniond rotation(m[6], m[3], m[4], m[5]);
+  require(std::fabs(rotation.norm() - 1) <= 1e-3,
+          "--pose-mount: quaternion (" + std::to_string(m[3]) + ", " + std::to_string(m[4]) + ", " +
+              std::to_string(m[5]) + ", " + std::to_string(m[6]) + ") has norm " +
+              std::to_string(rotation.norm()) + ", not 1");
+  Eigen::Isometry3d mount = Eigen::Isometry3d::Identity();
+  mount.linear() = rotation.normalized().toRotationMatrix();
+  mount.translation() = Eigen::Vector3d(m[0], m[1], m[2]);
+  return mount;
+}
+
 mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
-                                           bool by_frame_number, const std::string& option) {
+                                           bool by_frame_number, const std::string& option,
+                                           const Eigen::Isometry3d& mount) {
   if (poses.empty()) return {};
   const std::string named = command + " " + option;
   if (poses == "groundtruth") {
@@ -316,15 +350,15 @@ mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std
   require(!trajectory->empty(), named + ": '" + poses + "' holds no pose");
   std::sort(trajectory->begin(), trajectory->end(),
             [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
-  return [named, trajectory, poses, by_frame_number](std::size_t i,
-                                                     const registration::RgbdImages& images) {
+  return [named, trajectory, poses, by_frame_number, mount](
+             std::size_t i, const registration::RgbdImages& images) {
     const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp;
     const std::optional<Eigen::Isometry3d> pose = pose_at(*trajectory, stamp);
     require(pose.has_value(),
             named + ": '" + poses + "' has no pose within 20 ms of frame " + std::to_string(i) +
                 " (" + (by_frame_number ? "frame number " : "timestamp ") + std::to_string(stamp) +
                 "), nor two at most 0.5 s apart around it");
-    return *pose;
+    return Eigen::Isometry3d(*pose * mount);
   };
 }
 

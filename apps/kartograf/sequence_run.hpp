@@ -59,10 +59,13 @@ io::SequenceRunRecord run_record(const SequenceRunOptions& options,
 struct OpenedRun {
   io::OpenedSequence opened;
   std::unique_ptr<pipeline::SequenceFrameSource> source;
+  Eigen::Isometry3d pose_mount = Eigen::Isometry3d::Identity();  // --pose-mount
 };
-// open_input, then the first frames' depth checked against the odometry's depth range, and
-// --method color or planar refused on a sequence without colour.
-OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err);
+// --pose-mount checked against `poses` (the command's --poses, if it has one) and the motion
+// prior, open_input, then the first frames' depth checked against the odometry's depth range,
+// and --method color or planar refused on a sequence without colour.
+OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err,
+                   const std::string& poses = {});
 
 // Error naming `what` and the folder when the sequence has no colour images (a depth camera
 // alone), before any work.
@@ -109,12 +112,21 @@ std::optional<eval::MeasuredPoseAte> ate_at_measured_poses(
 // poses" and a newline.
 std::string measured_poses_line(const eval::MeasuredPoseAte& measured);
 
+// Registers --pose-mount (odometry, slam and map register it with the run options; fuse itself).
+void add_pose_mount_option(CLI::App& command, std::vector<double>& mount);
+// The camera's pose in the pose files' body (identity without --pose-mount); an Error naming the
+// option for a quaternion that is not a unit one, or where no --poses or --motion-prior FILE is
+// given for it to apply to.
+Eigen::Isometry3d pose_mount(const SequenceRunOptions& options, const std::string& poses);
+
 // --poses of `map` and `fuse` (and --motion-prior, `option`): each frame's pose from the
-// sequence's ground truth ("groundtruth") or from a TUM file, matched by timestamp, or by frame
-// number where the layout has no timestamps; a frame without one stops the run with an Error
-// naming `command`, `option` and the frame.
-mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
-                                           bool by_frame_number,
-                                           const std::string& option = "--poses");
+// sequence's ground truth ("groundtruth") or from a TUM file at the frame's timestamp (pose_at:
+// interpolated), or at its frame number where the layout has no timestamps, times `mount` (a
+// file's body to the camera); a frame without one stops the run with an Error naming `command`,
+// `option` and the frame.
+mapping::KnownPoseLookup known_pose_lookup(
+    const std::string& command, const std::string& poses, bool by_frame_number,
+    const std::string& option = "--poses",
+    const Eigen::Isometry3d& mount = Eigen::Isometry3d::Identity());
 
 }  // namespace kartograf::cli
