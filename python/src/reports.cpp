@@ -33,6 +33,8 @@ nb::dict frame_dict(const registration::OdometryFrame& frame) {
   d["retried"] = frame.retried;
   d["from_features"] = frame.from_features;
   d["from_motion_prior"] = frame.from_motion_prior;
+  d["prior_difference_m"] = frame.prior_difference_m;
+  d["prior_difference_deg"] = frame.prior_difference_deg;
   d["fallback"] = frame.fallback;
   d["degenerate"] = frame.degenerate;
   d["degenerate_overlap"] = frame.degenerate_overlap;

@@ -55,6 +55,8 @@ def test_a_motion_prior_predicts_each_step(cpu, synthetic):
     offset[:3, 3] = (1.0, 0.0, 0.0)
     reports = [odometry.track(f["depth"], None, offset @ f["pose"]) for f in frames_of(sequence)]
     assert [r.extra["from_motion_prior"] for r in reports] == [False] + [True] * 29
+    # How far each step ended from the prior's: the registration's error against an ideal prior.
+    assert np.median([r.extra["prior_difference_m"] for r in reports[1:]]) < 0.005
     truth = [f["pose"] for f in frames_of(sequence)]
     assert kg.ate(odometry.poses, truth).rmse_m < 0.05
     with pytest.raises(kg.Error, match="Odometry.track"):

@@ -15,6 +15,7 @@
 #include "kartograf/formats/ply.hpp"
 #include "kartograf/formats/top_view.hpp"
 #include "kartograf/formats/tum.hpp"
+#include "kartograf/outputs/odometry_stats.hpp"
 #include "kartograf/outputs/room_io.hpp"
 #include "kartograf/outputs/semantic_map_io.hpp"
 #include "outputs/json_array.hpp"
@@ -145,6 +146,8 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
         f.degenerate && !f.photometric && !f.scanned && !f.from_features && !f.from_motion_prior;
     fallbacks += f.fallback;
   }
+  const MotionPriorDifference prior =
+      count_odometry_frames(r.slam.odometry.frames).prior_difference;
   return {{"poses_given", r.slam.poses_given},
           {"loop_candidates", r.slam.loop_candidates},
           {"appearance_candidates", r.slam.appearance_candidates},
@@ -152,6 +155,9 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
           {"loop_closures_by_appearance", by_appearance},
           {"frames_from_features", from_features},
           {"frames_from_motion_prior", from_prior},
+          {"motion_prior_difference_median_m", prior.median_m},
+          {"motion_prior_difference_max_m", prior.max_m},
+          {"motion_prior_difference_max_deg", prior.max_deg},
           {"degenerate_frames", degenerate},
           {"degenerate_frames_unmeasured", unmeasured},
           {"fallback_frames", fallbacks},

@@ -1,6 +1,10 @@
 #include "kartograf/outputs/odometry_stats.hpp"
 
+#include <algorithm>
+#include <cstddef>
+#include <cstdio>
 #include <utility>
+#include <vector>
 
 #include "run_json.hpp"
 
@@ -54,6 +58,10 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["retried"] = frame.retried;
   json["from_features"] = frame.from_features;
   json["from_motion_prior"] = frame.from_motion_prior;
+  if (frame.from_motion_prior) {
+    json["prior_difference_m"] = frame.prior_difference_m;
+    json["prior_difference_deg"] = frame.prior_difference_deg;
+  }
   json["degenerate"] = frame.degenerate;
   json["degenerate_overlap"] = frame.degenerate_overlap;
   json["reestimate_degenerate_overlap"] = frame.reestimate_degenerate_overlap;
@@ -82,6 +90,9 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["retried_from_other_starts"] = counts.retried_from_other_starts;
   json["from_features"] = counts.from_features;
   json["motion_prior_frames"] = counts.motion_prior_frames;
+  json["motion_prior_difference_median_m"] = counts.prior_difference.median_m;
+  json["motion_prior_difference_max_m"] = counts.prior_difference.max_m;
+  json["motion_prior_difference_max_deg"] = counts.prior_difference.max_deg;
   json["degenerate_frames"] = counts.degenerate_frames;
   json["degenerate_overlap_frames"] = counts.degenerate_overlap_frames;
   json["photometric_frames"] = counts.photometric_frames;
@@ -107,8 +118,30 @@ std::string sequence_input_json(const OpenedSequence& opened) {
   return detail::input_json(opened).dump();
 }
 
+namespace {
+
+MotionPriorDifference motion_prior_difference(
+    const std::vector<registration::OdometryFrame>& frames) {
+  MotionPriorDifference d;
+  std::vector<double> metres;
+  for (const registration::OdometryFrame& f : frames) {
+    if (!f.from_motion_prior) continue;
+    metres.push_back(f.prior_difference_m);
+    d.max_m = std::max(d.max_m, f.prior_difference_m);
+    d.max_deg = std::max(d.max_deg, f.prior_difference_deg);
+  }
+  if (metres.empty()) return d;
+  const auto middle = metres.begin() + static_cast<std::ptrdiff_t>(metres.size() / 2);
+  std::nth_element(metres.begin(), middle, metres.end());
+  d.median_m = *middle;
+  return d;
+}
+
+}  // namespace
+
 OdometryFrameCounts count_odometry_frames(const std::vector<registration::OdometryFrame>& frames) {
   OdometryFrameCounts counts;
+  counts.prior_difference = motion_prior_difference(frames);
   counts.frames = frames.size();
   for (const registration::OdometryFrame& f : frames) {
     counts.fallbacks += f.fallback;
@@ -162,8 +195,14 @@ std::string reestimates_on_overlap_text(const OdometryFrameCounts& c) {
 std::string frame_counts_line(const OdometryFrameCounts& c) {
   const auto count = [](std::size_t n) { return std::to_string(n); };
   std::string seeded = c.from_features ? ", started from features " + count(c.from_features) : "";
-  if (c.motion_prior_frames > 0)
-    seeded += ", predicted by the motion prior " + count(c.motion_prior_frames);
+  if (c.motion_prior_frames > 0) {
+    char off[96];
+    std::snprintf(off, sizeof(off),
+                  " (its steps off by median %.1f mm, at most %.1f mm and %.2f deg)",
+                  1000 * c.prior_difference.median_m, 1000 * c.prior_difference.max_m,
+                  c.prior_difference.max_deg);
+    seeded += ", predicted by the motion prior " + count(c.motion_prior_frames) + off;
+  }
   return "keyframes " + count(c.keyframes) + ", fallbacks " + count(c.fallbacks) + seeded +
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
          reestimates_on_overlap_text(c) + "), degenerate frames " + count(c.degenerate_frames) +

@@ -360,7 +360,8 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
               ": its motion prior is not a finite rigid motion");
   prior_before_ = frame.index > 0 ? prior_now_ : std::nullopt;
   prior_now_ = motion_prior;
-  frame.from_motion_prior = prior_motion().has_value();
+  const std::optional<Eigen::Isometry3d> prior_step = prior_motion();
+  frame.from_motion_prior = prior_step.has_value();
   // Colour is read on the depth image's pixel grid (photometric refinement, planes).
   require(color == nullptr || color->empty() ||
               (color->width() == depth.width() && color->height() == depth.height()),
@@ -396,6 +397,7 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
     poses_.push_back(Eigen::Isometry3d::Identity());
   } else {
     track_previous(frame);
+    if (prior_step) record_prior_difference(*prior_step, frame);
     const auto k = static_cast<std::size_t>(params_.reestimate_interval);
     if (k > 0 && frame.index % k == 0) reestimate(frame);
   }
@@ -427,6 +429,14 @@ void RgbdOdometry::set_finest_gate(const DepthImage& depth) {
 
 Eigen::Isometry3d RgbdOdometry::predict(StepFrame step_frame) const {
   return predict(step_frame, params_.motion_model);
+}
+
+void RgbdOdometry::record_prior_difference(const Eigen::Isometry3d& prior_step,
+                                           OdometryFrame& frame) const {
+  const std::size_t n = poses_.size() - 1;  // the frame just tracked
+  const Eigen::Isometry3d off = prior_step.inverse() * (poses_[n - 1].inverse() * poses_[n]);
+  frame.prior_difference_m = off.translation().norm();
+  frame.prior_difference_deg = se3::rotation_angle(off) / kDegree;
 }
 
 std::optional<Eigen::Isometry3d> RgbdOdometry::prior_motion() const {

@@ -25,6 +25,12 @@ struct SequenceRunRecord {
 // The camera, depth scale and frames left out, a JSON object (the "input" of stats and reports).
 std::string sequence_input_json(const OpenedSequence& opened);
 
+// How far the steps a motion prior predicted were from those the odometry took (the frames
+// from_motion_prior): the median and largest translation, the largest rotation; 0 without any.
+struct MotionPriorDifference {
+  double median_m = 0, max_m = 0, max_deg = 0;
+};
+
 // Counts over an odometry run's frames.
 struct OdometryFrameCounts {
   std::size_t frames = 0, keyframes = 0, fallbacks = 0, retried_from_other_starts = 0,
@@ -32,6 +38,7 @@ struct OdometryFrameCounts {
               reestimates_rejected = 0, heading_prior_frames = 0, accelerated_frames = 0,
               speed_bounded_frames = 0, scanned_frames = 0, degenerate_overlap_frames = 0,
               reestimates_on_degenerate_overlap = 0, motion_prior_frames = 0;
+  MotionPriorDifference prior_difference;
 };
 OdometryFrameCounts count_odometry_frames(const std::vector<registration::OdometryFrame>& frames);
 // Those counts in one line, for the summaries on stdout.

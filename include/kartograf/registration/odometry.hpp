@@ -440,6 +440,10 @@ struct OdometryFrame {
   bool keyframe = false;
   // The prediction was the motion prior's (this frame and the one before had one).
   bool from_motion_prior = false;
+  // Where from_motion_prior: how far the step the registration took (before any re-estimate) is
+  // from the prior's, in translation (m) and rotation (degrees). Large: the wheels slipped, the
+  // prior's mount or clock is off, or the registration went wrong.
+  double prior_difference_m = 0, prior_difference_deg = 0;
   double seconds = 0;  // processing time of track() (no file I/O)
 };
 
@@ -681,6 +685,8 @@ class RgbdOdometry {
   // The relative motion of the frame to predict from the motion priors, when it and the frame
   // before have one.
   std::optional<Eigen::Isometry3d> prior_motion() const;
+  // The step frame.index took (poses_' last two) against the prior's step, into `frame`.
+  void record_prior_difference(const Eigen::Isometry3d& prior_step, OdometryFrame& frame) const;
   std::vector<OdometryFrame> frames_;
   std::vector<RelativePose> constraints_;
   std::vector<std::size_t> keyframes_;
