@@ -208,7 +208,9 @@ Json report_of(bool with_evaluation) {
                                           {"stage": "rooms", "seconds": 0.5}]},
     "slam": {"loop_candidates": 3, "loop_closures_accepted": 1, "loop_closures_pruned": 0,
              "pose_graph_converged": true, "map_points": 1000, "degenerate_frames": 7,
-             "degenerate_frames_unmeasured": 4, "fallback_frames": 1},
+             "degenerate_frames_unmeasured": 4, "fallback_frames": 1,
+             "frames_from_motion_prior": 19, "motion_prior_difference_median_m": 0.0004,
+             "motion_prior_difference_max_m": 0.0123, "motion_prior_difference_max_deg": 0.5},
     "views": {"labelled": 3, "unlabelled": 1, "first_unlabelled_reason": "no floor"},
     "planes": {"count": 3, "by_class": {"floor": 1, "wall": 2}},
     "grid": {"width": 10, "height": 20, "resolution_m": 0.05, "objects": {}},
@@ -275,6 +277,10 @@ TEST(MapReportHtml, SummaryAndMetricsFirstThenPicturesPlotsConfusionAnd3dView) {
   EXPECT_NE(page.at("7 degenerate views <span class=\"note\">(4 with no image or feature"),
             std::string::npos);
   EXPECT_NE(page.at(", 1 fallbacks"), std::string::npos);
+  // How far the steps taken were from the motion prior's (its slip or a wrong mount).
+  EXPECT_NE(page.at(", 19 steps predicted by the motion prior (the steps taken differ from its "
+                    "by median 0.4 mm, at most 1.23 cm)"),
+            std::string::npos);
   EXPECT_NE(page.at("1.23 cm"), std::string::npos);                         // the ATE
   EXPECT_NE(page.at("class=\"value missed\">1.23 cm"), std::string::npos);  // target 1 cm
   EXPECT_NE(page.at("odometry alone: ATE RMSE"), std::string::npos);        // before loop closure

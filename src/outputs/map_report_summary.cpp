@@ -93,7 +93,15 @@ void result_facts(std::ostringstream& html, const Json& r) {
       tracking += " <span class=\"note\">(" + text_of(slam["degenerate_frames_unmeasured"]) +
                   " with no image or feature to measure what their geometry leaves free: there "
                   "the trajectory is the motion model's)</span>";
-    fact(html, "tracking", tracking + ", " + text_of(slam["fallback_frames"]) + " fallbacks");
+    tracking += ", " + text_of(slam["fallback_frames"]) + " fallbacks";
+    if (slam.value("frames_from_motion_prior", 0) > 0)
+      tracking += ", " + text_of(slam["frames_from_motion_prior"]) +
+                  " steps predicted by the motion prior (the steps taken differ from its by "
+                  "median " +
+                  format_length(slam["motion_prior_difference_median_m"].get<double>()) +
+                  ", at most " +
+                  format_length(slam["motion_prior_difference_max_m"].get<double>()) + ")";
+    fact(html, "tracking", tracking);
   }
 }
 
