@@ -300,10 +300,6 @@ std::string measured_poses_line(const eval::MeasuredPoseAte& measured) {
   return line;
 }
 
-// --poses: each frame's pose from the sequence's ground truth or from a TUM file at the frame's
-// timestamp (interpolated between the file's poses: pose_at), or at its frame number where the
-// layout has no timestamps (as the trajectories Kartograf writes for it are stamped); a frame
-// without one stops the run with an Error naming it.
 void add_pose_mount_option(CLI::App& command, std::vector<double>& mount) {
   command
       .add_option("--pose-mount", mount,
@@ -334,6 +330,10 @@ Eigen::Isometry3d pose_mount(const SequenceRunOptions& options, const std::strin
   return mount;
 }
 
+// --poses: each frame's pose from the sequence's ground truth or from a TUM file at the frame's
+// timestamp (interpolated between the file's poses: pose_at), or at its frame number where the
+// layout has no timestamps (as the trajectories Kartograf writes for it are stamped); a frame
+// without one stops the run with an Error naming it.
 mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
                                            bool by_frame_number, const std::string& option,
                                            const Eigen::Isometry3d& mount) {
