@@ -310,7 +310,7 @@ exit 0
 # frame number as Kartograf stamps layouts without timestamps), each frame predicted by it (in
 # --stats); a file that lacks frames and a missing file are Errors naming it, before any output;
 # on a timestamped layout a prior sampled slower than the frames is interpolated between its poses;
-# --pose-mount turns a body's poses into the camera's.
+# --prior-time-offset reads it on another clock; --pose-mount turns a body's poses into the camera's.
 add_test(NAME Cli.input_motion_prior
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
@@ -339,6 +339,15 @@ test "$(wc -l < "$1/ten_hz.txt")" -eq 5 || { echo "FAIL: the 10 Hz prior"; exit 
 grep -q "predicted by the motion prior 12" "$1/syn.log" || { cat "$1/syn.log"; echo "FAIL: 10 Hz prior not used at every frame"; exit 1; }
 grep -v '^#' "$1/syn/groundtruth.txt" | awk 'NR == 1 { print } NR == 13 { $1 = "0.9"; print }' > "$1/gap.txt"
 fails_with "$1/err" "no pose within 20 ms of frame 1 (timestamp 0.033333), nor two at most 0.5 s apart around it" -- "$0" odometry "$1/syn" --motion-prior "$1/gap.txt" --out "$1/x.txt" || exit 1
+# --prior-time-offset: the same prior on a clock 50 ms ahead (its stamps + 0.05) is refused at
+# frame 0 without the offset and with it gives the 10 Hz run's steps to the digit.
+awk '{ $1 = sprintf("%.6f", $1 + 0.05); print }' "$1/ten_hz.txt" > "$1/ahead.txt"
+fails_with "$1/err" "no pose within 20 ms of frame 0" -- "$0" odometry "$1/syn" --motion-prior "$1/ahead.txt" --out "$1/x.txt" || exit 1
+"$0" odometry "$1/syn" --motion-prior "$1/ahead.txt" --prior-time-offset 0.05 --out "$1/ahead_run.txt" > "$1/ahead.log" 2>&1 || { cat "$1/ahead.log"; echo "FAIL: --prior-time-offset"; exit 1; }
+off() { grep -o "predicted by the motion prior [^)]*)" "$1"; }
+test -n "$(off "$1/syn.log")" && test "$(off "$1/syn.log")" = "$(off "$1/ahead.log")" || { echo "FAIL: offset prior '$(off "$1/ahead.log")' against '$(off "$1/syn.log")'"; exit 1; }
+fails_with "$1/err" "--prior-time-offset: no --motion-prior FILE to apply it to" -- "$0" odometry "$1/syn" --prior-time-offset 0.1 --out "$1/x.txt" || exit 1
+fails_with "$1/err" "has no timestamps" -- "$0" odometry "$1/seq" --motion-prior "$1/plain.txt" --prior-time-offset 0.1 --out "$1/x.txt" || exit 1
 # --pose-mount: a file of a body's poses (base = camera x mount^-1) and the camera's pose on it give
 # the camera's poses (map --poses: its steps are the ground truth's, RPE < 1e-6 m; without the
 # mount over 1 mm); a quaternion that is not a unit one, and a mount with no file to apply it to,

@@ -90,6 +90,12 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
       "'groundtruth': the sequence's own, an ideal one): each step is predicted from "
       "them instead of the motion model, and views that leave a direction free "
       "(a plain wall, a corridor) take their motion there");
+  command
+      .add_option("--prior-time-offset", o.prior_time_offset,
+                  "Seconds the --motion-prior FILE's clock is ahead of the frames' timestamps "
+                  "(its pose for a frame is read at the frame's time plus this); a wrong one "
+                  "shows in the summary's 'its steps off by'")
+      ->check(finite_in(-10.0, 10.0));
   add_pose_mount_option(command, o.pose_mount);
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
 }
@@ -164,7 +170,13 @@ void require_colour(const io::OpenedSequence& opened, const std::filesystem::pat
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const std::string& poses) {
   OpenedRun run;
   run.pose_mount = pose_mount(options, poses);
+  const bool prior_file = !options.motion_prior.empty() && options.motion_prior != "groundtruth";
+  require(options.prior_time_offset == 0 || prior_file,
+          "--prior-time-offset: no --motion-prior FILE to apply it to");
   run.opened = open_input(options.sequence, options.input, err);
+  require(options.prior_time_offset == 0 || run.opened.detected.has_timestamps,
+          "--prior-time-offset: '" + options.sequence.string() +
+              "' has no timestamps (its frames are matched to the prior by number)");
   if (options.method == "color") {
     require_colour(run.opened, options.sequence, "--method color (colour-checked ICP)");
   } else if (options.method == "planar") {
@@ -175,9 +187,9 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const s
   pipeline::check_depth_usable(*run.opened.sequence, range);
   run.source = std::make_unique<pipeline::SequenceFrameSource>(*run.opened.sequence);
   if (!options.motion_prior.empty()) {
-    run.source->set_motion_prior(known_pose_lookup("odometry", options.motion_prior,
-                                                   !run.opened.detected.has_timestamps,
-                                                   "--motion-prior", run.pose_mount));
+    run.source->set_motion_prior(
+        known_pose_lookup("odometry", options.motion_prior, !run.opened.detected.has_timestamps,
+                          "--motion-prior", run.pose_mount, options.prior_time_offset));
   }
   return run;
 }
@@ -336,7 +348,7 @@ Eigen::Isometry3d pose_mount(const SequenceRunOptions& options, const std::strin
 // without one stops the run with an Error naming it.
 mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std::string& poses,
                                            bool by_frame_number, const std::string& option,
-                                           const Eigen::Isometry3d& mount) {
+                                           const Eigen::Isometry3d& mount, double time_offset) {
   if (poses.empty()) return {};
   const std::string named = command + " " + option;
   if (poses == "groundtruth") {
@@ -350,9 +362,9 @@ mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std
   require(!trajectory->empty(), named + ": '" + poses + "' holds no pose");
   std::sort(trajectory->begin(), trajectory->end(),
             [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
-  return [named, trajectory, poses, by_frame_number, mount](
+  return [named, trajectory, poses, by_frame_number, mount, time_offset](
              std::size_t i, const registration::RgbdImages& images) {
-    const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp;
+    const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp + time_offset;
     const std::optional<Eigen::Isometry3d> pose = pose_at(*trajectory, stamp);
     require(pose.has_value(),
             named + ": '" + poses + "' has no pose within 20 ms of frame " + std::to_string(i) +

@@ -62,8 +62,9 @@ struct OpenedRun {
   Eigen::Isometry3d pose_mount = Eigen::Isometry3d::Identity();  // --pose-mount
 };
 // --pose-mount checked against `poses` (the command's --poses, if it has one) and the motion
-// prior, open_input, then the first frames' depth checked against the odometry's depth range,
-// and --method color or planar refused on a sequence without colour.
+// prior, open_input, --prior-time-offset refused without a prior file or timestamps, then the
+// first frames' depth checked against the odometry's depth range, and --method color or planar
+// refused on a sequence without colour.
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err,
                    const std::string& poses = {});
 
@@ -121,12 +122,12 @@ Eigen::Isometry3d pose_mount(const SequenceRunOptions& options, const std::strin
 
 // --poses of `map` and `fuse` (and --motion-prior, `option`): each frame's pose from the
 // sequence's ground truth ("groundtruth") or from a TUM file at the frame's timestamp (pose_at:
-// interpolated), or at its frame number where the layout has no timestamps, times `mount` (a
-// file's body to the camera); a frame without one stops the run with an Error naming `command`,
-// `option` and the frame.
+// interpolated; at the timestamp plus `time_offset`, the file's clock's lead), or at its frame
+// number where the layout has no timestamps, times `mount` (a file's body to the camera); a frame
+// without one stops the run with an Error naming `command`, `option` and the frame.
 mapping::KnownPoseLookup known_pose_lookup(
     const std::string& command, const std::string& poses, bool by_frame_number,
     const std::string& option = "--poses",
-    const Eigen::Isometry3d& mount = Eigen::Isometry3d::Identity());
+    const Eigen::Isometry3d& mount = Eigen::Isometry3d::Identity(), double time_offset = 0);
 
 }  // namespace kartograf::cli
