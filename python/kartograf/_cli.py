@@ -15,22 +15,21 @@ SEQUENCE_COMMANDS = {"odometry", "slam", "map", "fuse", "planes"}
 TOPIC_OPTIONS = {"--color-topic": "color_topic", "--depth-topic": "depth_topic",
                  "--camera-info-topic": "camera_info_topic", "--odometry-topic": "odometry_topic",
                  "--tf-world": "tf_world"}
-# Use the bag's odometry or /tf as the camera's poses: `--poses` of the converted prior; or as
-# the odometry's motion prior: `--motion-prior` of it.
-POSES_FLAG = "--bag-poses"
-PRIOR_FLAG = "--bag-prior"
+# Use the bag's odometry or /tf as the camera's poses (`--poses` of the converted prior) or as the
+# odometry's motion prior (`--motion-prior` of it): each flag and the option it becomes.
+POSE_FLAGS = {"--bag-poses": "--poses", "--bag-prior": "--motion-prior"}
 
 
 def _take_topic_options(args):
-    """The arguments without the topic options, and those options."""
-    rest, topics, i = [], {}, 0
+    """The arguments without the topic options, those options, and the option the bag's poses
+    become (None: no pose flag)."""
+    rest, topics, pose_option, i = [], {}, None, 0
     while i < len(args):
         name, _, value = args[i].partition("=")
-        if name in (POSES_FLAG, PRIOR_FLAG):
-            if topics.get("pose_prior"):
-                sys.exit(f"kartograf: give {POSES_FLAG} or {PRIOR_FLAG}, not both")
-            topics["pose_prior"] = True
-            topics["_prior_option"] = "--poses" if name == POSES_FLAG else "--motion-prior"
+        if name in POSE_FLAGS:
+            if pose_option:
+                sys.exit(f"kartograf: give {' or '.join(POSE_FLAGS)}, not both")
+            pose_option = POSE_FLAGS[name]
         elif name in TOPIC_OPTIONS:
             if not value:
                 i += 1
@@ -39,7 +38,7 @@ def _take_topic_options(args):
         else:
             rest.append(args[i])
         i += 1
-    return rest, topics
+    return rest, topics, pose_option
 
 
 def _convert_bags(args, scratch):
@@ -48,16 +47,16 @@ def _convert_bags(args, scratch):
         return args
     from . import rosbag
 
-    args, topics = _take_topic_options(args)
-    prior_option = topics.pop("_prior_option", "--poses")
+    args, topics, pose_option = _take_topic_options(args)
     for i, arg in enumerate(args[1:], start=1):
         if not arg.startswith("-") and not args[i - 1].startswith("--") and rosbag.is_bag(arg):
-            converted = rosbag.bag_to_folder(arg, Path(scratch) / "frames", **topics)
+            converted = rosbag.bag_to_folder(arg, Path(scratch) / "frames",
+                                             pose_prior=pose_option is not None, **topics)
             colour = (f"{converted.color_frames} colour images from {converted.topics.color}"
                       if converted.topics.color else "no colour topic (a depth camera alone)")
             print(f"bag: {arg}: {converted.depth_frames} depth images from "
                   f"{converted.topics.depth}; {colour}", file=sys.stderr)
-            poses = [prior_option, str(converted.prior)] if converted.prior else []
+            poses = [pose_option, str(converted.prior)] if converted.prior else []
             return [*args[:i], str(converted.folder), *args[i + 1:], *poses]
     return args
 

@@ -137,30 +137,26 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
     pruned += l.pruned;
     by_appearance += l.closure.report.accepted() && l.closure.candidate.by_appearance;
   }
-  std::size_t from_features = 0, from_prior = 0, degenerate = 0, unmeasured = 0, fallbacks = 0;
+  const OdometryFrameCounts counts = count_odometry_frames(r.slam.odometry.frames);
+  const MotionPriorDifference& prior = counts.prior_difference;
+  std::size_t unmeasured = 0;
   for (const registration::OdometryFrame& f : r.slam.odometry.frames) {
-    from_features += f.from_features;
-    from_prior += f.from_motion_prior;
-    degenerate += f.degenerate;
     unmeasured +=
         f.degenerate && !f.photometric && !f.scanned && !f.from_features && !f.from_motion_prior;
-    fallbacks += f.fallback;
   }
-  const MotionPriorDifference prior =
-      count_odometry_frames(r.slam.odometry.frames).prior_difference;
   return {{"poses_given", r.slam.poses_given},
           {"loop_candidates", r.slam.loop_candidates},
           {"appearance_candidates", r.slam.appearance_candidates},
           {"loop_closures_accepted", accepted},
           {"loop_closures_by_appearance", by_appearance},
-          {"frames_from_features", from_features},
-          {"frames_from_motion_prior", from_prior},
+          {"frames_from_features", counts.from_features},
+          {"frames_from_motion_prior", counts.motion_prior_frames},
           {"motion_prior_difference_median_m", prior.median_m},
           {"motion_prior_difference_max_m", prior.max_m},
           {"motion_prior_difference_max_deg", prior.max_deg},
-          {"degenerate_frames", degenerate},
+          {"degenerate_frames", counts.degenerate_frames},
           {"degenerate_frames_unmeasured", unmeasured},
-          {"fallback_frames", fallbacks},
+          {"fallback_frames", counts.fallbacks},
           {"loop_closures_pruned", pruned},
           {"pose_graph_converged", r.slam.final_graph.converged},
           {"map_points", r.map.size()}};
