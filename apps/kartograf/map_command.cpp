@@ -180,6 +180,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
       << info.device << ")\n";
   out << "  " << io::describe_input(run.opened) << "\n";
   print_summary(out, result, evaluation);
+  out << prior_clock_line(o.run, run, result.slam.odometry.poses, result.slam.odometry.timestamps);
   out << "  report: " << (o.out_dir / "report.html").string() << "\n";
   return 0;
 }

@@ -13,6 +13,7 @@
 #include "backend_option.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/trajectory.hpp"
+#include "kartograf/eval/clock_offset.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/pipeline/tracking_choices.hpp"
@@ -93,8 +94,8 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
   command
       .add_option("--prior-time-offset", o.prior_time_offset,
                   "Seconds the --motion-prior FILE's clock is ahead of the frames' timestamps "
-                  "(its pose for a frame is read at the frame's time plus this); a wrong one "
-                  "shows in the summary's 'its steps off by'")
+                  "(its pose for a frame is read at the frame's time plus this); the summary's "
+                  "'motion prior clock' line measures it from how the camera turned")
       ->check(finite_in(-10.0, 10.0));
   add_pose_mount_option(command, o.pose_mount);
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
@@ -186,10 +187,15 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const s
   range.units_per_metre = run.opened.sequence->depth_units_per_metre();
   pipeline::check_depth_usable(*run.opened.sequence, range);
   run.source = std::make_unique<pipeline::SequenceFrameSource>(*run.opened.sequence);
-  if (!options.motion_prior.empty()) {
+  if (prior_file) {
+    const std::string named = "odometry --motion-prior";
+    run.prior_poses = read_pose_file(named, options.motion_prior);
+    run.source->set_motion_prior(pose_file_lookup(named, run.prior_poses, options.motion_prior,
+                                                  !run.opened.detected.has_timestamps,
+                                                  run.pose_mount, options.prior_time_offset));
+  } else if (!options.motion_prior.empty()) {
     run.source->set_motion_prior(
-        known_pose_lookup("odometry", options.motion_prior, !run.opened.detected.has_timestamps,
-                          "--motion-prior", run.pose_mount, options.prior_time_offset));
+        known_pose_lookup("odometry", options.motion_prior, !run.opened.detected.has_timestamps));
   }
   return run;
 }
@@ -358,10 +364,23 @@ mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std
       return *images.ground_truth;
     };
   }
-  auto trajectory = std::make_shared<Trajectory>(io::read_tum_trajectory(poses));
-  require(!trajectory->empty(), named + ": '" + poses + "' holds no pose");
+  return pose_file_lookup(named, read_pose_file(named, poses), poses, by_frame_number, mount,
+                          time_offset);
+}
+
+std::shared_ptr<const Trajectory> read_pose_file(const std::string& named,
+                                                 const std::string& file) {
+  auto trajectory = std::make_shared<Trajectory>(io::read_tum_trajectory(file));
+  require(!trajectory->empty(), named + ": '" + file + "' holds no pose");
   std::sort(trajectory->begin(), trajectory->end(),
             [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  return trajectory;
+}
+
+mapping::KnownPoseLookup pose_file_lookup(const std::string& named,
+                                          std::shared_ptr<const Trajectory> trajectory,
+                                          const std::string& poses, bool by_frame_number,
+                                          const Eigen::Isometry3d& mount, double time_offset) {
   return [named, trajectory, poses, by_frame_number, mount, time_offset](
              std::size_t i, const registration::RgbdImages& images) {
     const double stamp = by_frame_number ? static_cast<double>(i) : images.timestamp + time_offset;
@@ -372,6 +391,51 @@ mapping::KnownPoseLookup known_pose_lookup(const std::string& command, const std
                 "), nor two at most 0.5 s apart around it");
     return Eigen::Isometry3d(*pose * mount);
   };
+}
+
+namespace {
+
+std::string signed_seconds(double s) {
+  char text[32];
+  std::snprintf(text, sizeof(text), "%+.3f s", s);
+  return text;
+}
+
+}  // namespace
+
+std::string prior_clock_line(const SequenceRunOptions& options, const OpenedRun& run,
+                             const std::vector<Eigen::Isometry3d>& poses,
+                             const std::vector<double>& timestamps) {
+  if (!run.prior_poses || !run.opened.detected.has_timestamps || poses.size() < 2) return "";
+  eval::ClockOffsetSearch search;
+  search.given_s = options.prior_time_offset;
+  const eval::ClockOffsetEstimate e = eval::estimate_clock_offset(
+      stamped_trajectory(poses, timestamps, true), *run.prior_poses, search);
+  const std::string head = "  motion prior clock: ";
+  if (e.steps == 0) {
+    return head + "not measured (the file's poses do not span the frames' times +- " +
+           std::to_string(static_cast<int>(1000 * search.half_range_s)) + " ms)\n";
+  }
+  if (!e.observable) {
+    return head + "not measurable from this run (" + std::to_string(e.steps) +
+           " steps compared; the camera must turn, and not at one rate)\n";
+  }
+  char line[320];
+  if (std::fabs(e.offset_s - search.given_s) <= std::max(3 * e.sigma_s, 0.005)) {
+    std::snprintf(line, sizeof(line),
+                  "agrees with the offset in use (%s; best match %s +- %.1f ms, turning off by "
+                  "%.2f deg a step)\n",
+                  signed_seconds(search.given_s).c_str(), signed_seconds(e.offset_s).c_str(),
+                  1000 * e.sigma_s, e.rms_deg);
+  } else {
+    std::snprintf(line, sizeof(line),
+                  "its turning matches best read at %s (+- %.1f ms) from the frames' timestamps, "
+                  "not %s as in use (turning off by %.2f deg a step there, %.2f in use): try "
+                  "--prior-time-offset %.3f\n",
+                  signed_seconds(e.offset_s).c_str(), 1000 * e.sigma_s,
+                  signed_seconds(search.given_s).c_str(), e.rms_deg, e.given_rms_deg, e.offset_s);
+  }
+  return head + line;
 }
 
 }  // namespace kartograf::cli

@@ -60,6 +60,8 @@ struct OpenedRun {
   io::OpenedSequence opened;
   std::unique_ptr<pipeline::SequenceFrameSource> source;
   Eigen::Isometry3d pose_mount = Eigen::Isometry3d::Identity();  // --pose-mount
+  // The --motion-prior FILE's poses, sorted by time (null without one).
+  std::shared_ptr<const Trajectory> prior_poses;
 };
 // --pose-mount checked against `poses` (the command's --poses, if it has one) and the motion
 // prior, open_input, --prior-time-offset refused without a prior file or timestamps, then the
@@ -129,5 +131,20 @@ mapping::KnownPoseLookup known_pose_lookup(
     const std::string& command, const std::string& poses, bool by_frame_number,
     const std::string& option = "--poses",
     const Eigen::Isometry3d& mount = Eigen::Isometry3d::Identity(), double time_offset = 0);
+// A TUM pose file sorted by time; an Error naming `named` and the file where it holds no pose.
+std::shared_ptr<const Trajectory> read_pose_file(const std::string& named, const std::string& file);
+// known_pose_lookup's rule over a file read already (`poses`: its name, for the errors).
+mapping::KnownPoseLookup pose_file_lookup(const std::string& named,
+                                          std::shared_ptr<const Trajectory> trajectory,
+                                          const std::string& poses, bool by_frame_number,
+                                          const Eigen::Isometry3d& mount, double time_offset);
+
+// "  motion prior clock: ..." and a newline: how well the --motion-prior FILE's turning agrees
+// with the estimated trajectory's, at the offset in use and at the best one
+// (eval::estimate_clock_offset), with the option to pass when they differ; empty without a prior
+// file or timestamps.
+std::string prior_clock_line(const SequenceRunOptions& options, const OpenedRun& run,
+                             const std::vector<Eigen::Isometry3d>& poses,
+                             const std::vector<double>& timestamps);
 
 }  // namespace kartograf::cli
