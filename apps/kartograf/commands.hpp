@@ -48,6 +48,7 @@ struct EvalOptions {
   bool sim3 = false;                  // traj
   double max_difference = 0.02;       // traj
   std::size_t worst_steps = 0;        // traj: 0 lists none
+  std::string offset = "0";           // traj: seconds added to the estimate's stamps, or "auto"
   double threshold = 0.8;             // planes
 };
 CLI::App* add_eval_command(CLI::App& app, EvalOptions& options);

@@ -1,6 +1,7 @@
 // `kartograf eval traj|planes|rooms|semantic`: reads the files, calls kartograf::eval, prints a
 // table (or one JSON object with --json; kartograf/outputs/eval_report.hpp). No metric is computed
 // here.
+#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -13,6 +14,7 @@
 
 #include "commands.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/eval/clock_offset.hpp"
 #include "kartograf/eval/plane_metrics.hpp"
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/eval/semantic_metrics.hpp"
@@ -33,9 +35,33 @@ std::vector<double> timestamps(const Trajectory& trajectory) {
   return times;
 }
 
+Trajectory sorted_by_time(Trajectory trajectory) {
+  std::stable_sort(
+      trajectory.begin(), trajectory.end(),
+      [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  return trajectory;
+}
+
+// --offset: the number given, or measured from the turning rates ("auto"; an Error where they
+// cannot tell it).
+io::TimeOffset time_offset(const EvalOptions& options, const Trajectory& ground_truth,
+                           const Trajectory& estimate) {
+  if (options.offset != "auto") return {std::stod(options.offset), std::nullopt};
+  const eval::ClockOffsetEstimate measured =
+      eval::estimate_clock_offset(sorted_by_time(estimate), sorted_by_time(ground_truth));
+  require(measured.observable,
+          "--offset auto: the clock offset is not measurable from these trajectories (" +
+              std::to_string(measured.steps) +
+              " steps compared within +-0.5 s of the other's times; they must turn, and not at "
+              "one rate): give --offset S");
+  return {measured.offset_s, measured};
+}
+
 io::MetricReport trajectory_report(const EvalOptions& options) {
   const Trajectory ground_truth = io::read_tum_trajectory(options.ground_truth);
-  const Trajectory estimate = io::read_tum_trajectory(options.prediction);
+  Trajectory estimate = io::read_tum_trajectory(options.prediction);
+  const io::TimeOffset offset = time_offset(options, ground_truth, estimate);
+  for (StampedPose& pose : estimate) pose.timestamp += offset.seconds;
   const auto pairs = io::associate_timestamps(timestamps(ground_truth), timestamps(estimate),
                                               options.max_difference);
   require(!pairs.empty(), "no estimated pose has a ground-truth pose within --max-difference " +
@@ -54,6 +80,7 @@ io::MetricReport trajectory_report(const EvalOptions& options) {
   input.estimate_poses = estimate.size();
   input.matched_poses = matched.size();
   input.max_difference_s = options.max_difference;
+  input.offset = offset;
   input.sim3 = options.sim3;
   input.delta = options.delta;
   input.delta_unit = options.delta_unit;
@@ -122,6 +149,12 @@ CLI::App* add_eval_command(CLI::App& app, EvalOptions& options) {
   traj->add_option("--max-difference", options.max_difference,
                    "Largest timestamp difference of a matched pose pair [s]")
       ->check(finite_number())
+      ->capture_default_str();
+  traj->add_option("--offset", options.offset,
+                   "Seconds added to the estimate's timestamps before matching (its clock's lag "
+                   "behind the ground truth's, as TUM's associate.py --offset); auto: measured "
+                   "from how fast both trajectories turn (within +-0.5 s)")
+      ->check(finite_number_or("auto"))
       ->capture_default_str();
 
   CLI::App* planes = add_metric("planes", "SegComp scores of a plane label image",

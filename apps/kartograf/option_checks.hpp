@@ -58,6 +58,20 @@ inline CLI::Validator finite_number() {
       "finite NUMBER");
 }
 
+// Any finite value, or the word `word` (e.g. "auto").
+inline CLI::Validator finite_number_or(const std::string& word) {
+  return CLI::Validator(
+      [word](std::string& input) -> std::string {
+        if (input == word) return {};
+        double value = 0;
+        if (!CLI::detail::lexical_cast(input, value) || !std::isfinite(value)) {
+          return "'" + input + "' is neither a finite number nor '" + word + "'";
+        }
+        return {};
+      },
+      "finite NUMBER or " + word);
+}
+
 // 0 <= value <= max, an integer written with digits only: CLI11 reads "-5" into an unsigned
 // option as 2^64 - 5, which no range check on the value can tell from a large number.
 inline CLI::Validator whole_number(std::uint64_t max) {

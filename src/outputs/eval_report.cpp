@@ -119,6 +119,20 @@ MetricReport image_pair_report(std::string title, const std::string& ground_trut
   return report;
 }
 
+// The offset added to the estimate's timestamps: a row, and a note where it was measured.
+void add_time_offset(MetricReport& report, const TimeOffset& offset) {
+  report.add("time_offset_s", offset.seconds, "seconds added to the estimate's timestamps");
+  if (!offset.measured) return;
+  const eval::ClockOffsetEstimate& m = *offset.measured;
+  char line[200];
+  std::snprintf(line, sizeof(line),
+                "time offset measured from the turning rates (--offset auto): %+.4f s +- %.1f ms "
+                "over %zu steps, rotation disagreement %.3f deg a step (%.3f at 0)",
+                m.offset_s, 1000 * m.sigma_s, m.steps, m.rms_deg, m.given_rms_deg);
+  report.note(line);
+  report.add_number("time_offset_sigma_s", m.sigma_s);
+}
+
 }  // namespace
 
 MetricReport trajectory_report(const eval::TrajectoryEvaluation& result,
@@ -144,6 +158,7 @@ MetricReport trajectory_report(const eval::TrajectoryEvaluation& result,
   report.add("rpe_rot_deg", result.rpe.rotation_deg.rmse, "RPE rotation RMSE [deg]");
   report.add("rpe_pairs", count(result.rpe.translation_m.count), "pose pairs in the RPE");
   report.add("matched_poses", count(input.matched_poses), "pose pairs matched by timestamp");
+  add_time_offset(report, input.offset);
   report.add("scale", result.ate.alignment.scale, "scale of the alignment (1 unless --sim3)");
   report.add_text("alignment", input.sim3 ? "sim3" : "se3");
   report.add_number("delta", input.delta);

@@ -8,6 +8,7 @@
 #include <string>
 #include <vector>
 
+#include "kartograf/eval/clock_offset.hpp"
 #include "kartograf/eval/plane_metrics.hpp"
 #include "kartograf/eval/room_metrics.hpp"
 #include "kartograf/eval/semantic_metrics.hpp"
@@ -54,13 +55,21 @@ class MetricReport {
 };
 
 // A trajectory's ATE and RPE (eval::evaluate_trajectory) and what it was computed from.
+// Seconds added to an estimate's timestamps before matching, and how they were measured where
+// they were (eval::estimate_clock_offset).
+struct TimeOffset {
+  double seconds = 0;
+  std::optional<eval::ClockOffsetEstimate> measured;
+};
+
 struct TrajectoryReportInput {
   std::string ground_truth_file, estimate_file;
   std::size_t ground_truth_poses = 0, estimate_poses = 0, matched_poses = 0;
   double max_difference_s = 0;  // of a matched pair's timestamps
-  bool sim3 = false;            // the alignment: Sim(3), else SE(3)
-  double delta = 1;             // the RPE's step
-  std::string delta_unit;       // frames | seconds
+  TimeOffset offset;
+  bool sim3 = false;       // the alignment: Sim(3), else SE(3)
+  double delta = 1;        // the RPE's step
+  std::string delta_unit;  // frames | seconds
 };
 MetricReport trajectory_report(const eval::TrajectoryEvaluation& result,
                                const TrajectoryReportInput& input);
