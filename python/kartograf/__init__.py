@@ -33,6 +33,7 @@ from .mapping import Mapper, run_slam  # noqa: E402
 from .odometry import Odometry, run_odometry  # noqa: E402
 from .results import (  # noqa: E402
     Ate,
+    ClockOffset,
     Cloud,
     DistanceField,
     FrameReport,
@@ -46,6 +47,7 @@ from .results import (  # noqa: E402
     StepError,
     WorstSteps,
     ate,
+    clock_offset,
     worst_steps,
 )
 from .scene import (  # noqa: E402
@@ -98,6 +100,8 @@ __all__ = [
     "ViewLabels",
     "WorstSteps",
     "ate",
+    "ClockOffset",
+    "clock_offset",
     "backends",
     "evaluate_rooms",
     "extract_planes",

@@ -57,6 +57,30 @@ def worst_steps(estimate: np.ndarray, ground_truth: list, count: int = 10,
 
 
 @dataclass
+class ClockOffset:
+    """Another sensor's clock lead over a trajectory's, measured from how fast both turn."""
+
+    offset_s: float  # read the other trajectory at a pose's time + offset_s
+    sigma_s: float  # its standard error (inf where the turning cannot tell it)
+    rms_deg: float  # the steps' rotation disagreement at offset_s (deg a step)
+    given_rms_deg: float  # and at the offset given
+    steps: int  # steps compared
+    observable: bool  # inside the search range and known to 10 ms
+
+
+def clock_offset(times: np.ndarray, poses: np.ndarray, other_times: np.ndarray,
+                 other_poses: np.ndarray, given: float = 0.0,
+                 half_range: float = 0.5) -> ClockOffset:
+    """The clock offset between two trajectories of one body (N times and N x 4 x 4 poses each;
+    say a camera's odometry and a robot's wheel odometry), searched within given +- half_range
+    seconds: the steps of the sparser one turn by the angles the other turns over the same spans
+    read `offset_s` later. Mounts and translation scale do not matter; see docs/slam.md."""
+    arrays = [np.ascontiguousarray(a, dtype=np.float64)
+              for a in (times, poses, other_times, other_poses)]
+    return ClockOffset(**_kartograf.clock_offset(*arrays, given, half_range))
+
+
+@dataclass
 class FrameReport:
     """What the odometry did with one frame (see registration/odometry.hpp)."""
 

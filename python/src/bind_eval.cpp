@@ -2,6 +2,8 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
+#include <algorithm>
+#include <cmath>
 #include <optional>
 #include <string>
 #include <vector>
@@ -9,6 +11,7 @@
 #include "bindings.hpp"
 #include "convert.hpp"
 #include "kartograf/core/error.hpp"
+#include "kartograf/eval/clock_offset.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
 
 namespace kartograf::python {
@@ -93,6 +96,45 @@ nb::dict worst_steps(const PoseStack& estimate, const nb::list& ground_truth, st
   return d;
 }
 
+using Times = nb::ndarray<const double, nb::shape<-1>, nb::device::cpu>;
+
+// Times and poses of one trajectory, sorted by time; an Error naming `what` where their counts
+// differ or a time is not finite.
+Trajectory trajectory_of(const Times& times, const PoseStack& poses, const std::string& what) {
+  require(times.shape(0) == poses.shape(0), what + ": " + std::to_string(times.shape(0)) +
+                                                " times but " + std::to_string(poses.shape(0)) +
+                                                " poses");
+  const std::vector<Eigen::Isometry3d> matrices = poses_of(poses, what.c_str());
+  Trajectory trajectory;
+  const auto view = times.view();
+  for (std::size_t i = 0; i < matrices.size(); ++i) {
+    require(std::isfinite(view(i)), what + ": time " + std::to_string(i) + " is not finite");
+    trajectory.push_back({view(i), matrices[i]});
+  }
+  std::stable_sort(
+      trajectory.begin(), trajectory.end(),
+      [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  return trajectory;
+}
+
+nb::dict clock_offset(const Times& times, const PoseStack& poses, const Times& other_times,
+                      const PoseStack& other_poses, double given, double half_range) {
+  eval::ClockOffsetSearch search;
+  search.given_s = given;
+  search.half_range_s = half_range;
+  const eval::ClockOffsetEstimate e = eval::estimate_clock_offset(
+      trajectory_of(times, poses, "clock_offset: trajectory"),
+      trajectory_of(other_times, other_poses, "clock_offset: other"), search);
+  nb::dict d;
+  d["offset_s"] = e.offset_s;
+  d["sigma_s"] = e.sigma_s;
+  d["rms_deg"] = e.rms_deg;
+  d["given_rms_deg"] = e.given_rms_deg;
+  d["steps"] = e.steps;
+  d["observable"] = e.observable;
+  return d;
+}
+
 }  // namespace
 
 void bind_eval(nb::module_& m) {
@@ -102,6 +144,9 @@ void bind_eval(nb::module_& m) {
         nb::arg("count") = 10, nb::arg("align") = "se3",
         "The steps with the largest error, each with the ATE with that step from the ground "
         "truth (kartograf eval traj --worst-steps)");
+  m.def("clock_offset", &clock_offset, nb::arg("times"), nb::arg("poses"), nb::arg("other_times"),
+        nb::arg("other_poses"), nb::arg("given") = 0.0, nb::arg("half_range") = 0.5,
+        "The other trajectory's clock lead from how fast both turn (eval::estimate_clock_offset)");
 }
 
 }  // namespace kartograf::python

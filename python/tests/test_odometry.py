@@ -131,3 +131,27 @@ def test_real_frames_track_and_score(cpu, data_dir):
     run = kg.run_odometry(cpu, kg.open_sequence(data_dir / "7scenes_redkitchen", frames=20))
     assert run.ate().rmse_m < 0.05
     assert run.frames_per_second > 0
+
+
+def _turning_body(times):
+    """A body turning unevenly about z while driving along x: N x 4 x 4 poses."""
+    yaw = 0.8 * np.sin(1.3 * times) + 0.3 * np.sin(3.1 * times)
+    poses = np.tile(np.eye(4), (len(times), 1, 1))
+    poses[:, 0, 0] = poses[:, 1, 1] = np.cos(yaw)
+    poses[:, 1, 0] = np.sin(yaw)
+    poses[:, 0, 1] = -np.sin(yaw)
+    poses[:, 0, 3] = 0.3 * times
+    return poses
+
+
+def test_clock_offset_finds_a_wheel_odometrys_lead():
+    frames = np.arange(0.0, 20.0, 1 / 30)
+    wheels = np.arange(-2.0, 22.0, 0.1)
+    # The wheels' clock runs 40 ms ahead: the pose they stamp t + 0.04 is the body's at t.
+    lead = kg.clock_offset(frames, _turning_body(frames), wheels + 0.04, _turning_body(wheels))
+    assert lead.observable and abs(lead.offset_s - 0.04) < 0.002, lead
+    assert lead.given_rms_deg > lead.rms_deg
+    still = np.tile(np.eye(4), (len(frames), 1, 1))
+    assert not kg.clock_offset(frames, still, frames, still).observable
+    with pytest.raises(kg.Error, match="times but"):
+        kg.clock_offset(frames[:5], _turning_body(frames), wheels, _turning_body(wheels))
