@@ -7,6 +7,7 @@
 #include <charconv>
 #include <cmath>
 #include <cstdint>
+#include <optional>
 #include <sstream>
 #include <string>
 #include <system_error>
@@ -15,6 +16,13 @@
 
 namespace kartograf::cli {
 
+// The number `input` reads as where it is one and finite.
+inline std::optional<double> finite_value(const std::string& input) {
+  double value = 0;
+  if (!CLI::detail::lexical_cast(input, value) || !std::isfinite(value)) return std::nullopt;
+  return value;
+}
+
 // min <= value <= max, finite; `description` is what the help shows.
 inline CLI::Validator finite_in(double min, double max, std::string description = "") {
   std::ostringstream range;
@@ -22,9 +30,8 @@ inline CLI::Validator finite_in(double min, double max, std::string description 
   if (description.empty()) description = "NUMBER in " + range.str();
   return CLI::Validator(
       [min, max, range = range.str()](std::string& input) -> std::string {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(input, value) || !std::isfinite(value) || value < min ||
-            value > max) {
+        const std::optional<double> value = finite_value(input);
+        if (!value || *value < min || *value > max) {
           return "'" + input + "' is not a finite number in " + range;
         }
         return {};
@@ -36,8 +43,8 @@ inline CLI::Validator finite_in(double min, double max, std::string description 
 inline CLI::Validator finite_positive() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(input, value) || !std::isfinite(value) || !(value > 0)) {
+        const std::optional<double> value = finite_value(input);
+        if (!value || !(*value > 0)) {
           return "'" + input + "' is not a finite number > 0";
         }
         return {};
@@ -49,10 +56,7 @@ inline CLI::Validator finite_positive() {
 inline CLI::Validator finite_number() {
   return CLI::Validator(
       [](std::string& input) -> std::string {
-        double value = 0;
-        if (!CLI::detail::lexical_cast(input, value) || !std::isfinite(value)) {
-          return "'" + input + "' is not a finite number";
-        }
+        if (!finite_value(input)) return "'" + input + "' is not a finite number";
         return {};
       },
       "finite NUMBER");
@@ -62,12 +66,8 @@ inline CLI::Validator finite_number() {
 inline CLI::Validator finite_number_or(const std::string& word) {
   return CLI::Validator(
       [word](std::string& input) -> std::string {
-        if (input == word) return {};
-        double value = 0;
-        if (!CLI::detail::lexical_cast(input, value) || !std::isfinite(value)) {
-          return "'" + input + "' is neither a finite number nor '" + word + "'";
-        }
-        return {};
+        if (input == word || finite_value(input)) return {};
+        return "'" + input + "' is neither a finite number nor '" + word + "'";
       },
       "finite NUMBER or " + word);
 }
