@@ -209,6 +209,7 @@ Json report_of(bool with_evaluation) {
     "slam": {"loop_candidates": 3, "loop_closures_accepted": 1, "loop_closures_pruned": 0,
              "pose_graph_converged": true, "map_points": 1000, "degenerate_frames": 7,
              "degenerate_frames_unmeasured": 4, "fallback_frames": 1,
+             "degenerate_unmeasured_poses": [3, 5, 9, 12], "fallback_poses": [7],
              "frames_from_motion_prior": 19, "motion_prior_difference_median_m": 0.0004,
              "motion_prior_difference_max_m": 0.0123, "motion_prior_difference_max_deg": 0.5},
     "views": {"labelled": 3, "unlabelled": 1, "first_unlabelled_reason": "no floor"},
@@ -276,7 +277,10 @@ TEST(MapReportHtml, SummaryAndMetricsFirstThenPicturesPlotsConfusionAnd3dView) {
   // Where the trajectory is the motion model's: degenerate views no image or feature measured.
   EXPECT_NE(page.at("7 degenerate views <span class=\"note\">(4 with no image or feature"),
             std::string::npos);
-  EXPECT_NE(page.at(", 1 fallbacks"), std::string::npos);
+  EXPECT_NE(page.at(", poses 3, 5, 9, 12 of trajectory.txt counting from 0: there the trajectory "
+                    "is the motion model's"),
+            std::string::npos);  // which poses to distrust
+  EXPECT_NE(page.at(", 1 fallbacks, pose 7 of trajectory.txt"), std::string::npos);
   // How far the steps taken were from the motion prior's (its slip or a wrong mount).
   EXPECT_NE(page.at(", 19 steps predicted by the motion prior (the steps taken differ from its "
                     "by median 0.4 mm, at most 1.23 cm)"),

@@ -139,10 +139,12 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
   }
   const OdometryFrameCounts counts = count_odometry_frames(r.slam.odometry.frames);
   const MotionPriorDifference& prior = counts.prior_difference;
-  std::size_t unmeasured = 0;
+  // Their poses (indices into the trajectory, from 0) too: where to distrust it.
+  std::vector<std::size_t> unmeasured, fallbacks;
   for (const registration::OdometryFrame& f : r.slam.odometry.frames) {
-    unmeasured +=
-        f.degenerate && !f.photometric && !f.scanned && !f.from_features && !f.from_motion_prior;
+    if (f.degenerate && !f.photometric && !f.scanned && !f.from_features && !f.from_motion_prior)
+      unmeasured.push_back(f.index);
+    if (f.fallback) fallbacks.push_back(f.index);
   }
   return {{"poses_given", r.slam.poses_given},
           {"loop_candidates", r.slam.loop_candidates},
@@ -155,8 +157,10 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
           {"motion_prior_difference_max_m", prior.max_m},
           {"motion_prior_difference_max_deg", prior.max_deg},
           {"degenerate_frames", counts.degenerate_frames},
-          {"degenerate_frames_unmeasured", unmeasured},
+          {"degenerate_frames_unmeasured", unmeasured.size()},
+          {"degenerate_unmeasured_poses", unmeasured},
           {"fallback_frames", counts.fallbacks},
+          {"fallback_poses", fallbacks},
           {"loop_closures_pruned", pruned},
           {"pose_graph_converged", r.slam.final_graph.converged},
           {"map_points", r.map.size()}};

@@ -56,6 +56,19 @@ void input_facts(std::ostringstream& html, const Json& r) {
   fact(html, "backend", html_escape(text_of(r["backend"]) + " (" + text_of(r["device"]) + ")"));
 }
 
+// ", poses 3, 5, 9 of trajectory.txt counting from 0" (the first 12 and how many more) from
+// the list `key` of the slam section; empty where it has none (a report of an older version).
+std::string poses_text(const Json& slam, const char* key) {
+  if (!slam.contains(key) || slam[key].empty()) return "";
+  constexpr std::size_t kShown = 12;
+  const Json& poses = slam[key];
+  std::string text = ", pose" + std::string(poses.size() > 1 ? "s " : " ");
+  for (std::size_t i = 0; i < std::min(poses.size(), kShown); ++i)
+    text += (i > 0 ? ", " : "") + text_of(poses[i]);
+  if (poses.size() > kShown) text += " and " + std::to_string(poses.size() - kShown) + " more";
+  return text + " of trajectory.txt counting from 0";
+}
+
 // What came out: time, map, rooms, views, loops.
 void result_facts(std::ostringstream& html, const Json& r) {
   const double total = r["timing_s"]["total"].get<double>();
@@ -91,9 +104,11 @@ void result_facts(std::ostringstream& html, const Json& r) {
     std::string tracking = text_of(slam["degenerate_frames"]) + " degenerate views";
     if (slam["degenerate_frames_unmeasured"] != 0)
       tracking += " <span class=\"note\">(" + text_of(slam["degenerate_frames_unmeasured"]) +
-                  " with no image or feature to measure what their geometry leaves free: there "
-                  "the trajectory is the motion model's)</span>";
-    tracking += ", " + text_of(slam["fallback_frames"]) + " fallbacks";
+                  " with no image or feature to measure what their geometry leaves free" +
+                  poses_text(slam, "degenerate_unmeasured_poses") +
+                  ": there the trajectory is the motion model's)</span>";
+    tracking +=
+        ", " + text_of(slam["fallback_frames"]) + " fallbacks" + poses_text(slam, "fallback_poses");
     if (slam.value("frames_from_motion_prior", 0) > 0)
       tracking += ", " + text_of(slam["frames_from_motion_prior"]) +
                   " steps predicted by the motion prior (the steps taken differ from its by "
