@@ -358,6 +358,8 @@ named=$(sed -n 's/.*motion prior clock: .* try --prior-time-offset \([0-9.]*\)$/
 awk -v s="$named" 'BEGIN { exit !(s != "" && s > 0.03 && s < 0.05) }' || { cat "$1/hand.log"; echo "FAIL: the clock offset named '$named' (0.04)"; exit 1; }
 "$0" odometry "$1/hand" --first 20 --motion-prior "$1/hand_ahead.txt" --prior-time-offset 0.04 --out "$1/hand.txt" --force > "$1/hand_right.log" 2>&1 || { cat "$1/hand_right.log"; exit 1; }
 grep -q "motion prior clock: agrees with the offset in use (+0.040 s" "$1/hand_right.log" || { cat "$1/hand_right.log"; echo "FAIL: the right offset not agreed with"; exit 1; }
+"$0" map "$1/hand" --first 20 --no-features --motion-prior "$1/hand_ahead.txt" --out "$1/hand_map" --no-progress > "$1/hand_map.log" 2>&1 || { cat "$1/hand_map.log"; echo "FAIL: map with the prior"; exit 1; }
+grep -q "motion prior clock: its turning matches best read at +0.0[345]" "$1/hand_map.log" && grep -q '"agrees": false' "$1/hand_map/report.json" && grep -q "the prior's clock: its turning matches" "$1/hand_map/report.html" || { cat "$1/hand_map.log"; echo "FAIL: the map's report of the clock"; exit 1; }
 fails_with "$1/err" "--prior-time-offset: no --motion-prior FILE to apply it to" -- "$0" odometry "$1/syn" --prior-time-offset 0.1 --out "$1/x.txt" || exit 1
 fails_with "$1/err" "has no timestamps" -- "$0" odometry "$1/seq" --motion-prior "$1/plain.txt" --prior-time-offset 0.1 --out "$1/x.txt" || exit 1
 # --pose-mount: a file of a body's poses (base = camera x mount^-1) and the camera's pose on it give

@@ -198,7 +198,7 @@ TEST(ReportSvg, ALinePlotHasEverySampleAndTheReferenceLine) {
 
 // report.json as report_json writes it (the members the page reads).
 Json report_of(bool with_evaluation) {
-  Json r = Json::parse(R"({"format": "kartograf-map-report", "version": 1,
+  Json r = Json::parse(R"json({"format": "kartograf-map-report", "version": 1,
     "sequence": "/data/a<b>&c", "layout": "synthetic", "backend": "cpu", "device": "cpu", "frames": 20,
     "input": {"camera": {"fx": 535.4, "fy": 539.2, "cx": 320.1, "cy": 247.6, "width": 640,
               "height": 480, "source": "preset", "description": "tum-fr3"},
@@ -211,11 +211,13 @@ Json report_of(bool with_evaluation) {
              "degenerate_frames_unmeasured": 4, "fallback_frames": 1,
              "degenerate_unmeasured_poses": [3, 5, 9, 12], "fallback_poses": [7],
              "frames_from_motion_prior": 19, "motion_prior_difference_median_m": 0.0004,
-             "motion_prior_difference_max_m": 0.0123, "motion_prior_difference_max_deg": 0.5},
+             "motion_prior_difference_max_m": 0.0123, "motion_prior_difference_max_deg": 0.5,
+             "motion_prior_clock": {"text": "its turning matches best read at +0.040 s (+- 0.2 ms)",
+                                    "agrees": false}},
     "views": {"labelled": 3, "unlabelled": 1, "first_unlabelled_reason": "no floor"},
     "planes": {"count": 3, "by_class": {"floor": 1, "wall": 2}},
     "grid": {"width": 10, "height": 20, "resolution_m": 0.05, "objects": {}},
-    "rooms": {"method": "distance", "count": 2, "enclosed_cells_taken": 0}})");
+    "rooms": {"method": "distance", "count": 2, "enclosed_cells_taken": 0}})json");
   if (with_evaluation)
     r["evaluation"] = Json::parse(R"({
       "trajectory": {"ate_rmse_m": 0.0123, "ate_max_m": 0.03, "rpe_translation_rmse_m": 0.002,
@@ -285,6 +287,9 @@ TEST(MapReportHtml, SummaryAndMetricsFirstThenPicturesPlotsConfusionAnd3dView) {
   EXPECT_NE(page.at(", 19 steps predicted by the motion prior (the steps taken differ from its "
                     "by median 0.4 mm, at most 1.23 cm)"),
             std::string::npos);
+  EXPECT_NE(page.at("at most 1.23 cm); the prior's clock: its turning matches best read at "
+                    "+0.040 s (+- 0.2 ms)"),
+            std::string::npos);                                             // as the summary says
   EXPECT_NE(page.at("1.23 cm"), std::string::npos);                         // the ATE
   EXPECT_NE(page.at("class=\"value missed\">1.23 cm"), std::string::npos);  // target 1 cm
   EXPECT_NE(page.at("odometry alone: ATE RMSE"), std::string::npos);        // before loop closure

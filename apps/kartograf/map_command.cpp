@@ -170,7 +170,9 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   std::optional<pipeline::MapEvaluation> evaluation;
   if (!truth.poses.empty()) evaluation = pipeline::evaluate_map(result, truth);
 
-  const io::MapRunInfo info = io::map_run_info(run_record(o.run, context), run.opened, params);
+  io::MapRunInfo info = io::map_run_info(run_record(o.run, context), run.opened, params);
+  info.prior_clock =
+      measure_prior_clock(o.run, run, result.slam.odometry.poses, result.slam.odometry.timestamps);
   {
     const InterruptsDeferred writing;  // a signal waits for the files, then drops them
     io::write_map_outputs(folder.dir(), result, evaluation, info);
@@ -180,7 +182,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
       << info.device << ")\n";
   out << "  " << io::describe_input(run.opened) << "\n";
   print_summary(out, result, evaluation);
-  out << prior_clock_line(o.run, run, result.slam.odometry.poses, result.slam.odometry.timestamps);
+  out << prior_clock_line(info.prior_clock);
   out << "  report: " << (o.out_dir / "report.html").string() << "\n";
   return 0;
 }

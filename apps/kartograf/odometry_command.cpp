@@ -66,7 +66,7 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
                 1000.0 * result.timing.load_seconds / std::max(frames, 1.0));
   out << line;
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.frames)) << "\n";
-  out << prior_clock_line(o.run, run, result.poses, result.timestamps);
+  out << prior_clock_line(measure_prior_clock(o.run, run, result.poses, result.timestamps));
   out << model_tracking_line(result);
   if (ate) {
     std::snprintf(line, sizeof(line), "  ate_rmse_m %.6f (max %.6f, %zu poses with ground truth)\n",

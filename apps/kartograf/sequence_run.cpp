@@ -13,7 +13,6 @@
 #include "backend_option.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/trajectory.hpp"
-#include "kartograf/eval/clock_offset.hpp"
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/pipeline/tracking_choices.hpp"
@@ -393,49 +392,21 @@ mapping::KnownPoseLookup pose_file_lookup(const std::string& named,
   };
 }
 
-namespace {
-
-std::string signed_seconds(double s) {
-  char text[32];
-  std::snprintf(text, sizeof(text), "%+.3f s", s);
-  return text;
-}
-
-}  // namespace
-
-std::string prior_clock_line(const SequenceRunOptions& options, const OpenedRun& run,
-                             const std::vector<Eigen::Isometry3d>& poses,
-                             const std::vector<double>& timestamps) {
-  if (!run.prior_poses || !run.opened.detected.has_timestamps || poses.size() < 2) return "";
+std::optional<io::PriorClock> measure_prior_clock(const SequenceRunOptions& options,
+                                                  const OpenedRun& run,
+                                                  const std::vector<Eigen::Isometry3d>& poses,
+                                                  const std::vector<double>& timestamps) {
+  if (!run.prior_poses || !run.opened.detected.has_timestamps || poses.size() < 2)
+    return std::nullopt;
   eval::ClockOffsetSearch search;
   search.given_s = options.prior_time_offset;
-  const eval::ClockOffsetEstimate e = eval::estimate_clock_offset(
-      stamped_trajectory(poses, timestamps, true), *run.prior_poses, search);
-  const std::string head = "  motion prior clock: ";
-  if (e.steps == 0) {
-    return head + "not measured (the file's poses do not span the frames' times +- " +
-           std::to_string(static_cast<int>(1000 * search.half_range_s)) + " ms)\n";
-  }
-  if (!e.observable) {
-    return head + "not measurable from this run (" + std::to_string(e.steps) +
-           " steps compared; the camera must turn, and not at one rate)\n";
-  }
-  char line[320];
-  if (std::fabs(e.offset_s - search.given_s) <= std::max(3 * e.sigma_s, 0.005)) {
-    std::snprintf(line, sizeof(line),
-                  "agrees with the offset in use (%s; best match %s +- %.1f ms, turning off by "
-                  "%.2f deg a step)\n",
-                  signed_seconds(search.given_s).c_str(), signed_seconds(e.offset_s).c_str(),
-                  1000 * e.sigma_s, e.rms_deg);
-  } else {
-    std::snprintf(line, sizeof(line),
-                  "its turning matches best read at %s (+- %.1f ms) from the frames' timestamps, "
-                  "not %s as in use (turning off by %.2f deg a step there, %.2f in use): try "
-                  "--prior-time-offset %.3f\n",
-                  signed_seconds(e.offset_s).c_str(), 1000 * e.sigma_s,
-                  signed_seconds(search.given_s).c_str(), e.rms_deg, e.given_rms_deg, e.offset_s);
-  }
-  return head + line;
+  return io::PriorClock{options.prior_time_offset,
+                        eval::estimate_clock_offset(stamped_trajectory(poses, timestamps, true),
+                                                    *run.prior_poses, search)};
+}
+
+std::string prior_clock_line(const std::optional<io::PriorClock>& clock) {
+  return clock ? "  motion prior clock: " + io::prior_clock_text(*clock) + "\n" : "";
 }
 
 }  // namespace kartograf::cli

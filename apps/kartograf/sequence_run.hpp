@@ -24,6 +24,7 @@
 #include "kartograf/formats/sequence_detect.hpp"
 #include "kartograf/mapping/slam.hpp"
 #include "kartograf/outputs/odometry_stats.hpp"
+#include "kartograf/outputs/prior_clock.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/registration/odometry.hpp"
 
@@ -139,12 +140,14 @@ mapping::KnownPoseLookup pose_file_lookup(const std::string& named,
                                           const std::string& poses, bool by_frame_number,
                                           const Eigen::Isometry3d& mount, double time_offset);
 
-// "  motion prior clock: ..." and a newline: how well the --motion-prior FILE's turning agrees
-// with the estimated trajectory's, at the offset in use and at the best one
-// (eval::estimate_clock_offset), with the option to pass when they differ; empty without a prior
-// file or timestamps.
-std::string prior_clock_line(const SequenceRunOptions& options, const OpenedRun& run,
-                             const std::vector<Eigen::Isometry3d>& poses,
-                             const std::vector<double>& timestamps);
+// How well the --motion-prior FILE's turning agrees with the estimated trajectory's, at the
+// offset in use and at the best one (eval::estimate_clock_offset); none without a prior file or
+// timestamps.
+std::optional<io::PriorClock> measure_prior_clock(const SequenceRunOptions& options,
+                                                  const OpenedRun& run,
+                                                  const std::vector<Eigen::Isometry3d>& poses,
+                                                  const std::vector<double>& timestamps);
+// "  motion prior clock: ..." (io::prior_clock_text) and a newline; empty without one.
+std::string prior_clock_line(const std::optional<io::PriorClock>& clock);
 
 }  // namespace kartograf::cli

@@ -85,7 +85,8 @@ void print_slam_summary(std::ostream& out, const SlamOptions& o, const OpenedRun
       << record.backend << " (" << record.device << ")\n";
   out << "  " << io::describe_input(run.opened) << "\n";
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.odometry.frames)) << "\n";
-  out << prior_clock_line(o.run, run, result.odometry.poses, result.odometry.timestamps);
+  out << prior_clock_line(
+      measure_prior_clock(o.run, run, result.odometry.poses, result.odometry.timestamps));
   out << model_tracking_line(result.odometry);
   std::snprintf(line, sizeof(line),
                 "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",

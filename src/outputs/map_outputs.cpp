@@ -139,10 +139,12 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
   }
   const OdometryFrameCounts counts = count_odometry_frames(r.slam.odometry.frames);
   const MotionPriorDifference& prior = counts.prior_difference;
-  // Their poses (indices into the trajectory, from 0) too: where to distrust it.
+  // Their poses (indices into the trajectory, from 0) too: where to distrust it. The first pose
+  // is the origin, no step of the motion model's whatever its view.
   std::vector<std::size_t> unmeasured, fallbacks;
   for (const registration::OdometryFrame& f : r.slam.odometry.frames) {
-    if (f.degenerate && !f.photometric && !f.scanned && !f.from_features && !f.from_motion_prior)
+    const bool measured = f.photometric || f.scanned || f.from_features || f.from_motion_prior;
+    if (f.index > 0 && f.degenerate && !measured)
       unmeasured.push_back(f.index);
     if (f.fallback) fallbacks.push_back(f.index);
   }
@@ -164,6 +166,20 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
           {"loop_closures_pruned", pruned},
           {"pose_graph_converged", r.slam.final_graph.converged},
           {"map_points", r.map.size()}};
+}
+
+// The motion prior file's clock as measured, and the sentence the summary prints.
+Json prior_clock_json(const PriorClock& clock) {
+  const eval::ClockOffsetEstimate& m = clock.measured;
+  return {{"offset_in_use_s", clock.given_s},
+          {"measured_offset_s", m.observable ? Json(m.offset_s) : Json()},
+          {"sigma_s", m.observable ? Json(m.sigma_s) : Json()},
+          {"rms_deg", m.rms_deg},
+          {"rms_deg_in_use", m.given_rms_deg},
+          {"steps", m.steps},
+          {"observable", m.observable},
+          {"agrees", prior_clock_agrees(clock)},
+          {"text", prior_clock_text(clock)}};
 }
 
 Json report_json(const pipeline::MapPipelineResult& r,
@@ -188,6 +204,7 @@ Json report_json(const pipeline::MapPipelineResult& r,
                       {"stages", std::move(stages)},
                       {"odometry_ms_per_frame", odometry_ms}};
   json["slam"] = slam_json(r);
+  if (info.prior_clock) json["slam"]["motion_prior_clock"] = prior_clock_json(*info.prior_clock);
   const pipeline::VolumeStats& v = r.volume;
   json["volume"] = {{"blocks", v.blocks},
                     {"peak_blocks", v.peak_blocks},

@@ -116,6 +116,9 @@ void result_facts(std::ostringstream& html, const Json& r) {
                   format_length(slam["motion_prior_difference_median_m"].get<double>()) +
                   ", at most " +
                   format_length(slam["motion_prior_difference_max_m"].get<double>()) + ")";
+    if (slam.contains("motion_prior_clock"))
+      tracking +=
+          "; the prior's clock: " + html_escape(text_of(slam["motion_prior_clock"]["text"]));
     fact(html, "tracking", tracking);
   }
 }

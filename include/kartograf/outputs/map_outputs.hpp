@@ -23,6 +23,7 @@
 #include <vector>
 
 #include "kartograf/core/image.hpp"
+#include "kartograf/outputs/prior_clock.hpp"
 #include "kartograf/pipeline/map_evaluation.hpp"
 #include "kartograf/pipeline/map_pipeline.hpp"
 
@@ -37,6 +38,7 @@ struct MapRunInfo {
   // The input as read, a JSON object (text) stored as "input": the camera, where it came from
   // (preset, file, option, default), the depth scale and the frames left out; or empty.
   std::string input_json;
+  std::optional<PriorClock> prior_clock;  // a motion prior file's clock, measured
 };
 
 // A distance field (metres) as grey levels: 0 at obstacles and inside them, 255 at 2 m or more.
