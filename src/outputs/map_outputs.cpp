@@ -144,8 +144,7 @@ Json slam_json(const pipeline::MapPipelineResult& r) {
   std::vector<std::size_t> unmeasured, fallbacks;
   for (const registration::OdometryFrame& f : r.slam.odometry.frames) {
     const bool measured = f.photometric || f.scanned || f.from_features || f.from_motion_prior;
-    if (f.index > 0 && f.degenerate && !measured)
-      unmeasured.push_back(f.index);
+    if (f.index > 0 && f.degenerate && !measured) unmeasured.push_back(f.index);
     if (f.fallback) fallbacks.push_back(f.index);
   }
   return {{"poses_given", r.slam.poses_given},
