@@ -50,7 +50,8 @@ io::TimeOffset time_offset(const EvalOptions& options, const Trajectory& ground_
   const eval::ClockOffsetEstimate measured =
       eval::estimate_clock_offset(sorted_by_time(estimate), sorted_by_time(ground_truth));
   require(measured.observable,
-          "--offset auto: the clock offset is not measurable from these trajectories (" +
+          "--offset auto: the clock offset is not measurable from '" +
+              options.ground_truth.string() + "' and '" + options.prediction.string() + "' (" +
               std::to_string(measured.steps) +
               " steps compared within +-0.5 s of the other's times; they must turn, and not at "
               "one rate): give --offset S");
