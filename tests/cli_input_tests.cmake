@@ -310,7 +310,8 @@ exit 0
 # frame number as Kartograf stamps layouts without timestamps), each frame predicted by it (in
 # --stats); a file that lacks frames and a missing file are Errors naming it, before any output;
 # on a timestamped layout a prior sampled slower than the frames is interpolated between its poses;
-# --prior-time-offset reads it on another clock, and the summary measures that clock's offset;
+# --prior-time-offset reads it on another clock, the summary measures that clock's offset, and
+# --prior-time-offset auto measures it before the run;
 # --pose-mount turns a body's poses into the camera's.
 add_test(NAME Cli.input_motion_prior
   COMMAND sh -c [=[
@@ -358,6 +359,11 @@ named=$(sed -n 's/.*motion prior clock: .* try --prior-time-offset \([0-9.]*\)$/
 awk -v s="$named" 'BEGIN { exit !(s != "" && s > 0.03 && s < 0.05) }' || { cat "$1/hand.log"; echo "FAIL: the clock offset named '$named' (0.04)"; exit 1; }
 "$0" odometry "$1/hand" --first 20 --motion-prior "$1/hand_ahead.txt" --prior-time-offset 0.04 --out "$1/hand.txt" --force > "$1/hand_right.log" 2>&1 || { cat "$1/hand_right.log"; exit 1; }
 grep -q "motion prior clock: agrees with the offset in use (+0.040 s" "$1/hand_right.log" || { cat "$1/hand_right.log"; echo "FAIL: the right offset not agreed with"; exit 1; }
+# auto: measured first (the odometry over the frames without the prior), then read at it; a run
+# too short to tell it is refused.
+"$0" odometry "$1/hand" --first 20 --motion-prior "$1/hand_ahead.txt" --prior-time-offset auto --out "$1/hand.txt" --force > "$1/hand_auto.log" 2> "$1/hand_auto.err" || { cat "$1/hand_auto.err"; echo "FAIL: --prior-time-offset auto"; exit 1; }
+grep -q "motion prior clock: +0.0[345][0-9] s (+- [0-9.]* ms) measured over the first 220 frames (--prior-time-offset auto)" "$1/hand_auto.err" && grep -q "motion prior clock: agrees with the offset in use (+0.0[345]" "$1/hand_auto.log" || { cat "$1/hand_auto.err" "$1/hand_auto.log"; echo "FAIL: the measured offset not used"; exit 1; }
+fails_with "$1/err" "--prior-time-offset auto: the motion prior's clock is not measurable from the first 13 frames" -- "$0" odometry "$1/syn" --motion-prior "$1/ten_hz.txt" --prior-time-offset auto --out "$1/x.txt" || exit 1
 "$0" map "$1/hand" --first 20 --no-features --motion-prior "$1/hand_ahead.txt" --out "$1/hand_map" --no-progress > "$1/hand_map.log" 2>&1 || { cat "$1/hand_map.log"; echo "FAIL: map with the prior"; exit 1; }
 grep -q "motion prior clock: its turning matches best read at +0.0[345]" "$1/hand_map.log" && grep -q '"agrees": false' "$1/hand_map/report.json" && grep -q "the prior's clock: its turning matches" "$1/hand_map/report.html" || { cat "$1/hand_map.log"; echo "FAIL: the map's report of the clock"; exit 1; }
 fails_with "$1/err" "--prior-time-offset: no --motion-prior FILE to apply it to" -- "$0" odometry "$1/syn" --prior-time-offset 0.1 --out "$1/x.txt" || exit 1

@@ -100,8 +100,10 @@ struct SequenceRunOptions {
   std::string tracking = pipeline::TrackingChoices{}.tracking;
   double model_voxel = pipeline::TrackingChoices{}.model_voxel;
   std::string motion_prior;  // --motion-prior: another sensor's camera poses (empty: none)
-  // --prior-time-offset: seconds the prior file's clock is ahead of the frames' timestamps.
+  // --prior-time-offset: seconds the prior file's clock is ahead of the frames' timestamps, or
+  // "auto" (measured before the run: calibrate_prior_clock).
   double prior_time_offset = 0;
+  bool prior_time_offset_auto = false;
   // --pose-mount x,y,z,qx,qy,qz,qw: the camera's pose in the body whose poses a --poses or
   // --motion-prior file gives (empty: the file gives the camera's own).
   std::vector<double> pose_mount;

@@ -121,13 +121,14 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
   std::vector<std::string> known_files = io::map_output_files();
   known_files.push_back("evaluation.png");
   OutputFolder folder("map", o.out_dir, o.force, known_files);
-  const OpenedRun run = open_run(o.run, err, o.poses);
+  OpenedRun run = open_run(o.run, err, o.poses);
   // A depth camera alone: the features (ORB) have no image to work on; the views' planes and
   // labels come from the depth (docs/user-guide.md, "A depth camera alone").
   const bool wants_features = !o.no_features && o.poses.empty();
   if (wants_features && !run.opened.has_color)
     err << "map: no colour images: no local image features (as --no-features)\n";
   const compute::Context context = make_run_context(o.run);
+  calibrate_prior_clock(o.run, context, run, err);
   pipeline::MapperParams params;
   pipeline::MapPipelineParams& stages = params.pipeline;
   stages.slam.odometry = odometry_params(o.run);
@@ -172,7 +173,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
 
   io::MapRunInfo info = io::map_run_info(run_record(o.run, context), run.opened, params);
   info.prior_clock =
-      measure_prior_clock(o.run, run, result.slam.odometry.poses, result.slam.odometry.timestamps);
+      measure_prior_clock(run, result.slam.odometry.poses, result.slam.odometry.timestamps);
   {
     const InterruptsDeferred writing;  // a signal waits for the files, then drops them
     io::write_map_outputs(folder.dir(), result, evaluation, info);

@@ -33,8 +33,9 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
   const std::filesystem::path trajectory_file = files.add("--out", o.out);
   const std::filesystem::path stats_file =
       o.stats.empty() ? o.stats : files.add("--stats", o.stats);
-  const OpenedRun run = open_run(o.run, err);
+  OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
+  calibrate_prior_clock(o.run, context, run, err);
   const registration::OdometryParams params = odometry_params(o.run);
   const bool has_timestamps = run.opened.detected.has_timestamps;
 
@@ -66,7 +67,7 @@ int run_odometry_command(const OdometryOptions& o, std::ostream& out, std::ostre
                 1000.0 * result.timing.load_seconds / std::max(frames, 1.0));
   out << line;
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.frames)) << "\n";
-  out << prior_clock_line(measure_prior_clock(o.run, run, result.poses, result.timestamps));
+  out << prior_clock_line(measure_prior_clock(run, result.poses, result.timestamps));
   out << model_tracking_line(result);
   if (ate) {
     std::snprintf(line, sizeof(line), "  ate_rmse_m %.6f (max %.6f, %zu poses with ground truth)\n",

@@ -91,11 +91,17 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& o) {
       "them instead of the motion model, and views that leave a direction free "
       "(a plain wall, a corridor) take their motion there");
   command
-      .add_option("--prior-time-offset", o.prior_time_offset,
-                  "Seconds the --motion-prior FILE's clock is ahead of the frames' timestamps "
-                  "(its pose for a frame is read at the frame's time plus this); the summary's "
-                  "'motion prior clock' line measures it from how the camera turned")
-      ->check(finite_in(-10.0, 10.0));
+      .add_option_function<std::string>(
+          "--prior-time-offset",
+          [&o](const std::string& value) {
+            o.prior_time_offset_auto = value == "auto";
+            o.prior_time_offset = o.prior_time_offset_auto ? 0.0 : std::stod(value);
+          },
+          "Seconds the --motion-prior FILE's clock is ahead of the frames' timestamps (its pose "
+          "for a frame is read at the frame's time plus this), -10..10; auto: measured first "
+          "from how the camera turns over the first 20 s without the prior (the summary's "
+          "'motion prior clock' line measures it after any run)")
+      ->check(finite_in(-10.0, 10.0) | CLI::IsMember({"auto"}));
   add_pose_mount_option(command, o.pose_mount);
   command.add_flag("!--no-progress", o.progress, "No progress bar on stderr");
 }
@@ -171,10 +177,11 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const s
   OpenedRun run;
   run.pose_mount = pose_mount(options, poses);
   const bool prior_file = !options.motion_prior.empty() && options.motion_prior != "groundtruth";
-  require(options.prior_time_offset == 0 || prior_file,
+  const bool offset_given = options.prior_time_offset != 0 || options.prior_time_offset_auto;
+  require(!offset_given || prior_file,
           "--prior-time-offset: no --motion-prior FILE to apply it to");
   run.opened = open_input(options.sequence, options.input, err);
-  require(options.prior_time_offset == 0 || run.opened.detected.has_timestamps,
+  require(!offset_given || run.opened.detected.has_timestamps,
           "--prior-time-offset: '" + options.sequence.string() +
               "' has no timestamps (its frames are matched to the prior by number)");
   if (options.method == "color") {
@@ -189,9 +196,10 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const s
   if (prior_file) {
     const std::string named = "odometry --motion-prior";
     run.prior_poses = read_pose_file(named, options.motion_prior);
+    run.prior_time_offset = options.prior_time_offset;
     run.source->set_motion_prior(pose_file_lookup(named, run.prior_poses, options.motion_prior,
                                                   !run.opened.detected.has_timestamps,
-                                                  run.pose_mount, options.prior_time_offset));
+                                                  run.pose_mount, run.prior_time_offset));
   } else if (!options.motion_prior.empty()) {
     run.source->set_motion_prior(
         known_pose_lookup("odometry", options.motion_prior, !run.opened.detected.has_timestamps));
@@ -392,17 +400,44 @@ mapping::KnownPoseLookup pose_file_lookup(const std::string& named,
   };
 }
 
-std::optional<io::PriorClock> measure_prior_clock(const SequenceRunOptions& options,
-                                                  const OpenedRun& run,
+std::optional<io::PriorClock> measure_prior_clock(const OpenedRun& run,
                                                   const std::vector<Eigen::Isometry3d>& poses,
                                                   const std::vector<double>& timestamps) {
   if (!run.prior_poses || !run.opened.detected.has_timestamps || poses.size() < 2)
     return std::nullopt;
   eval::ClockOffsetSearch search;
-  search.given_s = options.prior_time_offset;
-  return io::PriorClock{options.prior_time_offset,
+  search.given_s = run.prior_time_offset;
+  return io::PriorClock{run.prior_time_offset,
                         eval::estimate_clock_offset(stamped_trajectory(poses, timestamps, true),
                                                     *run.prior_poses, search)};
+}
+
+void calibrate_prior_clock(const SequenceRunOptions& options, const compute::Context& context,
+                           OpenedRun& run, std::ostream& err) {
+  if (!options.prior_time_offset_auto) return;
+  // The first 20 s at 30 Hz without the prior: the camera's own steps, whatever the file's clock.
+  constexpr std::size_t kFrames = 600;
+  const pipeline::SequenceFrameSource first(*run.opened.sequence,
+                                            std::min(kFrames, run.source->size()));
+  const mapping::OdometryRun odometry = mapping::run_odometry(
+      context, first, odometry_params(options), {}, model_tracking_params(options));
+  const std::optional<io::PriorClock> clock =
+      measure_prior_clock(run, odometry.poses, odometry.timestamps);
+  require(clock && clock->measured.observable,
+          "--prior-time-offset auto: the motion prior's clock is not measurable from the first " +
+              std::to_string(first.size()) + " frames (" +
+              (clock ? io::prior_clock_text(*clock) : std::string("fewer than two")) +
+              "): give --prior-time-offset S");
+  run.prior_time_offset = clock->measured.offset_s;
+  run.source->set_motion_prior(pose_file_lookup("odometry --motion-prior", run.prior_poses,
+                                                options.motion_prior, false, run.pose_mount,
+                                                run.prior_time_offset));
+  char line[160];
+  std::snprintf(line, sizeof(line),
+                "motion prior clock: %+.3f s (+- %.1f ms) measured over the first %zu frames "
+                "(--prior-time-offset auto)\n",
+                run.prior_time_offset, 1000 * clock->measured.sigma_s, first.size());
+  err << line;
 }
 
 std::string prior_clock_line(const std::optional<io::PriorClock>& clock) {

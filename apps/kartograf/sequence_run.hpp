@@ -61,8 +61,10 @@ struct OpenedRun {
   io::OpenedSequence opened;
   std::unique_ptr<pipeline::SequenceFrameSource> source;
   Eigen::Isometry3d pose_mount = Eigen::Isometry3d::Identity();  // --pose-mount
-  // The --motion-prior FILE's poses, sorted by time (null without one).
+  // The --motion-prior FILE's poses, sorted by time (null without one), and the offset its clock
+  // is read at (--prior-time-offset, or as calibrate_prior_clock measured it).
   std::shared_ptr<const Trajectory> prior_poses;
+  double prior_time_offset = 0;
 };
 // --pose-mount checked against `poses` (the command's --poses, if it has one) and the motion
 // prior, open_input, --prior-time-offset refused without a prior file or timestamps, then the
@@ -143,10 +145,14 @@ mapping::KnownPoseLookup pose_file_lookup(const std::string& named,
 // How well the --motion-prior FILE's turning agrees with the estimated trajectory's, at the
 // offset in use and at the best one (eval::estimate_clock_offset); none without a prior file or
 // timestamps.
-std::optional<io::PriorClock> measure_prior_clock(const SequenceRunOptions& options,
-                                                  const OpenedRun& run,
+std::optional<io::PriorClock> measure_prior_clock(const OpenedRun& run,
                                                   const std::vector<Eigen::Isometry3d>& poses,
                                                   const std::vector<double>& timestamps);
+// --prior-time-offset auto: the odometry over the first 600 frames without the prior, the
+// clock's offset measured from it (said on err) and the run's prior read at it from then on; an
+// Error where the motion cannot tell it. Nothing otherwise.
+void calibrate_prior_clock(const SequenceRunOptions& options, const compute::Context& context,
+                           OpenedRun& run, std::ostream& err);
 // "  motion prior clock: ..." (io::prior_clock_text) and a newline; empty without one.
 std::string prior_clock_line(const std::optional<io::PriorClock>& clock);
 

@@ -86,7 +86,7 @@ void print_slam_summary(std::ostream& out, const SlamOptions& o, const OpenedRun
   out << "  " << io::describe_input(run.opened) << "\n";
   out << "  " << io::frame_counts_line(io::count_odometry_frames(result.odometry.frames)) << "\n";
   out << prior_clock_line(
-      measure_prior_clock(o.run, run, result.odometry.poses, result.odometry.timestamps));
+      measure_prior_clock(run, result.odometry.poses, result.odometry.timestamps));
   out << model_tracking_line(result.odometry);
   std::snprintf(line, sizeof(line),
                 "  loop_closures %zu accepted of %zu candidates, %zu pruned by the pose graph\n",
@@ -136,8 +136,9 @@ int run_slam_command(const SlamOptions& o, std::ostream& out, std::ostream& err)
   OutputFolder folder("slam", o.out_dir, o.force,
                       {"trajectory.txt", "odometry.txt", "groundtruth.txt", "map.ply",
                        "top_view.png", "stats.json"});
-  const OpenedRun run = open_run(o.run, err);
+  OpenedRun run = open_run(o.run, err);
   const compute::Context context = make_run_context(o.run);
+  calibrate_prior_clock(o.run, context, run, err);
   mapping::SlamParams params;
   params.odometry = odometry_params(o.run);
   params.loop_closure = !o.no_loop_closure;
