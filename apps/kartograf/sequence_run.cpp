@@ -419,6 +419,8 @@ void calibrate_prior_clock(const SequenceRunOptions& options, const compute::Con
   constexpr std::size_t kFrames = 600;
   const pipeline::SequenceFrameSource first(*run.opened.sequence,
                                             std::min(kFrames, run.source->size()));
+  err << "motion prior clock: tracking the first " << first.size()
+      << " frames without the prior to measure it (--prior-time-offset auto)\n";
   const mapping::OdometryRun odometry = mapping::run_odometry(
       context, first, odometry_params(options), {}, model_tracking_params(options));
   const std::optional<io::PriorClock> clock =
