@@ -54,7 +54,6 @@ class MetricReport {
   std::unique_ptr<Json> json_;
 };
 
-// A trajectory's ATE and RPE (eval::evaluate_trajectory) and what it was computed from.
 // Seconds added to an estimate's timestamps before matching, and how they were measured where
 // they were (eval::estimate_clock_offset).
 struct TimeOffset {
@@ -62,6 +61,7 @@ struct TimeOffset {
   std::optional<eval::ClockOffsetEstimate> measured;
 };
 
+// A trajectory's ATE and RPE (eval::evaluate_trajectory) and what it was computed from.
 struct TrajectoryReportInput {
   std::string ground_truth_file, estimate_file;
   std::size_t ground_truth_poses = 0, estimate_poses = 0, matched_poses = 0;
