@@ -1,7 +1,6 @@
 // `kartograf eval traj|planes|rooms|semantic`: reads the files, calls kartograf::eval, prints a
 // table (or one JSON object with --json; kartograf/outputs/eval_report.hpp). No metric is computed
 // here.
-#include <algorithm>
 #include <cstdint>
 #include <filesystem>
 #include <optional>
@@ -36,9 +35,7 @@ std::vector<double> timestamps(const Trajectory& trajectory) {
 }
 
 Trajectory sorted_by_time(Trajectory trajectory) {
-  std::stable_sort(
-      trajectory.begin(), trajectory.end(),
-      [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  sort_by_time(trajectory);
   return trajectory;
 }
 

@@ -379,8 +379,7 @@ std::shared_ptr<const Trajectory> read_pose_file(const std::string& named,
                                                  const std::string& file) {
   auto trajectory = std::make_shared<Trajectory>(io::read_tum_trajectory(file));
   require(!trajectory->empty(), named + ": '" + file + "' holds no pose");
-  std::sort(trajectory->begin(), trajectory->end(),
-            [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  sort_by_time(*trajectory);
   return trajectory;
 }
 

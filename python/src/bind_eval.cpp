@@ -2,7 +2,6 @@
 #include <nanobind/stl/string.h>
 #include <nanobind/stl/vector.h>
 
-#include <algorithm>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -111,9 +110,7 @@ Trajectory trajectory_of(const Times& times, const PoseStack& poses, const std::
     require(std::isfinite(view(i)), what + ": time " + std::to_string(i) + " is not finite");
     trajectory.push_back({view(i), matrices[i]});
   }
-  std::stable_sort(
-      trajectory.begin(), trajectory.end(),
-      [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+  sort_by_time(trajectory);
   return trajectory;
 }
 

@@ -19,6 +19,12 @@ Eigen::Isometry3d interpolated(const StampedPose& a, const StampedPose& b, doubl
 
 }  // namespace
 
+void sort_by_time(Trajectory& trajectory) {
+  std::stable_sort(
+      trajectory.begin(), trajectory.end(),
+      [](const StampedPose& a, const StampedPose& b) { return a.timestamp < b.timestamp; });
+}
+
 std::optional<Eigen::Isometry3d> pose_at(const Trajectory& by_time, double t,
                                          const PoseAtTolerance& tolerance) {
   const auto after =

@@ -22,6 +22,9 @@ struct PoseAtTolerance {
   double max_offset = 0.02;
 };
 
+// Sorts by timestamp, keeping the file order of equal ones (pose_at and the clock offset need it).
+void sort_by_time(Trajectory& trajectory);
+
 // The pose at time `t` from a trajectory sorted by time: between two poses at most `max_gap` apart,
 // interpolated (translation linearly, rotation along the shorter arc), as a sensor sampled at
 // another rate than the camera needs; else the nearest pose within `max_offset` (a time just
