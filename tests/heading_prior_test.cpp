@@ -18,10 +18,14 @@ constexpr double kDegree = std::numbers::pi / 180.0;
 // The surveys' camera, tilted 20 degrees down: it travels forward and a little up in its frame.
 const Eigen::Vector3d kTravel(0, -std::sin(20 * kDegree), std::cos(20 * kDegree));
 
-// A step turning `turn_deg` about the camera's y axis, `metres` along the travel direction turned
-// by half the turn (an arc), plus `offset`.
-Eigen::Isometry3d arc_step(double metres, double turn_deg, const Eigen::Vector3d& offset) {
-  const Eigen::AngleAxisd turn(turn_deg * kDegree, Eigen::Vector3d::UnitY());
+// Its vertical (up is -y in a camera's frame), about which a robot turns.
+const Eigen::Vector3d kVertical(0, -std::cos(20 * kDegree), -std::sin(20 * kDegree));
+
+// A step turning `turn_deg` about `axis` (the camera's y axis unless given), `metres` along the
+// travel direction turned by half the turn (an arc), plus `offset`.
+Eigen::Isometry3d arc_step(double metres, double turn_deg, const Eigen::Vector3d& offset,
+                           const Eigen::Vector3d& axis = Eigen::Vector3d::UnitY()) {
+  const Eigen::AngleAxisd turn(turn_deg * kDegree, axis);
   Eigen::Isometry3d step = Eigen::Isometry3d::Identity();
   step.linear() = turn.toRotationMatrix();
   step.translation() =
@@ -89,6 +93,44 @@ TEST(HeadingPrior, LeavesAHandHeldCamerasSlideToTheMeasurement) {
   // A slide measured to 1 mm (the odometry's motion prior is about that).
   const Eigen::Isometry3d held = prior.combine(slid, all_but_the_slide(1e6));
   EXPECT_GT((held.translation() - truth.translation()).dot(sideways), 0.0095);
+}
+
+TEST(HeadingPrior, LearnsTheAxisTheRobotTurnsAbout) {
+  HeadingPrior prior;
+  // Small turns (under 2 degrees) about another axis say nothing: the odometry's noise.
+  for (int i = 0; i < 5; ++i)
+    prior.learn(arc_step(0.3, 1.5, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX()));
+  EXPECT_EQ(prior.turn_axis(), Eigen::Vector3d::Zero());
+  // Turns left and right about the tilted camera's vertical, the small ones in between.
+  for (int i = 0; i < 20; ++i) {
+    prior.learn(arc_step(0.3, (i % 2 ? -1 : 1) * (3.0 + i), Eigen::Vector3d::Zero(), kVertical));
+    prior.learn(arc_step(0.3, 1.5, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX()));
+  }
+  const Eigen::Vector3d axis = prior.turn_axis();
+  EXPECT_NEAR(axis.norm(), 1.0, 1e-12);
+  EXPECT_LT(std::acos(std::min(1.0, std::abs(axis.dot(kVertical)))), 0.01 * kDegree);
+}
+
+TEST(HeadingPrior, StepsAroundAStepLieAlongTheTravelOnEachTurnsArc) {
+  const HeadingPrior prior = learned(60, 3e-4);
+  const Eigen::Isometry3d step = arc_step(0.5, 8, Eigen::Vector3d::Zero(), kVertical);
+  EXPECT_TRUE(HeadingPrior().steps_around(step, {0.2, 0.6, 0.1, kDegree, 0.5 * kDegree}).empty());
+  HeadingStepGrid grid{0.2, 0.6, 0.1, kDegree, 0.5 * kDegree, kVertical};
+  const std::vector<Eigen::Isometry3d> steps = prior.steps_around(step, grid);
+  ASSERT_EQ(steps.size(), 5u * 5u);  // turns -1, -0.5, 0, 0.5, 1 degrees; 0.2 .. 0.6 m
+  for (std::size_t i = 0; i < steps.size(); ++i) {
+    const double offset_deg = (static_cast<double>(i / 5) - 2) * 0.5;
+    const Eigen::AngleAxisd offset(step.linear().transpose() * steps[i].linear());
+    EXPECT_NEAR(offset.angle(), std::abs(offset_deg) * kDegree, 1e-9) << i;
+    if (offset_deg != 0) {
+      EXPECT_NEAR(std::abs(offset.axis().dot(kVertical)), 1.0, 1e-9) << i;
+    }
+    EXPECT_NEAR(steps[i].translation().norm(), 0.2 + 0.1 * static_cast<double>(i % 5), 1e-9) << i;
+    EXPECT_TRUE(steps[i].translation().normalized().isApprox(prior.travel_on(steps[i]), 1e-9)) << i;
+  }
+  grid.backwards = true;
+  const Eigen::Isometry3d reversing = prior.steps_around(step, grid)[7];
+  EXPECT_TRUE(reversing.translation().isApprox(-steps[7].translation(), 1e-12));
 }
 
 TEST(HeadingPrior, HoldsNothingBeforeItHasLearned) {

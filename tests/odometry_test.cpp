@@ -244,31 +244,45 @@ TEST(Odometry, DegenerateGeometryTakesTheMotionModelInItsWeakDirections) {
   }
 }
 
-// A fronto-parallel textured wall seen from two camera positions 3 cm apart along it: the slide,
-// invisible to geometry, is recovered from intensity.
-TEST(PhotometricRefinement, RecoversTheSlideAlongATexturedWall) {
-  const PinholeIntrinsics camera = testing::qvga_camera();
-  const double distance = 2.0;
-  const auto texture = [](double x, double y) {
-    return 128.0 + 60.0 * std::sin(2 * std::numbers::pi * x / 0.25) *
-                       std::cos(2 * std::numbers::pi * y / 0.18);
-  };
-  const Eigen::Vector3d slide(0.03, 0, 0);  // source camera in the target frame
-  DepthImage depth(camera.width, camera.height, 0);
-  RgbImage source(camera.width, camera.height), target(camera.width, camera.height);
-  for (int v = 0; v < camera.height; ++v) {
-    for (int u = 0; u < camera.width; ++u) {
-      const double x = (u - camera.cx) / camera.fx * distance;
-      const double y = (v - camera.cy) / camera.fy * distance;
-      const auto level = [](double value) {
-        const auto c = static_cast<std::uint8_t>(std::lround(value));
-        return Rgb8{c, c, c};
-      };
-      target(u, v) = level(texture(x, y));
-      source(u, v) = level(texture(x + slide.x(), y));
-      depth(u, v) = static_cast<std::uint16_t>(distance * 1000.0);
+// A fronto-parallel textured wall 2 m ahead seen from two camera positions `slide` apart along it
+// (the source camera in the target's frame).
+struct TexturedWallPair {
+  PinholeIntrinsics camera = testing::qvga_camera();
+  DepthImage depth;
+  RgbImage source, target;
+
+  explicit TexturedWallPair(const Eigen::Vector3d& slide)
+      : depth(camera.width, camera.height, 0),
+        source(camera.width, camera.height),
+        target(camera.width, camera.height) {
+    const double distance = 2.0;
+    const auto texture = [](double x, double y) {
+      return 128.0 + 60.0 * std::sin(2 * std::numbers::pi * x / 0.25) *
+                         std::cos(2 * std::numbers::pi * y / 0.18);
+    };
+    const auto level = [](double value) {
+      const auto c = static_cast<std::uint8_t>(std::lround(value));
+      return Rgb8{c, c, c};
+    };
+    for (int v = 0; v < camera.height; ++v) {
+      for (int u = 0; u < camera.width; ++u) {
+        const double x = (u - camera.cx) / camera.fx * distance;
+        const double y = (v - camera.cy) / camera.fy * distance;
+        target(u, v) = level(texture(x, y));
+        source(u, v) = level(texture(x + slide.x(), y));
+        depth(u, v) = static_cast<std::uint16_t>(distance * 1000.0);
+      }
     }
   }
+};
+
+// The slide, invisible to geometry, is recovered from intensity.
+TEST(PhotometricRefinement, RecoversTheSlideAlongATexturedWall) {
+  const Eigen::Vector3d slide(0.03, 0, 0);
+  const TexturedWallPair pair(slide);
+  const PinholeIntrinsics& camera = pair.camera;
+  const DepthImage& depth = pair.depth;
+  const RgbImage &source = pair.source, &target = pair.target;
   const Eigen::Isometry3d truth{Eigen::Translation3d(slide)};
   const Eigen::Isometry3d start = truth * Eigen::Translation3d(0.008, 0, 0);
   const std::vector<se3::Vector6d> along_x{(se3::Vector6d() << 0, 0, 0, 1, 0, 0).finished()};
@@ -301,6 +315,46 @@ TEST(PhotometricRefinement, RecoversTheSlideAlongATexturedWall) {
   EXPECT_TRUE(flat.motion.isApprox(start));
   EXPECT_THROW(registration::refine_photometrically(depth, source, RgbImage(4, 4), camera, 1000.0,
                                                     start, along_x),
+               Error);
+}
+
+// Candidate slides along the textured wall, 2 mm apart, compared by their robust disagreement
+// while a fifth of the target is overexposed (a lamp, a reflection: pixels no motion explains).
+TEST(IntensityDisagreement, FindsTheSlideAmongCandidatesAndCountsPixelsOffTheImage) {
+  const Eigen::Vector3d slide(0.03, 0, 0);
+  TexturedWallPair pair(slide);
+  for (int v = 0; v < pair.camera.height; ++v) {
+    for (int u = 0; u < pair.camera.width / 5; ++u) pair.target(u, v) = Rgb8{255, 255, 255};
+  }
+  std::vector<Eigen::Isometry3d> candidates;
+  for (int i = 0; i <= 30; ++i) {
+    candidates.emplace_back(Eigen::Translation3d(0.002 * i, 0, 0));
+  }
+  const registration::PhotometricParams params;
+  const std::vector<double> cost = registration::intensity_disagreement(
+      pair.depth, pair.source, pair.target, pair.camera, 1000.0, candidates, params);
+  ASSERT_EQ(cost.size(), candidates.size());
+  const auto best = std::min_element(cost.begin(), cost.end()) - cost.begin();
+  EXPECT_NEAR(candidates[static_cast<std::size_t>(best)].translation().x(), slide.x(), 0.002);
+  RecordProperty("cost_at_truth", testing::scientific(cost[15]));
+  RecordProperty("cost_1_cm_off", testing::scientific(cost[10]));
+  EXPECT_LT(cost[15], 0.8 * cost[10]);                            // measured 0.43 of it
+  for (const double c : cost) EXPECT_LE(c, params.huber_levels);  // each pixel's is capped
+
+  // Every pixel behind the camera or beside the image counts the cap.
+  const Eigen::Isometry3d away[2] = {Eigen::Isometry3d(Eigen::Translation3d(0, 0, -5)),
+                                     Eigen::Isometry3d(Eigen::Translation3d(50, 0, 0))};
+  for (const double c : registration::intensity_disagreement(pair.depth, pair.source, pair.target,
+                                                             pair.camera, 1000.0, away, params)) {
+    EXPECT_DOUBLE_EQ(c, params.huber_levels);
+  }
+  // No texture: nothing measured (0), as intensity_rmse says it.
+  const RgbImage grey(pair.camera.width, pair.camera.height, Rgb8{128, 128, 128});
+  EXPECT_EQ(registration::intensity_disagreement(pair.depth, grey, grey, pair.camera, 1000.0,
+                                                 candidates, params)[0],
+            0.0);
+  EXPECT_THROW(registration::intensity_disagreement(pair.depth, pair.source, RgbImage(4, 4),
+                                                    pair.camera, 1000.0, candidates, params),
                Error);
 }
 

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 
 namespace kartograf::registration {
 
@@ -10,6 +11,9 @@ namespace {
 constexpr double kKeep = 0.95;  // decay per learned step: about the last 20 steps
 
 constexpr double kVarianceFloor = 1e-12;  // m^2: a spread of nothing is no reason to divide by 0
+
+constexpr double kLeastTurn =
+    2.0 * std::numbers::pi / 180.0;  // radians: a step's turn that shows its axis
 
 }  // namespace
 
@@ -33,11 +37,45 @@ void HeadingPrior::learn(const Eigen::Isometry3d& step) {
   }
   // Weighted by its length: short steps are mostly noise.
   heading_ = kKeep * heading_ + (1 - kKeep) * travel;
+  // Weighted by its angle, left and right turns alike: small turns are mostly noise.
+  const Eigen::AngleAxisd turn(step.linear());
+  if (turn.angle() > kLeastTurn) {
+    const double side = turn_axis_.dot(turn.axis()) < 0 ? -1.0 : 1.0;
+    turn_axis_ = kKeep * turn_axis_ + (1 - kKeep) * side * turn.angle() * turn.axis();
+  }
+}
+
+Eigen::Vector3d HeadingPrior::turn_axis() const {
+  if (turn_axis_.squaredNorm() == 0) return Eigen::Vector3d::Zero();
+  return turn_axis_.normalized();
 }
 
 Eigen::Vector3d HeadingPrior::travel_on(const Eigen::Isometry3d& step) const {
   if (heading_.squaredNorm() == 0) return Eigen::Vector3d::Zero();
   return travel_on_arc(heading_, step);
+}
+
+std::vector<Eigen::Isometry3d> HeadingPrior::steps_around(const Eigen::Isometry3d& step,
+                                                          const HeadingStepGrid& grid) const {
+  std::vector<Eigen::Isometry3d> steps;
+  if (heading_.squaredNorm() == 0 || grid.length_spacing <= 0) return steps;
+  // Whole spacings that fit, a rounding error short of one still counting.
+  const auto fitting = [](double range, double spacing) {
+    return static_cast<int>(std::floor(range / spacing + 1e-9));
+  };
+  const int turns = grid.turn_spacing > 0 ? fitting(grid.max_turn, grid.turn_spacing) : 0;
+  const int lengths = fitting(grid.longest - grid.shortest, grid.length_spacing);
+  for (int t = -turns; t <= turns; ++t) {
+    Eigen::Isometry3d turned = Eigen::Isometry3d::Identity();
+    turned.linear() =
+        step.linear() * Eigen::AngleAxisd(t * grid.turn_spacing, grid.turn_axis).toRotationMatrix();
+    const Eigen::Vector3d travel = (grid.backwards ? -1.0 : 1.0) * travel_on(turned);
+    for (int l = 0; l <= lengths; ++l) {
+      turned.translation() = (grid.shortest + l * grid.length_spacing) * travel;
+      steps.push_back(turned);
+    }
+  }
+  return steps;
 }
 
 bool HeadingPrior::ready() const {

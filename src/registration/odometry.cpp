@@ -509,6 +509,17 @@ bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
 
 RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& predicted,
                                                      OdometryFrame& frame) {
+  Attempt chosen = chosen_previous(predicted, frame);
+  // However it was chosen (another start, the features), a step the images left open is measured.
+  if (scans_along_heading() && !chosen.scanned && images_left_open(chosen)) {
+    if (std::optional<Attempt> scanned = scan_along_heading(frame.step_frame, predicted, chosen))
+      chosen = std::move(*scanned);
+  }
+  return chosen;
+}
+
+RgbdOdometry::Attempt RgbdOdometry::chosen_previous(const Eigen::Isometry3d& predicted,
+                                                    OdometryFrame& frame) {
   const std::size_t previous = frame.index - 1;
   // A large predicted motion may be beyond ICP's basin: ICP from the features' motion as well,
   // kept unless the pair agrees better with ICP from the prediction (features matched on a
@@ -521,11 +532,10 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
   Attempt attempt = accelerating_if_better(
       frame.step_frame, predicted, register_frames(previous, predicted, frame_limits_now()));
   if (images_left_open(attempt)) {
-    std::optional<Attempt> scanned = scan_step_lengths(frame.step_frame, predicted, attempt);
-    if (scanned && agrees_better(*scanned, attempt)) {
-      attempt = std::move(*scanned);
-      attempt.scanned = true;
-    }
+    std::optional<Attempt> scanned = scans_along_heading()
+                                         ? scan_along_heading(frame.step_frame, predicted, attempt)
+                                         : scan_step_lengths(frame.step_frame, predicted, attempt);
+    if (scanned) attempt = std::move(*scanned);
   }
   // A large motion on a constrained view: a settled answer may still be a neighbouring basin's.
   const bool recheck_large =
@@ -560,7 +570,16 @@ RgbdOdometry::Attempt RgbdOdometry::straight_if_better(std::size_t previous,
       se3::rotation_angle(predicted) <= params_.feature_arbitration_deg * kDegree) {
     return attempt;
   }
-  Attempt other = register_frames(previous, without_its_turn(predicted), frame_limits_now());
+  // A robot that stopped turning drives along its heading, not on the turn's arc.
+  Eigen::Isometry3d straight = without_its_turn(predicted);
+  if (scans_along_heading()) {
+    straight.translation() = predicted.translation().norm() * heading_prior_.travel_on(straight);
+  }
+  Attempt other = register_frames(previous, straight, frame_limits_now());
+  if (scans_along_heading() && images_left_open(other)) {
+    if (std::optional<Attempt> scanned = scan_along_heading(frame.step_frame, predicted, other))
+      other = std::move(*scanned);
+  }
   if (!better_start(previous, other, attempt)) return attempt;
   frame.retried = true;
   return other;
@@ -629,7 +648,49 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_step_lengths(
     if (rmse[i] > 0 && (best == candidates.size() || rmse[i] < rmse[best])) best = i;
   }
   if (best == candidates.size()) return {};
-  return register_frames(frames_.size() - 1, candidates[best], frame_limits_now());
+  Attempt scanned = register_frames(frames_.size() - 1, candidates[best], frame_limits_now());
+  if (!agrees_better(scanned, attempt)) return {};
+  scanned.scanned = true;
+  return scanned;
+}
+
+bool RgbdOdometry::scans_along_heading() const {
+  return params_.step_scan && params_.heading_scan && params_.heading_prior &&
+         heading_prior_.ready() && color_ && !color_->empty();
+}
+
+std::pair<double, double> RgbdOdometry::drive_step_lengths(
+    StepFrame step_frame, const Eigen::Isometry3d& predicted) const {
+  // Once the drive's bound is known the images choose within all of it: the models' range
+  // misses a change of speed the step before already missed.
+  if (speed_bound_.ready()) return speed_bound_.admitted(frames_.size());
+  return plausible_step_lengths(step_frame, predicted);
+}
+
+std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_along_heading(
+    StepFrame step_frame, const Eigen::Isometry3d& predicted, const Attempt& attempt) {
+  constexpr double kLengthSpacing = 0.02;  // metres: within the images' basin along a step
+  constexpr double kMaxTurn = 1.5 * kDegree, kTurnSpacing = 0.15 * kDegree;
+  const auto [shortest, longest] = drive_step_lengths(step_frame, predicted);
+  if (longest - shortest <= params_.feature_arbitration_m) return {};
+  HeadingStepGrid grid{shortest, longest, kLengthSpacing, kMaxTurn, kTurnSpacing};
+  const Eigen::Vector3d axis = heading_prior_.turn_axis();
+  if (axis.squaredNorm() > 0) grid.turn_axis = axis;
+  grid.backwards = heading_prior_.travel_on(attempt.motion).dot(predicted.translation()) < 0;
+  // The attempt's own step last: the candidates must beat it clearly.
+  std::vector<Eigen::Isometry3d> candidates = heading_prior_.steps_around(attempt.motion, grid);
+  candidates.push_back(attempt.motion);
+  const std::size_t target = frames_.size() - 1;
+  const std::vector<double> cost = images_disagreement(target, candidates);
+  if (cost.empty() || cost.back() <= 0) return {};
+  const auto best = std::min_element(cost.begin(), cost.end() - 1);
+  Attempt scanned = register_frames(
+      target, candidates[static_cast<std::size_t>(best - cost.begin())], frame_limits_now());
+  if (!scanned.report.accepted()) return {};
+  const std::vector<double> found = images_disagreement(target, {&scanned.motion, 1});
+  if (found[0] <= 0 || found[0] >= params_.feature_arbitration_ratio * cost.back()) return {};
+  scanned.scanned = true;
+  return scanned;
 }
 
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
@@ -760,6 +821,14 @@ std::vector<double> RgbdOdometry::images_rmse(std::size_t target,
   if (!color_ || color_->empty() || target_color.empty()) return {};
   return intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
                         params_.depth_range.units_per_metre, motions, params_.photometric);
+}
+
+std::vector<double> RgbdOdometry::images_disagreement(
+    std::size_t target, std::span<const Eigen::Isometry3d> motions) const {
+  const RgbImage& target_color = colors_[slot_of(target)];
+  if (!color_ || color_->empty() || target_color.empty()) return {};
+  return intensity_disagreement(*depth_, *color_, target_color, builder_.camera(),
+                                params_.depth_range.units_per_metre, motions, params_.photometric);
 }
 
 double RgbdOdometry::images_rmse_at(std::size_t target, Attempt& attempt) const {

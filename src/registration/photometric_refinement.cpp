@@ -298,6 +298,25 @@ void require_camera_sized(const DepthImage& source_depth, const RgbImage& source
               std::to_string(camera.width) + "x" + std::to_string(camera.height));
 }
 
+// A pair's images as intensity_rmse and intensity_disagreement compare motions on: one smoothing
+// pass, the source's textured pixels (none where fewer than params.min_pixels).
+struct ComparedPair {
+  Textured target;
+  std::vector<Sample> samples;
+};
+
+ComparedPair compared_pair(const DepthImage& source_depth, const RgbImage& source_color,
+                           const RgbImage& target_color, const PinholeIntrinsics& camera,
+                           double units_per_metre, const PhotometricParams& params) {
+  require_camera_sized(source_depth, source_color, target_color, camera);
+  const Textured source(blurred(grey_of(source_color), 1));
+  const Mask excluded = excluded_pixels(source_depth, units_per_metre, params);
+  ComparedPair pair{Textured(blurred(grey_of(target_color), 1)),
+                    samples_of(source_depth, source, camera, units_per_metre, params, excluded)};
+  if (pair.samples.size() < params.min_pixels) pair.samples.clear();
+  return pair;
+}
+
 }  // namespace
 
 std::vector<double> intensity_rmse(const DepthImage& source_depth, const RgbImage& source_color,
@@ -305,20 +324,42 @@ std::vector<double> intensity_rmse(const DepthImage& source_depth, const RgbImag
                                    double units_per_metre,
                                    std::span<const Eigen::Isometry3d> source_to_target,
                                    const PhotometricParams& params) {
-  require_camera_sized(source_depth, source_color, target_color, camera);
+  const ComparedPair pair =
+      compared_pair(source_depth, source_color, target_color, camera, units_per_metre, params);
   std::vector<double> rmse(source_to_target.size(), 0.0);
-  const Textured source(blurred(grey_of(source_color), 1));
-  const Textured target(blurred(grey_of(target_color), 1));
-  const Mask excluded = excluded_pixels(source_depth, units_per_metre, params);
-  const std::vector<Sample> samples =
-      samples_of(source_depth, source, camera, units_per_metre, params, excluded);
-  if (samples.size() < params.min_pixels) return rmse;
+  if (pair.samples.empty()) return rmse;
   for (std::size_t m = 0; m < source_to_target.size(); ++m) {
     const Sums sums =
-        evaluate(samples, target, camera, source_to_target[m], {}, params.huber_levels);
+        evaluate(pair.samples, pair.target, camera, source_to_target[m], {}, params.huber_levels);
     if (sums.count >= params.min_pixels) rmse[m] = std::sqrt(sums.squared / sums.count);
   }
   return rmse;
+}
+
+std::vector<double> intensity_disagreement(const DepthImage& source_depth,
+                                           const RgbImage& source_color,
+                                           const RgbImage& target_color,
+                                           const PinholeIntrinsics& camera, double units_per_metre,
+                                           std::span<const Eigen::Isometry3d> source_to_target,
+                                           const PhotometricParams& params) {
+  const ComparedPair pair =
+      compared_pair(source_depth, source_color, target_color, camera, units_per_metre, params);
+  std::vector<double> disagreement(source_to_target.size(), 0.0);
+  if (pair.samples.empty()) return disagreement;
+  const double cap = params.huber_levels;
+  for (std::size_t m = 0; m < source_to_target.size(); ++m) {
+    double sum = 0;
+    for (const Sample& sample : pair.samples) {
+      const Eigen::Vector3d q = source_to_target[m] * sample.point;
+      double intensity = 0, gx = 0, gy = 0;
+      const bool seen =
+          q.z() > 0 && pair.target.sample(camera.fx * q.x() / q.z() + camera.cx,
+                                          camera.fy * q.y() / q.z() + camera.cy, intensity, gx, gy);
+      sum += seen ? std::min(cap, std::abs(intensity - sample.intensity)) : cap;
+    }
+    disagreement[m] = sum / static_cast<double>(pair.samples.size());
+  }
+  return disagreement;
 }
 
 PhotometricResult refine_photometrically(const DepthImage& source_depth,

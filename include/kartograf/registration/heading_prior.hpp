@@ -12,6 +12,8 @@
 // noise (a few tenths of a millimetre on the synthetic surveys), a hand-held camera's by
 // millimetres to centimetres, which makes the prior too weak to matter there. Both means decay
 // over about the last 20 such frames.
+#include <vector>
+
 #include <Eigen/Geometry>
 
 #include "kartograf/core/se3.hpp"
@@ -26,6 +28,15 @@ Eigen::Vector3d untwisted(const Eigen::Isometry3d& step);
 // half the step's turn.
 Eigen::Vector3d travel_on_arc(const Eigen::Vector3d& heading, const Eigen::Isometry3d& step);
 
+// A grid of steps along the heading (HeadingPrior::steps_around): lengths (metres) and turns
+// (radians) about a step's own.
+struct HeadingStepGrid {
+  double shortest = 0, longest = 0, length_spacing = 0.02;
+  double max_turn = 0, turn_spacing = 0;
+  Eigen::Vector3d turn_axis = Eigen::Vector3d::UnitY();  // camera frame, unit
+  bool backwards = false;                                // against the heading (a robot reversing)
+};
+
 class HeadingPrior {
  public:
   // One step (T_{n-1}^-1 T_n, camera frames) of a frame whose geometry measured every direction.
@@ -38,6 +49,17 @@ class HeadingPrior {
   // The unit direction of travel on `step`'s arc (camera frame of the step's start): the heading
   // turned by half the step's turn. Zero before the first step.
   Eigen::Vector3d travel_on(const Eigen::Isometry3d& step) const;
+
+  // The axis the camera turns about (camera frame, unit: a robot's vertical; its sign
+  // arbitrary), a mean of the learned steps' axes weighted by their turns, over those turning
+  // more than 2 degrees. Zero before the first such step.
+  Eigen::Vector3d turn_axis() const;
+
+  // `step`'s turn changed by each of the grid's turns, each with each of its lengths along the
+  // direction of travel on that turn's arc: the steps a robot can have made from where `step`
+  // turned to. Empty before the first learned step.
+  std::vector<Eigen::Isometry3d> steps_around(const Eigen::Isometry3d& step,
+                                              const HeadingStepGrid& grid) const;
 
   // Whether enough steps were learned for the spread to mean anything.
   bool ready() const;
@@ -57,6 +79,7 @@ class HeadingPrior {
   Eigen::Vector3d heading_ = Eigen::Vector3d::Zero();
   double across_squared_ = 0;  // decaying sums
   double weight_ = 0;
+  Eigen::Vector3d turn_axis_ = Eigen::Vector3d::Zero();  // decaying sum of axis times angle
 };
 
 }  // namespace kartograf::registration

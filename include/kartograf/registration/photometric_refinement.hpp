@@ -89,4 +89,17 @@ std::vector<double> intensity_rmse(const DepthImage& source_depth, const RgbImag
                                    std::span<const Eigen::Isometry3d> source_to_target,
                                    const PhotometricParams& params = {});
 
+// The mean grey-level disagreement min(|r|, params.huber_levels) at each of `source_to_target`
+// over the same pixels, a pixel that lands outside the target image counting the cap; 0 where
+// fewer than params.min_pixels are textured. A robust comparison of far-apart candidates, where
+// the RMSE is decided by its outliers: on the synthetic surveys' sparse tours (a floor seen from
+// 0.8 m further back, its grain aliased), the RMSE along a straight step was lowest 0.3-0.4 m
+// from the true length in 5 of 14 steps checked, this at most 2 cm off in all 14.
+std::vector<double> intensity_disagreement(const DepthImage& source_depth,
+                                           const RgbImage& source_color,
+                                           const RgbImage& target_color,
+                                           const PinholeIntrinsics& camera, double units_per_metre,
+                                           std::span<const Eigen::Isometry3d> source_to_target,
+                                           const PhotometricParams& params = {});
+
 }  // namespace kartograf::registration
