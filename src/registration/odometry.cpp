@@ -688,7 +688,10 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_along_heading(
       target, candidates[static_cast<std::size_t>(best - cost.begin())], frame_limits_now());
   if (!scanned.report.accepted()) return {};
   const std::vector<double> found = images_disagreement(target, {&scanned.motion, 1});
-  if (found[0] <= 0 || found[0] >= params_.feature_arbitration_ratio * cost.back()) return {};
+  if (found.empty() || found[0] <= 0 ||
+      found[0] >= params_.feature_arbitration_ratio * cost.back()) {
+    return {};
+  }
   scanned.scanned = true;
   return scanned;
 }
