@@ -383,7 +383,7 @@ struct OdometryParams {
   // on the step finally chosen (from any start) and on the straight start below, which then starts
   // along the heading rather than on the predicted turn's arc. Found on the synthetic surveys
   // every 10th frame: a robot speeding up or slowing down by 0.1-0.2 m a frame on a degenerate
-  // view (seed 5, frames 38-40: 0.82-0.98 m steps taken for 0.58).
+  // view (seed 5, into frames 380-400: steps of 0.82-0.98 m taken for 0.58).
   bool heading_scan = true;
   // A degenerate view whose images the registration left doubtful and whose features found no
   // motion, while the prediction is large (beyond feature_seed_m or feature_seed_deg, where the
