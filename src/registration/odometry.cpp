@@ -677,23 +677,55 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_along_heading(
   const Eigen::Vector3d axis = heading_prior_.turn_axis();
   if (axis.squaredNorm() > 0) grid.turn_axis = axis;
   grid.backwards = heading_prior_.travel_on(attempt.motion).dot(predicted.translation()) < 0;
+  if (std::optional<Attempt> scanned = scan_around(attempt.motion, grid, attempt)) return scanned;
+  const std::optional<Eigen::Isometry3d> turned = widest_turn_fit(predicted, grid, attempt);
+  if (!turned) return {};
+  return scan_around(*turned, grid, attempt);
+}
+
+std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_around(const Eigen::Isometry3d& centre,
+                                                               const HeadingStepGrid& grid,
+                                                               const Attempt& attempt) {
   // The attempt's own step last: the candidates must beat it clearly.
-  std::vector<Eigen::Isometry3d> candidates = heading_prior_.steps_around(attempt.motion, grid);
+  std::vector<Eigen::Isometry3d> candidates = heading_prior_.steps_around(centre, grid);
   candidates.push_back(attempt.motion);
   const std::size_t target = frames_.size() - 1;
-  const std::vector<double> cost = images_disagreement(target, candidates);
+  const int pixel_step = params_.photometric.pixel_step;
+  const std::vector<double> cost = images_disagreement(target, candidates, pixel_step);
   if (cost.empty() || cost.back() <= 0) return {};
   const auto best = std::min_element(cost.begin(), cost.end() - 1);
   Attempt scanned = register_frames(
       target, candidates[static_cast<std::size_t>(best - cost.begin())], frame_limits_now());
   if (!scanned.report.accepted()) return {};
-  const std::vector<double> found = images_disagreement(target, {&scanned.motion, 1});
+  const std::vector<double> found = images_disagreement(target, {&scanned.motion, 1}, pixel_step);
   if (found.empty() || found[0] <= 0 ||
       found[0] >= params_.feature_arbitration_ratio * cost.back()) {
     return {};
   }
   scanned.scanned = true;
   return scanned;
+}
+
+std::optional<Eigen::Isometry3d> RgbdOdometry::widest_turn_fit(const Eigen::Isometry3d& predicted,
+                                                               const HeadingStepGrid& grid,
+                                                               const Attempt& attempt) const {
+  if (!params_.wide_turn_scan || attempt.photometric_rmse <= params_.photometric_doubt_rmse ||
+      predicted.translation().norm() <= params_.feature_seed_m) {
+    return {};
+  }
+  HeadingStepGrid wide = grid;
+  wide.max_turn = 40 * kDegree;
+  wide.turn_spacing = 1 * kDegree;
+  const std::vector<Eigen::Isometry3d> candidates =
+      heading_prior_.steps_around(attempt.motion, wide);
+  const std::vector<double> cost =
+      images_disagreement(frames_.size() - 1, candidates, 2 * params_.photometric.pixel_step);
+  const auto best = std::min_element(cost.begin(), cost.end());
+  if (best == cost.end() || *best <= 0) return {};  // no colour, or too few textured pixels
+  // Within the scan around the attempt's own turn, which found nothing.
+  const Eigen::Isometry3d found = candidates[static_cast<std::size_t>(best - cost.begin())];
+  if (se3::rotation_angle(attempt.motion.inverse() * found) <= grid.max_turn) return {};
+  return found;
 }
 
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::arbitrate_by_intensity(
@@ -826,12 +858,15 @@ std::vector<double> RgbdOdometry::images_rmse(std::size_t target,
                         params_.depth_range.units_per_metre, motions, params_.photometric);
 }
 
-std::vector<double> RgbdOdometry::images_disagreement(
-    std::size_t target, std::span<const Eigen::Isometry3d> motions) const {
+std::vector<double> RgbdOdometry::images_disagreement(std::size_t target,
+                                                      std::span<const Eigen::Isometry3d> motions,
+                                                      int pixel_step) const {
   const RgbImage& target_color = colors_[slot_of(target)];
   if (!color_ || color_->empty() || target_color.empty()) return {};
+  PhotometricParams photometric = params_.photometric;
+  photometric.pixel_step = pixel_step;
   return intensity_disagreement(*depth_, *color_, target_color, builder_.camera(),
-                                params_.depth_range.units_per_metre, motions, params_.photometric);
+                                params_.depth_range.units_per_metre, motions, photometric);
 }
 
 double RgbdOdometry::images_rmse_at(std::size_t target, Attempt& attempt) const {
