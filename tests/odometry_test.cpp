@@ -420,6 +420,50 @@ TEST(PhotometricRefinement, ACabinetsEdgeMovingAcrossTheWallBehindItDoesNotPullT
   EXPECT_GT(error_of(with_edges), 1.5e-4);
 }
 
+// Frames prepared once (PhotometricFrame, as the odometry keeps them) give what each call on the
+// images gives, whatever was asked of them before: smoothings, depth-edge masks and pixel steps
+// are kept per frame and must not leak from one set of parameters into another.
+TEST(PhotometricFrame, PreparedOnceGivesWhatEachCallOnTheImagesGives) {
+  const CabinetBeforeAWall scene;
+  const double slide = -0.05;
+  const DepthImage depth = scene.depth(slide);
+  const RgbImage source = scene.color(slide), target = scene.color(0.0);
+  const registration::PhotometricFrame source_frame(source, depth, 1000.0);
+  const registration::PhotometricFrame target_frame(target, DepthImage(), 1000.0);
+  const Eigen::Isometry3d start{Eigen::Translation3d(slide + 0.004, 0, 0)};
+  const std::vector<se3::Vector6d> along_x{(se3::Vector6d() << 0, 0, 0, 1, 0, 0).finished()};
+  const std::vector<Eigen::Isometry3d> motions = {start, Eigen::Isometry3d::Identity()};
+  registration::PhotometricParams unmasked, coarser, sparser;
+  unmasked.mask_depth_edges = false;
+  coarser.blur_passes = 2;
+  sparser.pixel_step = 4;
+  for (const registration::PhotometricParams& params :
+       {registration::PhotometricParams{}, unmasked, coarser, sparser,
+        registration::PhotometricParams{}}) {
+    const registration::PhotometricResult once = registration::refine_photometrically(
+        source_frame, target_frame, scene.camera, start, along_x, params);
+    const registration::PhotometricResult each = registration::refine_photometrically(
+        depth, source, target, scene.camera, 1000.0, start, along_x, params);
+    EXPECT_TRUE(once.refined);
+    EXPECT_EQ(once.refined, each.refined);
+    EXPECT_TRUE(once.motion.matrix() == each.motion.matrix());
+    EXPECT_EQ(once.pixels, each.pixels);
+    EXPECT_EQ(once.rmse_before, each.rmse_before);
+    EXPECT_EQ(once.rmse_after, each.rmse_after);
+    EXPECT_EQ(once.sigma_m, each.sigma_m);
+    EXPECT_EQ(
+        registration::intensity_rmse(source_frame, target_frame, scene.camera, motions, params),
+        registration::intensity_rmse(depth, source, target, scene.camera, 1000.0, motions, params));
+    EXPECT_EQ(registration::intensity_disagreement(source_frame, target_frame, scene.camera,
+                                                   motions, params),
+              registration::intensity_disagreement(depth, source, target, scene.camera, 1000.0,
+                                                   motions, params));
+  }
+  // A frame without depth is no source.
+  EXPECT_THROW(registration::intensity_rmse(target_frame, source_frame, scene.camera, motions),
+               Error);
+}
+
 registration::GeometricInformation information_of(const testing::Scene& scene,
                                                   const compute::Context& context) {
   const PinholeIntrinsics camera = testing::qvga_camera();

@@ -205,7 +205,7 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
   ring_.reserve(slots);
   for (std::size_t i = 0; i < slots; ++i)
     ring_.emplace_back(context, camera, pyramid_params(params_, finest_level_, information_level_));
-  colors_.resize(slots);
+  images_.resize(slots);
   if (params_.method == OdometryMethod::planar) {
     require(params_.points_per_plane > 0, "odometry: points_per_plane must be > 0");
     planar_ = std::make_unique<PlanarFrames>(context, camera, params_.icp, slots);
@@ -290,8 +290,9 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
         keep_constrained_directions(result.source_to_target, initial, geometry_, ratio);
   }
   // ...or from the images, when there are colours.
-  const RgbImage& target_color = colors_[slot_of(target)];
-  if (params_.photometric_refinement && color_ && !color_->empty() && !target_color.empty()) {
+  const PhotometricFrame& source_images = images_[slot_of(current)];
+  const PhotometricFrame& target_images = images_[slot_of(target)];
+  if (!source_images.empty() && !target_images.empty()) {
     // Ascending eigenvalues: the degenerate directions come first, and the images must measure
     // those; the barely constrained ones after them are held by what ICP measured.
     const std::vector<se3::Vector6d> directions =
@@ -303,9 +304,9 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
         edge_information(constrained_information(geometry_, ratio), attempt.inlier_rmse,
                          {pairs, params_.information.min_sigma}) +
         attempt.across_heading;
-    const PhotometricResult refined = refine_photometrically(
-        *depth_, *color_, target_color, builder_.camera(), params_.depth_range.units_per_metre,
-        attempt.motion, directions, params_.photometric, held, degenerate);
+    const PhotometricResult refined =
+        refine_photometrically(source_images, target_images, builder_.camera(), attempt.motion,
+                               directions, params_.photometric, held, degenerate);
     if (keeps_refinement(initial, refined, limits, params_.photometric_doubt_rmse)) {
       attempt.motion = refined.motion;
       attempt.photometric = true;
@@ -383,12 +384,11 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
   }
   depth_ = &depth;
   color_ = color;
-  RgbImage& kept_color = colors_[slot_of(frame.index)];
-  if (params_.photometric_refinement && color && !color->empty()) {
-    kept_color = *color;
-  } else {
-    kept_color = RgbImage();
-  }
+  // Prepared on first use: frames the refinement never compares cost a copy of their images.
+  images_[slot_of(frame.index)] =
+      params_.photometric_refinement && color && !color->empty()
+          ? PhotometricFrame(*color, depth, params_.depth_range.units_per_metre)
+          : PhotometricFrame();
   geometry_ = level_geometry(pyramid.level(information_level_).view());
   set_finest_gate(depth);
   frame.degenerate = geometry_.degeneracy.degenerate;
@@ -852,21 +852,21 @@ RgbdOdometry::Attempt RgbdOdometry::best_of_other_starts(std::size_t previous,
 
 std::vector<double> RgbdOdometry::images_rmse(std::size_t target,
                                               std::span<const Eigen::Isometry3d> motions) const {
-  const RgbImage& target_color = colors_[slot_of(target)];
-  if (!color_ || color_->empty() || target_color.empty()) return {};
-  return intensity_rmse(*depth_, *color_, target_color, builder_.camera(),
-                        params_.depth_range.units_per_metre, motions, params_.photometric);
+  const PhotometricFrame& source = images_[slot_of(frames_.size())];
+  const PhotometricFrame& onto = images_[slot_of(target)];
+  if (source.empty() || onto.empty()) return {};
+  return intensity_rmse(source, onto, builder_.camera(), motions, params_.photometric);
 }
 
 std::vector<double> RgbdOdometry::images_disagreement(std::size_t target,
                                                       std::span<const Eigen::Isometry3d> motions,
                                                       int pixel_step) const {
-  const RgbImage& target_color = colors_[slot_of(target)];
-  if (!color_ || color_->empty() || target_color.empty()) return {};
+  const PhotometricFrame& source = images_[slot_of(frames_.size())];
+  const PhotometricFrame& onto = images_[slot_of(target)];
+  if (source.empty() || onto.empty()) return {};
   PhotometricParams photometric = params_.photometric;
   photometric.pixel_step = pixel_step;
-  return intensity_disagreement(*depth_, *color_, target_color, builder_.camera(),
-                                params_.depth_range.units_per_metre, motions, photometric);
+  return intensity_disagreement(source, onto, builder_.camera(), motions, photometric);
 }
 
 double RgbdOdometry::images_rmse_at(std::size_t target, Attempt& attempt) const {

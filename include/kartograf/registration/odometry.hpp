@@ -726,7 +726,7 @@ class RgbdOdometry {
   IcpEngine engine_;
   static constexpr std::size_t kNoFrame = static_cast<std::size_t>(-1);
   std::vector<FramePyramid> ring_;        // the frames still needed (claim_slot)
-  std::vector<RgbImage> colors_;          // their colours (photometric refinement), same slots
+  std::vector<PhotometricFrame> images_;  // their images (photometric refinement), same slots
   std::vector<std::size_t> slot_frames_;  // the frame each slot holds (kNoFrame: none yet)
   GeometricInformation geometry_;         // of the frame being tracked
   const DepthImage* depth_ = nullptr;     // of the frame being tracked

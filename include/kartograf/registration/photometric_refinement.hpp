@@ -20,6 +20,7 @@
 // images' own uncertainty in the first measured_directions directions, given the others: those
 // the start knows (the geometry's weak but not free ones) need not be measured by the images.
 #include <cstddef>
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -56,6 +57,38 @@ struct PhotometricParams {
   // the images. Set once (the synthetic camera has 2 levels per channel); the weight of the other
   // side, OdometryParams::photometric_geometry_weight, was chosen on the surveys.
   double intensity_sigma = 4.0;
+};
+
+namespace detail {
+struct PreparedImages;
+}
+
+// One frame's images for the functions below, and what they derive from them, made on first use
+// and kept: the grey levels, each smoothing with its gradients, the pixels beside depth edges.
+// Comparing many motions, or a frame against several others (the odometry's starts, scans and
+// re-estimates), then prepares each frame once. The depth (in depth units, units_per_metre) is
+// needed where the frame is the source, whose pixels are moved; a target needs only its colour.
+// Not for concurrent first use from several threads.
+class PhotometricFrame {
+ public:
+  PhotometricFrame();  // none: empty()
+  PhotometricFrame(RgbImage color, DepthImage depth, double units_per_metre);
+  PhotometricFrame(PhotometricFrame&&) noexcept;
+  PhotometricFrame& operator=(PhotometricFrame&&) noexcept;
+  ~PhotometricFrame();
+
+  bool empty() const { return color_.empty(); }
+  const RgbImage& color() const { return color_; }
+  const DepthImage& depth() const { return depth_; }
+  double units_per_metre() const { return units_per_metre_; }
+  // What the functions below derive from the images (private to them), made on first use.
+  detail::PreparedImages& prepared() const;
+
+ private:
+  RgbImage color_;
+  DepthImage depth_;
+  double units_per_metre_ = 0;
+  mutable std::unique_ptr<detail::PreparedImages> prepared_;
 };
 
 struct PhotometricResult {
@@ -99,6 +132,25 @@ std::vector<double> intensity_disagreement(const DepthImage& source_depth,
                                            const RgbImage& source_color,
                                            const RgbImage& target_color,
                                            const PinholeIntrinsics& camera, double units_per_metre,
+                                           std::span<const Eigen::Isometry3d> source_to_target,
+                                           const PhotometricParams& params = {});
+
+// The three functions above on prepared frames (PhotometricFrame): the same results, each
+// frame's images prepared once however often it is compared. Throws Error where a size is not
+// the camera's or the source has no depth units.
+PhotometricResult refine_photometrically(
+    const PhotometricFrame& source, const PhotometricFrame& target, const PinholeIntrinsics& camera,
+    const Eigen::Isometry3d& source_to_target, std::span<const se3::Vector6d> directions,
+    const PhotometricParams& params = {},
+    const se3::Matrix6d& start_information = se3::Matrix6d::Zero(),
+    std::size_t measured_directions = 6);
+std::vector<double> intensity_rmse(const PhotometricFrame& source, const PhotometricFrame& target,
+                                   const PinholeIntrinsics& camera,
+                                   std::span<const Eigen::Isometry3d> source_to_target,
+                                   const PhotometricParams& params = {});
+std::vector<double> intensity_disagreement(const PhotometricFrame& source,
+                                           const PhotometricFrame& target,
+                                           const PinholeIntrinsics& camera,
                                            std::span<const Eigen::Isometry3d> source_to_target,
                                            const PhotometricParams& params = {});
 
