@@ -8,24 +8,44 @@ namespace kartograf::registration::detail {
 
 namespace {
 
-// One pass of the separable binomial filter [1 4 6 4 1] / 16, borders clamped.
+// The five taps of the binomial filter [1 4 6 4 1] / 16 summed in order, as every pass sums them.
+float binomial(float a, float b, float c, float d, float e) {
+  constexpr float k[5] = {1 / 16.0f, 4 / 16.0f, 6 / 16.0f, 4 / 16.0f, 1 / 16.0f};
+  float sum = 0;
+  sum += k[0] * a;
+  sum += k[1] * b;
+  sum += k[2] * c;
+  sum += k[3] * d;
+  sum += k[4] * e;
+  return sum;
+}
+
+// One pass of the separable binomial filter, borders clamped. The clamping is confined to the
+// first and last two columns, so the loops over a row's pixels vectorize (the same sums).
 void blur(GreyImage& image) {
   const int w = image.width(), h = image.height();
-  const float k[5] = {1 / 16.0f, 4 / 16.0f, 6 / 16.0f, 4 / 16.0f, 1 / 16.0f};
   GreyImage tmp(w, h);
+  const int inner_begin = std::min(2, w), inner_end = std::max(inner_begin, w - 2);
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      float sum = 0;
-      for (int d = -2; d <= 2; ++d) sum += k[d + 2] * image(std::clamp(x + d, 0, w - 1), y);
-      tmp(x, y) = sum;
+    const float* in = image.data() + static_cast<std::size_t>(y) * w;
+    float* out = tmp.data() + static_cast<std::size_t>(y) * w;
+    const auto clamped = [&](int x) {
+      const auto at = [&](int d) { return in[std::clamp(x + d, 0, w - 1)]; };
+      return binomial(at(-2), at(-1), at(0), at(1), at(2));
+    };
+    for (int x = 0; x < inner_begin; ++x) out[x] = clamped(x);
+    for (int x = inner_begin; x < inner_end; ++x) {
+      out[x] = binomial(in[x - 2], in[x - 1], in[x], in[x + 1], in[x + 2]);
     }
+    for (int x = inner_end; x < w; ++x) out[x] = clamped(x);
   }
   for (int y = 0; y < h; ++y) {
-    for (int x = 0; x < w; ++x) {
-      float sum = 0;
-      for (int d = -2; d <= 2; ++d) sum += k[d + 2] * tmp(x, std::clamp(y + d, 0, h - 1));
-      image(x, y) = sum;
-    }
+    const auto row = [&](int d) {
+      return tmp.data() + static_cast<std::size_t>(std::clamp(y + d, 0, h - 1)) * w;
+    };
+    const float *r0 = row(-2), *r1 = row(-1), *r2 = row(0), *r3 = row(1), *r4 = row(2);
+    float* out = image.data() + static_cast<std::size_t>(y) * w;
+    for (int x = 0; x < w; ++x) out[x] = binomial(r0[x], r1[x], r2[x], r3[x], r4[x]);
   }
 }
 

@@ -5,6 +5,9 @@
 #include <cstdint>
 #include <map>
 #include <optional>
+#include <vector>
+
+#include <Eigen/Core>
 
 #include "kartograf/core/color.hpp"
 #include "kartograf/core/point_image.hpp"
@@ -49,10 +52,28 @@ struct Textured {
 // few textured pixels to refine; masked to 3 in both passes, seeds 5, 6 and 10 drifted more.
 Mask near_depth_edges(const DepthImage& depth, double units_per_metre);
 
+// A textured source pixel: its point and its smoothed grey level.
+struct Sample {
+  Eigen::Vector3d point;  // source camera frame
+  double intensity = 0;
+};
+
+// What selects a frame's samples: the smoothing, whether the pixels beside depth edges are left
+// out, the parameters that pick pixels and the camera that back-projects them.
+struct SampleChoice {
+  int passes = 1;
+  bool masked = false;
+  int pixel_step = 1;
+  double min_gradient = 0, max_depth = 0;
+  double fx = 0, fy = 0, cx = 0, cy = 0;
+  auto operator<=>(const SampleChoice&) const = default;
+};
+
 // What a PhotometricFrame derives from its images, each part made on first use.
 struct PreparedImages {
   std::optional<GreyImage> grey;
   std::map<int, Textured> smoothed;  // by the number of binomial passes
+  std::map<SampleChoice, std::vector<Sample>> samples;
   std::optional<Mask> near_depth_edges;
   std::optional<Mask> kept_all;  // no pixel left out
 };

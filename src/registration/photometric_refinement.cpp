@@ -17,12 +17,8 @@ namespace {
 
 using detail::GreyImage;
 using detail::Mask;
+using detail::Sample;
 using detail::Textured;
-
-struct Sample {
-  Eigen::Vector3d point;  // source camera frame
-  double intensity = 0;
-};
 
 // Robust Gauss-Newton sums of all residuals at `motion`.
 struct Sums {
@@ -33,9 +29,9 @@ struct Sums {
   std::size_t count = 0;
 };
 
-Sums evaluate(const std::vector<Sample>& samples, const Textured& target,
-              const PinholeIntrinsics& k, const Eigen::Isometry3d& motion,
-              std::span<const se3::Vector6d> directions, double huber) {
+Sums evaluate(std::span<const Sample> samples, const Textured& target, const PinholeIntrinsics& k,
+              const Eigen::Isometry3d& motion, std::span<const se3::Vector6d> directions,
+              double huber) {
   const auto n = static_cast<Eigen::Index>(directions.size());
   Sums sums{Eigen::MatrixXd::Zero(n, n), Eigen::VectorXd::Zero(n), 0, 0, 0};
   const Eigen::Matrix3d rotation = motion.linear();
@@ -167,7 +163,7 @@ double mean_cost(const Sums& sums) {
 }
 
 // Robust Gauss-Newton from `motion` (updated), a step kept only if it lowers the mean cost.
-Sums descend(const std::vector<Sample>& samples, const Textured& target, const PinholeIntrinsics& k,
+Sums descend(std::span<const Sample> samples, const Textured& target, const PinholeIntrinsics& k,
              std::span<const se3::Vector6d> directions, const PhotometricParams& params,
              Eigen::Isometry3d& motion, Prior& prior) {
   Sums sums = evaluate(samples, target, k, motion, directions, params.huber_levels);
@@ -203,16 +199,43 @@ void require_camera_sized(const PhotometricFrame& source, const PhotometricFrame
   require(source.units_per_metre() > 0, "photometric refinement: units_per_metre must be > 0");
 }
 
-// The source's textured pixels after one smoothing pass, as intensity_rmse and
-// intensity_disagreement compare motions on (none where fewer than params.min_pixels).
-std::vector<Sample> compared_samples(const PhotometricFrame& source, const PhotometricFrame& target,
-                                     const PinholeIntrinsics& camera,
-                                     const PhotometricParams& params) {
+// The source's textured pixels after `passes` smoothing passes, without those beside depth edges
+// where `masked` (and params.mask_depth_edges), gathered once per frame and choice.
+const std::vector<Sample>& samples_for(const PhotometricFrame& source, int passes, bool masked,
+                                       const PinholeIntrinsics& k,
+                                       const PhotometricParams& params) {
+  masked = masked && params.mask_depth_edges;
+  const detail::SampleChoice choice{.passes = passes,
+                                    .masked = masked,
+                                    .pixel_step = params.pixel_step,
+                                    .min_gradient = params.min_gradient,
+                                    .max_depth = params.max_depth,
+                                    .fx = k.fx,
+                                    .fy = k.fy,
+                                    .cx = k.cx,
+                                    .cy = k.cy};
+  auto& cache = source.prepared().samples;
+  auto found = cache.find(choice);
+  if (found == cache.end()) {
+    const Mask& excluded = masked ? excluded_pixels(source, params) : kept_all(source);
+    found = cache
+                .try_emplace(choice, samples_of(source.depth(), smoothed(source, passes), k,
+                                                source.units_per_metre(), params, excluded))
+                .first;
+  }
+  return found->second;
+}
+
+// The samples intensity_rmse and intensity_disagreement compare motions on: one smoothing pass,
+// the pixels beside depth edges left out (params.mask_depth_edges); none where fewer than
+// params.min_pixels.
+std::span<const Sample> compared_samples(const PhotometricFrame& source,
+                                         const PhotometricFrame& target,
+                                         const PinholeIntrinsics& camera,
+                                         const PhotometricParams& params) {
   require_camera_sized(source, target, camera);
-  std::vector<Sample> samples =
-      samples_of(source.depth(), smoothed(source, 1), camera, source.units_per_metre(), params,
-                 excluded_pixels(source, params));
-  if (samples.size() < params.min_pixels) samples.clear();
+  const std::vector<Sample>& samples = samples_for(source, 1, true, camera, params);
+  if (samples.size() < params.min_pixels) return {};
   return samples;
 }
 
@@ -234,7 +257,7 @@ std::vector<double> intensity_rmse(const PhotometricFrame& source, const Photome
                                    const PinholeIntrinsics& camera,
                                    std::span<const Eigen::Isometry3d> source_to_target,
                                    const PhotometricParams& params) {
-  const std::vector<Sample> samples = compared_samples(source, target, camera, params);
+  const std::span<const Sample> samples = compared_samples(source, target, camera, params);
   std::vector<double> rmse(source_to_target.size(), 0.0);
   if (samples.empty()) return rmse;
   const Textured& onto = smoothed(target, 1);
@@ -250,7 +273,7 @@ std::vector<double> intensity_disagreement(const PhotometricFrame& source,
                                            const PinholeIntrinsics& camera,
                                            std::span<const Eigen::Isometry3d> source_to_target,
                                            const PhotometricParams& params) {
-  const std::vector<Sample> samples = compared_samples(source, target, camera, params);
+  const std::span<const Sample> samples = compared_samples(source, target, camera, params);
   std::vector<double> disagreement(source_to_target.size(), 0.0);
   if (samples.empty()) return disagreement;
   const Textured& onto = smoothed(target, 1);
@@ -282,22 +305,21 @@ PhotometricResult refine_photometrically(
   unrefined.motion = source_to_target;
   if (directions.empty()) return unrefined;
   Prior prior(start_information, directions, params.intensity_sigma);
-  const auto samples = [&](int passes, const Mask& excluded) {
-    return samples_of(source.depth(), smoothed(source, passes), camera, source.units_per_metre(),
-                      params, excluded);
+  const auto samples = [&](int passes, bool masked) -> const std::vector<Sample>& {
+    return samples_for(source, passes, masked, camera, params);
   };
   // Coarse (wide basin), on every textured pixel. A faint texture that three passes blur under
   // the gradient threshold (a floor's wood grain: 61 pixels left of 700 on survey seed 4) skips
   // it: the fine pass then measures from ICP's answer, under the same gate.
   Eigen::Isometry3d coarse = source_to_target;
-  if (const std::vector<Sample> wide = samples(params.blur_passes, kept_all(source));
+  if (const std::vector<Sample>& wide = samples(params.blur_passes, false);
       wide.size() >= params.min_pixels) {
     descend(wide, smoothed(target, params.blur_passes), camera, directions, params, coarse, prior);
   }
-  // Fine (sharp minimum), from the coarse answer, without the pixels `excluded`.
+  // Fine (sharp minimum), from the coarse answer, without the pixels beside depth edges.
   const Textured& onto = smoothed(target, 1);
-  const auto fine = [&](const Mask& excluded) {
-    const std::vector<Sample> sharp = samples(1, excluded);
+  const auto fine = [&](bool masked) {
+    const std::vector<Sample>& sharp = samples(1, masked);
     if (sharp.size() < params.min_pixels) return unrefined;
     PhotometricResult result;
     const Sums original =
@@ -314,12 +336,12 @@ PhotometricResult refine_photometrically(
     if (!result.refined) result.motion = source_to_target;
     return result;
   };
-  const PhotometricResult masked = fine(excluded_pixels(source, params));
+  const PhotometricResult masked = fine(true);
   // Where the images cannot measure the motion without the pixels beside depth edges (too few
   // left, or sigma over the gate: the 320x240 hand-held views), those pixels measure it as they
   // did before they were left out.
   if (masked.refined || !params.mask_depth_edges) return masked;
-  return fine(kept_all(source));
+  return fine(false);
 }
 
 // The same on images given one by one (each call prepares them).

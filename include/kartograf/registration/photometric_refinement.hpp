@@ -64,7 +64,8 @@ struct PreparedImages;
 }
 
 // One frame's images for the functions below, and what they derive from them, made on first use
-// and kept: the grey levels, each smoothing with its gradients, the pixels beside depth edges.
+// and kept: the grey levels, each smoothing with its gradients, the pixels beside depth edges,
+// the textured pixels for each choice of parameters and camera.
 // Comparing many motions, or a frame against several others (the odometry's starts, scans and
 // re-estimates), then prepares each frame once. The depth (in depth units, units_per_metre) is
 // needed where the frame is the source, whose pixels are moved; a target needs only its colour.
