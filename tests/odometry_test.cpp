@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numbers>
 
 #include "icp_test_scene.hpp"
@@ -464,8 +465,13 @@ TEST(PhotometricFrame, PreparedOnceGivesWhatEachCallOnTheImagesGives) {
   EXPECT_TRUE(
       registration::refine_photometrically(source_frame, target_frame, scene.camera, start, along_x)
           .refined);
-  // A frame without depth is no source.
+  // A frame without depth is no source, and a limit that is no number picks no pixels.
   EXPECT_THROW(registration::intensity_rmse(target_frame, source_frame, scene.camera, motions),
+               Error);
+  registration::PhotometricParams unknown;
+  unknown.max_depth = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(registration::intensity_disagreement(source_frame, target_frame, scene.camera,
+                                                    motions, unknown),
                Error);
 }
 

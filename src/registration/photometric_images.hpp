@@ -1,7 +1,7 @@
 #pragma once
 // A frame's images as the photometric refinement reads them (photometric_refinement.cpp): grey
-// levels, their binomial smoothings with gradients, and the pixels beside depth edges. Private to
-// the registration layer.
+// levels, their binomial smoothings with gradients, the pixels beside depth edges, and the
+// textured pixels (samples) it compares. Private to the registration layer.
 #include <cstdint>
 #include <map>
 #include <optional>

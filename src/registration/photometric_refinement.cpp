@@ -199,11 +199,18 @@ void require_camera_sized(const PhotometricFrame& source, const PhotometricFrame
   require(source.units_per_metre() > 0, "photometric refinement: units_per_metre must be > 0");
 }
 
+// The limits that pick the samples (and key the frame's kept samples) must be numbers.
+void require_finite_limits(const PhotometricParams& params) {
+  require(std::isfinite(params.min_gradient) && std::isfinite(params.max_depth),
+          "photometric refinement: min_gradient and max_depth must be finite");
+}
+
 // The source's textured pixels after `passes` smoothing passes, without those beside depth edges
 // where `masked` (and params.mask_depth_edges), gathered once per frame and choice.
 const std::vector<Sample>& samples_for(const PhotometricFrame& source, int passes, bool masked,
                                        const PinholeIntrinsics& k,
                                        const PhotometricParams& params) {
+  require_finite_limits(params);
   masked = masked && params.mask_depth_edges;
   const detail::SampleChoice choice{.passes = passes,
                                     .masked = masked,

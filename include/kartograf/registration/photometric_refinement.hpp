@@ -65,11 +65,11 @@ struct PreparedImages;
 
 // One frame's images for the functions below, and what they derive from them, made on first use
 // and kept: the grey levels, each smoothing with its gradients, the pixels beside depth edges,
-// the textured pixels for each choice of parameters and camera.
-// Comparing many motions, or a frame against several others (the odometry's starts, scans and
-// re-estimates), then prepares each frame once. The depth (in depth units, units_per_metre) is
-// needed where the frame is the source, whose pixels are moved; a target needs only its colour.
-// Not for concurrent first use from several threads.
+// the textured pixels for each choice of parameters and camera. Comparing many motions, or a
+// frame against several others (the odometry's starts, scans and re-estimates), then prepares
+// each frame once. The depth (in depth units, units_per_metre) is needed where the frame is the
+// source, whose pixels are moved; a target needs only its colour. Not for concurrent first use
+// from several threads.
 class PhotometricFrame {
  public:
   PhotometricFrame();  // none: empty()
@@ -138,7 +138,7 @@ std::vector<double> intensity_disagreement(const DepthImage& source_depth,
 
 // The three functions above on prepared frames (PhotometricFrame): the same results, each
 // frame's images prepared once however often it is compared. Throws Error where a size is not
-// the camera's or the source has no depth units.
+// the camera's, the source has no depth units or a gradient or depth limit is not finite.
 PhotometricResult refine_photometrically(
     const PhotometricFrame& source, const PhotometricFrame& target, const PinholeIntrinsics& camera,
     const Eigen::Isometry3d& source_to_target, std::span<const se3::Vector6d> directions,
