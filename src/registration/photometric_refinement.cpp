@@ -90,9 +90,9 @@ const Mask& kept_all(const PhotometricFrame& frame) {
   return *prepared.kept_all;
 }
 
-// The pixels the fine pass and intensity_rmse leave out: none unless params.mask_depth_edges.
-const Mask& excluded_pixels(const PhotometricFrame& frame, const PhotometricParams& params) {
-  if (!params.mask_depth_edges) return kept_all(frame);
+// The pixels beside depth edges (detail::near_depth_edges), which the fine pass and the
+// comparisons leave out where params.mask_depth_edges.
+const Mask& depth_edges(const PhotometricFrame& frame) {
   detail::PreparedImages& prepared = frame.prepared();
   if (!prepared.near_depth_edges) {
     prepared.near_depth_edges = detail::near_depth_edges(frame.depth(), frame.units_per_metre());
@@ -224,7 +224,7 @@ const std::vector<Sample>& samples_for(const PhotometricFrame& source, int passe
   auto& cache = source.prepared().samples;
   auto found = cache.find(choice);
   if (found == cache.end()) {
-    const Mask& excluded = masked ? excluded_pixels(source, params) : kept_all(source);
+    const Mask& excluded = masked ? depth_edges(source) : kept_all(source);
     found = cache
                 .try_emplace(choice, samples_of(source.depth(), smoothed(source, passes), k,
                                                 source.units_per_metre(), params, excluded))
@@ -312,21 +312,19 @@ PhotometricResult refine_photometrically(
   unrefined.motion = source_to_target;
   if (directions.empty()) return unrefined;
   Prior prior(start_information, directions, params.intensity_sigma);
-  const auto samples = [&](int passes, bool masked) -> const std::vector<Sample>& {
-    return samples_for(source, passes, masked, camera, params);
-  };
   // Coarse (wide basin), on every textured pixel. A faint texture that three passes blur under
   // the gradient threshold (a floor's wood grain: 61 pixels left of 700 on survey seed 4) skips
   // it: the fine pass then measures from ICP's answer, under the same gate.
   Eigen::Isometry3d coarse = source_to_target;
-  if (const std::vector<Sample>& wide = samples(params.blur_passes, false);
+  if (const std::vector<Sample>& wide =
+          samples_for(source, params.blur_passes, false, camera, params);
       wide.size() >= params.min_pixels) {
     descend(wide, smoothed(target, params.blur_passes), camera, directions, params, coarse, prior);
   }
   // Fine (sharp minimum), from the coarse answer, without the pixels beside depth edges.
   const Textured& onto = smoothed(target, 1);
   const auto fine = [&](bool masked) {
-    const std::vector<Sample>& sharp = samples(1, masked);
+    const std::vector<Sample>& sharp = samples_for(source, 1, masked, camera, params);
     if (sharp.size() < params.min_pixels) return unrefined;
     PhotometricResult result;
     const Sums original =
