@@ -304,8 +304,16 @@ CellCandidates candidates_of(const CellGrid& cells, std::size_t cell, PlanesOf&&
   const auto in_one = [](const std::array<std::uint32_t, 4>& p) {
     return p[0] != geometry::kNoLabel && p[0] == p[1] && p[0] == p[2] && p[0] == p[3];
   };
+  // A cell's entries repeat (a cell in one plane has it four times): a repeat of the entry
+  // before it adds nothing, and is skipped without searching the list.
+  const auto add_all = [&out](const std::array<std::uint32_t, 4>& p) {
+    out.add(p[0]);
+    for (std::size_t k = 1; k < 4; ++k) {
+      if (p[k] != p[k - 1]) out.add(p[k]);
+    }
+  };
   const std::array<std::uint32_t, 4> own = planes_of(cell);
-  for (const std::uint32_t p : own) out.add(p);
+  add_all(own);
   out.own = out.whole = in_one(own);
   const int cx = static_cast<int>(cell % cells.columns),
             cy = static_cast<int>(cell / cells.columns);
@@ -314,7 +322,7 @@ CellCandidates candidates_of(const CellGrid& cells, std::size_t cell, PlanesOf&&
       const std::array<std::uint32_t, 4> p =
           planes_of(static_cast<std::size_t>(y) * cells.columns + x);
       out.whole = out.whole && in_one(p) && p[0] == own[0];
-      for (const std::uint32_t plane : p) out.add(plane);
+      add_all(p);
     }
   }
   return out;
@@ -544,10 +552,16 @@ class RectChoices {
                 candidates.count};
   }
 
-  // Row `row` (the image row's first point) is next.
-  void start_row(const Point4f* row) {
-    if (wide_)
-      wide_row_choices(wide_in_, row, rect_.x0, rect_.x1, choices_.data(), distances_.data());
+  // Row y is next (`row`: the image row's first point, `stride`: points from row to row). The
+  // wide path chooses for kBatchRows rows at once.
+  void start_row(const Point4f* row, int y, int stride) {
+    if (!wide_) return;
+    const int width = rect_.x1 - rect_.x0;
+    batch_offset_ = (y - rect_.y0) % kBatchRows * width;
+    if (batch_offset_ == 0) {
+      wide_rows_choices(wide_in_, row, stride, std::min(kBatchRows, rect_.y1 - y), rect_.x0,
+                        rect_.x1, choices_.data(), distances_.data());
+    }
   }
 
   bool wide() const { return wide_; }
@@ -558,12 +572,13 @@ class RectChoices {
   void tally_row(const CellCandidates& candidates, std::array<std::uint64_t, 36>& bits,
                  std::array<float, 36>& squared, std::uint32_t* pixel_row) const {
     const int width = rect_.x1 - rect_.x0;
-    wide_row_tally(choices_.data(), distances_.data(), width, candidates.count, bits.data(),
+    const std::int32_t* choices = choices_.data() + batch_offset_;
+    wide_row_tally(choices, distances_.data() + batch_offset_, width, candidates.count, bits.data(),
                    squared.data());
     std::array<std::uint32_t, 37> plane_of;  // of a choice + 1 (0: none)
     plane_of[0] = geometry::kNoLabel;
     std::copy_n(candidates.planes.begin(), candidates.count, plane_of.begin() + 1);
-    for (int j = 0; j < width; ++j) pixel_row[j] = plane_of[choices_[j] + 1];
+    for (int j = 0; j < width; ++j) pixel_row[j] = plane_of[choices[j] + 1];
   }
 
   // The four-lane path (not wide()): the pixels x .. x + 3 of row y (`row` its first point),
@@ -575,6 +590,7 @@ class RectChoices {
 
  private:
   static constexpr int kMaxWidth = 64;  // a cell's largest side
+  static constexpr int kBatchRows = 8;
   const AssignInputs& in_;
   PixelRect rect_;
   std::size_t job_;
@@ -582,8 +598,9 @@ class RectChoices {
   CandidateLanes lanes_;
   std::array<float, 36> nx_, ny_, nz_, offset_;
   WideScoreInputs wide_in_{};
-  std::array<std::int32_t, kMaxWidth> choices_;
-  std::array<float, kMaxWidth> distances_;
+  int batch_offset_ = 0;  // the row's first entry in the batch's choices
+  std::array<std::int32_t, kMaxWidth * kBatchRows> choices_;
+  std::array<float, kMaxWidth * kBatchRows> distances_;
 };
 
 // A cell's pixels taken per candidate while it is scored: counts and squared distances for the
@@ -654,7 +671,7 @@ std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRe
       compute::detail::prefetch_lines(next + x0, next + x1);
     }
     std::fill_n(tally.first.begin(), count, -1);
-    source.start_row(points + row);
+    source.start_row(points + row, y, in.points.width());
     if (source.wide()) {
       tally.add_row(source, candidates, x0, pixel_plane.data() + row + x0);
     } else {

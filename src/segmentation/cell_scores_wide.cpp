@@ -1,5 +1,6 @@
 #include "cell_scores_wide.hpp"
 
+#include <cstddef>
 #include <cstring>
 #include <stdexcept>
 
@@ -70,15 +71,20 @@ void wide_row_tally(const std::int32_t* choices, const float* distance2, int wid
   row_tally(choices, distance2, width, count, bits, squared);
 }
 
-void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
-                      std::int32_t* choices, float* distance2) {
-  row_choices(in, row, x0, x1, choices, distance2);
+void wide_rows_choices(const WideScoreInputs& in, const Point4f* first_row, int stride, int rows,
+                       int x0, int x1, std::int32_t* choices, float* distance2) {
+  const int width = x1 - x0;
+  for (int r = 0; r < rows; ++r) {
+    row_choices(in, first_row + static_cast<std::ptrdiff_t>(r) * stride, x0, x1,
+                choices + r * width, distance2 + r * width);
+  }
 }
 
 #else
 
-void wide_row_choices(const WideScoreInputs&, const Point4f*, int, int, std::int32_t*, float*) {
-  throw std::logic_error("wide_row_choices: no AVX2 code in this build");
+void wide_rows_choices(const WideScoreInputs&, const Point4f*, int, int, int, int, std::int32_t*,
+                       float*) {
+  throw std::logic_error("wide_rows_choices: no AVX2 code in this build");
 }
 
 void wide_row_tally(const std::int32_t*, const float*, int, int, std::uint64_t*, float*) {

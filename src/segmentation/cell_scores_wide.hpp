@@ -16,10 +16,12 @@ struct WideScoreInputs {
   int count;
 };
 
-// Pixels row[x0 .. x1) ((x1 - x0) a multiple of 8): per pixel the index of the candidate it takes
-// (-1: none) and its squared distance to it (1 where none), from choices[0] and distance2[0] on.
-void wide_row_choices(const WideScoreInputs& in, const Point4f* row, int x0, int x1,
-                      std::int32_t* choices, float* distance2);
+// Pixels x0 .. x1 - 1 ((x1 - x0) a multiple of 8) of `rows` rows, `stride` points apart from
+// `first_row`: per pixel the index of the candidate it takes (-1: none) and its squared distance
+// to it (1 where none), row after row from choices[0] and distance2[0] on. Rows are independent,
+// so the processor overlaps one row's chain of comparisons over the candidates with the next's.
+void wide_rows_choices(const WideScoreInputs& in, const Point4f* first_row, int stride, int rows,
+                       int x0, int x1, std::int32_t* choices, float* distance2);
 
 // The row's choices (width a multiple of 8, at most 64) per candidate k < count: bit j of bits[k]
 // is set where pixel j took k, and squared[k] sums those pixels' squared distances (in float,
