@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <array>
+#include <bit>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -401,13 +402,23 @@ void PlaneExtractor::add_leftover_planes(const PointImage& points, const detail:
                                          std::vector<SegmentPlane>& planes,
                                          std::vector<detail::PlanePixelSums>& sums) {
   const std::size_t cell_plane_count = planes.size();
+  // Only valid pixels that no plane took can seed a region, in the same order: a row's seeds as
+  // bits (the visit checks each again, since a region grown from an earlier seed takes pixels).
+  const int half = cells.cell_size / 2;
   const auto pixels_of_open_cells = [&](auto&& visit) {
     for (const std::uint32_t c : open_cells_) {
       const int x0 = cells.first_x(c), y0 = cells.first_y(c);
       const int x1 = std::min(points.width(), x0 + cells.cell_size);
       const int y1 = std::min(points.height(), y0 + cells.cell_size);
       for (int y = y0; y < y1; ++y) {
-        for (int x = x0; x < x1; ++x) visit(static_cast<std::uint32_t>(y * points.width() + x));
+        const auto row = static_cast<std::uint32_t>(y * points.width() + x0);
+        std::uint64_t seeds = cells.valid_bits(x0 / half, y);
+        if (x1 - x0 > half) seeds |= std::uint64_t{cells.valid_bits(x0 / half + 1, y)} << half;
+        std::uint64_t untaken = 0;
+        for (int j = 0; j < x1 - x0; ++j)
+          untaken |= std::uint64_t{pixel_plane_[row + j] == geometry::kNoLabel} << j;
+        for (seeds &= untaken; seeds != 0; seeds &= seeds - 1)
+          visit(row + static_cast<std::uint32_t>(std::countr_zero(seeds)));
       }
     }
   };
