@@ -272,7 +272,10 @@ SegmentGraph cell_segment_graph(const CellGrid& cells, std::uint32_t segment_cou
         const int nx = x + step[0], ny = y + step[1];
         if (nx < 0 || nx >= columns || ny >= rows) continue;
         const std::uint32_t b = cells.block_segment(nx, ny);
-        if (b != geometry::kNoLabel && b != a) edges.push_back(segment_edge(a, b));
+        if (b == geometry::kNoLabel || b == a) continue;
+        // A cell's blocks share its segment: the same pair comes up block after block.
+        const std::uint64_t edge = segment_edge(a, b);
+        if (edges.empty() || edges.back() != edge) edges.push_back(edge);
       }
     }
   }
