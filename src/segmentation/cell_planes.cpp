@@ -145,11 +145,13 @@ void measure_cells(const compute::Context& context, const compute::Buffer<Point4
 
 namespace {
 
-// The piece's fit when it is planar, else none.
+// The piece's fit when it is planar, else none. min_facing: the cosine of the merge's incidence
+// limit.
 std::optional<SegmentPlane> planar_piece(const CellPlaneParams& params,
                                          const PlaneMergeParams& merge,
                                          const geometry::SegmentMoments& moments,
-                                         const Eigen::Vector3d& origin, std::uint64_t min_count) {
+                                         const Eigen::Vector3d& origin, std::uint64_t min_count,
+                                         double min_facing) {
   if (moments.count < std::max<std::uint64_t>(min_count, 3)) return std::nullopt;
   SegmentPlane fit = fit_plane(moments, origin, merge.fit);
   if (!fit.valid) return std::nullopt;
@@ -157,7 +159,7 @@ std::optional<SegmentPlane> planar_piece(const CellPlaneParams& params,
   if (fit.rms_error > params.rms_base + params.rms_per_z2 * z * z) return std::nullopt;
   // A surface seen edge-on is no plane to this sensor (the merge's incidence limit).
   const double facing = std::fabs(fit.normal.dot(fit.centroid.normalized()));
-  if (facing < std::cos(merge.max_incidence_deg * M_PI / 180.0)) return std::nullopt;
+  if (facing < min_facing) return std::nullopt;
   return fit;
 }
 
@@ -197,10 +199,12 @@ void planar_pieces(const CellPlaneParams& params, const PlaneMergeParams& merge,
   const auto min_count = [&](int side) {
     return static_cast<std::uint64_t>(std::ceil(params.min_valid_fraction * side * side));
   };
+  const double min_facing = std::cos(merge.max_incidence_deg * M_PI / 180.0);
   for (std::size_t c = begin; c < end; ++c) {
     const std::optional<SegmentPlane> cell_fit =
-        cells.continuous[c] ? planar_piece(params, merge, cells.moments[c], origin, min_count(size))
-                            : std::nullopt;
+        cells.continuous[c]
+            ? planar_piece(params, merge, cells.moments[c], origin, min_count(size), min_facing)
+            : std::nullopt;
     if (cell_fit) {
       const std::size_t k = 4 * c;
       const Eigen::Vector3d colour = cells.block_colours[k] + cells.block_colours[k + 1] +
@@ -212,7 +216,7 @@ void planar_pieces(const CellPlaneParams& params, const PlaneMergeParams& merge,
       const std::size_t k = 4 * c + static_cast<std::size_t>(b);
       if (!cells.block_continuous[k]) continue;
       const std::optional<SegmentPlane> fit =
-          planar_piece(params, merge, cells.block_moments[k], origin, min_count(half));
+          planar_piece(params, merge, cells.block_moments[k], origin, min_count(half), min_facing);
       if (fit)
         out.push_back({c, b, *fit, mean_lab(cells.block_colours[k], cells.block_moments[k].count)});
     }
