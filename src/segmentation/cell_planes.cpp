@@ -672,7 +672,8 @@ std::array<std::uint32_t, 36> score_pixels(const AssignInputs& in, const PixelRe
   CellTally tally;
   for (int y = y0; y < y1; ++y) {
     const std::size_t row = static_cast<std::size_t>(y) * in.points.width();
-    // The next row's points, a row of the image away, fetched while this one is scored.
+    // The next row's points, a row of the image away, fetched while this one is scored (the wide
+    // path chooses for eight rows at once: for it this readies the next batch's first row).
     if (y + 1 < y1) {
       const Point4f* next = points + row + in.points.width();
       compute::detail::prefetch_lines(next + x0, next + x1);
