@@ -1211,7 +1211,18 @@ RgbdOdometry::Attempt RgbdOdometry::features_turn_on_the_arc(const Eigen::Isomet
   Eigen::Isometry3d start = seeded.motion;
   start.translation() = predicted.translation().norm() * travel;
   Attempt on_the_arc = register_frames(frames_.size() - 1, start, frame_limits_now());
+  if (params_.features_along_the_drive && !heading_prior_.ready() && on_the_arc.report.accepted() &&
+      across_the_drive(seeded.motion, travel)) {
+    return on_the_arc;
+  }
   return agrees_better(on_the_arc, seeded) ? on_the_arc : seeded;
+}
+
+bool RgbdOdometry::across_the_drive(const Eigen::Isometry3d& step,
+                                    const Eigen::Vector3d& travel) const {
+  const Eigen::Vector3d t = step.translation();
+  const double along = t.dot(travel);
+  return t.norm() > params_.feature_arbitration_m && (t - along * travel).norm() > along;
 }
 
 Eigen::Vector3d RgbdOdometry::travel_on_arc(const Eigen::Isometry3d& step) const {
