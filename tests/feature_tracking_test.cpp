@@ -328,8 +328,8 @@ const Counterfactual kCounterfactuals[] = {
      [](registration::OdometryParams& p) { p.arc_start_from_the_prediction = false; }, 0.03, 0.08,
      7, 0, 0, true},
     // Seed 2's survey, frames 0-180 as `kartograf synth` writes them and with the map's
-    // features: the robot turns on the spot through a full turn, sets off (0.01, 0.15, 0.33, 0.51,
-    // 0.69 m a frame, every view floor only) and turns 33 degrees at 0.81 m into frame 180. The
+    // features: the robot turns on the spot through a full turn, sets off (0.01, 0.15, 0.35, 0.54,
+    // 0.73 m a frame, every view floor only) and turns 33 degrees at 0.85 m into frame 180. The
     // features found the turn with a step 0.35 m sideways, which the images fitted best (the
     // floor's tiles); the heading prior had learned no step yet. A step more across the drive
     // than along it is left for the features' turn on its arc: 0.31 m off against 1.03 m. (The

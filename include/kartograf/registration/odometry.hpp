@@ -297,7 +297,7 @@ struct OdometryParams {
   // turn undone) than along it: a robot drives along its heading, and where the features matched
   // a floor's tiles the images fit their step as well (features_turn_on_the_arc's arbitration).
   // Survey seed 2 every 10th frame, frame 180: the robot sets off from a turn on the spot, every
-  // view floor only, and turns 33 degrees at 0.81 m a frame; the features found the turn with a
+  // view floor only, and turns 33 degrees at 0.85 m a frame; the features found the turn with a
   // step 0.35 m sideways, and the images fitted it best (grey-level RMSE 15 against 24-30 along
   // that direction): 1.03 m off, 0.31 m from the features' turn on its arc (odometry 54.1 -> 30.4
   // cm, SLAM 28.7 -> 16.3 cm). Only steps longer than feature_arbitration_m are judged.
