@@ -41,6 +41,10 @@ int main(int argc, char** argv) {
       ->check(CLI::Range(1, 1000));
   app.add_option("--overlays", options.overlays, "Write every mode's planes over every frame here");
   app.add_flag("!--no-device-backends", options.device_backends, "The CPU backend only");
+  app.add_option("--streams", options.throughput.streams,
+                 "Frames at a time: threads, each extracting its own frames (0: skip)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
   app.add_flag("--details", options.details, "Every frame's time and scores on stderr");
   app.add_option("--only", options.only, "Only methods whose name contains this");
   CLI11_PARSE(app, argc, argv);

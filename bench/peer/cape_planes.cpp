@@ -128,6 +128,7 @@ std::vector<PlaneMethod> cape_plane_methods() {
     run.output = [prepared]() { return cape_output(*prepared); };
     return run;
   };
+  method.another = [] { return cape_plane_methods().front(); };  // its own detectors
   return {method};
 }
 

@@ -86,12 +86,18 @@ std::vector<PlaneMethod> kartograf_plane_methods(bool device_backends) {
   using segmentation::PlaneExtractionMode;
   std::vector<PlaneMethod> methods;
   const ContextPtr cpu = make_context(compute::BackendChoice::cpu);
-  methods.push_back(
-      extractor_method(kKartografPlanes, kartograf_threads(), cpu, PlaneExtractionMode::regions));
-  methods.push_back(
-      extractor_method(kKartografCellPlanes, kartograf_threads(), cpu, PlaneExtractionMode::cells));
-  methods.push_back(extractor_method("kartograf PlaneExtractor cells, depth only (cpu)",
-                                     kartograf_threads(), cpu, PlaneExtractionMode::cells, true));
+  // The CPU rows run side by side too, each instance with its own context and extractor.
+  const auto cpu_method = [&](std::string name, PlaneExtractionMode mode, bool depth_only) {
+    PlaneMethod method = extractor_method(name, kartograf_threads(), cpu, mode, depth_only);
+    method.another = [name, mode, depth_only] {
+      return extractor_method(name, kartograf_threads(), make_context(compute::BackendChoice::cpu),
+                              mode, depth_only);
+    };
+    methods.push_back(std::move(method));
+  };
+  cpu_method(kKartografPlanes, PlaneExtractionMode::regions, false);
+  cpu_method(kKartografCellPlanes, PlaneExtractionMode::cells, false);
+  cpu_method("kartograf PlaneExtractor cells, depth only (cpu)", PlaneExtractionMode::cells, true);
   if (device_backends) {
     // CPU-hosted drivers here (lavapipe, PoCL): for the record, not a speed claim.
     for (const DeviceContext& device : device_contexts()) {

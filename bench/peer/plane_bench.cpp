@@ -153,6 +153,7 @@ void run_plane_bench(const PlaneBenchOptions& options, std::ostream& out) {
   out << "\nSettings:\n\n";
   for (const PlaneMethod& method : methods)
     out << "- " << method.name << ": " << method.settings << "\n";
+  print_plane_throughput(out, methods, frames, options.throughput);
   if (options.details) print_plane_details(std::cerr, outcomes);
   out.flush();
 }

@@ -10,6 +10,7 @@
 
 #include "peer_timing.hpp"
 #include "plane_methods.hpp"
+#include "plane_throughput.hpp"
 
 namespace kartograf::peer {
 
@@ -24,6 +25,7 @@ struct PlaneBenchOptions {
   bool details = false;            // every frame's time and scores on stderr
   std::filesystem::path overlays;  // write each method's planes over each frame here (PNG)
   TimingOptions timing;
+  ThroughputOptions throughput;    // the frames-at-a-time table (streams 0: none)
   std::vector<PlaneMethod> peers;  // run after Kartograf's own rows
 };
 

@@ -38,6 +38,9 @@ struct PlaneMethod {
   std::string threads;   // how its thread count is set
   std::string settings;  // its parameters, for the notes under the table
   std::function<PlaneRun(const PlaneFrame&)> prepare;
+  // A new instance that shares nothing with this one, for another thread (plane_throughput.hpp);
+  // empty where the method runs threads of its own (PCL, Open3D, the device backends).
+  std::function<PlaneMethod()> another;
 };
 
 // The smallest plane every method keeps: Kartograf's min_plane_pixels default.
