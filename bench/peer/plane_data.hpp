@@ -19,6 +19,9 @@ namespace kartograf::peer {
 
 enum class PlaneDataset { synthetic, seven_scenes, mosd };
 const char* to_string(PlaneDataset dataset);  // "synthetic", "7scenes", "mosd"
+// Every data set, in the order the tables show them.
+inline constexpr PlaneDataset kPlaneDatasets[] = {PlaneDataset::synthetic,
+                                                  PlaneDataset::seven_scenes, PlaneDataset::mosd};
 
 struct PlaneFrame {
   PlaneDataset dataset = PlaneDataset::synthetic;

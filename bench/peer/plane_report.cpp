@@ -14,9 +14,6 @@
 namespace kartograf::peer {
 namespace {
 
-constexpr PlaneDataset kDatasets[] = {PlaneDataset::synthetic, PlaneDataset::seven_scenes,
-                                      PlaneDataset::mosd};
-
 double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
   const double cosine = std::min(1.0, std::abs(a.normalized().dot(b.normalized())));
   return std::acos(cosine) * 180.0 / std::numbers::pi;
@@ -244,23 +241,24 @@ void print_plane_table(std::ostream& out, const std::vector<PlaneMethodOutcome>&
 
 void print_plane_dataset_table(std::ostream& out, const std::vector<PlaneMethodOutcome>& outcomes) {
   out << "| method |";
-  for (const PlaneDataset dataset : kDatasets) out << " " << to_string(dataset) << ": wall ms |";
-  for (const PlaneDataset dataset : kDatasets)
+  for (const PlaneDataset dataset : kPlaneDatasets)
+    out << " " << to_string(dataset) << ": wall ms |";
+  for (const PlaneDataset dataset : kPlaneDatasets)
     out << " " << to_string(dataset) << ": planes/frame |";
   out << " synthetic SegComp T = 0.8, all ground-truth planes: correct / over / under / missed / "
          "noise | frames with labels identical to Kartograf (cpu) |\n|---|";
-  for (std::size_t i = 0; i < 2 * std::size(kDatasets); ++i) out << "---:|";
+  for (std::size_t i = 0; i < 2 * std::size(kPlaneDatasets); ++i) out << "---:|";
   out << "---|---:|\n";
   const PlaneMethodOutcome* reference = kartograf_reference(outcomes);
   for (const PlaneMethodOutcome& outcome : outcomes) {
     out << "| " << outcome.method->name << " |";
-    for (const PlaneDataset dataset : kDatasets) {
+    for (const PlaneDataset dataset : kPlaneDatasets) {
       out << " "
           << (has_frames(outcome, dataset) ? fixed(1000 * median_over(outcome, wall, dataset), 1)
                                            : "-")
           << " |";
     }
-    for (const PlaneDataset dataset : kDatasets) {
+    for (const PlaneDataset dataset : kPlaneDatasets) {
       out << " "
           << (has_frames(outcome, dataset) ? fixed(median_over(outcome, plane_count, dataset), 1)
                                            : "-")

@@ -14,9 +14,6 @@
 namespace kartograf::peer {
 namespace {
 
-constexpr PlaneDataset kDatasets[] = {PlaneDataset::synthetic, PlaneDataset::seven_scenes,
-                                      PlaneDataset::mosd};
-
 // One thread's instance and its prepared calls (untimed), the first already made once.
 struct Stream {
   PlaneMethod instance;
@@ -94,16 +91,16 @@ void print_plane_throughput(std::ostream& out, const std::vector<PlaneMethod>& m
       << fixed(options.min_time, 1)
       << " s; beside it the same runner with one thread; throughput, not one frame's latency):\n\n"
       << "| method |";
-  for (const PlaneDataset dataset : kDatasets)
+  for (const PlaneDataset dataset : kPlaneDatasets)
     out << " " << to_string(dataset) << ": 1 | " << to_string(dataset) << ": " << n << " |";
   out << "\n|---|";
-  for (std::size_t i = 0; i < 2 * std::size(kDatasets); ++i) out << "---:|";
+  for (std::size_t i = 0; i < 2 * std::size(kPlaneDatasets); ++i) out << "---:|";
   out << "\n";
   for (const PlaneMethod& method : methods) {
     if (!method.another) continue;
     std::cerr << "  " << method.name << ", frames at a time\n";
     out << "| " << method.name << " |";
-    for (const PlaneDataset dataset : kDatasets) {
+    for (const PlaneDataset dataset : kPlaneDatasets) {
       const std::vector<const PlaneFrame*> chosen = frames_of(frames, dataset);
       if (chosen.empty()) {
         out << " - | - |";
