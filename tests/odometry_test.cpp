@@ -509,6 +509,14 @@ TEST(GeometricInformation, FindsTheFreeDirectionOfAWallAndTheFloor) {
   const se3::Matrix6d constrained = registration::constrained_information(degenerate, 0.01);
   const se3::Vector6d u = weak[0].normalized();
   EXPECT_LT(u.dot(constrained * u), 1e-9 * constrained.trace());
+  // translation_constraint: nothing along the slide, much along the wall's and floor's normals.
+  const Eigen::Matrix3d to_camera = testing::reference_camera().linear().transpose();
+  EXPECT_LT(registration::translation_constraint(degenerate, world_x), 0.01);
+  for (const Eigen::Vector3d& normal : {Eigen::Vector3d(0, 0, 1), Eigen::Vector3d(0, 1, 0)}) {
+    EXPECT_GT(registration::translation_constraint(degenerate, to_camera * normal), 0.2);
+  }
+  EXPECT_LT(registration::translation_constraint(corner, world_x), 1.0 + 1e-9);
+  EXPECT_GT(registration::translation_constraint(corner, world_x), 0.2);
 
   // keep_constrained_directions: a measured slide along x is replaced by the predicted one.
   const Eigen::Isometry3d measured(Eigen::Translation3d(0.05 * world_x));

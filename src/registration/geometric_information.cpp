@@ -211,6 +211,14 @@ std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
   return directions;
 }
 
+double translation_constraint(const GeometricInformation& geometry,
+                              const Eigen::Vector3d& direction) {
+  const Eigen::Matrix3d translation = geometry.information.bottomRightCorner<3, 3>();
+  const double largest =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(translation).eigenvalues().maxCoeff();
+  return largest > 0 ? direction.dot(translation * direction) / largest : 0.0;
+}
+
 se3::Matrix6d information_along(const se3::Matrix6d& information,
                                 std::span<const se3::Vector6d> directions) {
   if (directions.empty()) return se3::Matrix6d::Zero();

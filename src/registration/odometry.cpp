@@ -307,14 +307,40 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
     const PhotometricResult refined =
         refine_photometrically(source_images, target_images, builder_.camera(), attempt.motion,
                                directions, params_.photometric, held, degenerate);
+    attempt.photometric_rmse = refined.rmse_before;
+    attempt.refined_rmse = refined.rmse_after;
     if (keeps_refinement(initial, refined, limits, params_.photometric_doubt_rmse)) {
       attempt.motion = refined.motion;
       attempt.photometric = true;
+      attempt.photometric_rmse = refined.rmse_after;
+      measure_travel_length(attempt, initial, limits, source_images, target_images);
     }
-    attempt.photometric_rmse = attempt.photometric ? refined.rmse_after : refined.rmse_before;
-    attempt.refined_rmse = refined.rmse_after;
   }
   return attempt;
+}
+
+void RgbdOdometry::measure_travel_length(Attempt& attempt, const Eigen::Isometry3d& initial,
+                                         const RegistrationLimits& limits,
+                                         const PhotometricFrame& source,
+                                         const PhotometricFrame& target) const {
+  if (!params_.photometric_travel_length || attempt.heading_sigma_m <= 0 ||
+      is_large(attempt.motion))
+    return;
+  const Eigen::Vector3d travel = heading_prior_.travel_on(attempt.motion);
+  // The length along the travel (target frame) is a translation of the source along R^T travel.
+  se3::Vector6d along = se3::Vector6d::Zero();
+  along.tail<3>() = (attempt.motion.linear().transpose() * travel).normalized();
+  if (translation_constraint(geometry_, along.tail<3>()) > params_.photometric_direction_ratio)
+    return;
+  const PhotometricResult length =
+      refine_photometrically(source, target, builder_.camera(), attempt.motion,
+                             std::span<const se3::Vector6d>(&along, 1), params_.photometric);
+  if (!keeps_refinement(initial, length, limits, params_.photometric_doubt_rmse) ||
+      length.rmse_after > params_.photometric_travel_max_rmse)
+    return;
+  attempt.motion = length.motion;
+  attempt.photometric_rmse = length.rmse_after;
+  attempt.refined_rmse = length.rmse_after;
 }
 
 se3::Matrix6d RgbdOdometry::information_of(const Attempt& attempt) const {

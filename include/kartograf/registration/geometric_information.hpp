@@ -87,6 +87,13 @@ se3::Matrix6d motion_prior_information(const GeometricInformation& geometry, dou
 std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
                                            double min_eigenvalue_ratio);
 
+// How much `geometry` constrains a translation of the source along `direction` (its camera
+// frame, unit): the translation information along it over the largest eigenvalue of the
+// translation information. 0: free (a floor alone leaves a slide over it), 1: as constrained as
+// any translation. 0 where the geometry constrains no translation at all.
+double translation_constraint(const GeometricInformation& geometry,
+                              const Eigen::Vector3d& direction);
+
 // `information` restricted to `directions` (tangent vectors, as weak_directions gives them): it
 // says as much about their amounts and nothing about the directions off their span (the
 // least-squares amounts of a perturbation are what it weighs).
