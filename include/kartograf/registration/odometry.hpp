@@ -150,11 +150,11 @@ struct OdometryParams {
   // more, by the images alone. That refinement holds the barely constrained directions to ICP's
   // answer and the slide to the heading, and together they held the length near the
   // prediction's: on held-out survey seed 16, frames 421-437 (the robot slowing over a bare
-  // floor), the images' own minimum along the heading lay 1.5-6 mm shorter, as did the truth,
-  // where the refinement had moved 0.4-0.7 mm. Not on large steps (beyond feature_seed_m or
-  // feature_seed_deg, where other starts and the features are weighed): on the surveys taken
-  // every 10th frame it moved steps of 0.5-1 m by 0.5-1.5 cm, as often away from the truth as
-  // towards it.
+  // floor), the images' own minimum along the heading lay 0.5-6 mm shorter, as did the truth
+  // (0.7-6.7 mm), where the refinement had moved 0.1-0.9 mm. Not on large steps (beyond
+  // feature_seed_m or feature_seed_deg, where other starts and the features are weighed): on
+  // the surveys taken every 10th frame it moved steps of 0.5-1 m by 0.5-1.5 cm, as often away
+  // from the truth as towards it.
   bool photometric_travel_length = true;
   // ...kept only where the images fit the measured step: a grey-level RMSE (the refinement's
   // pixels, after it) of at most this. Where they do not (survey seed 5, frames 815-829: a wall
