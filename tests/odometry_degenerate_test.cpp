@@ -72,12 +72,14 @@ struct TrackedFrames {
   std::vector<registration::OdometryFrame> frames;
   std::vector<Eigen::Isometry3d> poses, truth;
   std::vector<registration::RelativePose> constraints;  // the pose graph's odometry edges
-  // The pose error of frame `index` relative to the stretch's first frame (metres, degrees).
-  StepError error_at(std::size_t index) const {
+  // The error of frame `to`'s pose relative to frame `from`'s (metres, degrees).
+  StepError error_between(std::size_t from, std::size_t to) const {
     const Eigen::Isometry3d error =
-        (truth[0].inverse() * truth[index]).inverse() * (poses[0].inverse() * poses[index]);
+        (truth[from].inverse() * truth[to]).inverse() * (poses[from].inverse() * poses[to]);
     return {error.translation().norm(), se3::rotation_angle(error) / kDegree};
   }
+  // The pose error of frame `index` relative to the stretch's first frame.
+  StepError error_at(std::size_t index) const { return error_between(0, index); }
 };
 
 // The stretch rendered at 640x480 with the Kinect noise model and tracked with `params`.
@@ -102,12 +104,8 @@ TrackedFrames track_frames(const DegenerateStretch& stretch, registration::Odome
 TrackedStretch stretch_of(const TrackedFrames& frames) {
   TrackedStretch tracked;
   for (const auto& frame : frames.frames) tracked.degenerate += frame.degenerate ? 1 : 0;
-  for (std::size_t i = 1; i < frames.poses.size(); ++i) {
-    const Eigen::Isometry3d truth = frames.truth[i - 1].inverse() * frames.truth[i];
-    const Eigen::Isometry3d error =
-        truth.inverse() * (frames.poses[i - 1].inverse() * frames.poses[i]);
-    tracked.steps.push_back({error.translation().norm(), se3::rotation_angle(error) / kDegree});
-  }
+  for (std::size_t i = 1; i < frames.poses.size(); ++i)
+    tracked.steps.push_back(frames.error_between(i - 1, i));
   tracked.ate = testing::ate_rmse(frames.poses, frames.truth);
   return tracked;
 }
@@ -440,17 +438,18 @@ TEST(HeadingPriorOnTheSurvey, ALoopDoesNotBendTheStepsTheImagesMeasured) {
   loop_error.translation() = Eigen::Vector3d(0, 0, 0.01);  // the camera looks along the travel
   const TrackedFrames held = closed_by_a_loop(track_frames(slowing, {}), loop_error);
   const TrackedFrames bent = closed_by_a_loop(track_frames(slowing, without_images), loop_error);
-  // The error the degenerate stretch gathers between its first frame and its last.
+  // The error the degenerate steps gather: from the frame before the first degenerate one to the
+  // last degenerate one.
   const auto degenerate_span_error = [](const TrackedFrames& tracked) {
-    std::size_t first = 0, last = 0;
+    std::optional<std::size_t> first;
+    std::size_t last = 0;
     for (std::size_t i = 1; i < tracked.frames.size(); ++i) {
       if (!tracked.frames[i].degenerate) continue;
-      if (first == 0) first = i - 1;
+      if (!first) first = i - 1;
       last = i;
     }
-    const Eigen::Isometry3d truth = tracked.truth[first].inverse() * tracked.truth[last];
-    const Eigen::Isometry3d pose = tracked.poses[first].inverse() * tracked.poses[last];
-    return (truth.inverse() * pose).translation().norm();
+    if (!first) ADD_FAILURE() << "the stretch has no degenerate frame";
+    return first ? tracked.error_between(*first, last).metres : 0.0;
   };
   RecordProperty("degenerate_span_error_mm", std::to_string(1000 * degenerate_span_error(held)));
   RecordProperty("degenerate_span_error_mm_without",
