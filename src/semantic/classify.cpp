@@ -137,16 +137,18 @@ class RegionRules {
   bool in_wall_plane(const RegionMeasurements& r, const std::vector<SemanticClass>& classes) const {
     if (r.orientation != RegionOrientation::vertical) return false;
     return std::any_of(regions_.begin(), regions_.end(), [&](const RegionMeasurements& o) {
-      if (classes[o.id - 1u] != SemanticClass::wall || o.id == r.id ||
-          o.plane_normal.dot(r.plane_normal) < cos_deg(params_.parallel_tolerance_deg)) {
-        return false;
-      }
-      if (std::fabs(o.plane_normal.dot(r.centroid - o.centroid)) > params_.coplanar_wall_offset)
-        return false;
-      const Eigen::Vector3d along = up_.cross(o.plane_normal).normalized();
-      const double gap = std::fabs(along.dot(r.centroid - o.centroid)) - 0.5 * (r.width + o.width);
-      return gap <= params_.coplanar_wall_gap;
+      return classes[o.id - 1u] == SemanticClass::wall && o.id != r.id &&
+             coplanar_within(r, o, params_.coplanar_wall_gap);
     });
+  }
+  // r in o's plane (parallel, r's centroid within coplanar_wall_offset of it) and no farther than
+  // `gap` from o along it.
+  bool coplanar_within(const RegionMeasurements& r, const RegionMeasurements& o, double gap) const {
+    if (o.plane_normal.dot(r.plane_normal) < cos_deg(params_.parallel_tolerance_deg)) return false;
+    if (std::fabs(o.plane_normal.dot(r.centroid - o.centroid)) > params_.coplanar_wall_offset)
+      return false;
+    const Eigen::Vector3d along = up_.cross(o.plane_normal).normalized();
+    return std::fabs(along.dot(r.centroid - o.centroid)) - 0.5 * (r.width + o.width) <= gap;
   }
 
   // Stands on the floor and ends below the ceiling, within furniture size.
@@ -161,8 +163,19 @@ class RegionRules {
     if (!furniture_sized(r)) return false;
     if (r.orientation == RegionOrientation::horizontal) return true;
     // A side or a front: from the floor (seen there or hidden), and wholly in view above.
-    return r.orientation == RegionOrientation::vertical && !r.cut_above &&
+    return r.orientation == RegionOrientation::vertical && !r.cut_above && !goes_on_above(r) &&
            (reaches_floor(r) || r.cut_below || r.occluded_below);
+  }
+  // Hidden above by a nearer surface, and its plane seen again above that: the wall between a
+  // table's legs and above its top (a leg hidden by the top has no such piece; a cabinet's front
+  // behind a table has its wall behind it, not in its plane).
+  bool goes_on_above(const RegionMeasurements& r) const {
+    if (!r.occluded_above) return false;
+    return std::any_of(regions_.begin(), regions_.end(), [&](const RegionMeasurements& o) {
+      return o.id != r.id && o.orientation == RegionOrientation::vertical &&
+             o.max_height > r.max_height + params_.reach_tolerance &&
+             coplanar_within(r, o, params_.coplanar_wall_gap);
+    });
   }
 
   bool beside(const RegionMeasurements& r, const std::vector<SemanticClass>& classes,

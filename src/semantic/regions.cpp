@@ -599,6 +599,7 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
       m.cut_below = m.cut_below || bottom;
       m.cut_sideways = m.cut_sideways || (!top && !bottom);
     } else {
+      m.occluded_above = m.occluded_above || top;
       m.occluded_below = m.occluded_below || bottom;
       m.occluded_sideways = m.occluded_sideways || (!top && !bottom);
     }

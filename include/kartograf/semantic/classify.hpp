@@ -67,7 +67,9 @@ struct ClassificationParams {
   // Furniture (tables, chairs, beds, cabinets, shelves): what is left that stands on the floor
   // and ends below the ceiling: a horizontal face (a top, a seat, a shelf board) from
   // furniture_min_height to furniture_max_height above the floor, a vertical face from the floor
-  // (or hidden there) up to at most furniture_max_height, and what joins them within that height.
+  // (or hidden there) up to at most furniture_max_height, its top in view (not cut by the image,
+  // nor hidden by a nearer surface with its plane seen again above that: the wall between a
+  // table's legs), and what joins them within that height.
   // At most furniture_max_width wide: a longer face is part of the room (a wall seen in part).
   double furniture_min_height = 0.15;  // m
   double furniture_max_height = 2.1;   // m

@@ -112,8 +112,8 @@ struct RegionMeasurements {
   // out of view (above, below, or beside the visible part).
   bool cut_above = false, cut_below = false, cut_sideways = false;
   // The region borders a nearer surface (occluder_relative_range x range nearer: furniture in
-  // front of a wall) at its bottom or side: it may go on behind it.
-  bool occluded_below = false, occluded_sideways = false;
+  // front of a wall) at its top, bottom or side: it may go on behind it.
+  bool occluded_above = false, occluded_below = false, occluded_sideways = false;
   std::vector<Label> neighbours;  // regions within adjacency_radius pixels, ascending
 
   double height() const { return max_height - min_height; }
