@@ -153,7 +153,9 @@ TEST(SemanticRegions, MissingDepthCutsARegionOnlyWhereItMayGoOn) {
   EXPECT_TRUE(open.cut_above);
   const RegionMeasurements hidden = measure(30, 59, 1.0);  // a nearer surface beyond the gap
   EXPECT_FALSE(hidden.cut_above);
-  EXPECT_TRUE(hidden.occluded_above);  // it may go on behind that surface
+  EXPECT_TRUE(hidden.occluded_above);                    // it may go on behind that surface
+  EXPECT_NEAR(hidden.occluder_offset_above, 1.0, 0.05);  // which stands 1 m before it
+  EXPECT_EQ(ended.occluder_offset_above, 0.0);
   EXPECT_FALSE(ended.occluded_above);
   EXPECT_FALSE(open.occluded_above);
   const RegionMeasurements strip = measure(40, 43, 4.0);
@@ -405,8 +407,9 @@ TEST(SemanticClassify, FurnitureStandsOnTheFloorAndEndsBelowTheCeiling) {
   gravity.ceiling_height = 1.6;
   // Furniture: a table top 0.75 m up (facing up), the edge band below it (joins the top), a low
   // face 3 m long (longer than furniture: unknown), a face cut above (may be a wall: unknown), a
-  // face hidden above by a nearer surface whose plane is seen again above it (the wall between a
-  // table's legs and above its top: unknown), and a leg hidden above by the top (furniture).
+  // face hidden above by a surface 1.5 m before it whose plane is seen again above it (the wall
+  // between a table's legs and above its top: unknown), and a leg hidden above by the top
+  // (furniture).
   RegionMeasurements top;
   top.id = 1;
   top.orientation = RegionOrientation::horizontal;
@@ -422,10 +425,12 @@ TEST(SemanticClassify, FurnitureStandsOnTheFloorAndEndsBelowTheCeiling) {
   cut_face.cut_above = true;
   RegionMeasurements hidden_face = vertical(5, 3.0, -1.0, -0.6, 0.7);
   hidden_face.occluded_above = true;
+  hidden_face.occluder_offset_above = 1.5;  // a table's edge before the wall
   RegionMeasurements wall_above = vertical(6, 3.0, -0.2, 0.5, 1.5);
   wall_above.cut_above = wall_above.occluded_below = true;
   RegionMeasurements leg = vertical(7, 1.45, -1.0, -0.28, 0.05);
   leg.occluded_above = true;
+  leg.occluder_offset_above = 0.05;
   const auto furniture = classify_regions(
       std::vector{top, band, long_face, cut_face, hidden_face, wall_above, leg}, gravity);
   EXPECT_EQ(furniture[0], SemanticClass::furniture);
@@ -435,8 +440,12 @@ TEST(SemanticClassify, FurnitureStandsOnTheFloorAndEndsBelowTheCeiling) {
   EXPECT_EQ(furniture[4], SemanticClass::unknown);
   EXPECT_EQ(furniture[5], SemanticClass::unknown);
   EXPECT_EQ(furniture[6], SemanticClass::furniture);
-  // Without the plane seen above it, the hidden face may be a low cabinet's front.
+  // Without the plane seen above it, the hidden face may be a low cabinet's front; hidden by a
+  // board 0.3 m before it, with its plane seen above the board, it is a shelf's back.
   EXPECT_EQ(classify_regions(std::vector{hidden_face}, gravity)[0], SemanticClass::furniture);
+  hidden_face.occluder_offset_above = 0.3;
+  EXPECT_EQ(classify_regions(std::vector{hidden_face, wall_above}, gravity)[0],
+            SemanticClass::furniture);
 }
 
 class SemanticLabels : public testing::BackendTest {};

@@ -166,11 +166,12 @@ class RegionRules {
     return r.orientation == RegionOrientation::vertical && !r.cut_above && !goes_on_above(r) &&
            (reaches_floor(r) || r.cut_below || r.occluded_below);
   }
-  // Hidden above by a nearer surface, and its plane seen again above that: the wall between a
-  // table's legs and above its top (a leg hidden by the top has no such piece; a cabinet's front
-  // behind a table has its wall behind it, not in its plane).
+  // Hidden above by a nearer surface standing further before it than a shelf is deep, and its
+  // plane seen again above that: the wall between a table's legs and above its top (a leg hidden
+  // by the top has no such piece; a cabinet's front behind a table has its wall behind it, not in
+  // its plane; a shelf's back below a board is furniture).
   bool goes_on_above(const RegionMeasurements& r) const {
-    if (!r.occluded_above) return false;
+    if (!r.occluded_above || r.occluder_offset_above <= params_.shelf_max_depth) return false;
     return std::any_of(regions_.begin(), regions_.end(), [&](const RegionMeasurements& o) {
       return o.id != r.id && o.orientation == RegionOrientation::vertical &&
              o.max_height > r.max_height + params_.reach_tolerance &&

@@ -528,8 +528,9 @@ Beyond compare_with_plane(const RegionMeasurements& m, const Eigen::Vector3d& q,
   return q.norm() < on_plane - margin ? Beyond::nearer : Beyond::seen;
 }
 
+// `occluder`: the nearer point, where the answer is Beyond::nearer.
 Beyond look_beyond(const RegionInputs& in, const RegionMeasurements& m, int x, int y, int dx,
-                   int dy, double range) {
+                   int dy, double range, Eigen::Vector3d& occluder) {
   const PointImage& points = in.points;
   const int max_gap = static_cast<int>(in.params.max_gap_fraction * std::max(in.w, in.h));
   for (int step = 1; step <= max_gap + 1; ++step) {
@@ -538,7 +539,8 @@ Beyond look_beyond(const RegionInputs& in, const RegionMeasurements& m, int x, i
     const Point4f& q = points(qx, qy);
     if (!is_valid(q)) continue;
     const double margin = in.params.occluder_relative_range * range;
-    if (step > 1) return compare_with_plane(m, vec3(q), margin);
+    occluder = vec3(q);
+    if (step > 1) return compare_with_plane(m, occluder, margin);
     if (in.labels(qx, qy) != m.id && q.head<3>().norm() < range - margin) return Beyond::nearer;
     return Beyond::seen;
   }
@@ -571,20 +573,22 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
   const int w = in.w;
   const PointImage& points = in.points;
   const double band = std::max(0.1, 0.15 * m.height());
+  std::vector<double> offsets_above;
   for (const int i : members) {
     const int x = i % w, y = i / w;
     const double range = vec3(points(x, y)).norm();
     bool open = false, occluded = false;
     int open_dx = 0, open_dy = 0;
+    Eigen::Vector3d occluder = Eigen::Vector3d::Zero(), nearest_occluder = occluder;
     for (const auto& [dx, dy] :
          {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
-      const Beyond beyond = look_beyond(in, m, x, y, dx, dy, range);
+      const Beyond beyond = look_beyond(in, m, x, y, dx, dy, range, occluder);
       if (beyond == Beyond::open) {
         open = true;
         open_dx = dx, open_dy = dy;
       } else if (beyond == Beyond::nearer) {
         occluded = true;  // a nearer surface of another region hides what lies behind it
-        if (!open) open_dx = dx, open_dy = dy;
+        if (!open) open_dx = dx, open_dy = dy, nearest_occluder = occluder;
       }
     }
     if (!open && !occluded) continue;
@@ -599,10 +603,16 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
       m.cut_below = m.cut_below || bottom;
       m.cut_sideways = m.cut_sideways || (!top && !bottom);
     } else {
+      if (top) offsets_above.push_back(m.plane_normal.dot(nearest_occluder - m.centroid));
       m.occluded_above = m.occluded_above || top;
       m.occluded_below = m.occluded_below || bottom;
       m.occluded_sideways = m.occluded_sideways || (!top && !bottom);
     }
+  }
+  if (!offsets_above.empty()) {
+    auto middle = offsets_above.begin() + static_cast<std::ptrdiff_t>(offsets_above.size() / 2);
+    std::nth_element(offsets_above.begin(), middle, offsets_above.end());
+    m.occluder_offset_above = *middle;
   }
 }
 

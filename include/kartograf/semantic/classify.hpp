@@ -68,12 +68,17 @@ struct ClassificationParams {
   // and ends below the ceiling: a horizontal face (a top, a seat, a shelf board) from
   // furniture_min_height to furniture_max_height above the floor, a vertical face from the floor
   // (or hidden there) up to at most furniture_max_height, its top in view (not cut by the image,
-  // nor hidden by a nearer surface with its plane seen again above that: the wall between a
-  // table's legs), and what joins them within that height.
+  // nor hidden by a surface more than shelf_max_depth before it with its plane seen again above
+  // that: the wall between a table's legs), and what joins them within that height.
   // At most furniture_max_width wide: a longer face is part of the room (a wall seen in part).
   double furniture_min_height = 0.15;  // m
   double furniture_max_height = 2.1;   // m
   double furniture_max_width = 2.5;    // m
+  // A face whose top is hidden by a surface standing at most this far before it (along its
+  // normal) may be a shelf's back below a board, and stays a furniture face; further before it
+  // (a table's edge before the wall between its legs: 1.4-1.9 m on survey seed 12), the face is
+  // furniture only where its plane is not seen again above (bookcases are 0.25-0.45 m deep).
+  double shelf_max_depth = 0.5;  // m
 };
 
 // Classes per region (index = label - 1).

@@ -114,6 +114,10 @@ struct RegionMeasurements {
   // The region borders a nearer surface (occluder_relative_range x range nearer: furniture in
   // front of a wall) at its top, bottom or side: it may go on behind it.
   bool occluded_above = false, occluded_below = false, occluded_sideways = false;
+  // How far in front of the region's plane the surface that hides its top stands (m, median over
+  // its top's pixels; 0 when nothing hides it): a table's edge before a wall, a shelf's board
+  // before its back.
+  double occluder_offset_above = 0;
   std::vector<Label> neighbours;  // regions within adjacency_radius pixels, ascending
 
   double height() const { return max_height - min_height; }
