@@ -167,9 +167,9 @@ class RegionRules {
            (reaches_floor(r) || r.cut_below || r.occluded_below);
   }
   // Hidden above by a nearer surface standing further before it than a shelf is deep, and its
-  // plane seen again above that: the wall between a table's legs and above its top (a leg hidden
-  // by the top has no such piece; a cabinet's front behind a table has its wall behind it, not in
-  // its plane; a shelf's back below a board is furniture).
+  // plane seen again above that: the wall between a table's legs and above its top, whose end the
+  // view does not show (a leg hidden by the top has no such piece; a shelf's back below a board
+  // stays furniture; tall furniture behind a table, going on above it, is unknown as well).
   bool goes_on_above(const RegionMeasurements& r) const {
     if (!r.occluded_above || r.occluder_offset_above <= params_.shelf_max_depth) return false;
     return std::any_of(regions_.begin(), regions_.end(), [&](const RegionMeasurements& o) {
