@@ -579,7 +579,7 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
     const double range = vec3(points(x, y)).norm();
     bool open = false, occluded = false;
     int open_dx = 0, open_dy = 0;
-    Eigen::Vector3d occluder = Eigen::Vector3d::Zero(), nearest_occluder = occluder;
+    Eigen::Vector3d occluder = Eigen::Vector3d::Zero(), hiding_point = occluder;
     for (const auto& [dx, dy] :
          {std::pair{-1, 0}, std::pair{1, 0}, std::pair{0, -1}, std::pair{0, 1}}) {
       const Beyond beyond = look_beyond(in, m, x, y, dx, dy, range, occluder);
@@ -588,7 +588,7 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
         open_dx = dx, open_dy = dy;
       } else if (beyond == Beyond::nearer) {
         occluded = true;  // a nearer surface of another region hides what lies behind it
-        if (!open) open_dx = dx, open_dy = dy, nearest_occluder = occluder;
+        if (!open) open_dx = dx, open_dy = dy, hiding_point = occluder;
       }
     }
     if (!open && !occluded) continue;
@@ -603,17 +603,13 @@ void find_cuts(const RegionInputs& in, const std::vector<int>& members, RegionMe
       m.cut_below = m.cut_below || bottom;
       m.cut_sideways = m.cut_sideways || (!top && !bottom);
     } else {
-      if (top) offsets_above.push_back(m.plane_normal.dot(nearest_occluder - m.centroid));
+      if (top) offsets_above.push_back(m.plane_normal.dot(hiding_point - m.centroid));
       m.occluded_above = m.occluded_above || top;
       m.occluded_below = m.occluded_below || bottom;
       m.occluded_sideways = m.occluded_sideways || (!top && !bottom);
     }
   }
-  if (!offsets_above.empty()) {
-    auto middle = offsets_above.begin() + static_cast<std::ptrdiff_t>(offsets_above.size() / 2);
-    std::nth_element(offsets_above.begin(), middle, offsets_above.end());
-    m.occluder_offset_above = *middle;
-  }
+  if (!offsets_above.empty()) m.occluder_offset_above = quantile(offsets_above, 0.5);
 }
 
 }  // namespace
