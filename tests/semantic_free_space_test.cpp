@@ -527,6 +527,39 @@ TEST(SemanticGridFreeSpace, AWallFacesSpillIntoTheCellInFrontIsFloor) {
   EXPECT_EQ(class_at(blind, 4.975, 2.0), C::wall);
 }
 
+// Views from the room's west end (x = 0.6) drop the floor more than 3.7 m off, too grazing to
+// return, but see the east wall (x = 5) down to its foot, and their rays to it pass low over that
+// floor: the cells they crossed at every observable height from the band's bottom up are floor.
+// Behind a 0.3 m crate the rays pass above 0.25 m only, and those cells stay unknown. Without the
+// rule (or the origins) the strip along the wall is unknown: it is no hole in seen floor.
+TEST(SemanticGridFreeSpace, TheFloorTheRaysCrossLowIsFloor) {
+  std::vector<Box> scene = room();
+  scene.push_back({{4.3, 1.6, 0}, {4.7, 2.4, 0.3}, C::furniture, C::furniture});
+  const std::vector<Eigen::Vector3d> west_end{{0.6, 1.2, 1}, {0.6, 2.8, 1}};
+  const Views v = look(scene, west_end);
+  const SemanticGrid grid =
+      build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  const auto unobserved_at = [](const SemanticGrid& g, double x, double y) {
+    const Eigen::Vector2i c = g.cell_of({x, y});
+    return std::isnan(g.weight(c.x(), c.y()));
+  };
+  for (const double y : {0.6, 1.0, 3.0, 3.4}) {
+    EXPECT_EQ(class_at(grid, 4.725, y), C::floor) << "the floor before the wall at y " << y;
+    EXPECT_EQ(class_at(grid, 5.025, y), C::wall) << "the wall at y " << y;
+  }
+  EXPECT_NE(class_at(grid, 4.825, 2.0), C::floor) << "behind the crate";
+  EXPECT_NE(class_at(grid, 4.5, 2.0), C::floor) << "the crate";
+  EXPECT_GT(grid.inferred.floor_seen_through, 0);
+
+  SemanticGridParams off = every_ray();
+  off.floor_seen_through = false;
+  const SemanticGrid unseen = build_semantic_grid(v.points, v.labels, off, {}, v.ids, v.origins);
+  EXPECT_TRUE(unobserved_at(unseen, 4.725, 1.0));
+  EXPECT_EQ(unseen.inferred.floor_seen_through, 0);
+  const SemanticGrid blind = build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids);
+  EXPECT_TRUE(unobserved_at(blind, 4.725, 1.0));
+}
+
 // Bad free-space options and origins that do not match the views are refused.
 TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
   const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};

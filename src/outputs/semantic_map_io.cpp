@@ -80,7 +80,8 @@ void write_semantic_json(const std::filesystem::path& path, const semantic::Sema
       {"wall_cells_across_unseen", d.inferred.wall_cells_across_unseen},
       {"tables_on_legs", d.inferred.tables_on_legs},
       {"fill_cells_trimmed_at_tables", d.inferred.fill_cells_trimmed_at_tables},
-      {"lone_posts_kept", d.inferred.lone_posts_kept}};
+      {"lone_posts_kept", d.inferred.lone_posts_kept},
+      {"floor_seen_through", d.inferred.floor_seen_through}};
   Json objects = Json::array();
   for (const semantic::ObjectRecord& o : d.objects) objects.push_back(object_json(o));
   json["objects"] = std::move(objects);

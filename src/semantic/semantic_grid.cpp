@@ -1231,6 +1231,7 @@ void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& opti
 // pockets, floor shadows), and the wall faces placed on the wall points.
 void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& evidence,
                            const detail::BandPointIndex& wall_points,
+                           const detail::BandFreeSpace* free_space,
                            const SemanticGridParams& options, ObstacleMasks& masks) {
   const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
   const bool fronts = options.furniture_max_depth > 0 && options.furniture_max_extent > 0;
@@ -1282,6 +1283,11 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
         grid, options.furniture_max_extent, options.max_furniture_fill_area,
         cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
         masks.furniture);
+  }
+  // Before the floor's shadows and holes, which the floor seen through may close.
+  if (free_space && options.floor_seen_through) {
+    grid.inferred.floor_seen_through =
+        detail::floor_seen_through(grid, *free_space, options.weights.of(SemanticClass::floor));
   }
   if (options.max_floor_shadow > 0) {
     fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
@@ -1379,7 +1385,8 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
-  complete_hidden_cells(grid, evidence, wall_points, options, masks);
+  complete_hidden_cells(grid, evidence, wall_points, free_space ? &*free_space : nullptr, options,
+                        masks);
   place_leaf_faces(grid, evidence, points, labels, options, masks);
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);

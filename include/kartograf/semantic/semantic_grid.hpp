@@ -148,6 +148,11 @@ struct SemanticGridParams {
   // floor: the depth noise of that wall's face spread into the room (a face's own cell holds its
   // points by the thousand, the spill a few percent of them). 0: off.
   double face_spill_ratio = 10.0;
+  // An unobserved cell seen through at every observable height from band_min up is floor: nothing
+  // stands in the robot's band there, and the floor runs on under the rays (a depth camera loses
+  // the floor at grazing angles far off, while its rays to the walls behind pass low over it). A
+  // drop in the floor (stairs down) would read the same. false: off.
+  bool floor_seen_through = true;
   int free_space_ray_stride = 4;         // 0: no free space
   double free_space_slab = 0.02;         // m
   double free_space_end_margin = 0.025;  // m per m of range
@@ -207,7 +212,8 @@ struct SemanticObject {
 // corners hidden behind furniture made wall, the cells of wall lines run on across what no
 // view saw, the tables found by their legs, the cells a fill had joined to such a table made
 // floor again, and the lone posts kept as obstacles (a leg inside one cell, no obstacle beside
-// it, which the speck removal would have dropped).
+// it, which the speck removal would have dropped), and the unobserved cells the views' rays
+// crossed low made floor.
 struct GridInferences {
   std::optional<double> wall_thickness;  // m
   // Where the cell lattice stands: the offset its boundaries moved by to lie on the wall faces (0
@@ -226,6 +232,7 @@ struct GridInferences {
   int tables_on_legs = 0;
   int fill_cells_trimmed_at_tables = 0;
   int lone_posts_kept = 0;
+  int floor_seen_through = 0;  // unobserved cells the rays crossed low: floor
 };
 
 struct SemanticGrid {
