@@ -16,6 +16,7 @@
 #include <optional>
 #include <queue>
 #include <random>
+#include <set>
 #include <span>
 #include <vector>
 
@@ -203,6 +204,45 @@ void expect_doorway_spans_the_wall(double thickness) {
 TEST(SemanticGrid, DoorwayCellsSpanTheWallThicknessBetweenTheJambs) {
   expect_doorway_spans_the_wall(0.2);
   expect_doorway_spans_the_wall(0.0995);
+}
+
+// A 0.15 m wall whose faces, within 0.15 m of the jambs (where the jambs' faces are measured), came
+// back 2 cm out from the wall on both sides, as a depth camera's noise and mixed pixels at a
+// doorway's edges may put them, on a lattice that does not follow the faces (1.2 cm off): the
+// faces measure 0.19 m apart, and the doorway took a row of the hall's floor. It is as deep as the
+// walls are thick: the three rows whose centres lie in the wall.
+TEST(SemanticGrid, ADoorwayIsAsDeepAsTheWallsAreThick) {
+  const double kFace0 = 3.012, kFace1 = kFace0 + 0.15;
+  LabelledPoints s;
+  const LabelledPoints scene = doorway_scene(kFace1 - kFace0);
+  for (std::size_t i = 0; i < scene.points.size(); ++i) {
+    Eigen::Vector3d p = scene.points[i];
+    const double from_jamb = std::min(std::fabs(p.x() - kDoorX0), std::fabs(p.x() - kDoorX1));
+    const bool by_a_jamb = from_jamb < 0.15 && (p.x() < kDoorX0 || p.x() > kDoorX1);
+    if (scene.labels[i] == SemanticClass::wall && by_a_jamb) {
+      if (std::fabs(p.y() - kFace0) < 1e-9) p.y() -= 0.02;
+      if (std::fabs(p.y() - kFace1) < 1e-9) p.y() += 0.02;
+    }
+    s.add(p, scene.labels[i]);
+  }
+  const auto door_rows = [&](bool as_deep_as_walls) {
+    SemanticGridParams params;
+    params.align_cells_to_walls = false;
+    params.doors_as_deep_as_walls = as_deep_as_walls;
+    const SemanticGrid grid = build_semantic_grid(s.points, s.labels, params);
+    EXPECT_EQ(doorways(grid).size(), 1u);
+    std::set<long> rows;  // the door cells' centres' y [mm]
+    for (int row = 0; row < grid.height(); ++row)
+      for (int col = 0; col < grid.width(); ++col)
+        if (grid.classes(col, row) == SemanticClass::door)
+          rows.insert(std::lround(grid.cell_center({col, row}).y() * 1000));
+    return rows;
+  };
+  const std::set<long> rows = door_rows(true);
+  ASSERT_EQ(rows.size(), 3u);
+  EXPECT_GT(*rows.begin(), std::lround(kFace0 * 1000));
+  EXPECT_LT(*rows.rbegin(), std::lround(kFace1 * 1000));
+  EXPECT_GT(door_rows(false).size(), 3u);
 }
 
 // A wall seen from the room only (its hall face never in view, as with a corridor's wall whose
@@ -934,6 +974,35 @@ TEST(SemanticGrid, NoisyWallFacesAreMeasuredAlongTheWall) {
   SemanticGridParams off;
   off.place_wall_faces = false;
   EXPECT_GT(wrong(build_semantic_grid(s.points, s.labels, off)).first, 18);  // of 36 probes
+}
+
+// The same room, but no floor seen in the cells along its east face (as before a wall seen from
+// afar, whose floor a depth camera loses at grazing angles): the face, measured along the wall,
+// still puts the cells in front of it on the floor, as on the other walls.
+TEST(SemanticGrid, AFaceIsPlacedWhereNoFloorWasSeenBeforeIt) {
+  using C = SemanticClass;
+  constexpr double kWest = 0.512, kEast = 4.012, kSouth = 0.512, kNorth = 3.012;
+  const LabelledPoints room = noisy_room({kWest, kSouth}, {kEast, kNorth}, 0.02, 11);
+  LabelledPoints s;
+  for (std::size_t i = 0; i < room.points.size(); ++i) {
+    const bool floor_at_face = room.labels[i] == C::floor && room.points[i].x() > kEast - 0.07;
+    if (!floor_at_face) s.add(room.points[i], room.labels[i]);
+  }
+  const auto wrong_east = [&](const SemanticGrid& grid) {
+    int in_front_wall = 0, behind_not_wall = 0;
+    for (double t = 0.3; t <= 0.7; t += 0.05) {
+      const double y = kSouth + t * (kNorth - kSouth);
+      in_front_wall += class_at(grid, kEast - 0.035, y).first != C::floor;
+      behind_not_wall += class_at(grid, kEast + 0.035, y).first != C::wall;
+    }
+    return std::pair{in_front_wall, behind_not_wall};
+  };
+  const auto [in_front, behind] = wrong_east(build_semantic_grid(s.points, s.labels));
+  EXPECT_LE(in_front, 1);  // of 9 probes
+  EXPECT_EQ(behind, 0);
+  SemanticGridParams off;
+  off.place_wall_faces = false;
+  EXPECT_GT(wrong_east(build_semantic_grid(s.points, s.labels, off)).first, 4);
 }
 
 // Faces that agree poorly on where they cross x (the west face on a cell boundary, the east one

@@ -328,6 +328,18 @@ std::optional<std::pair<double, double>> wall_rows_beside(
   return std::pair{std::min(lo[0], lo[1]), std::max(hi[0], hi[1])};
 }
 
+// A doorway is as deep as its wall is thick: about the middle found across it, the opening takes
+// the thickness measured on the walls seen from both sides where its jambs were measured (their
+// faces, means of noisy points, miss the depth by a row now and then), and at least that thickness
+// where it took the wall's rows beside it (which the faces' placement thins where the views saw
+// one face; more rows there hold an open leaf's hinge, on the side it stands).
+void as_deep_as_the_walls(Opening& opening, double wall_thickness, bool jambs_measured) {
+  const double middle = 0.5 * (opening.across_min + opening.across_max);
+  const double half = 0.5 * wall_thickness;
+  opening.across_min = jambs_measured ? middle - half : std::min(opening.across_min, middle - half);
+  opening.across_max = jambs_measured ? middle + half : std::max(opening.across_max, middle + half);
+}
+
 // The doorway of one (merged) gap: its cells become door cells and a doorway object.
 void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const BandPointIndex& walls,
                  const WallGap& gap, int& doorway_count, const AddObject& add_object) {
@@ -340,12 +352,15 @@ void add_doorway(SemanticGrid& grid, const SemanticGridParams& options, const Ba
   const double across = 0.5 * options.max_wall_misalignment + res;
   Opening opening{-0.5 * width, 0.5 * width, -across, across};
   const int reach = static_cast<int>(std::ceil((0.5 * width + kMaxWallThickness) / res)) + 1;
-  if (const auto measured = measure_jambs(grid, walls, centre, u, width, options))
+  const std::optional<Opening> measured = measure_jambs(grid, walls, centre, u, width, options);
+  if (measured)
     opening = *measured;
   else if (const auto rows = wall_rows_beside(grid, opening, centre, u, n, across, reach)) {
     opening.across_min = std::max(rows->first - 0.5 * res, -across);
     opening.across_max = std::min(rows->second + 0.5 * res, across);
   }
+  if (options.doors_as_deep_as_walls && grid.inferred.wall_thickness)
+    as_deep_as_the_walls(opening, *grid.inferred.wall_thickness, measured.has_value());
   const Eigen::Vector2d door_centre = centre + 0.5 * (opening.along_min + opening.along_max) * u +
                                       0.5 * (opening.across_min + opening.across_max) * n;
   std::vector<Eigen::Vector2i> cells = opening_cells(grid, opening, centre, u, n, reach);

@@ -77,14 +77,13 @@ std::optional<SemanticClass> room_in_front(const SemanticGrid& grid, const Eigen
 }  // namespace
 
 int place_wall_faces(SemanticGrid& grid, const BandPointIndex& walls,
-                     const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
-                     Image<std::uint8_t>& furniture) {
+                     const TraversabilityWeights& weights, Image<std::uint8_t>& furniture) {
   const double res = grid.resolution;
   int moved = 0;
   for (int row = 0; row < grid.height(); ++row) {
     for (int col = 0; col < grid.width(); ++col) {
       const Eigen::Vector2i c(col, row);
-      if (!seen_as(grid, c, SemanticClass::wall) || !floor_seen(col, row)) continue;
+      if (!seen_as(grid, c, SemanticClass::wall)) continue;
       for (const Eigen::Vector2i& step : kFourNeighbours) {
         // Two cells of wall stay behind (a wall is thicker than a cell; one cell of it lets the
         // rooms leak diagonally), so the two faces of a thin wall never both move in. In scan

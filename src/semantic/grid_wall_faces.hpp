@@ -14,13 +14,14 @@ namespace kartograf::semantic::detail {
 // Each wall cell beside a floor cell (or furniture two cells deep) is judged on the face between
 // them, measured as the median offset of the wall points along kFaceStretch cells of it: a cell
 // whose centre lies on the room's side of the face holds less wall than room and becomes what the
-// room holds there, floor or furniture (marked in `furniture`), where floor was seen (floor_seen),
-// and an unseen cell behind it whose centre the wall then covers becomes wall. Two cells of wall
-// (or unseen) stay behind every moved cell. One pass, in scan order: a bulge of noise two cells
-// into the room is judged from its outer cell only. Returns the number of wall cells moved.
+// room holds there, floor or furniture (marked in `furniture`), and an unseen cell behind it whose
+// centre the wall then covers becomes wall. Whether floor was seen in the cell itself does not
+// matter: the floor before a face seen from afar is lost at grazing angles, while the face's
+// points spread over cells into the room. Two cells of wall (or unseen) stay behind every moved
+// cell. One pass, in scan order: a bulge of noise two cells into the room is judged from its outer
+// cell only. Returns the number of wall cells moved.
 int place_wall_faces(SemanticGrid& grid, const BandPointIndex& walls,
-                     const Image<std::uint8_t>& floor_seen, const TraversabilityWeights& weights,
-                     Image<std::uint8_t>& furniture);
+                     const TraversabilityWeights& weights, Image<std::uint8_t>& furniture);
 
 // A door leaf (a few centimetres thick) whose room-side face lies near a cell boundary puts that
 // face's points in the cells on both sides of it, and comes out two cells thick. Each leaf cell

@@ -1229,8 +1229,7 @@ void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& opti
 
 // The cells no view saw that the seen ones imply (walls' insides and hidden backs, furniture
 // pockets, floor shadows), and the wall faces placed on the wall points.
-void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& evidence,
-                           const detail::BandPointIndex& wall_points,
+void complete_hidden_cells(SemanticGrid& grid, const detail::BandPointIndex& wall_points,
                            const detail::BandFreeSpace* free_space,
                            const SemanticGridParams& options, ObstacleMasks& masks) {
   const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
@@ -1305,8 +1304,7 @@ void complete_hidden_cells(SemanticGrid& grid, const Image<CellEvidence>& eviden
   // After the fronts (a front's face moved in would take a row from its pocket), before the
   // walls' hidden backs (which start at the faces).
   if (options.place_wall_faces) {
-    detail::place_wall_faces(grid, wall_points, floor_seen(evidence, options), options.weights,
-                             masks.furniture);
+    detail::place_wall_faces(grid, wall_points, options.weights, masks.furniture);
   }
   complete_one_sided_walls(grid, options, thickness, max_wall, masks);
 }
@@ -1385,8 +1383,7 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
-  complete_hidden_cells(grid, evidence, wall_points, free_space ? &*free_space : nullptr, options,
-                        masks);
+  complete_hidden_cells(grid, wall_points, free_space ? &*free_space : nullptr, options, masks);
   place_leaf_faces(grid, evidence, points, labels, options, masks);
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);

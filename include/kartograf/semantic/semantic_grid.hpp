@@ -90,6 +90,10 @@ struct SemanticGridParams {
   // Door leaf cells two or three deep are judged the same way on the leaf's face, measured on the
   // door points: a leaf is a few centimetres thick, and its face on a cell boundary made it two.
   bool place_leaf_faces = true;
+  // A doorway is as deep as the walls seen from both sides are thick (when that was measured):
+  // about the middle found across it, where its jambs were measured, and at least that deep where
+  // it took the wall's rows beside it.
+  bool doors_as_deep_as_walls = true;
   // Furniture outlines (legs, edges: a table top drops out at grazing views) are closed and
   // filled to their convex hull when that is at most this area [m^2]; 0: off.
   // The same bound holds for floor enclosed by unclassified obstacles.
