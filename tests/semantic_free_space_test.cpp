@@ -560,6 +560,34 @@ TEST(SemanticGridFreeSpace, TheFloorTheRaysCrossLowIsFloor) {
   EXPECT_TRUE(unobserved_at(blind, 4.725, 1.0));
 }
 
+// A pit 0.3 m deep before the east wall (x 4.3-4.9, y 1.6-2.4: stairs down, a sunken floor), seen
+// from the west end and from 1.2 m before it: its far part returns its bottom, below the floor, its
+// near part (under the rim) nothing, and rays to the wall pass low over both, as over floor lost
+// at grazing angles; the seen floor encloses it. No floor fill takes it. The same views of a flat
+// floor there make those cells floor.
+TEST(SemanticGridFreeSpace, ADropInTheFloorIsNoFloor) {
+  const auto scene = [](bool pit) {
+    std::vector<Box> boxes = room();
+    boxes.front() = {{0, 0, -0.4}, {4.3, 4, 0}, C::floor, C::unknown};
+    boxes.push_back({{4.9, 0, -0.4}, {5, 4, 0}, C::floor, C::unknown});
+    boxes.push_back({{4.3, 0, -0.4}, {4.9, 1.6, 0}, C::floor, C::unknown});
+    boxes.push_back({{4.3, 2.4, -0.4}, {4.9, 4, 0}, C::floor, C::unknown});
+    boxes.push_back({{4.3, 1.6, -0.4}, {4.9, 2.4, pit ? -0.3 : 0.0}, C::floor, C::unknown});
+    return boxes;
+  };
+  const std::vector<Eigen::Vector3d> places{{0.6, 1.2, 1}, {0.6, 2.8, 1}, {3.1, 2.0, 1}};
+  const auto grid_of = [&](bool pit) {
+    const Views v = look(scene(pit), places);
+    return build_semantic_grid(v.points, v.labels, every_ray(), {}, v.ids, v.origins);
+  };
+  const SemanticGrid flat = grid_of(false), pit = grid_of(true);
+  for (const double x : {4.375, 4.575, 4.825}) {
+    EXPECT_EQ(class_at(flat, x, 2.0), C::floor) << "the flat floor at x " << x;
+    EXPECT_NE(class_at(pit, x, 2.0), C::floor) << "the pit at x " << x;
+  }
+  EXPECT_EQ(class_at(pit, 4.2, 2.0), C::floor) << "the floor before the pit";
+}
+
 // Bad free-space options and origins that do not match the views are refused.
 TEST(SemanticGridFreeSpace, BadOptionsAndOriginsAreRefused) {
   const std::vector<Eigen::Vector3d> points{{0, 0, 0}, {1, 0, 0}, {0, 1, 0}};

@@ -205,12 +205,14 @@ int free_seen_through_walls(SemanticGrid& grid, const BandFreeSpace& free_space,
   return static_cast<int>(freed.size());
 }
 
-int floor_seen_through(SemanticGrid& grid, const BandFreeSpace& free_space, float floor_weight) {
+int floor_seen_through(SemanticGrid& grid, const BandFreeSpace& free_space,
+                       const Image<std::uint8_t>& drops, float floor_weight) {
   std::vector<Eigen::Vector2i> freed;
   for (int row = 0; row < grid.height(); ++row) {
     for (int col = 0; col < grid.width(); ++col) {
       const Eigen::Vector2i cell(col, row);
-      if (unobserved(grid, cell) && free_space.clear_throughout(cell)) freed.push_back(cell);
+      if (unobserved(grid, cell) && !drops(col, row) && free_space.clear_throughout(cell))
+        freed.push_back(cell);
     }
   }
   set_class(grid, freed, SemanticClass::floor, floor_weight);

@@ -97,8 +97,10 @@ int free_seen_through_walls(SemanticGrid& grid, const BandFreeSpace& free_space,
                             const SemanticGridParams& options);
 
 // Unobserved cells seen through at every observable height from the band's bottom up are floor
-// (SemanticGridParams::floor_seen_through). Returns how many.
-int floor_seen_through(SemanticGrid& grid, const BandFreeSpace& free_space, float floor_weight);
+// (SemanticGridParams::floor_seen_through), but for the `drops`, where the views saw below the
+// floor (stairs down: rays pass over a drop as over lost floor). Returns how many.
+int floor_seen_through(SemanticGrid& grid, const BandFreeSpace& free_space,
+                       const Image<std::uint8_t>& drops, float floor_weight);
 
 // The free space of the rays of every free_space_ray_stride-th point, each from its view's origin
 // (view_origins[view_ids[i]]).

@@ -59,6 +59,9 @@ constexpr std::size_t index_of(SemanticClass c) {
 // What the points say about one cell.
 struct CellEvidence {
   int floor = 0;
+  // Points further below the floor than floor_tolerance: the views saw down past the floor there
+  // (stairs down, a drop), which is then no floor, whatever passes over it.
+  int below_floor = 0;
   std::array<int, kSemanticClassCount> band{};  // points in the robot's height band, per class
   // Band points within the spill margin of each side: -x, +x, -y, +y.
   std::array<int, 4> near_side{};
@@ -658,9 +661,28 @@ void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells,
   }
 }
 
+// The drops: each piece of unseen cells (4-neighbours) where the views saw below the floor in a
+// cell, whole. A stairwell's far part returns its steps; its near part, hidden under the edge,
+// returns nothing, and rays pass over both as over floor the camera lost at grazing angles.
+Image<std::uint8_t> drop_regions(const SemanticGrid& grid, const Image<std::uint8_t>& below) {
+  Image<std::uint8_t> unseen(grid.width(), grid.height(), 0);
+  for (int row = 0; row < grid.height(); ++row)
+    for (int col = 0; col < grid.width(); ++col)
+      unseen(col, row) = detail::unobserved(grid, {col, row});
+  Image<std::uint8_t> drops(grid.width(), grid.height(), 0);
+  for (const std::vector<Eigen::Vector2i>& piece : components(unseen, Connectivity::four)) {
+    const bool drop = std::any_of(piece.begin(), piece.end(),
+                                  [&](const Eigen::Vector2i& c) { return below(c.x(), c.y()); });
+    if (drop)
+      for (const Eigen::Vector2i& c : piece) drops(c.x(), c.y()) = 1;
+  }
+  return drops;
+}
+
 // Holes of unseen cells (4-neighbours) whose every neighbour is seen floor, up to max_area [m^2],
-// are floor (SemanticGridParams::max_floor_hole).
-void fill_floor_holes(SemanticGrid& grid, double max_area, float weight) {
+// are floor (SemanticGridParams::max_floor_hole), unless the views saw below the floor in them.
+void fill_floor_holes(SemanticGrid& grid, double max_area, float weight,
+                      const Image<std::uint8_t>& drops) {
   Image<std::uint8_t> unseen(grid.width(), grid.height(), 0);
   for (int row = 0; row < grid.height(); ++row)
     for (int col = 0; col < grid.width(); ++col)
@@ -668,15 +690,16 @@ void fill_floor_holes(SemanticGrid& grid, double max_area, float weight) {
   const auto max_cells = static_cast<std::size_t>(max_area / (grid.resolution * grid.resolution));
   for (const std::vector<Eigen::Vector2i>& hole : components(unseen, Connectivity::four)) {
     if (hole.size() > max_cells) continue;
-    bool enclosed = true;
+    bool fillable = true;  // enclosed by seen floor, and no drop in it
     for (const Eigen::Vector2i& c : hole) {
+      fillable &= !drops(c.x(), c.y());
       for (const Eigen::Vector2i& d : detail::kFourNeighbours) {
         const Eigen::Vector2i n = c + d;
-        enclosed &= grid.contains(n) &&
+        fillable &= grid.contains(n) &&
                     (detail::unobserved(grid, n) || detail::seen_as(grid, n, SemanticClass::floor));
       }
     }
-    if (!enclosed) continue;
+    if (!fillable) continue;
     detail::set_class(grid, hole, SemanticClass::floor, weight);
   }
 }
@@ -741,6 +764,15 @@ void remove_spill(SemanticGrid& grid, const Image<CellEvidence>& evidence,
     grid.weight(c.x(), c.y()) = options.weights.of(SemanticClass::floor);
     leaf(c.x(), c.y()) = 0, furniture(c.x(), c.y()) = 0;
   }
+}
+
+// The cells where the views saw below the floor.
+Image<std::uint8_t> below_floor_seen(const Image<CellEvidence>& evidence) {
+  Image<std::uint8_t> seen(evidence.width(), evidence.height(), 0);
+  for (int row = 0; row < evidence.height(); ++row)
+    for (int col = 0; col < evidence.width(); ++col)
+      seen(col, row) = evidence(col, row).below_floor > 0;
+  return seen;
 }
 
 // The cells where floor was seen.
@@ -873,6 +905,10 @@ Image<CellEvidence> gather_evidence(const SemanticGrid& grid,
     CellEvidence& e = evidence(cell.x(), cell.y());
     const double h = p.z() - grid.floor_z;
     const SemanticClass c = labels[i];
+    if (h < -options.floor_tolerance) {
+      ++e.below_floor;
+      continue;
+    }
     if (c == SemanticClass::floor) {
       if (std::fabs(h) <= options.floor_tolerance) ++e.floor;
       continue;  // a floor label far from the floor is a bad label, not an obstacle
@@ -1227,9 +1263,26 @@ void complete_one_sided_walls(SemanticGrid& grid, const SemanticGridParams& opti
   if (thickness > 0) grid.inferred.wall_thickness = thickness * options.resolution;
 }
 
+// The floor no view saw: under the rays that crossed it low, in thin shadows and in holes of the
+// seen floor; no fill takes a drop (the views saw below the floor in its piece of unseen cells).
+void fill_unseen_floor(SemanticGrid& grid, const Image<std::uint8_t>& below_floor,
+                       const detail::BandFreeSpace* free_space, const SemanticGridParams& options) {
+  const float weight = options.weights.of(SemanticClass::floor);
+  const Image<std::uint8_t> drops = drop_regions(grid, below_floor);
+  // Before the floor's shadows and holes, which the floor seen through may close.
+  if (free_space && options.floor_seen_through)
+    grid.inferred.floor_seen_through = detail::floor_seen_through(grid, *free_space, drops, weight);
+  if (options.max_floor_shadow > 0) {
+    fill_unobserved_runs(grid, SemanticClass::floor,
+                         whole_cells(options.max_floor_shadow, options.resolution), weight, &drops);
+  }
+  if (options.max_floor_hole > 0) fill_floor_holes(grid, options.max_floor_hole, weight, drops);
+}
+
 // The cells no view saw that the seen ones imply (walls' insides and hidden backs, furniture
 // pockets, floor shadows), and the wall faces placed on the wall points.
 void complete_hidden_cells(SemanticGrid& grid, const detail::BandPointIndex& wall_points,
+                           const Image<std::uint8_t>& below_floor,
                            const detail::BandFreeSpace* free_space,
                            const SemanticGridParams& options, ObstacleMasks& masks) {
   const auto cells = [&](double metres) { return whole_cells(metres, options.resolution); };
@@ -1283,17 +1336,7 @@ void complete_hidden_cells(SemanticGrid& grid, const detail::BandPointIndex& wal
         cells(options.furniture_max_depth), options.weights.of(SemanticClass::furniture),
         masks.furniture);
   }
-  // Before the floor's shadows and holes, which the floor seen through may close.
-  if (free_space && options.floor_seen_through) {
-    grid.inferred.floor_seen_through =
-        detail::floor_seen_through(grid, *free_space, options.weights.of(SemanticClass::floor));
-  }
-  if (options.max_floor_shadow > 0) {
-    fill_unobserved_runs(grid, SemanticClass::floor, cells(options.max_floor_shadow),
-                         options.weights.of(SemanticClass::floor));
-  }
-  if (options.max_floor_hole > 0)
-    fill_floor_holes(grid, options.max_floor_hole, options.weights.of(SemanticClass::floor));
+  fill_unseen_floor(grid, below_floor, free_space, options);
   // The walls' thickness is measured before their faces are placed: a wall's two faces, seen
   // from views whose poses differ by a centimetre or two, lose a row to the placement often
   // enough to move the median (0.15 -> 0.10 m on a survey with the SLAM's poses).
@@ -1383,7 +1426,8 @@ SemanticGrid build_semantic_grid(std::span<const Eigen::Vector3d> points,
   }
   if (options.max_furniture_fill_area > 0 && options.weights.unclassified_obstacle == 0.0f)
     fill_enclosed_by_unclassified(grid, options.max_furniture_fill_area, 0.0f);
-  complete_hidden_cells(grid, wall_points, free_space ? &*free_space : nullptr, options, masks);
+  complete_hidden_cells(grid, wall_points, below_floor_seen(evidence),
+                        free_space ? &*free_space : nullptr, options, masks);
   place_leaf_faces(grid, evidence, points, labels, options, masks);
   add_obstacle_objects(masks, add_object);
   const WallPieces walls = add_straight_walls(grid, evidence, options, add_object);

@@ -154,8 +154,10 @@ struct SemanticGridParams {
   double face_spill_ratio = 10.0;
   // An unobserved cell seen through at every observable height from band_min up is floor: nothing
   // stands in the robot's band there, and the floor runs on under the rays (a depth camera loses
-  // the floor at grazing angles far off, while its rays to the walls behind pass low over it). A
-  // drop in the floor (stairs down) would read the same. false: off.
+  // the floor at grazing angles far off, while its rays to the walls behind pass low over it).
+  // Neither this nor the floor's shadows and holes take a piece of unobserved cells in which the
+  // views saw points more than floor_tolerance below the floor: a drop (stairs down), over which
+  // rays pass as over lost floor. false: off.
   bool floor_seen_through = true;
   int free_space_ray_stride = 4;         // 0: no free space
   double free_space_slab = 0.02;         // m
