@@ -28,18 +28,6 @@ RgbImage colour_or_grey(const registration::RgbdImages& frame) {
   return RgbImage(frame.depth.width(), frame.depth.height(), Rgb8{128, 128, 128});
 }
 
-// Median height along `up` (metres) of the points of one class, if any.
-std::optional<double> median_height(const semantic::LabelledViews& views, SemanticClass label,
-                                    const Eigen::Vector3d& up = Eigen::Vector3d::UnitZ()) {
-  std::vector<double> heights;
-  for (std::size_t i = 0; i < views.points().size(); ++i)
-    if (views.labels()[i] == label) heights.push_back(views.points()[i].dot(up));
-  if (heights.empty()) return std::nullopt;
-  const auto middle = heights.begin() + static_cast<std::ptrdiff_t>(heights.size() / 2);
-  std::nth_element(heights.begin(), middle, heights.end());
-  return *middle;
-}
-
 // Stage bookkeeping: announces a stage, and records its time when the next one starts.
 class StageClock {
  public:
@@ -203,7 +191,7 @@ void label_views(const compute::Context& context, const mapping::FrameSource& so
     if (observer.slam.on_progress) observer.slam.on_progress("views", i + 1, poses.size());
   }
   const Eigen::Vector3d up = views.up();
-  const std::optional<double> floor = median_height(views, SemanticClass::floor, up);
+  const std::optional<double> floor = semantic::floor_height(views, up);
   for (const auto& [i, failure] : retry) {
     if (views.views() == 0 || !floor) {
       views.skip(failure);
@@ -265,13 +253,13 @@ void complete_map(const compute::Context& context, const mapping::FrameSource& v
 
   clock.start("gravity");
   const Eigen::Matrix3d up_to_z = views.make_up_z();
-  const std::optional<double> floor_height = median_height(views, SemanticClass::floor);
-  require(floor_height.has_value(), "map: gravity: no view saw the floor");
+  const std::optional<double> floor = semantic::floor_height(views);
+  require(floor.has_value(), "map: gravity: no view saw the floor");
   Eigen::Isometry3d& map_from_slam = result.map_from_slam;
   map_from_slam = Eigen::Isometry3d::Identity();
   map_from_slam.linear() = up_to_z;
-  map_from_slam.translation() = Eigen::Vector3d(0, 0, -*floor_height);
-  views.transform(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -*floor_height)));
+  map_from_slam.translation() = Eigen::Vector3d(0, 0, -*floor);
+  views.transform(Eigen::Isometry3d(Eigen::Translation3d(0, 0, -*floor)));
   for (const Eigen::Isometry3d& pose : result.slam.poses)
     result.poses.push_back(map_from_slam * pose);
   result.planes = plane_map.planes(map_from_slam);
