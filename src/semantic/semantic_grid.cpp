@@ -17,6 +17,7 @@
 #include "kartograf/core/connected_components.hpp"
 #include "kartograf/core/error.hpp"
 #include "kartograf/core/memory_budget.hpp"
+#include "kartograf/semantic/labelled_views.hpp"
 #include "semantic/grid_cabinets.hpp"
 #include "semantic/grid_cells.hpp"
 #include "semantic/grid_doorways.hpp"
@@ -79,12 +80,18 @@ struct CellEvidence {
   }
 };
 
-std::optional<double> median_z(std::span<const Eigen::Vector3d> points,
+std::vector<double> heights_of(std::span<const Eigen::Vector3d> points,
                                std::span<const SemanticClass> labels, SemanticClass wanted) {
   std::vector<double> z;
   for (std::size_t i = 0; i < points.size(); ++i) {
     if (labels[i] == wanted && points[i].allFinite()) z.push_back(points[i].z());
   }
+  return z;
+}
+
+std::optional<double> median_z(std::span<const Eigen::Vector3d> points,
+                               std::span<const SemanticClass> labels, SemanticClass wanted) {
+  std::vector<double> z = heights_of(points, labels, wanted);
   if (z.empty()) return std::nullopt;
   std::nth_element(z.begin(), z.begin() + z.size() / 2, z.end());
   return z[z.size() / 2];
@@ -844,8 +851,8 @@ SemanticGrid empty_grid(std::span<const Eigen::Vector3d> points,
   SemanticGrid grid;
   grid.resolution = options.resolution;
   grid.weights = options.weights;
-  grid.floor_z =
-      options.floor_z.value_or(median_z(points, labels, SemanticClass::floor).value_or(0.0));
+  grid.floor_z = options.floor_z.value_or(
+      floor_level(heights_of(points, labels, SemanticClass::floor)).value_or(0.0));
   grid.ceiling_z =
       options.ceiling_z ? options.ceiling_z : median_z(points, labels, SemanticClass::ceiling);
 

@@ -65,7 +65,7 @@ struct TraversabilityWeights {
 
 struct SemanticGridParams {
   double resolution = 0.05;         // metres per cell
-  std::optional<double> floor_z;    // default: median z of the floor points (else 0)
+  std::optional<double> floor_z;    // default: floor_level of the floor points' z (else 0)
   std::optional<double> ceiling_z;  // default: median z of the ceiling points (else none)
   double floor_tolerance = 0.08;    // floor points within this of floor_z are floor evidence
   double band_min = 0.10;           // robot height band above the floor [m]: obstacles
