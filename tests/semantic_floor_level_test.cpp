@@ -34,6 +34,11 @@ TEST(SemanticFloorLevel, IsTheLowestLevelTheViewsCalledFloor) {
   add_level(strays, -0.5, 60, rng);  // 2 % below: noise, no level
   EXPECT_NEAR(*floor_level(strays), 0.0, 0.01);
 
+  std::vector<double> far = table;  // a garbage height either way bins nothing
+  far.push_back(1e9);
+  far.push_back(-1e9);
+  EXPECT_NEAR(*floor_level(far), 0.0, 0.01);
+
   std::vector<double> small_floor;
   add_level(small_floor, 0.0, 100, rng);  // 6 %: too few to be a level
   add_level(small_floor, 0.75, 1500, rng);

@@ -61,11 +61,15 @@ std::optional<double> floor_level(std::vector<double> heights) {
   constexpr double kBin = 0.05;       // m: levels are told apart at 2 bins (a table is 0.7 m up)
   constexpr double kMinShare = 0.15;  // of the heights, within a bin either side of a level
   if (heights.empty()) return std::nullopt;
+  constexpr double kMaxSpan = 50;  // m of heights binned above the lowest (strays aside)
   std::sort(heights.begin(), heights.end());
-  const double lowest = heights.front();
+  const std::size_t strays = heights.size() / 100;  // at either end: kept out of the bins
+  const double lowest = heights[strays];
+  const double highest = std::min(heights[heights.size() - 1 - strays], lowest + kMaxSpan);
   const double median = heights[heights.size() / 2];
-  std::vector<std::size_t> bins(static_cast<std::size_t>((heights.back() - lowest) / kBin) + 3);
-  for (const double h : heights) ++bins[static_cast<std::size_t>((h - lowest) / kBin) + 1];
+  std::vector<std::size_t> bins(static_cast<std::size_t>((highest - lowest) / kBin) + 3);
+  for (const double h : heights)
+    if (h >= lowest && h <= highest) ++bins[static_cast<std::size_t>((h - lowest) / kBin) + 1];
   const double needed = kMinShare * static_cast<double>(heights.size());
   for (std::size_t b = 1; b + 1 < bins.size(); ++b) {
     if (static_cast<double>(bins[b - 1] + bins[b] + bins[b + 1]) < needed) continue;
