@@ -668,14 +668,20 @@ void fill_unobserved_runs(SemanticGrid& grid, SemanticClass ends, int max_cells,
   }
 }
 
-// The drops: each piece of unseen cells (4-neighbours) where the views saw below the floor in a
-// cell, whole. A stairwell's far part returns its steps; its near part, hidden under the edge,
-// returns nothing, and rays pass over both as over floor the camera lost at grazing angles.
-Image<std::uint8_t> drop_regions(const SemanticGrid& grid, const Image<std::uint8_t>& below) {
+// The cells no view saw (a mask).
+Image<std::uint8_t> unobserved_cells(const SemanticGrid& grid) {
   Image<std::uint8_t> unseen(grid.width(), grid.height(), 0);
   for (int row = 0; row < grid.height(); ++row)
     for (int col = 0; col < grid.width(); ++col)
       unseen(col, row) = detail::unobserved(grid, {col, row});
+  return unseen;
+}
+
+// The drops: each piece of unseen cells (4-neighbours) where the views saw below the floor in a
+// cell, whole. A stairwell's far part returns its steps; its near part, hidden under the edge,
+// returns nothing, and rays pass over both as over floor the camera lost at grazing angles.
+Image<std::uint8_t> drop_regions(const SemanticGrid& grid, const Image<std::uint8_t>& below) {
+  const Image<std::uint8_t> unseen = unobserved_cells(grid);
   Image<std::uint8_t> drops(grid.width(), grid.height(), 0);
   for (const std::vector<Eigen::Vector2i>& piece : components(unseen, Connectivity::four)) {
     const bool drop = std::any_of(piece.begin(), piece.end(),
@@ -690,10 +696,7 @@ Image<std::uint8_t> drop_regions(const SemanticGrid& grid, const Image<std::uint
 // are floor (SemanticGridParams::max_floor_hole), unless the views saw below the floor in them.
 void fill_floor_holes(SemanticGrid& grid, double max_area, float weight,
                       const Image<std::uint8_t>& drops) {
-  Image<std::uint8_t> unseen(grid.width(), grid.height(), 0);
-  for (int row = 0; row < grid.height(); ++row)
-    for (int col = 0; col < grid.width(); ++col)
-      unseen(col, row) = detail::unobserved(grid, {col, row});
+  const Image<std::uint8_t> unseen = unobserved_cells(grid);
   const auto max_cells = static_cast<std::size_t>(max_area / (grid.resolution * grid.resolution));
   for (const std::vector<Eigen::Vector2i>& hole : components(unseen, Connectivity::four)) {
     if (hole.size() > max_cells) continue;
@@ -773,23 +776,25 @@ void remove_spill(SemanticGrid& grid, const Image<CellEvidence>& evidence,
   }
 }
 
+// The cells whose evidence meets `holds` (a mask).
+template <typename Holds>
+Image<std::uint8_t> cells_where(const Image<CellEvidence>& evidence, Holds holds) {
+  Image<std::uint8_t> mask(evidence.width(), evidence.height(), 0);
+  for (int row = 0; row < evidence.height(); ++row)
+    for (int col = 0; col < evidence.width(); ++col) mask(col, row) = holds(evidence(col, row));
+  return mask;
+}
+
 // The cells where the views saw below the floor.
 Image<std::uint8_t> below_floor_seen(const Image<CellEvidence>& evidence) {
-  Image<std::uint8_t> seen(evidence.width(), evidence.height(), 0);
-  for (int row = 0; row < evidence.height(); ++row)
-    for (int col = 0; col < evidence.width(); ++col)
-      seen(col, row) = evidence(col, row).below_floor > 0;
-  return seen;
+  return cells_where(evidence, [](const CellEvidence& e) { return e.below_floor > 0; });
 }
 
 // The cells where floor was seen.
 Image<std::uint8_t> floor_seen(const Image<CellEvidence>& evidence,
                                const SemanticGridParams& options) {
-  Image<std::uint8_t> seen(evidence.width(), evidence.height(), 0);
-  for (int row = 0; row < evidence.height(); ++row)
-    for (int col = 0; col < evidence.width(); ++col)
-      seen(col, row) = evidence(col, row).floor >= options.min_floor_points;
-  return seen;
+  return cells_where(evidence,
+                     [&](const CellEvidence& e) { return e.floor >= options.min_floor_points; });
 }
 
 bool is_obstacle(float weight_value) {
