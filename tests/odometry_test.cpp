@@ -359,6 +359,39 @@ TEST(IntensityDisagreement, FindsTheSlideAmongCandidatesAndCountsPixelsOffTheIma
                Error);
 }
 
+// Over the pixels every motion keeps in view (PhotometricParams::unseen_at_cap false): a pixel
+// that one candidate moves off the image is left out of every candidate's mean instead of
+// counting the cap for that one.
+TEST(IntensityDisagreement, OverThePixelsEveryMotionSeesLeavesOutThoseOffTheImage) {
+  const Eigen::Vector3d slide(0.03, 0, 0);
+  const TexturedWallPair pair(slide);
+  registration::PhotometricParams capped;
+  registration::PhotometricParams shared;
+  shared.unseen_at_cap = false;
+  std::vector<Eigen::Isometry3d> candidates;
+  for (int i = 0; i <= 30; ++i) candidates.emplace_back(Eigen::Translation3d(0.002 * i, 0, 0));
+  // Four of the texture's periods (0.25 m) over, at 2 m: the frame's two fifths that stay in
+  // view agree as at the truth, the rest leave the image.
+  candidates.emplace_back(Eigen::Translation3d(slide.x() + 1.0, 0, 0));
+  const auto cost = [&](const registration::PhotometricParams& params) {
+    return registration::intensity_disagreement(pair.depth, pair.source, pair.target, pair.camera,
+                                                1000.0, candidates, params);
+  };
+  const std::vector<double> with_cap = cost(capped), over_shared = cost(shared);
+  ASSERT_EQ(over_shared.size(), candidates.size());
+  const auto best =
+      std::min_element(over_shared.begin(), over_shared.end() - 1) - over_shared.begin();
+  EXPECT_NEAR(candidates[static_cast<std::size_t>(best)].translation().x(), slide.x(), 0.002);
+  RecordProperty("far_with_cap", testing::scientific(with_cap.back()));
+  RecordProperty("far_over_shared", testing::scientific(over_shared.back()));
+  EXPECT_GT(with_cap.back(), 0.35 * capped.huber_levels);  // the pixels off count the cap
+  EXPECT_LT(over_shared.back(), 0.5 * with_cap.back());
+  EXPECT_LT(over_shared[15], 0.5 * over_shared[10]);  // the truth against 1 cm off, as with the cap
+  // A motion that takes every pixel off the image leaves none to compare on: 0 for all.
+  candidates.emplace_back(Eigen::Translation3d(50, 0, 0));
+  for (const double c : cost(shared)) EXPECT_EQ(c, 0.0);
+}
+
 // A dark cabinet 0.6 m away covers the left of a textured wall 3 m away. Each pixel's ray is cast
 // from a camera at `camera_x` on the x axis, looking along z.
 struct CabinetBeforeAWall {

@@ -219,6 +219,20 @@ double translation_constraint(const GeometricInformation& geometry,
   return largest > 0 ? direction.dot(translation * direction) / largest : 0.0;
 }
 
+std::vector<Eigen::Vector3d> free_translations(const GeometricInformation& geometry,
+                                               double min_eigenvalue_ratio) {
+  // The translation block is the same about the camera or the centroid (sums of n n^T).
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eigen(
+      geometry.information.bottomRightCorner<3, 3>());
+  std::vector<Eigen::Vector3d> free;
+  const double largest = eigen.eigenvalues()(2);
+  if (!(largest > 0)) return free;
+  for (int k = 0; k < 3 && eigen.eigenvalues()(k) < min_eigenvalue_ratio * largest; ++k) {
+    free.push_back(eigen.eigenvectors().col(k).normalized());  // ascending
+  }
+  return free;
+}
+
 se3::Matrix6d information_along(const se3::Matrix6d& information,
                                 std::span<const se3::Vector6d> directions) {
   if (directions.empty()) return se3::Matrix6d::Zero();

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <memory>
 #include <numbers>
+#include <numeric>
 #include <span>
 #include <string>
 #include <utility>
@@ -551,6 +552,7 @@ RgbdOdometry::Attempt RgbdOdometry::attempt_previous(const Eigen::Isometry3d& pr
     if (std::optional<Attempt> scanned = scan_along_heading(frame.step_frame, predicted, chosen))
       chosen = std::move(*scanned);
   }
+  if (std::optional<Attempt> freed = scan_free_translations(chosen)) chosen = std::move(*freed);
   return chosen;
 }
 
@@ -742,6 +744,127 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_around(const Eigen::Isom
   return scanned;
 }
 
+namespace {
+
+// `motion` with its translation shifted along `direction` (the source camera's frame) by every
+// multiple of `spacing` up to `reach`, the unshifted one left out.
+std::vector<Eigen::Isometry3d> shifted_along(const Eigen::Isometry3d& motion,
+                                             const Eigen::Vector3d& direction, double reach,
+                                             double spacing) {
+  const int n = static_cast<int>(std::floor(reach / spacing + 1e-9));
+  std::vector<Eigen::Isometry3d> shifted;
+  for (int i = -n; i <= n; ++i) {
+    if (i == 0) continue;
+    Eigen::Isometry3d candidate = motion;
+    candidate.translation() += motion.linear() * (i * spacing * direction);
+    shifted.push_back(candidate);
+  }
+  return shifted;
+}
+
+// The indices of the `count` lowest costs (> 0) whose motions' translations lie more than
+// `apart` metres from each other's, lowest first.
+std::vector<std::size_t> lowest_apart(std::span<const double> cost,
+                                      std::span<const Eigen::Isometry3d> motions, std::size_t count,
+                                      double apart) {
+  std::vector<std::size_t> order(cost.size());
+  std::iota(order.begin(), order.end(), std::size_t{0});
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return cost[a] < cost[b]; });
+  std::vector<std::size_t> picked;
+  for (const std::size_t k : order) {
+    if (picked.size() >= count) break;
+    if (cost[k] <= 0) continue;
+    const bool far = std::all_of(picked.begin(), picked.end(), [&](std::size_t p) {
+      return (motions[p].translation() - motions[k].translation()).norm() > apart;
+    });
+    if (far) picked.push_back(k);
+  }
+  return picked;
+}
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0;
+  const auto middle = values.begin() + static_cast<std::ptrdiff_t>(values.size() / 2);
+  std::nth_element(values.begin(), middle, values.end());
+  return *middle;
+}
+
+}  // namespace
+
+std::vector<Eigen::Vector3d> RgbdOdometry::free_translations_now() const {
+  constexpr double kFreeRatio = 0.1;  // of the largest translation information
+  std::vector<Eigen::Vector3d> free = free_translations(geometry_, kFreeRatio);
+  const Eigen::Vector3d axis = heading_prior_.turn_axis();
+  if (!heading_prior_.ready() || axis.squaredNorm() == 0) return free;
+  // A robot drives on its floor: no shift along its turning axis.
+  const Eigen::Vector3d up = axis.normalized();
+  std::vector<Eigen::Vector3d> level;
+  for (const Eigen::Vector3d& direction : free) {
+    if (std::abs(direction.dot(up)) > 0.5) continue;
+    level.push_back((direction - direction.dot(up) * up).normalized());
+  }
+  return level;
+}
+
+Eigen::Isometry3d RgbdOdometry::basin_bottom(const Eigen::Isometry3d& start,
+                                             const Eigen::Vector3d& direction, double reach) const {
+  constexpr double kFine = 0.002;  // metres
+  std::vector<Eigen::Isometry3d> shifts = shifted_along(start, direction, reach, kFine);
+  shifts.push_back(start);
+  const std::vector<double> cost =
+      images_disagreement(frames_.size() - 1, shifts, params_.photometric.pixel_step, false);
+  std::size_t best = shifts.size() - 1;
+  for (std::size_t i = 0; i < cost.size(); ++i) {
+    if (cost[i] > 0 && (cost[best] <= 0 || cost[i] < cost[best])) best = i;
+  }
+  return shifts[best];
+}
+
+std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_free_translations(const Attempt& attempt) {
+  constexpr double kReach = 0.5;     // metres: a sparse sequence's change of speed, a period or two
+  constexpr double kSpacing = 0.01;  // metres
+  constexpr std::size_t kStarts = 4;
+  constexpr double kApart = 0.045;         // metres: beyond one basin
+  constexpr double kBelowTheLevel = 0.75;  // of the shifts' median: a basin, not a slope
+  if (!params_.free_translation_scan || !geometry_.degeneracy.degenerate ||
+      !attempt.report.accepted() ||
+      attempt.photometric_rmse <= params_.free_translation_scan_rmse) {
+    return {};
+  }
+  const std::vector<Eigen::Vector3d> free = free_translations_now();
+  if (free.size() != 1) return {};
+  const std::vector<Eigen::Isometry3d> shifts =
+      shifted_along(attempt.motion, free[0], kReach, kSpacing);
+  const std::size_t target = frames_.size() - 1;
+  const int pixel_step = params_.photometric.pixel_step;
+  const std::vector<double> cost = images_disagreement(target, shifts, pixel_step, false);
+  // ICP from the best shifts and from the answer itself, each at the bottom of its basin.
+  std::vector<Eigen::Isometry3d> starts;
+  for (const std::size_t k : lowest_apart(cost, shifts, kStarts, kApart)) {
+    starts.push_back(basin_bottom(shifts[k], free[0], kSpacing));
+  }
+  starts.push_back(basin_bottom(attempt.motion, free[0], kApart / 2));
+  std::vector<Attempt> found;
+  std::vector<Eigen::Isometry3d> compared{attempt.motion};
+  for (const Eigen::Isometry3d& start : starts) {
+    Attempt scanned = register_frames(target, start, frame_limits_now());
+    if (!scanned.report.accepted()) continue;
+    compared.push_back(scanned.motion);
+    found.push_back(std::move(scanned));
+  }
+  const std::vector<double> final_cost = images_disagreement(target, compared, pixel_step, false);
+  if (found.empty() || final_cost.empty() || final_cost[0] <= 0) return {};
+  const auto best = std::min_element(final_cost.begin() + 1, final_cost.end());
+  if (*best >= params_.feature_arbitration_ratio * final_cost[0] ||
+      *best >= kBelowTheLevel * median_of(cost)) {
+    return {};
+  }
+  Attempt chosen = std::move(found[static_cast<std::size_t>(best - final_cost.begin()) - 1]);
+  chosen.scanned = true;
+  return chosen;
+}
+
 std::optional<Eigen::Isometry3d> RgbdOdometry::widest_turn_fit(const Eigen::Isometry3d& predicted,
                                                                const HeadingStepGrid& grid,
                                                                const Attempt& attempt) const {
@@ -896,12 +1019,13 @@ std::vector<double> RgbdOdometry::images_rmse(std::size_t target,
 
 std::vector<double> RgbdOdometry::images_disagreement(std::size_t target,
                                                       std::span<const Eigen::Isometry3d> motions,
-                                                      int pixel_step) const {
+                                                      int pixel_step, bool unseen_at_cap) const {
   const PhotometricFrame& source = images_[slot_of(frames_.size())];
   const PhotometricFrame& onto = images_[slot_of(target)];
   if (source.empty() || onto.empty()) return {};
   PhotometricParams photometric = params_.photometric;
   photometric.pixel_step = pixel_step;
+  photometric.unseen_at_cap = unseen_at_cap;
   return intensity_disagreement(source, onto, builder_.camera(), motions, photometric);
 }
 

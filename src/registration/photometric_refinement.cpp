@@ -285,17 +285,41 @@ std::vector<double> intensity_disagreement(const PhotometricFrame& source,
   if (samples.empty()) return disagreement;
   const Textured& onto = smoothed(target, 1);
   const double cap = params.huber_levels;
-  for (std::size_t m = 0; m < source_to_target.size(); ++m) {
-    double sum = 0;
-    for (const Sample& sample : samples) {
-      const Eigen::Vector3d q = source_to_target[m] * sample.point;
-      double intensity = 0, gx = 0, gy = 0;
-      const bool seen =
-          q.z() > 0 && onto.sample(camera.fx * q.x() / q.z() + camera.cx,
-                                   camera.fy * q.y() / q.z() + camera.cy, intensity, gx, gy);
-      sum += seen ? std::min(cap, std::abs(intensity - sample.intensity)) : cap;
+  // Each sample's capped difference under each motion (< 0: outside the target's view).
+  const auto difference = [&](const Sample& sample, const Eigen::Isometry3d& motion) {
+    const Eigen::Vector3d q = motion * sample.point;
+    double intensity = 0, gx = 0, gy = 0;
+    const bool seen =
+        q.z() > 0 && onto.sample(camera.fx * q.x() / q.z() + camera.cx,
+                                 camera.fy * q.y() / q.z() + camera.cy, intensity, gx, gy);
+    return seen ? std::min(cap, std::abs(intensity - sample.intensity)) : -1.0;
+  };
+  if (params.unseen_at_cap) {
+    for (std::size_t m = 0; m < source_to_target.size(); ++m) {
+      double sum = 0;
+      for (const Sample& sample : samples) {
+        const double d = difference(sample, source_to_target[m]);
+        sum += d < 0 ? cap : d;
+      }
+      disagreement[m] = sum / static_cast<double>(samples.size());
     }
-    disagreement[m] = sum / static_cast<double>(samples.size());
+    return disagreement;
+  }
+  std::vector<double> sums(source_to_target.size(), 0.0), row(source_to_target.size());
+  std::size_t shared = 0;
+  for (const Sample& sample : samples) {
+    bool everywhere = true;
+    for (std::size_t m = 0; m < source_to_target.size() && everywhere; ++m) {
+      row[m] = difference(sample, source_to_target[m]);
+      everywhere = row[m] >= 0;
+    }
+    if (!everywhere) continue;
+    ++shared;
+    for (std::size_t m = 0; m < source_to_target.size(); ++m) sums[m] += row[m];
+  }
+  if (shared < params.min_pixels) return disagreement;
+  for (std::size_t m = 0; m < source_to_target.size(); ++m) {
+    disagreement[m] = sums[m] / static_cast<double>(shared);
   }
   return disagreement;
 }

@@ -94,6 +94,13 @@ std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,
 double translation_constraint(const GeometricInformation& geometry,
                               const Eigen::Vector3d& direction);
 
+// The translations of the source (its camera frame, unit) that `geometry` leaves free: the
+// eigenvectors of its translation information below min_eigenvalue_ratio x the largest, weakest
+// first (a floor and a wall: the line they meet along; a floor alone: two). None where the
+// geometry constrains no translation at all.
+std::vector<Eigen::Vector3d> free_translations(const GeometricInformation& geometry,
+                                               double min_eigenvalue_ratio);
+
 // `information` restricted to `directions` (tangent vectors, as weak_directions gives them): it
 // says as much about their amounts and nothing about the directions off their span (the
 // least-squares amounts of a perturbation are what it weighs).
