@@ -257,6 +257,8 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   // free direction alone stays within 7 mm.
   free_only.step_frame = registration::StepFrame::camera;
   free_only.photometric.mask_depth_edges = false;
+  // The scan along the free line (2026-12-06) mends part of it (19 mm): off, as before it.
+  free_only.free_translation_scan = false;
   EXPECT_GT(worst_step(cabinet, free_only).first, 0.02);
 
   const DegenerateStretch stripes{8, 674, 24, true};
