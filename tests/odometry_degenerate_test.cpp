@@ -204,6 +204,46 @@ TEST(PhotometricRefinement, AFloorTooFaintForTheCoarsePassIsMeasuredByTheFinePas
   EXPECT_LT(tracked.ate, 0.005);  // measured 2.2 mm (15.3 mm before)
 }
 
+// Held-out survey seed 24, frames 790-870: a floor-only drive (the far wall beyond the depth's
+// range) speeding up from 4 to 6.6 cm a frame and slowing down again, over a carpet whose soft
+// blotches stay under the gradient threshold: fewer than 200 pixels reach 4 grey levels, so the
+// refinement measured nothing and the motion model kept the old speed (steps up to 3 cm short).
+// The texture from 0.75 up to 4 grey levels measures those steps.
+TEST(PhotometricRefinement, AFaintCarpetIsMeasuredBelowTheGradientThreshold) {
+  const DegenerateStretch stretch{24, 790, 80, true};
+  const TrackedStretch tracked = track_stretch(stretch, {});
+  EXPECT_GE(tracked.degenerate, 40u);
+  double worst = 0;
+  for (std::size_t i = 0; i < tracked.steps.size(); ++i) {
+    EXPECT_LT(tracked.steps[i].metres, 0.005) << "frame " << stretch.first + i + 1;
+    EXPECT_LT(tracked.steps[i].degrees, 0.25) << "frame " << stretch.first + i + 1;
+    worst = std::max(worst, tracked.steps[i].metres);
+  }
+  RecordProperty("worst_step_m", std::to_string(worst));
+  registration::OdometryParams without;
+  without.photometric.faint_min_gradient = 0;
+  const double worst_without = worst_step(stretch, without).first;
+  RecordProperty("worst_step_without_m", std::to_string(worst_without));
+  EXPECT_GT(worst_without, 0.02);
+}
+
+// Held-out survey seed 11, frames 200-280: a floor-only drive over a faint carpet, speeding up
+// from 6 to 11 cm a frame, through a doorway at frame 248. There the jambs, seen edge-on at the
+// image's sides, misfit by tens of grey levels: the faint texture's answer moved the step 4 cm
+// too far at an RMSE of 2.7-3.2 (a carpet fits at 0.4-0.7), and the RMSE gate
+// (PhotometricParams::faint_max_rmse) refuses it.
+TEST(PhotometricRefinement, AFaintTextureIsKeptOnlyWhereItFitsTheImages) {
+  const DegenerateStretch stretch{11, 200, 80, true};
+  registration::OdometryParams ungated;
+  ungated.photometric.faint_max_rmse = 1e9;
+  const double worst = worst_step(stretch, {}).first;
+  const double worst_ungated = worst_step(stretch, ungated).first;
+  RecordProperty("worst_step_m", std::to_string(worst));
+  RecordProperty("worst_step_ungated_m", std::to_string(worst_ungated));
+  EXPECT_LT(worst, 0.01);
+  EXPECT_GT(worst_ungated, 0.02);
+}
+
 // Seed 10, frames 263-300: the robot drives straight, then starts an arc of 2.3 degrees a frame
 // (frame 288) into a view of one wall and the floor (frames 289-297 degenerate; tracked without the
 // images, which now measure them as well). ICP at the onset took the turn 0.1 degrees short and the

@@ -252,13 +252,14 @@ struct TexturedWallPair {
   DepthImage depth;
   RgbImage source, target;
 
-  explicit TexturedWallPair(const Eigen::Vector3d& slide)
+  // `contrast`: the texture's amplitude in grey levels.
+  explicit TexturedWallPair(const Eigen::Vector3d& slide, double contrast = 60.0)
       : depth(camera.width, camera.height, 0),
         source(camera.width, camera.height),
         target(camera.width, camera.height) {
     const double distance = 2.0;
-    const auto texture = [](double x, double y) {
-      return 128.0 + 60.0 * std::sin(2 * std::numbers::pi * x / 0.25) *
+    const auto texture = [contrast](double x, double y) {
+      return 128.0 + contrast * std::sin(2 * std::numbers::pi * x / 0.25) *
                          std::cos(2 * std::numbers::pi * y / 0.18);
     };
     const auto level = [](double value) {
@@ -317,6 +318,42 @@ TEST(PhotometricRefinement, RecoversTheSlideAlongATexturedWall) {
   EXPECT_THROW(registration::refine_photometrically(depth, source, RgbImage(4, 4), camera, 1000.0,
                                                     start, along_x),
                Error);
+}
+
+// A texture too faint for the gradient threshold (12 grey levels of contrast: under 2.5 grey
+// levels per pixel, so no pixel reaches 4) is measured by the pass over the gradients from
+// PhotometricParams::faint_min_gradient up; without that pass nothing is.
+TEST(PhotometricRefinement, AFaintTextureIsMeasuredUnderTheGradientThreshold) {
+  const Eigen::Vector3d slide(0.03, 0, 0);
+  const TexturedWallPair pair(slide, 12.0);
+  const Eigen::Isometry3d truth{Eigen::Translation3d(slide)};
+  const Eigen::Isometry3d start = truth * Eigen::Translation3d(0.008, 0, 0);
+  const std::vector<se3::Vector6d> along_x{(se3::Vector6d() << 0, 0, 0, 1, 0, 0).finished()};
+  const auto refine = [&](const registration::PhotometricParams& params) {
+    return registration::refine_photometrically(pair.depth, pair.source, pair.target, pair.camera,
+                                                1000.0, start, along_x, params);
+  };
+  const registration::PhotometricResult faint = refine({});
+  EXPECT_TRUE(faint.refined);
+  EXPECT_TRUE(faint.faint);
+  EXPECT_LE(faint.rmse_after, registration::PhotometricParams{}.faint_max_rmse);
+  RecordProperty("error_m",
+                 testing::scientific((truth.inverse() * faint.motion).translation().norm()));
+  EXPECT_LT((truth.inverse() * faint.motion).translation().norm(), 1e-3);
+
+  registration::PhotometricParams without;
+  without.faint_min_gradient = 0;
+  const registration::PhotometricResult unmeasured = refine(without);
+  EXPECT_FALSE(unmeasured.refined);
+  EXPECT_TRUE(unmeasured.motion.isApprox(start));
+  // The strong texture is measured by the first pass, as before.
+  const TexturedWallPair strong(slide);
+  EXPECT_FALSE(registration::refine_photometrically(strong.depth, strong.source, strong.target,
+                                                    strong.camera, 1000.0, start, along_x)
+                   .faint);
+  registration::PhotometricParams broken;
+  broken.faint_max_rmse = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(refine(broken), Error);
 }
 
 // Candidate slides along the textured wall, 2 mm apart, compared by their robust disagreement

@@ -314,7 +314,9 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
       attempt.motion = refined.motion;
       attempt.photometric = true;
       attempt.photometric_rmse = refined.rmse_after;
-      attempt.photometric_sigma_m = refined.sigma_m;
+      // A faint texture's sigma (thousands of pixels at the noise's level: 0.01 mm) claims more
+      // than it measures; the pose graph leaves such a step's free directions to the loops.
+      attempt.photometric_sigma_m = refined.faint ? 0.0 : refined.sigma_m;
       measure_travel_length(attempt, initial, limits, source_images, target_images);
     }
   }

@@ -64,7 +64,7 @@ struct SampleChoice {
   int passes = 1;
   bool masked = false;
   int pixel_step = 1;
-  double min_gradient = 0, max_depth = 0;
+  double min_gradient = 0, max_gradient = 0, max_depth = 0;
   double fx = 0, fy = 0, cx = 0, cy = 0;
   auto operator<=>(const SampleChoice&) const = default;
 };

@@ -105,12 +105,14 @@ std::vector<Sample> samples_of(const DepthImage& depth, const Textured& source,
                                const PhotometricParams& params, const Mask& excluded) {
   std::vector<Sample> samples;
   const double min_squared = params.min_gradient * params.min_gradient;
+  const double max_squared = params.max_gradient * params.max_gradient;
   for (int y = 2; y + 2 < depth.height(); y += params.pixel_step) {
     for (int x = 2; x + 2 < depth.width(); x += params.pixel_step) {
       const double z = depth(x, y) / units_per_metre;
       if (depth(x, y) == 0 || z > params.max_depth || excluded(x, y)) continue;
       const double gx = source.dx(x, y), gy = source.dy(x, y);
-      if (gx * gx + gy * gy < min_squared) continue;
+      const double squared = gx * gx + gy * gy;
+      if (squared < min_squared || squared >= max_squared) continue;
       samples.push_back(
           {Eigen::Vector3d((x - k.cx) * z / k.fx, (y - k.cy) * z / k.fy, z), source.value(x, y)});
     }
@@ -201,8 +203,10 @@ void require_camera_sized(const PhotometricFrame& source, const PhotometricFrame
 
 // The limits that pick the samples (and key the frame's kept samples) must be numbers.
 void require_finite_limits(const PhotometricParams& params) {
-  require(std::isfinite(params.min_gradient) && std::isfinite(params.max_depth),
-          "photometric refinement: min_gradient and max_depth must be finite");
+  require(std::isfinite(params.min_gradient) && std::isfinite(params.max_depth) &&
+              !std::isnan(params.max_gradient),
+          "photometric refinement: min_gradient and max_depth must be finite, max_gradient a "
+          "number");
 }
 
 // The source's textured pixels after `passes` smoothing passes, without those beside depth edges
@@ -216,6 +220,7 @@ const std::vector<Sample>& samples_for(const PhotometricFrame& source, int passe
                                     .masked = masked,
                                     .pixel_step = params.pixel_step,
                                     .min_gradient = params.min_gradient,
+                                    .max_gradient = params.max_gradient,
                                     .max_depth = params.max_depth,
                                     .fx = k.fx,
                                     .fy = k.fy,
@@ -324,14 +329,14 @@ std::vector<double> intensity_disagreement(const PhotometricFrame& source,
   return disagreement;
 }
 
-PhotometricResult refine_photometrically(
+namespace {
+
+// One refinement on the pixels params' gradient limits pick: the coarse pass, then the fine one.
+PhotometricResult refine_on_gradients(
     const PhotometricFrame& source, const PhotometricFrame& target, const PinholeIntrinsics& camera,
     const Eigen::Isometry3d& source_to_target, std::span<const se3::Vector6d> directions,
     const PhotometricParams& params, const se3::Matrix6d& start_information,
     std::size_t measured_directions) {
-  require_camera_sized(source, target, camera);
-  require(params.pixel_step >= 1 && params.iterations >= 0 && params.blur_passes >= 1,
-          "photometric refinement: pixel_step, blur_passes >= 1 and iterations >= 0 are required");
   PhotometricResult unrefined;
   unrefined.motion = source_to_target;
   if (directions.empty()) return unrefined;
@@ -371,6 +376,39 @@ PhotometricResult refine_photometrically(
   // did before they were left out.
   if (masked.refined || !params.mask_depth_edges) return masked;
   return fine(false);
+}
+
+// PhotometricParams::faint_min_gradient: whether the faint texture's pass runs.
+bool measures_faint_texture(const PhotometricParams& params) {
+  return params.faint_min_gradient > 0 && params.faint_min_gradient < params.min_gradient;
+}
+
+}  // namespace
+
+PhotometricResult refine_photometrically(
+    const PhotometricFrame& source, const PhotometricFrame& target, const PinholeIntrinsics& camera,
+    const Eigen::Isometry3d& source_to_target, std::span<const se3::Vector6d> directions,
+    const PhotometricParams& params, const se3::Matrix6d& start_information,
+    std::size_t measured_directions) {
+  require_camera_sized(source, target, camera);
+  require(params.pixel_step >= 1 && params.iterations >= 0 && params.blur_passes >= 1,
+          "photometric refinement: pixel_step, blur_passes >= 1 and iterations >= 0 are required");
+  require(std::isfinite(params.faint_min_gradient) && std::isfinite(params.faint_max_rmse),
+          "photometric refinement: faint_min_gradient and faint_max_rmse must be finite");
+  const PhotometricResult textured =
+      refine_on_gradients(source, target, camera, source_to_target, directions, params,
+                          start_information, measured_directions);
+  if (textured.refined || directions.empty() || !measures_faint_texture(params)) return textured;
+  // The texture under min_gradient alone: the pixels above it did not measure the motion.
+  PhotometricParams faint = params;
+  faint.min_gradient = params.faint_min_gradient;
+  faint.max_gradient = std::min(params.min_gradient, params.max_gradient);
+  PhotometricResult result =
+      refine_on_gradients(source, target, camera, source_to_target, directions, faint,
+                          start_information, measured_directions);
+  if (!result.refined || result.rmse_after > params.faint_max_rmse) return textured;
+  result.faint = true;
+  return result;
 }
 
 // The same on images given one by one (each call prepares them).
