@@ -44,12 +44,12 @@ struct PhotometricParams {
   // gradient lies from faint_min_gradient up to min_gradient, and that answer is kept where it
   // also fits the images within faint_max_rmse grey levels (PhotometricResult::faint). Held-out
   // survey seeds 11, 24 and 26 (floor-only drives speeding up or slowing down; seed 26 between
-  // striped walls that misfit): the motion model's steps were up to 3.8 cm short, 9-22 cm over a
-  // stretch. At 0.5-1 grey levels those steps come within 1 cm; at 0.25 the sensor noise (about
-  // 0.2 grey levels of gradient after smoothing) misleads steps. A carpet fits at 0.4-0.7 at the
-  // right motion; the gate refuses a doorway's jambs seen edge-on (seed 11, frame 248: 4 cm wrong
-  // at 2.7-3.2) and a 39-degree turn's wrong basin (seed 5 every 10th frame: 6 cm at 1.2-1.4).
-  // 0 turns the pass off.
+  // striped walls that misfit): the motion model's steps were up to 3.8 cm short, their errors
+  // summing to 23-59 cm over a stretch. At 0.5-1 grey levels those steps come within 1 cm; at 0.25
+  // the sensor noise (about 0.2 grey levels of gradient after smoothing) misleads steps. A carpet
+  // fits at 0.4-0.7 at the right motion; the gate refuses a doorway's jambs seen edge-on (seed 11,
+  // frame 248: 4 cm wrong at 2.7-3.2) and a 39-degree turn's wrong basin (seed 5 every 10th frame:
+  // 6 cm at 1.2-1.4). 0 turns the pass off.
   double faint_min_gradient = 0.75;
   double faint_max_rmse = 1.0;
   int iterations = 10;       // per pass
