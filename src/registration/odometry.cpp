@@ -667,6 +667,20 @@ std::pair<double, double> RgbdOdometry::plausible_step_lengths(
   return {shortest, longest};
 }
 
+namespace {
+
+// The index of the lowest of `values` above 0 (0: not measured), the first among equals; none
+// where no value was measured.
+std::optional<std::size_t> lowest_measured(std::span<const double> values) {
+  std::optional<std::size_t> best;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    if (values[i] > 0 && (!best || values[i] < values[*best])) best = i;
+  }
+  return best;
+}
+
+}  // namespace
+
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_step_lengths(
     StepFrame step_frame, const Eigen::Isometry3d& predicted, const Attempt& attempt) {
   constexpr double kSpacing = 0.01;  // metres: about the images' basin along a step
@@ -682,13 +696,10 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_step_lengths(
     candidate.translation() = length * step.normalized();
     candidates.push_back(candidate);
   }
-  const std::vector<double> rmse = images_rmse(frames_.size() - 1, candidates);
-  std::size_t best = candidates.size();
-  for (std::size_t i = 0; i < rmse.size(); ++i) {
-    if (rmse[i] > 0 && (best == candidates.size() || rmse[i] < rmse[best])) best = i;
-  }
-  if (best == candidates.size()) return {};
-  Attempt scanned = register_frames(frames_.size() - 1, candidates[best], frame_limits_now());
+  const std::optional<std::size_t> best =
+      lowest_measured(images_rmse(frames_.size() - 1, candidates));
+  if (!best) return {};
+  Attempt scanned = register_frames(frames_.size() - 1, candidates[*best], frame_limits_now());
   if (!agrees_better(scanned, attempt)) return {};
   scanned.scanned = true;
   return scanned;
@@ -812,15 +823,14 @@ std::vector<Eigen::Vector3d> RgbdOdometry::free_translations_now() const {
 Eigen::Isometry3d RgbdOdometry::basin_bottom(const Eigen::Isometry3d& start,
                                              const Eigen::Vector3d& direction, double reach) const {
   constexpr double kFine = 0.002;  // metres
-  std::vector<Eigen::Isometry3d> shifts = shifted_along(start, direction, reach, kFine);
-  shifts.push_back(start);
-  const std::vector<double> cost =
-      images_disagreement(frames_.size() - 1, shifts, params_.photometric.pixel_step, false);
-  std::size_t best = shifts.size() - 1;
-  for (std::size_t i = 0; i < cost.size(); ++i) {
-    if (cost[i] > 0 && (cost[best] <= 0 || cost[i] < cost[best])) best = i;
+  // The start first: a shift must be strictly lower to replace it.
+  std::vector<Eigen::Isometry3d> shifts{start};
+  for (const Eigen::Isometry3d& shifted : shifted_along(start, direction, reach, kFine)) {
+    shifts.push_back(shifted);
   }
-  return shifts[best];
+  const std::optional<std::size_t> best = lowest_measured(
+      images_disagreement(frames_.size() - 1, shifts, params_.photometric.pixel_step, false));
+  return shifts[best.value_or(0)];
 }
 
 std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_free_translations(const Attempt& attempt) {
@@ -855,8 +865,9 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::scan_free_translations(const 
     compared.push_back(scanned.motion);
     found.push_back(std::move(scanned));
   }
+  if (found.empty()) return {};
   const std::vector<double> final_cost = images_disagreement(target, compared, pixel_step, false);
-  if (found.empty() || final_cost.empty() || final_cost[0] <= 0) return {};
+  if (final_cost.empty() || final_cost[0] <= 0) return {};
   const auto best = std::min_element(final_cost.begin() + 1, final_cost.end());
   if (*best >= params_.feature_arbitration_ratio * final_cost[0] ||
       *best >= kBelowTheLevel * median_of(cost)) {
