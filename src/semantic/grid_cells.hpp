@@ -34,6 +34,17 @@ inline int wall_run(const SemanticGrid& grid, Eigen::Vector2i cell, const Eigen:
   return run;
 }
 
+// Whether the wall cells through wall cell c along `across` are at most `max_cells`, with seen
+// floor just beyond both ends: a wall the rooms on both its sides saw.
+inline bool floor_beyond_both_faces(const SemanticGrid& grid, const Eigen::Vector2i& c,
+                                    const Eigen::Vector2i& across, int max_cells) {
+  const int ahead = wall_run(grid, c, across, max_cells);
+  const int behind = wall_run(grid, c, -across, max_cells);
+  return ahead + behind + 1 <= max_cells &&
+         seen_as(grid, c + (ahead + 1) * across, SemanticClass::floor) &&
+         seen_as(grid, c - (behind + 1) * across, SemanticClass::floor);
+}
+
 // Whether a door cell is a 4-neighbour of any of the cells: beside a door, an unseen pocket is a
 // wall's inside behind its leaf, not what furniture hid.
 inline bool beside_door(const SemanticGrid& grid, std::span<const Eigen::Vector2i> cells) {

@@ -209,19 +209,63 @@ JoinedFront front_and_sides(const SemanticGrid& grid, const std::vector<cv::Poin
   return joined;
 }
 
+// How far a wall's far face runs on either way along its line from a cell of it [m]: farther than
+// a wall is thick, so the side of a cabinet that joins a wall (wall cells with floor beyond them
+// too) is no far face.
+constexpr double kFarFaceRunsOn = 0.4;
+
+// Whether wall cell c lies in a wall that the rooms on both its sides saw: across it, along a row
+// or a column, at most `max_across` wall cells with seen floor just beyond both ends, in a line
+// that runs on along the other axis for kFarFaceRunsOn or more. A cabinet's front is as thin but
+// has the pocket its top hid behind it; a narrow front's corner has floor beyond both of the
+// front's ends, but no line across it.
+bool between_rooms(const SemanticGrid& grid, const Eigen::Vector2i& c, int max_across) {
+  const int along = static_cast<int>(std::ceil(kFarFaceRunsOn / grid.resolution));
+  for (const Eigen::Vector2i& across : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
+    if (!floor_beyond_both_faces(grid, c, across, max_across)) continue;
+    const Eigen::Vector2i line(across.y(), across.x());
+    if (wall_run(grid, c, line, along) + wall_run(grid, c, -line, along) + 1 >= along) return true;
+  }
+  return false;
+}
+
+// Whether a piece of wall cells holds a wall between two rooms (`between_rooms`) for
+// kFarFaceRunsOn or more. A cabinet's front and sides have its pocket behind them; on survey seed
+// 18 a wall between two rooms, seen from both between two cabinets standing back to back against
+// it, had joined the front of one into a furniture-sized piece, become furniture, and the rooms
+// merged.
+bool holds_wall_between_rooms(const SemanticGrid& grid, const std::vector<cv::Point>& cells,
+                              int max_across) {
+  const int enough = static_cast<int>(std::ceil(kFarFaceRunsOn / grid.resolution));
+  int between = 0;
+  for (const cv::Point& c : cells)
+    if (between_rooms(grid, {c.x, c.y}, max_across) && ++between >= enough) return true;
+  return false;
+}
+
 // The wall pieces of the grid (8-neighbours) and which are longer than furniture.
 struct WallPieces {
   Pieces pieces;
   std::vector<bool> long_wall, front_like;  // by label; front_like: furniture sized, facing floor
 };
 
-WallPieces wall_pieces(const SemanticGrid& grid, double max_extent, double max_area) {
+// The most wall cells across a wall between two rooms, from the cells of a wall's inside (its
+// thickness less a cell): the thickness, and a cell of depth noise.
+int max_wall_across(int inside_cells) {
+  return inside_cells + 2;
+}
+
+// `max_across`: the most cells across a wall between two rooms, which no front holds (0: none).
+WallPieces wall_pieces(const SemanticGrid& grid, double max_extent, double max_area,
+                       int max_across) {
   WallPieces w{pieces_of(seen_mask(grid, SemanticClass::wall)), {}, {}};
   w.long_wall.resize(w.pieces.cells.size());
   w.front_like.resize(w.pieces.cells.size());
   for (std::size_t k = 1; k < w.pieces.cells.size(); ++k) {
-    const bool sized = furniture_sized(w.pieces.cells[k], grid.resolution, max_extent, max_area);
-    w.front_like[k] = sized && faces_floor(grid, w.pieces.cells[k]);
+    const std::vector<cv::Point>& cells = w.pieces.cells[k];
+    const bool sized = furniture_sized(cells, grid.resolution, max_extent, max_area);
+    w.front_like[k] =
+        sized && faces_floor(grid, cells) && !holds_wall_between_rooms(grid, cells, max_across);
     w.long_wall[k] = !sized;
   }
   return w;
@@ -237,11 +281,6 @@ bool backed_pocket(const SemanticGrid& grid, const WallPieces& walls,
   beside = walls_around(grid, walls.pieces.labels, pocket);
   return std::any_of(beside.begin(), beside.end(), [&](int w) { return walls.long_wall[w]; });
 }
-
-// How far a wall's far face runs on either way along its line from a cell of it [m]: farther than
-// a wall is thick, so the side of a cabinet that joins a wall (wall cells with floor beyond them
-// too) is no far face.
-constexpr double kFarFaceRunsOn = 0.4;
 
 // Whether a cell of a longer wall's face whose other side the room saw (floor within 2 cells beyond
 // it, the line running on either way) lies within `inside` cells of unseen cell c along `step`.
@@ -307,7 +346,8 @@ FrontsFound fronts_against_walls(SemanticGrid& grid, double max_extent, double m
                                  int min_depth_cells, int inside_cells, int max_depth_cells,
                                  const TraversabilityWeights& weights,
                                  Image<std::uint8_t>& furniture) {
-  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
+  const WallPieces walls =
+      wall_pieces(grid, max_extent, max_area, max_wall_across(min_depth_cells));
   const Pieces pockets =
       pieces_of(pockets_between_walls(grid, min_depth_cells, max_depth_cells, true));
   int fronts = 0;
@@ -333,7 +373,8 @@ FrontsFound joined_fronts_against_walls(SemanticGrid& grid, double max_extent, d
                                         int inside_cells, int max_depth_cells,
                                         const TraversabilityWeights& weights,
                                         Image<std::uint8_t>& furniture) {
-  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
+  // Its fronts are the wall cells around a pocket's box, not pieces.
+  const WallPieces walls = wall_pieces(grid, max_extent, max_area, 0);
   const Pieces pockets = pieces_of(pockets_between_walls(grid, 1, max_depth_cells, false));
   int fronts = 0;
   PocketSplit split;
@@ -463,7 +504,7 @@ int furniture_specks_in_walls(SemanticGrid& grid, int max_cells, float weight,
 
 Image<std::uint8_t> front_pockets(const SemanticGrid& grid, double max_extent, double max_area,
                                   int min_cells, int max_cells) {
-  const WallPieces walls = wall_pieces(grid, max_extent, max_area);
+  const WallPieces walls = wall_pieces(grid, max_extent, max_area, max_wall_across(min_cells));
   const auto front = [&](const Eigen::Vector2i& c) {
     return grid.contains(c) &&
            walls.front_like[static_cast<std::size_t>(walls.pieces.labels.at<int>(c.y(), c.x()))];

@@ -15,6 +15,7 @@ struct FrontsFound {
 
 // A cabinet or shelf against a wall, whose front the views took for a wall: a piece of wall cells
 // of furniture size (at most `max_extent` long, `max_area` in hull), most of them next to floor,
+// holding no wall between two rooms (seen floor just beyond both sides of a few cells across),
 // that stands in front of a longer wall with only unseen cells between them (rows or columns of
 // more than `min_depth_cells`, a wall's inside, and at most `max_depth_cells`, with floor within
 // 3 cells beyond one end: the pocket its top and sides hid, behind a face the room saw) and no

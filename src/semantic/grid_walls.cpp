@@ -305,11 +305,37 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight) {
   }
 }
 
+namespace {
+
+// Whether a line along `step` from wall cell `start` to wall cell `end` is a wall between two rooms
+// that meets another wall (a T), where cabinets standing against both hid where they meet: within
+// `beyond` cells behind `start` the rooms on both its sides saw it (at most `beyond` - 1 cells
+// thick), and the wall reached at `end` runs across the line for `beyond` cells both ways in one
+// of its first `beyond` rows. The top edge of a thicker piece of wall (a cabinet the views took for
+// one) is no wall between rooms.
+bool meets_wall_across(const SemanticGrid& grid, const Eigen::Vector2i& start,
+                       const Eigen::Vector2i& end, const Eigen::Vector2i& step, int beyond) {
+  const Eigen::Vector2i across(step.y(), step.x());
+  bool between_rooms = false;
+  for (int k = 0; k < beyond && !between_rooms; ++k)
+    between_rooms = floor_beyond_both_faces(grid, start - k * step, across, beyond - 1);
+  if (!between_rooms) return false;
+  for (Eigen::Vector2i k = end;
+       (k - end).cwiseAbs().sum() < beyond && seen_as(grid, k, SemanticClass::wall); k += step) {
+    if (wall_run(grid, k, across, beyond) >= beyond && wall_run(grid, k, -across, beyond) >= beyond)
+      return true;
+  }
+  return false;
+}
+
+}  // namespace
+
 int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyond_cells,
                                 float weight, Image<std::uint8_t>& furniture) {
   const auto hidden = [&](const Eigen::Vector2i& c) { return hidden_by_furniture(grid, c); };
   std::vector<Eigen::Vector2i> bridged;
-  for (const Eigen::Vector2i& step : {Eigen::Vector2i(1, 0), Eigen::Vector2i(0, 1)}) {
+  // Each way: a line that meets a wall (a T) is found from its open end only.
+  for (const Eigen::Vector2i& step : kFourNeighbours) {
     const Eigen::Vector2i across(step.y(), step.x());
     for (int row = 0; row < grid.height(); ++row) {
       for (int col = 0; col < grid.width(); ++col) {
@@ -323,7 +349,8 @@ int wall_lines_behind_furniture(SemanticGrid& grid, int max_gap_cells, int beyon
         for (; hidden(c) && gap <= max_gap_cells; c += step, ++gap)
           furniture |= furniture_across(grid, c, across, beyond_cells);
         if (gap > max_gap_cells || !furniture || !seen_as(grid, c, SemanticClass::wall) ||
-            wall_run(grid, c, step, beyond_cells) < beyond_cells)
+            (wall_run(grid, c, step, beyond_cells) < beyond_cells &&
+             !meets_wall_across(grid, start, c, step, beyond_cells)))
           continue;
         for (Eigen::Vector2i k = start + step; k != c; k += step) bridged.push_back(k);
       }

@@ -54,7 +54,9 @@ void fill_wall_corners(SemanticGrid& grid, int thickness, float weight);
 // A wall line hidden behind furniture: along a row or a column, a gap of at most `max_gap_cells`
 // unseen or furniture cells, with furniture within `beyond_cells` across it, between two wall
 // cells from which the wall runs on for at least `beyond_cells` each way (more than a wall is
-// thick, so that the line is a wall's length, not another wall's thickness), is wall: its unseen
+// thick, so that the line is a wall's length, not another wall's thickness), or, at the far end,
+// across the line both ways in one of its first `beyond_cells` rows (the wall the line meets: a
+// T), is wall: its unseen
 // cells, and its furniture cells (the wall's face seen above the furniture, which the views left
 // unlabelled in a region the furniture cut small, or the furniture's back in the noise of the face:
 // furniture stands in front of a wall, not in its line); `furniture` unmarks those. Returns the

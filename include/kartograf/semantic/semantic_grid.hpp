@@ -133,9 +133,10 @@ struct SemanticGridParams {
   // Unobserved cells between floor cells this close along a row or a column are floor: the thin
   // shadows behind corners that a camera turning in place leaves as a fan. 0: off.
   double max_floor_shadow = 0.15;  // m
-  // An unobserved hole whose every neighbour is seen floor, up to this area, is floor: nothing
-  // stands in it, or its sides would have been seen from around it (the floor under and around a
-  // camera that turned in place is out of its view). 0: off.
+  // An unobserved hole whose every neighbour is seen floor, or with seen floor at both ends of its
+  // rows (or columns) and walls beside it, up to this area, is floor: nothing stands in it, or its
+  // sides would have been seen from around it (the floor under and around a camera that turned in
+  // place is out of its view; a stretch of corridor the views from its ends lost). 0: off.
   double max_floor_hole = 4.0;  // m^2
   // Free space from the views' rays (when their origins are known): every free_space_ray_stride-th
   // point's ray marks the slabs (free_space_slab high, from band_min) of the cells it crosses,
