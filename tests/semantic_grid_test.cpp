@@ -854,7 +854,7 @@ TEST(SemanticGrid, ACabinetStandsAgainstTheWallLineSeenBeyondItsEnds) {
 
 // Two rooms west and east of a wall 0.1 m thick (x 2.012-2.112) with a doorway (y 0.612-1.412),
 // a corridor north of them behind another (y 3.012-3.112), and two cabinets back to back against
-// the wall near the corridor: the west one (x 1.412-2.012, y 1.812-2.612) stands 0.4 m off the
+// the wall near the corridor: the west one (x 1.412-2.012, y 2.012-2.612) stands 0.4 m off the
 // corridor's wall, its front and west side taken for walls by the views, what lies behind them
 // unseen; the east one (x 2.112-2.612, y 2.212-3.012) stands in the corner, its faces seen as
 // furniture. No view saw the wall between them. Held-out survey seed 18 had this: the west
