@@ -18,8 +18,10 @@ namespace kartograf::semantic::detail {
 // centre the wall then covers becomes wall. Whether floor was seen in the cell itself does not
 // matter: the floor before a face seen from afar is lost at grazing angles, while the face's
 // points spread over cells into the room. Two cells of wall (or unseen) stay behind every moved
-// cell. One pass, in scan order: a bulge of noise two cells into the room is judged from its outer
-// cell only. Returns the number of wall cells moved.
+// cell. The cells move a layer at a time (at most 4 layers): first those whose front was
+// floor or furniture, then those behind a cell the layer before moved, so a bulge of noise in
+// front of a face loses the same cells on every side of a room. Returns the number of wall cells
+// moved.
 int place_wall_faces(SemanticGrid& grid, const BandPointIndex& walls,
                      const TraversabilityWeights& weights, Image<std::uint8_t>& furniture);
 
