@@ -9,6 +9,7 @@
 #include <random>
 
 #include "kartograf/eval/semantic_metrics.hpp"
+#include "kartograf/formats/pcd.hpp"
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/mapping/frame_store.hpp"
 #include "kartograf/outputs/synthetic_dataset.hpp"
@@ -399,6 +400,61 @@ TEST(SemanticClassify, DoorLeafBesideWallAndPartialWalls) {
   EXPECT_EQ(classify_regions(std::vector{lowered}, high_ceiling)[0], SemanticClass::ceiling);
   lowered.centroid.z() = 2.0;  // lintel height: not ceiling
   EXPECT_EQ(classify_regions(std::vector{lowered}, high_ceiling)[0], SemanticClass::unknown);
+}
+
+// A closed door sits in its frame, behind its wall's face (PCL's office1.pcd: 9 cm, 5 m away;
+// it had been taken for furniture). A surface as far behind a wall is a door only where its top
+// edge is in view below the wall's: a step back of the wall reaches the ceiling, a wall whose
+// top the view cut may be one, and a wall seen through a doorway lies a room further back.
+TEST(SemanticClassify, AClosedDoorStandsInItsFrame) {
+  GravityEstimate gravity;
+  gravity.floor_height = -1.0;
+  gravity.ceiling_height = 1.6;
+  const auto classes_behind = [&](double behind, double top, bool cut_above,
+                                  const RegionMeasurements& wall) {
+    std::vector<RegionMeasurements> regions = {wall, vertical(2, 3.0 + behind, -1.0, top, 0.85)};
+    regions[0].neighbours = {2};
+    regions[1].neighbours = {1};
+    regions[1].cut_above = cut_above;
+    return classify_regions(regions, gravity);
+  };
+  const auto class_behind = [&](double behind, double top, bool cut_above) {
+    return classes_behind(behind, top, cut_above, vertical(1, 3.0, -1.0, 1.6, 3.5))[1];
+  };
+  EXPECT_EQ(class_behind(0.09, 1.0, false), SemanticClass::door);  // office1's
+  EXPECT_EQ(class_behind(0.25, 1.0, false), SemanticClass::door);  // flush with a thick wall's back
+  EXPECT_NE(class_behind(0.01, 1.0, false), SemanticClass::door);  // in the wall's plane
+  EXPECT_NE(class_behind(0.09, 1.0, true), SemanticClass::door);   // its top out of view
+  EXPECT_NE(class_behind(0.12, 1.6, false), SemanticClass::door);  // a step reaching the ceiling
+  EXPECT_NE(class_behind(0.45, 1.0, false), SemanticClass::door);  // deeper than a wall
+  EXPECT_NE(class_behind(1.50, 1.0, false), SemanticClass::door);  // a wall through a doorway
+  // Behind a door-sized piece of wall (cut above and sideways by the view): that may be a leaf
+  // in front of its wall, not a wall in front of a door.
+  RegionMeasurements door_sized_wall = vertical(1, 3.0, -1.0, 1.2, 1.0);
+  door_sized_wall.cut_above = door_sized_wall.cut_sideways = true;
+  const auto behind_door_sized = classes_behind(0.09, 1.0, false, door_sized_wall);
+  EXPECT_EQ(behind_door_sized[0], SemanticClass::wall);
+  EXPECT_NE(behind_door_sized[1], SemanticClass::door);
+}
+
+// The same on the real frame: office1's door (pixels 270-340 x 180-360 lie on it) is a door,
+// and little else of the frame is.
+TEST(SemanticLabels, OfficeOnesClosedDoorIsADoor) {
+  const io::PcdCloud cloud = io::read_pcd(testing::data_dir() / "pcl_clouds/office1.pcd");
+  const SemanticImage semantic =
+      label_organized_points(compute::Context::cpu(), cloud.to_point_image()).semantic;
+  int on_leaf = 0, leaf_doors = 0, doors_elsewhere = 0;
+  for (int y = 0; y < semantic.height(); ++y) {
+    for (int x = 0; x < semantic.width(); ++x) {
+      const bool leaf = x >= 270 && x < 340 && y >= 180 && y < 360;
+      const bool door = semantic(x, y) == SemanticClass::door;
+      on_leaf += leaf, leaf_doors += leaf && door;
+      doors_elsewhere += !leaf && door && (x < 250 || x >= 390);
+    }
+  }
+  RecordProperty("door_share_on_leaf", std::to_string(double(leaf_doors) / on_leaf));
+  EXPECT_GT(leaf_doors, 0.6 * on_leaf);
+  EXPECT_LT(doors_elsewhere, 500);
 }
 
 TEST(SemanticClassify, FurnitureStandsOnTheFloorAndEndsBelowTheCeiling) {

@@ -100,12 +100,16 @@ class RegionRules {
     return top >= params_.door_min_height || r.cut_above;
   }
 
-  // A wall parallel to r, r standing door_min..max_wall_offset in front of it, and next to r:
-  // a neighbour, a neighbour's neighbour (the leaf's own edge face often lies between), or
-  // within door_max_wall_gap of r along the wall (the wall behind a leaf is hidden by it, and the
+  // A wall parallel to r, r standing door_min..max_wall_offset in front of it (a leaf open
+  // against it) or, with its top in view and below the wall's, door_min_wall_offset..
+  // door_max_recess behind it (a closed door in its frame), and next to r: a neighbour, a
+  // neighbour's neighbour (the leaf's own edge face often lies between), or within
+  // door_max_wall_gap of r along the wall (the wall behind a leaf is hidden by it, and the
   // visible pieces beside it may be parted from it by a jamb or by clutter).
   bool beside_parallel_wall(const RegionMeasurements& r,
                             const std::vector<SemanticClass>& classes) const {
+    const double min_offset = std::max(params_.door_min_wall_offset,
+                                       params_.door_relative_wall_offset * r.centroid.norm());
     auto parallel_wall = [&](Label id) {
       const RegionMeasurements& o = regions_[id - 1u];
       if (classes[id - 1u] != SemanticClass::wall || id == r.id) return false;
@@ -113,9 +117,8 @@ class RegionRules {
       // Distance of r's centroid from the wall's plane, positive towards the sensor (normals face
       // it).
       const double in_front = o.plane_normal.dot(r.centroid - o.centroid);
-      const double min_offset = std::max(params_.door_min_wall_offset,
-                                         params_.door_relative_wall_offset * r.centroid.norm());
-      return in_front >= min_offset && in_front <= params_.door_max_wall_offset;
+      if (in_front >= min_offset) return in_front <= params_.door_max_wall_offset;
+      return recessed_in(r, o, -in_front, min_offset);
     };
     for (const Label id : r.neighbours) {
       if (parallel_wall(id)) return true;
@@ -129,6 +132,15 @@ class RegionRules {
       if (gap <= params_.door_max_wall_gap) return true;
     }
     return false;
+  }
+
+  // A closed door sits in its frame, behind the wall's face by up to the wall's thickness: its
+  // top edge is in view and the wall, no door itself, goes on above it (a wall's step back
+  // reaches the ceiling, and a wall seen through a doorway lies a room further back).
+  bool recessed_in(const RegionMeasurements& r, const RegionMeasurements& wall, double behind,
+                   double min_offset) const {
+    return behind >= min_offset && behind <= params_.door_max_recess && !r.cut_above &&
+           wall.max_height >= r.max_height + params_.door_min_lintel && !door_shaped(wall);
   }
 
   // In the plane of a wall (parallel, centroid within coplanar_wall_offset of the wall's plane)
@@ -282,8 +294,9 @@ std::vector<SemanticClass> classify_regions(std::span<const RegionMeasurements> 
       }
     }
   }
-  // Doors among the door-shaped regions, walls so far or not: a leaf in front of a wall (which
-  // is farther from the sensor, so two regions never make each other doors).
+  // Doors among the door-shaped regions, walls so far or not: a leaf in front of a wall, or a
+  // closed door behind the face of a wall that is not door-shaped, so two regions never make
+  // each other doors.
   const std::vector<SemanticClass> walls = classes;
   for (std::size_t i = 0; i < regions.size(); ++i) {
     if ((classes[i] == SemanticClass::unknown || classes[i] == SemanticClass::wall) &&

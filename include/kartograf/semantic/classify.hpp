@@ -12,7 +12,9 @@
 //    the view), its top at door_min_height..door_max_height above the floor (or cut above by the
 //    view and at most door_max_height), at least half door_min_height of it in view, and next to
 //    a wall region parallel to it that it stands door_min_wall_offset (more far away) to
-//    door_max_wall_offset in front of (a door leaf standing open against the wall). "Next to":
+//    door_max_wall_offset in front of (a door leaf standing open against the wall) or, its top
+//    in view and at least door_min_lintel below the wall's, door_min_wall_offset to
+//    door_max_recess behind (a closed door in its frame). "Next to":
 //    adjacent, directly or through one region between (the leaf's edge face), or within
 //    door_max_wall_gap along the wall (the wall behind a leaf is hidden by it);
 //  - wall: vertical and, as in the paper, height >= wall_height_fraction x (ceiling - floor) and
@@ -58,6 +60,10 @@ struct ClassificationParams {
   double door_relative_wall_offset = 0.01;
   double door_max_wall_gap = 0.5;  // m along the wall between a leaf and its wall's visible part
   double door_max_wall_offset = 0.09;  // m: a leaf is ~5 cm out; a wall step (thickness) >= 10 cm
+  // A closed door stands in its frame up to door_max_recess behind its wall's face (a wall's
+  // thickness), its top in view with the wall going on at least door_min_lintel above it.
+  double door_max_recess = 0.30;  // m
+  double door_min_lintel = 0.10;  // m
   double parallel_tolerance_deg = 15.0;
   // A vertical region in a wall's plane (within coplanar_wall_offset, below a door leaf's 3 cm)
   // and within coplanar_wall_gap of it along the wall is that wall, whatever its height.
