@@ -183,7 +183,7 @@ exit 0
 # and exit 0); --skip-bad-frames leaves it out and counts it. Defect 6: a pose that is not a
 # rotation names its file; a semantic --trajectory with fewer poses than frames names both counts.
 # Defect 11: --frames -1 is an error on every sequence command. planes takes --camera and the
-# range too.
+# range too. A scan whose up cannot be found is an error naming it.
 add_test(NAME Cli.input_missing_frames_bad_poses_and_short_trajectories
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
@@ -209,6 +209,10 @@ grep -q '"fx": 525' "$1/planes/summary.json" && test -d "$1/planes/000002" || { 
 for command in odometry slam map semantic planes; do
   fails_with "$1/err" "--frames" -- "$0" $command "$1/short" --frames -1 --out "$1/x" || exit 1
 done
+# A scan in which no plane tells which way is up (a table top seen steeply from above) names itself.
+fails_with "$1/err" "table_scene_mug_stereo_textured.pcd': estimate_gravity: no plane of at least 0.3 m^2 to tell which way is up" \
+  -- "$0" semantic "$2/pcl_clouds/table_scene_mug_stereo_textured.pcd" --out "$1/mug" || exit 1
+test ! -e "$1/mug" || { echo "FAIL: semantic left an output folder behind"; exit 1; }
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-missing ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})

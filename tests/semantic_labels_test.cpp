@@ -278,7 +278,7 @@ TEST(SemanticGravity, FindsUpFloorAndCeilingInAnyFrame) {
   prior.prior_up = Eigen::Vector3d(0.2, 0.1, 1.0);
   EXPECT_LT(angle_deg(estimate_gravity(corridor, prior).up, Eigen::Vector3d::UnitZ()), 1e-6);
   EXPECT_ERROR_MENTIONS(estimate_gravity(std::vector<RegionMeasurements>{}), "estimate_gravity",
-                        "no region");
+                        "no plane");
 }
 
 // A scanner that sees only upwards (the ceiling, no floor) or a camera that sees only the floor:
@@ -562,7 +562,7 @@ TEST(SemanticLabels, KnownUpLabelsAViewWithoutFloor) {
   params.gravity.prior_up = Eigen::Vector3d(0, -1, 0);
   params.normals.smoothing_radius = 2;
   params.regions.min_region_pixels = 20;
-  EXPECT_ERROR_MENTIONS(label_organized_points(context, points, params), "vote for the up axis");
+  EXPECT_ERROR_MENTIONS(label_organized_points(context, points, params), "to tell which way is up");
   const Eigen::Vector3d up = pose.linear().transpose() * Eigen::Vector3d::UnitZ();
   params.gravity.known_up = up;
   params.gravity.known_floor_height = -pose.translation().z();  // the floor is at z = 0

@@ -153,7 +153,12 @@ LabelledPoints scan_points(const SemanticOptions& o, const Views& views, std::os
   if (!cloud.organized()) return map_points(o, views, cloud.to_point_cloud(), cloud.viewpoint, err);
   const PointImage points = cloud.to_point_image();
   LabelledPoints out;
-  semantic::SemanticLabelling labelling = semantic::label_organized_points(views.context, points);
+  semantic::SemanticLabelling labelling;
+  try {
+    labelling = semantic::label_organized_points(views.context, points);
+  } catch (const Error& e) {
+    throw Error("semantic: '" + o.input.string() + "': " + e.what());
+  }
   out.pooled.add(points, labelling.semantic, labelling.gravity, Eigen::Isometry3d::Identity());
   note_view(points, std::move(labelling), Eigen::Isometry3d::Identity(), views, out);
   make_up_z(out);

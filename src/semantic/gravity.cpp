@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <sstream>
+#include <string>
 
 #include "kartograf/core/error.hpp"
 
@@ -80,6 +82,24 @@ void find_floor_and_ceiling(std::span<const RegionMeasurements> regions,
   }
 }
 
+namespace {
+
+// Why no axis was found, with the limits that decided it.
+std::string no_up_axis_message(const GravityParams& params, bool with_prior) {
+  std::ostringstream s;
+  s << "estimate_gravity: no plane of at least " << params.min_region_area
+    << " m^2 to tell which way is up: ";
+  if (with_prior) {
+    s << "a floor or a ceiling (a plane within " << params.prior_tolerance_deg
+      << " degrees of level for an upright camera, whose up is its -y) must be in view";
+  } else {
+    s << "a floor, a ceiling or a wall must be in view";
+  }
+  return s.str();
+}
+
+}  // namespace
+
 GravityEstimate estimate_gravity(std::span<const RegionMeasurements> regions,
                                  const GravityParams& params) {
   const double parallel_cos = cos_deg(params.axis_tolerance_deg);
@@ -109,9 +129,7 @@ GravityEstimate estimate_gravity(std::span<const RegionMeasurements> regions,
       best_axis = axis;
     }
   }
-  require(best_score > 0, "estimate_gravity: no region of at least " +
-                              std::to_string(params.min_region_area) +
-                              " m^2 (within the prior's tolerance) to vote for the up axis");
+  if (best_score <= 0) throw Error(no_up_axis_message(params, prior.has_value()));
   Eigen::Vector3d refined = Eigen::Vector3d::Zero();
   for (const RegionMeasurements& r : regions) {
     if (!is_large(r, params)) continue;
