@@ -218,8 +218,9 @@ exit 0
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
 
 # Defect 8: depth that is all zero, or read at a scale that puts it all beyond range (metres
-# stored as millimetres), is an error before the run naming the depth file, the scale and the
-# values, suggesting --depth-scale; for odometry, slam and map (not a gravity message).
+# stored as millimetres) or most of it (a scale 10 times too small), is an error before the run
+# naming the depth file, the scale and the values, suggesting --depth-scale; for odometry, slam
+# and map (not a gravity message).
 add_test(NAME Cli.input_unusable_depth_is_named_before_the_run
   COMMAND sh -c [=[
 DATA=$2; . "$3"; . "$4"
@@ -242,12 +243,14 @@ done
 kitchen_copy "$1/far" 0 5
 fails_with --regex "$1/err" "frame-000000.depth.png'.*at a depth scale of 1 units per metre (values [0-9]* to [0-9]*, i.e. .* m).*--depth-scale" \
   -- "$0" slam "$1/far" --depth-scale 1 --out "$1/out" || exit 1
+fails_with --regex "$1/err" "frame-000000.depth.png'.*: only [0-9]* % of the measured pixels within the usable depth range, 0.1 to 10 m at a depth scale of 100 units per metre (values .*, median .* m).*--depth-scale" \
+  -- "$0" odometry "$1/far" --depth-scale 100 --out "$1/out100.txt" || exit 1
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth ${KARTOGRAF_DATA_DIR}
   ${CMAKE_CURRENT_SOURCE_DIR}/kitchen_copy.sh ${fails_with_helper})
 # A depth camera without colour: planes of a depth PNG alone or an organized PCD without colour
 # in the cells mode (fy = fx when only --fx is given); the regions mode, which grows colour
-# regions, refuses them naming the cells mode.
+# regions, refuses them naming the cells mode. A depth PNG read at the wrong scale is refused.
 add_test(NAME Cli.input_planes_from_depth_alone
   COMMAND sh -c [=[
 DATA=$2; . "$3"
@@ -265,6 +268,11 @@ planes=$(grep -c '"normal"' "$1/depth/planes.json")
 [ "$planes" -ge 20 ] && test -s "$1/depth/segmentation.png" && test -s "$1/depth/labels.png" || { cat "$1/depth.log"; echo "FAIL: $planes planes from depth alone"; exit 1; }
 "$0" planes "$scan" --mode cells --out "$1/scan" > "$1/scan.log" 2>&1 || { cat "$1/scan.log"; echo "FAIL: cells mode on a colourless scan"; exit 1; }
 grep -q "A601.pcd: [1-9][0-9]* planes" "$1/scan.log" || { cat "$1/scan.log"; echo "FAIL: no plane in the scan"; exit 1; }
+# A TUM depth image (5000 units per metre) read as millimetres puts most of it beyond range.
+tum="$DATA/open3d_testdata/RGBD/other_formats/TUM_depth.png"
+fails_with "$1/err" "TUM_depth.png': only" "at a depth scale of 1000 units per metre" "--depth-scale" \
+  -- "$0" planes "$tum" --mode cells --camera tum-fr1 --out "$1/tum" || exit 1
+"$0" planes "$tum" --mode cells --camera tum-fr1 --depth-scale 5000 --out "$1/tum" > "$1/tum.log" 2>&1 || { cat "$1/tum.log"; echo "FAIL: TUM depth at its scale"; exit 1; }
 exit 0
 ]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-input-depth-alone ${KARTOGRAF_DATA_DIR}
   ${fails_with_helper})

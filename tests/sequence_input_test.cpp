@@ -246,6 +246,22 @@ TEST_F(SequenceInput, UnusableDepthIsFoundBeforeARun) {  // defect 8
                         "values 7500 to 7500", "--depth-scale");
   range.units_per_metre = 5000;
   EXPECT_NO_THROW(pipeline::check_depth_usable(*io::open_sequence(far).sequence, range));
+
+  // Most of the depth beyond range (a scale 10 times too small) is an error too; a part is not.
+  const auto with_far_rows = [&](const std::string& name, int far_rows) {
+    const fs::path folder = tum_folder(name, 2);
+    DepthImage depth(640, 480, std::uint16_t(7500));  // 1.5 m
+    for (int y = 0; y < far_rows; ++y) {
+      for (int x = 0; x < 640; ++x) depth(x, y) = 60000;  // 12 m
+    }
+    for (int i = 0; i < 2; ++i)
+      io::write_png(folder / "depth" / (std::to_string(i) + ".png"), depth);
+    return io::open_sequence(folder);
+  };
+  EXPECT_ERROR_MENTIONS(pipeline::check_depth_usable(*with_far_rows("most", 288).sequence, range),
+                        "depth/0.png", "only 40 % of the measured pixels", "median 12 m",
+                        "--depth-scale");
+  EXPECT_NO_THROW(pipeline::check_depth_usable(*with_far_rows("some", 192).sequence, range));
 }
 
 TEST_F(SequenceInput, TruncatedJpegAndPngAreErrorsNamingTheFile) {  // defect 12

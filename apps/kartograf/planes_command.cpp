@@ -29,6 +29,7 @@
 #include "kartograf/geometry/backproject.hpp"
 #include "kartograf/outputs/plane_io.hpp"
 #include "kartograf/outputs/plane_run.hpp"
+#include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "option_checks.hpp"
 #include "output_transaction.hpp"
 #include "sequence_run.hpp"
@@ -131,6 +132,7 @@ PlaneInput rgbd_input(const PlanesOptions& o, const compute::Context& context) {
   input.intrinsics.validate("planes");
   geometry::DepthRange range;
   range.units_per_metre = o.depth_scale > 0 ? o.depth_scale : 1000.0;
+  pipeline::check_depth_usable(depth, o.input, range);
   input.points = geometry::backproject(context, depth, input.intrinsics, range);
   return input;
 }

@@ -2,6 +2,7 @@
 // Where the formats meet the pipeline: a sequence read from a folder (formats/sequence.hpp) as the
 // pipeline's FrameSource, and the check before a run that its depth is usable at all.
 #include <cstddef>
+#include <filesystem>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -16,9 +17,14 @@
 namespace kartograf::pipeline {
 
 // Unusable depth found before a run: throws Error naming the depth file, the depth scale, the
-// values found and --depth-scale when none of the first frames (up to 5) has a pixel within
-// range (all zero, or all beyond range as when metres are stored as millimetres).
-void check_depth_usable(const io::Sequence& sequence, const geometry::DepthRange& range);
+// values found and --depth-scale when fewer than half the measured pixels of the first frames
+// (up to 5) lie within range (all zero; all beyond range, as when metres are stored as
+// millimetres; most beyond it, as with a depth scale 10 times too small).
+// The range's depth scale is the sequence's.
+void check_depth_usable(const io::Sequence& sequence, geometry::DepthRange range);
+// The same for one depth image read from `file`, at the range's depth scale.
+void check_depth_usable(const DepthImage& depth, const std::filesystem::path& file,
+                        const geometry::DepthRange& range);
 
 // A Sequence as the pipeline's FrameSource: frames [0, count) (count: all when empty or larger).
 // Ground-truth poses are collected as frames are read, so that the caller can score a run
