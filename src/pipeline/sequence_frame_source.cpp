@@ -55,9 +55,10 @@ void add_depth(const DepthImage& depth, const geometry::DepthRange& range, Depth
   }
 }
 
-std::string format_text(const char* format, double a, double b, double c) {
+template <class... Numbers>
+std::string format_text(const char* format, Numbers... numbers) {
   char text[200];
-  std::snprintf(text, sizeof(text), format, a, b, c);
+  std::snprintf(text, sizeof(text), format, numbers...);
   return text;
 }
 
@@ -82,8 +83,7 @@ void check_survey(DepthSurvey s, const geometry::DepthRange& range) {
       s.usable == 0
           ? "no pixel within the usable depth range, "
           : format_text("only %.0f %% of the measured pixels within the usable depth range, ",
-                        100.0 * static_cast<double>(s.usable) / static_cast<double>(s.measured), 0,
-                        0);
+                        100.0 * static_cast<double>(s.usable) / static_cast<double>(s.measured));
   const std::string others =
       s.frames > 1 ? " (and the next " + std::to_string(s.frames - 1) + " frames)" : "";
   throw Error("depth image " + detail::quoted(s.first_file) + others + ": " + within + limits +
