@@ -118,7 +118,7 @@ io::SequenceParams sequence_options(const SequenceInputOptions& o) {
 }
 
 io::OpenedSequence open_input(const std::filesystem::path& folder, const SequenceInputOptions& o,
-                              std::ostream& err) {
+                              std::ostream& err, const geometry::DepthRange& range) {
   io::OpenedSequence opened = io::open_sequence(folder, sequence_options(o));
   for (const std::string& warning : opened.warnings) err << "warning: " << warning << "\n";
   for (const io::SkippedFrame& skipped : opened.skipped)
@@ -126,6 +126,7 @@ io::OpenedSequence open_input(const std::filesystem::path& folder, const Sequenc
   err << "input: " << opened.sequence->size() << " frames";
   if (!opened.skipped.empty()) err << " (" << opened.skipped.size() << " bad frames left out)";
   err << "; " << io::describe_input(opened) << "\n";
+  pipeline::check_depth_usable(*opened.sequence, range);
   return opened;
 }
 
@@ -180,7 +181,8 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const s
   const bool offset_given = options.prior_time_offset != 0 || options.prior_time_offset_auto;
   require(!offset_given || prior_file,
           "--prior-time-offset: no --motion-prior FILE to apply it to");
-  run.opened = open_input(options.sequence, options.input, err);
+  run.opened =
+      open_input(options.sequence, options.input, err, odometry_params(options).depth_range);
   require(!offset_given || run.opened.detected.has_timestamps,
           "--prior-time-offset: '" + options.sequence.string() +
               "' has no timestamps (its frames are matched to the prior by number)");
@@ -189,9 +191,6 @@ OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err, const s
   } else if (options.method == "planar") {
     require_colour(run.opened, options.sequence, "--method planar (planes of Lab regions)");
   }
-  geometry::DepthRange range = odometry_params(options).depth_range;
-  range.units_per_metre = run.opened.sequence->depth_units_per_metre();
-  pipeline::check_depth_usable(*run.opened.sequence, range);
   run.source = std::make_unique<pipeline::SequenceFrameSource>(*run.opened.sequence);
   if (prior_file) {
     const std::string named = "odometry --motion-prior";

@@ -22,6 +22,7 @@
 #include "kartograf/eval/ground_truth_sampling.hpp"
 #include "kartograf/eval/trajectory_metrics.hpp"
 #include "kartograf/formats/sequence_detect.hpp"
+#include "kartograf/geometry/backproject.hpp"
 #include "kartograf/mapping/slam.hpp"
 #include "kartograf/outputs/odometry_stats.hpp"
 #include "kartograf/outputs/prior_clock.hpp"
@@ -42,9 +43,12 @@ void add_sequence_run_options(CLI::App& command, SequenceRunOptions& options);
 
 io::SequenceParams sequence_options(const SequenceInputOptions& options);
 // Opens a sequence folder as the options say; on err: warnings (a camera assumed), each frame left
-// out, and one line with the frame count, the camera and the depth scale.
+// out, and one line with the frame count, the camera and the depth scale. Then the first frames'
+// depth is checked against `range` (at the sequence's depth scale): a wrong scale is an error
+// before any command's work (pipeline::check_depth_usable).
 io::OpenedSequence open_input(const std::filesystem::path& folder,
-                              const SequenceInputOptions& options, std::ostream& err);
+                              const SequenceInputOptions& options, std::ostream& err,
+                              const geometry::DepthRange& range = {});
 registration::OdometryParams odometry_params(const SequenceRunOptions& options);
 compute::Context make_run_context(const SequenceRunOptions& options);
 // --tracking and --model-voxel.
@@ -67,8 +71,8 @@ struct OpenedRun {
   double prior_time_offset = 0;
 };
 // --pose-mount checked against `poses` (the command's --poses, if it has one) and the motion
-// prior, open_input, --prior-time-offset refused without a prior file or timestamps, then the
-// first frames' depth checked against the odometry's depth range, and --method color or planar
+// prior, open_input (the first frames' depth checked against the odometry's depth range),
+// --prior-time-offset refused without a prior file or timestamps, and --method color or planar
 // refused on a sequence without colour.
 OpenedRun open_run(const SequenceRunOptions& options, std::ostream& err,
                    const std::string& poses = {});
