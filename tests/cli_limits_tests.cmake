@@ -58,11 +58,13 @@ fails_with "$1/look.txt" "--look-around" -- "$0" synth --look-around nan --out "
 fails_with "$1/sfx.txt" "--fx" -- "$0" synth --fx -1 --out "$1/y" || exit 1
 fails_with "$1/delta.txt" "--delta" -- "$0" eval traj "$3" "$3" --delta nan || exit 1
 fails_with "$1/threshold.txt" "--threshold" -- "$0" eval planes "$3" "$3" --threshold nan || exit 1
+fails_with "$1/rres.txt" "--resolution" -- "$0" eval rooms "$4" "$4" --resolution nan || exit 1
 fails_with "$1/voxel.txt" "--voxel" -- "$0" slam "$1" --voxel nan --out "$1/v" || exit 1
 fails_with "$1/mres.txt" "--resolution" -- "$0" map "$1" --resolution nan --out "$1/m" || exit 1
 for dir in p r s y v m; do test ! -e "$1/$dir" || { echo "FAIL: $1/$dir was created"; exit 1; }; done
 ]=] $<TARGET_FILE:kartograf> ${fails_with_helper} ${CMAKE_BINARY_DIR}/cli-limits-options ${KARTOGRAF_DATA_DIR}
-    ${KARTOGRAF_DATA_DIR}/tum_fr1_xyz_lists_only/groundtruth.txt)
+    ${KARTOGRAF_DATA_DIR}/tum_fr1_xyz_lists_only/groundtruth.txt
+    ${KARTOGRAF_DATA_DIR}/ipa_room_maps/test_maps/office_e_gt_segmentation.png)
 
 # Defect 9: KARTOGRAF_DEVICE picks the device on every command: a bad value or an index beyond
 # the backend's devices is an error naming the variable, the value and the devices there are.

@@ -86,6 +86,23 @@ TEST(EvalRooms, RegionsOfAHundredPixelsOrLessAreIgnoredLikeIpa) {
   EXPECT_EQ(eval::evaluate_room_segmentation(two_rooms(), segmentation, keep_all).segments, 3);
 }
 
+// ipa's 100 pixels are 0.25 m^2 of its 0.05 m maps: the same area at any resolution.
+TEST(EvalRooms, TheSpeckAreaHoldsAtAnyResolution) {
+  EXPECT_EQ(eval::room_evaluation_params(0.05).min_region_pixels, 101);
+  EXPECT_EQ(eval::room_evaluation_params(0.1).min_region_pixels, 26);
+  EXPECT_EQ(eval::room_evaluation_params(0.025).min_region_pixels, 401);
+  EXPECT_EQ(eval::room_evaluation_params(1.0).min_region_pixels, 1);
+  // At 0.1 m the 100-pixel segment of the test above is 1 m^2: a segment of its own.
+  LabelImage segmentation = two_rooms();
+  paint(segmentation, {{0, 0, 10, 10, 8}});
+  EXPECT_EQ(
+      eval::evaluate_room_segmentation(two_rooms(), segmentation, eval::room_evaluation_params(0.1))
+          .segments,
+      3);
+  for (const double bad : {0.0, -0.05, std::nan("")})
+    EXPECT_ERROR_MENTIONS(eval::room_evaluation_params(bad), "resolution");
+}
+
 TEST(EvalRooms, RejectsBadInput) {
   EXPECT_THROW(eval::evaluate_room_segmentation(two_rooms(), LabelImage(60, 10, 0)), Error);
   EXPECT_THROW(eval::evaluate_room_segmentation(LabelImage(61, 10, 0), two_rooms()), Error);

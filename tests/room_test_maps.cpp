@@ -109,4 +109,72 @@ eval::RoomSegmentationScores benchmark_map_scores(const std::string& map,
   return scores;
 }
 
+namespace {
+
+// A coarse cell: free only where all four are, occupied where any is, else unknown.
+OccupancyGrid coarsened(const OccupancyGrid& map) {
+  OccupancyGrid out = map;
+  out.resolution = 2 * map.resolution;
+  out.cells = Image<CellState>(map.width() / 2, map.height() / 2, CellState::unknown);
+  for (int y = 0; y < out.height(); ++y) {
+    for (int x = 0; x < out.width(); ++x) {
+      int free = 0, occupied = 0;
+      for (int k = 0; k < 4; ++k) {
+        const CellState c = map.cells(2 * x + k % 2, 2 * y + k / 2);
+        free += c == CellState::free;
+        occupied += c == CellState::occupied;
+      }
+      out.cells(x, y) = free == 4      ? CellState::free
+                        : occupied > 0 ? CellState::occupied
+                                       : CellState::unknown;
+    }
+  }
+  return out;
+}
+
+LabelImage coarsened(const LabelImage& rooms) {
+  LabelImage out(rooms.width() / 2, rooms.height() / 2, 0);
+  for (int y = 0; y < out.height(); ++y) {
+    for (int x = 0; x < out.width(); ++x) {
+      const Label l = rooms(2 * x, 2 * y);
+      const bool whole = rooms(2 * x + 1, 2 * y) == l && rooms(2 * x, 2 * y + 1) == l &&
+                         rooms(2 * x + 1, 2 * y + 1) == l;
+      out(x, y) = whole ? l : 0;
+    }
+  }
+  return out;
+}
+
+template <class T>
+Image<T> refined(const Image<T>& image) {
+  Image<T> out(2 * image.width(), 2 * image.height());
+  for (int y = 0; y < out.height(); ++y)
+    for (int x = 0; x < out.width(); ++x) out(x, y) = image(x / 2, y / 2);
+  return out;
+}
+
+}  // namespace
+
+eval::RoomSegmentationScores resampled_map_scores(const std::string& map, int factor,
+                                                  const SegmentRooms& segment) {
+  OccupancyGrid grid = io::read_png_map(benchmark_folder() / (map + ".png"));
+  LabelImage truth =
+      io::read_room_ground_truth_png(benchmark_folder() / (map + "_gt_segmentation.png"));
+  if (factor == 2) {
+    grid = coarsened(grid);
+    truth = coarsened(truth);
+  } else {
+    EXPECT_EQ(factor, -2) << "resampled_map_scores: factor 2 or -2";
+    grid.cells = refined(grid.cells);
+    grid.resolution /= 2;
+    truth = refined(truth);
+  }
+  const rooms::RoomSegmentation result = segment(grid);
+  const eval::RoomSegmentationScores scores = eval::evaluate_room_segmentation(
+      truth, result.rooms, eval::room_evaluation_params(grid.resolution));
+  ::testing::Test::RecordProperty("recall", std::to_string(scores.recall_mean));
+  ::testing::Test::RecordProperty("precision", std::to_string(scores.precision_mean));
+  return scores;
+}
+
 }  // namespace kartograf::testing

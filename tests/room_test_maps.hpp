@@ -43,4 +43,11 @@ BenchmarkMeans benchmark_means(const std::string& name, const std::string& varia
 eval::RoomSegmentationScores benchmark_map_scores(const std::string& map,
                                                   const SegmentRooms& segment);
 
+// The same map resampled by `factor` (2: 0.1 m cells, a cell free only where its four were, a
+// room keeping only the cells whose four were its own; -2: 0.025 m, each cell split in four),
+// scored as a map of that resolution (eval::room_evaluation_params); also returns the segments'
+// count (at least 0.25 m^2 each) so that a caller can compare it with the original's.
+eval::RoomSegmentationScores resampled_map_scores(const std::string& map, int factor,
+                                                  const SegmentRooms& segment);
+
 }  // namespace kartograf::testing

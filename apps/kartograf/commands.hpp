@@ -50,6 +50,7 @@ struct EvalOptions {
   std::size_t worst_steps = 0;        // traj: 0 lists none
   std::string offset = "0";           // traj: seconds added to the estimate's stamps, or "auto"
   double threshold = 0.8;             // planes
+  double resolution = 0.05;           // rooms: metres per cell
 };
 CLI::App* add_eval_command(CLI::App& app, EvalOptions& options);
 int run_eval_command(const EvalOptions& options, std::ostream& out);

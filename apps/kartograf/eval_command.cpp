@@ -101,8 +101,10 @@ io::MetricReport plane_report(const EvalOptions& options) {
 io::MetricReport room_report(const EvalOptions& options) {
   const LabelImage ground_truth = io::read_ground_truth_rooms(options.ground_truth);
   const LabelImage segmentation = io::read_ground_truth_rooms(options.prediction);
-  return io::room_report(eval::evaluate_room_segmentation(ground_truth, segmentation),
-                         options.ground_truth.string(), options.prediction.string());
+  return io::room_report(
+      eval::evaluate_room_segmentation(ground_truth, segmentation,
+                                       eval::room_evaluation_params(options.resolution)),
+      options.ground_truth.string(), options.prediction.string());
 }
 
 io::MetricReport semantic_report(const EvalOptions& options) {
@@ -162,9 +164,16 @@ CLI::App* add_eval_command(CLI::App& app, EvalOptions& options) {
       ->check(finite_in(0.5, 1.0))
       ->capture_default_str();
 
-  add_metric("rooms", "Recall, precision and MCC of a room segmentation",
-             "Ground-truth rooms: an ipa *_gt_segmentation.png (8-bit) or a 16-bit label PNG",
-             "Segmentation: a 16-bit label PNG (an 8-bit drawing is read like GT)");
+  CLI::App* rooms =
+      add_metric("rooms", "Recall, precision and MCC of a room segmentation",
+                 "Ground-truth rooms: an ipa *_gt_segmentation.png (8-bit) or a 16-bit label PNG",
+                 "Segmentation: a 16-bit label PNG (an 8-bit drawing is read like GT)");
+  rooms
+      ->add_option("--resolution", options.resolution,
+                   "Metres per cell: regions of at most 0.25 m^2 are left out (ipa's 100 cells "
+                   "at 0.05 m)")
+      ->check(finite_positive())
+      ->capture_default_str();
   add_metric("semantic", "Confusion matrix, IoU and accuracy of semantic classes",
              "Ground truth: 8-bit PNG of SemanticClass values",
              "Prediction: 8-bit PNG of SemanticClass values");

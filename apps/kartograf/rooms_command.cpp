@@ -225,8 +225,8 @@ int run_rooms_eval_command(const RoomsEvalOptions& o, std::ostream& out, std::os
         truth = truths.emplace(c.name, io::read_room_ground_truth_png(c.ground_truth)).first;
       const OccupancyGrid map = io::read_png_map(c.map, o.map.resolution, o.map.free_threshold);
       const rooms::RoomSegmentation result = rooms::segment_rooms(context, map, method, options);
-      const eval::RoomSegmentationScores s =
-          eval::evaluate_room_segmentation(truth->second, result.rooms);
+      const eval::RoomSegmentationScores s = eval::evaluate_room_segmentation(
+          truth->second, result.rooms, eval::room_evaluation_params(map.resolution));
       groups[c.variant].add(s, result.seconds);
       csv << rooms::to_string(method) << ',' << c.name << ',' << c.variant << ','
           << s.ground_truth_rooms << ',' << s.segments << ',' << fixed(s.recall_mean, 4) << ','

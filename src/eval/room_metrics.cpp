@@ -96,6 +96,20 @@ void compute_mcc(const LabelOverlap& overlap, RoomSegmentationScores& scores) {
 
 }  // namespace
 
+RoomEvaluationParams room_evaluation_params(double metres_per_cell) {
+  require(std::isfinite(metres_per_cell) && metres_per_cell > 0,
+          std::string(kWhat) +
+              ": the map's resolution must be a positive number of metres per "
+              "cell, got " +
+              std::to_string(metres_per_cell));
+  constexpr double kIpaSpeckArea = 100 * 0.05 * 0.05;  // m^2
+  // The small epsilon keeps 0.05 m at exactly 100 cells despite rounding in the division.
+  const double cells = std::floor(kIpaSpeckArea / (metres_per_cell * metres_per_cell) + 1e-9);
+  RoomEvaluationParams params;
+  params.min_region_pixels = static_cast<int>(std::min(cells, 1e9)) + 1;
+  return params;
+}
+
 RoomSegmentationScores evaluate_room_segmentation(const LabelImage& ground_truth,
                                                   const LabelImage& segmentation,
                                                   const RoomEvaluationParams& options) {

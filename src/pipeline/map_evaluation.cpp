@@ -79,7 +79,8 @@ MapEvaluation evaluate_map(const MapPipelineResult& result, const MapGroundTruth
   out.true_rooms = truth.rooms;
   out.true_classes = truth.classes;
   try {
-    out.rooms = eval::evaluate_room_segmentation(truth.rooms, out.rooms_on_plan);
+    out.rooms = eval::evaluate_room_segmentation(truth.rooms, out.rooms_on_plan,
+                                                 eval::room_evaluation_params(plan.resolution));
   } catch (const Error& e) {
     out.skipped.push_back(std::string("rooms: ") + e.what());
   }

@@ -53,15 +53,28 @@ int count_bits(int config) {
   return __builtin_popcount(static_cast<unsigned>(config));
 }
 
+// The stretch lengths for this map's resolution (VoronoiGraphParams::reference_resolution).
+VoronoiGraphParams at_resolution(VoronoiGraphParams params, double resolution) {
+  const double scale = params.reference_resolution / resolution;
+  const auto scaled = [](double cells) {
+    return static_cast<int>(std::clamp(std::lround(cells), 1L, long{1} << 30));
+  };
+  params.neighbourhood_index = scaled(params.neighbourhood_index * scale * scale);
+  params.max_iterations = scaled(params.max_iterations * scale);
+  return params;
+}
+
 // The free space where the graph may run: opened by a 3x3 square, then eroded twice (reference).
-Image<std::uint8_t> graph_domain(const Image<std::uint8_t>& free_cells) {
+Image<std::uint8_t> graph_domain(const Image<std::uint8_t>& free_cells, double scale) {
   const int width = free_cells.width(), height = free_cells.height();
   cv::Mat m(height, width, CV_8UC1);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) m.at<std::uint8_t>(y, x) = free_cells(x, y) ? 255 : 0;
-  cv::erode(m, m, cv::Mat());
-  cv::dilate(m, m, cv::Mat());
-  cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), 2);
+  const int open = std::max(1, static_cast<int>(std::lround(scale)));
+  cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), open);
+  cv::dilate(m, m, cv::Mat(), cv::Point(-1, -1), open);
+  cv::erode(m, m, cv::Mat(), cv::Point(-1, -1),
+            std::max(1, static_cast<int>(std::lround(2 * scale))));
   Image<std::uint8_t> domain(width, height, 0);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
@@ -436,21 +449,25 @@ VoronoiGraph build_voronoi_graph(const OccupancyGrid& map, const VoronoiGraphPar
           what + ": min_angle_deg must lie in [0, 180]");
   require(std::isfinite(params.feature_separation) && params.feature_separation >= 0,
           what + ": feature_separation must be >= 0");
+  require(std::isfinite(params.reference_resolution) && params.reference_resolution > 0,
+          what + ": reference_resolution must be > 0");
   const int width = map.width(), height = map.height();
   Image<std::uint8_t> free_cells(width, height, 0);
   for (std::size_t i = 0; i < free_cells.size(); ++i)
     free_cells.data()[i] = map.cells.data()[i] == CellState::free ? 1 : 0;
 
   NearestObstacles near = nearest_obstacles(free_cells);
-  const Image<std::uint8_t> domain = graph_domain(free_cells);
+  const Image<std::uint8_t> domain =
+      graph_domain(free_cells, params.reference_resolution / map.resolution);
   VoronoiGraph result;
   result.graph =
       thin(domain, medial_anchors(near, domain, params.feature_separation), near.clearance);
   prune_leaves(result.graph);
   const Image<std::uint8_t> border = obstacle_border(free_cells);
+  const VoronoiGraphParams scaled = at_resolution(params, map.resolution);
   const std::vector<Eigen::Vector2i> points =
-      params.stretch_minima ? stretch_minima(result.graph, near.clearance, params)
-                            : critical_points(result.graph, near.clearance, params);
+      params.stretch_minima ? stretch_minima(result.graph, near.clearance, scaled)
+                            : critical_points(result.graph, near.clearance, scaled);
   for (const Eigen::Vector2i& p : points)
     result.candidates.push_back(critical_line(p, near, border));
   result.critical_lines = filter_lines(result.candidates, params);

@@ -77,8 +77,13 @@ VrfNodeGraph vrf_node_graph(const OccupancyGrid& map, const VrfNodeParams& param
   require(params.node_spacing >= 1,
           what + ": node_spacing must be >= 1, got " + std::to_string(params.node_spacing));
   VrfNodeGraph result;
-  result.node_spacing = params.node_spacing;
-  result.voronoi = build_voronoi_graph(map, params.graph);
+  result.voronoi = build_voronoi_graph(map, params.graph);  // checks the reference resolution
+  const double scale = params.graph.reference_resolution / map.resolution;
+  const auto steps = [scale](int reference) {
+    return static_cast<int>(std::clamp(std::lround(reference * scale), 1L, long{1} << 20));
+  };
+  result.node_spacing = steps(params.node_spacing);
+  result.graph_radius = steps(kVrfGraphRadius);
   const Image<std::uint8_t>& graph = result.voronoi.graph;
   const int width = graph.width();
   const auto index = [&](const Eigen::Vector2i& c) {
@@ -114,7 +119,7 @@ VrfNodeGraph vrf_node_graph(const OccupancyGrid& map, const VrfNodeParams& param
     }
   }
   std::vector<std::uint32_t> nodes = seeds;
-  const auto spacing = static_cast<std::uint32_t>(params.node_spacing);
+  const auto spacing = static_cast<std::uint32_t>(result.node_spacing);
   for (std::uint32_t i = 0; i < graph.size(); ++i) {
     if (graph.data()[i] && flood.distance[i] > 0 && flood.distance[i] % spacing == 0)
       nodes.push_back(i);
@@ -170,7 +175,7 @@ std::vector<VrfFeatures> vrf_node_features(const OccupancyGrid& map, const VrfNo
           stamp[start] = visit;
           frontier.assign(1, start);
           float least = node.clearance, most = node.clearance;
-          for (int step = 0; step < kVrfGraphRadius && !frontier.empty(); ++step) {
+          for (int step = 0; step < graph.graph_radius && !frontier.empty(); ++step) {
             next.clear();
             for (const std::uint32_t i : frontier) {
               detail::for_each_neighbour8(i, cells.width(), cells.height(), [&](std::uint32_t j) {

@@ -38,6 +38,12 @@ struct RoomEvaluationParams {
   int min_region_pixels = 101;  // smaller regions are ignored by recall/precision (ipa: > 100)
 };
 
+// ipa's "> 100 pixels" is an area on its 0.05 m maps: regions of more than 0.25 m^2 count. The
+// same area at another resolution (0.025 m: > 400 cells; 0.1 m: > 25), so that a finer map's
+// specks of wall-side free space do not count as rooms. Throws Error unless the resolution is a
+// finite positive number.
+RoomEvaluationParams room_evaluation_params(double metres_per_cell);
+
 struct RoomSegmentationScores {
   int ground_truth_rooms = 0;  // rooms with >= min_region_pixels
   int segments = 0;            // segments with >= min_region_pixels

@@ -10,8 +10,10 @@
 //    nearest obstacles lie far apart (more than feature_separation x clearance) anchor it, and a
 //    homotopic thinning ordered by clearance joins the anchors along the ridges of the clearance.
 //    As in the reference, the graph lives only in the free space opened by a 3x3 square and then
-//    eroded twice more (it keeps off walls and clutter), and every leaf branch is collapsed into
-//    the node it starts from (one level: branch points of the unpruned graph are kept).
+//    eroded twice more (it keeps off walls and clutter; on maps at reference_resolution, the
+//    reference's 0.05 m; the counts scale with the cells' size), and every leaf branch is
+//    collapsed into the node it starts from (one level: branch points of the unpruned graph are
+//    kept).
 // 3. Critical points (as the reference): the graph is cut into stretches, each grown breadth first
 //    along the graph from the first unvisited graph cell in raster order over unvisited cells until
 //    it holds more than neighbourhood_index / clearance cells or max_iterations steps were taken
@@ -35,26 +37,31 @@
 namespace kartograf::rooms {
 
 struct VoronoiGraphParams {
-  int neighbourhood_index = 280;                   // the reference's voronoi_neighborhood_index
-  int max_iterations = 150;                        // the reference's max_iterations
-  double min_critical_point_distance_factor = 0.5; // the reference's evaluation setting
-  double min_angle_deg = 0.0;                      // 0: keep every angle (the reference)
+  int neighbourhood_index = 280;                    // the reference's voronoi_neighborhood_index
+  int max_iterations = 150;                         // the reference's max_iterations
+  double min_critical_point_distance_factor = 0.5;  // the reference's evaluation setting
+  double min_angle_deg = 0.0;                       // 0: keep every angle (the reference)
   double feature_separation = 1.0;  // anchor: nearest obstacles > this x clearance apart
   bool stretch_minima = true;  // false: strict local minima instead of the reference's stretches
+  // neighbourhood_index and max_iterations count cells of maps at this resolution (m/cell; the
+  // reference's 0.05 m maps). On another map they are scaled so that a stretch covers the same
+  // metres: max_iterations (steps along the graph) by reference / resolution, and
+  // neighbourhood_index (cells x clearance in cells) by its square.
+  double reference_resolution = 0.05;
 };
 
 struct CriticalLine {
-  Eigen::Vector2i point = Eigen::Vector2i::Zero();  // critical point (column, row)
+  Eigen::Vector2i point = Eigen::Vector2i::Zero();    // critical point (column, row)
   Eigen::Vector2i basis_a = Eigen::Vector2i::Zero();  // its nearest obstacle cell
   Eigen::Vector2i basis_b = Eigen::Vector2i::Zero();  // the second one (other side)
-  double clearance = 0.0;                           // cells
-  double angle_deg = 0.0;                           // between point->basis_a and point->basis_b
-  double length = 0.0;                              // |point-basis_a| + |point-basis_b|, cells
+  double clearance = 0.0;                             // cells
+  double angle_deg = 0.0;                             // between point->basis_a and point->basis_b
+  double length = 0.0;                                // |point-basis_a| + |point-basis_b|, cells
 };
 
 struct VoronoiGraph {
-  Image<float> clearance;             // cells; 0 on cells that are not free
-  Image<std::uint8_t> graph;          // 1: pruned Voronoi graph cell
+  Image<float> clearance;                // cells; 0 on cells that are not free
+  Image<std::uint8_t> graph;             // 1: pruned Voronoi graph cell
   std::vector<CriticalLine> candidates;  // every critical point, before the angle/spacing filter
   std::vector<CriticalLine> critical_lines;  // those kept
 };

@@ -108,9 +108,13 @@ double field_score(const PlaceField& field, std::span<const PlaceLabel> labels);
 
 // ---- Nodes on the Voronoi graph -----------------------------------------------------------------
 
+inline constexpr int kVrfGraphRadius = 16;  // graph steps on maps of the reference resolution
+
 struct VrfNodeParams {
   VoronoiGraphParams graph;
-  int node_spacing = 4;  // graph steps between nodes
+  // Graph steps between nodes on maps of graph.reference_resolution; scaled to the map's, so
+  // that nodes lie the same metres apart (as the graph's stretches and kVrfGraphRadius are).
+  int node_spacing = 4;
 };
 
 struct VrfNode {
@@ -123,13 +127,13 @@ struct VrfNodeGraph {
   std::vector<VrfNode> nodes;
   std::vector<std::pair<int, int>> edges;  // i < j
   VoronoiGraph voronoi;
-  int node_spacing = 1;
+  int node_spacing = 1;                // graph steps, at the map's resolution
+  int graph_radius = kVrfGraphRadius;  // the same (vrf_node_features' clearance around a node)
 };
 
 // Throws Error for a map without free cells or node_spacing < 1 (or bad graph parameters).
 VrfNodeGraph vrf_node_graph(const OccupancyGrid& map, const VrfNodeParams& params = {});
 
-inline constexpr int kVrfGraphRadius = 16;  // graph steps
 inline constexpr std::size_t kVrfFeatureCount = kLaserFeatureCount + 5;
 using VrfFeatures = std::array<float, kVrfFeatureCount>;
 
