@@ -75,8 +75,10 @@ struct MapPipelineParams {
   rooms::RoomMethodParams rooms;
   bool rooms_end_at_doorways = true;  // doorway cells count as occupied for the segmentation
   // Islands of unseen cells up to this area inside the map (an open door's leaf and its shadow in
-  // a corridor) count as free for the segmentation (rooms::free_unseen_islands); 0: off.
-  double room_unseen_island_m2 = 0.5;
+  // a corridor; a corridor's middle that no view saw from its ends) count as free for the
+  // segmentation (rooms::free_unseen_islands); 0: off. A room is larger than 1 m^2, so no island
+  // freed is a room no view entered.
+  double room_unseen_island_m2 = 1.0;
   // Rooms take the unlabelled cells their walls and doorways enclose: furniture, floor the views
   // missed (rooms::extend_rooms_over_enclosed). Off: rooms cover observed free floor only.
   bool rooms_take_enclosed = true;
