@@ -85,8 +85,22 @@ test ! -e "$1/p" && test ! -e "$1/r" && test ! -e "$1/t.txt" || { echo "FAIL: ou
 KARTOGRAF_DEVICE=0 "$0" planes "$pcd" --backend vulkan --out "$1/p" > "$1/ok.txt" 2>&1 || { cat "$1/ok.txt"; exit 1; }
 test -s "$1/p/planes.json" || { echo "FAIL: KARTOGRAF_DEVICE=0 planes wrote nothing"; exit 1; }
 ]=] $<TARGET_FILE:kartograf> ${fails_with_helper} ${CMAKE_BINARY_DIR}/cli-limits-device ${KARTOGRAF_DATA_DIR})
+# A grid resolution other than the 0.05 m the semantic grid's thresholds were set for runs with a
+# warning that says so (docs/user-guide.md, "Grid resolution"); the default runs without one.
+add_test(NAME Cli.limits_an_untuned_grid_resolution_is_warned_of
+  COMMAND sh -c [=[
+rm -rf "$1" && mkdir -p "$1" || exit 1
+"$0" semantic "$2/pcl_clouds/office1.pcd" --resolution 0.1 --out "$1/coarse" 2> "$1/coarse.err" ||
+  { cat "$1/coarse.err"; exit 1; }
+grep -qF "semantic: warning: --resolution 0.1 m: the semantic grid's thresholds are set for 0.05 m" "$1/coarse.err" ||
+  { echo "FAIL: no warning in:"; cat "$1/coarse.err"; exit 1; }
+"$0" semantic "$2/pcl_clouds/office1.pcd" --out "$1/default" 2> "$1/default.err" || exit 1
+! grep -qF "warning: --resolution" "$1/default.err" || { echo "FAIL: a warning at 0.05 m"; exit 1; }
+]=] $<TARGET_FILE:kartograf> ${CMAKE_BINARY_DIR}/cli-grid-resolution ${KARTOGRAF_DATA_DIR})
+
 set_tests_properties(Cli.limits_maps_too_large_for_memory_are_refused
   Cli.limits_invalid_option_values_are_errors Cli.limits_kartograf_device_on_every_command
+  Cli.limits_an_untuned_grid_resolution_is_warned_of
   PROPERTIES ENVIRONMENT "${KARTOGRAF_TEST_ENV}")
 
 # The defaults the help prints are the ones the run uses: --anchor-bounds once listed 17 numbers,

@@ -140,6 +140,7 @@ int run_map_command(const MapOptions& o, std::ostream& out, std::ostream& err) {
                                          "--poses", run.pose_mount);
   stages.label_width = o.label_width;
   stages.grid.resolution = o.resolution;
+  warn_untuned_grid_resolution("map", o.resolution, err);
   stages.room_method = rooms::parse_room_method(o.room_method);
   params.volume.voxel_size = o.voxel;
   params.volume.truncation = 3 * o.voxel;

@@ -361,6 +361,7 @@ int run_semantic_command(const SemanticOptions& o, std::ostream& out, std::ostre
   require(std::isfinite(o.resolution) && o.resolution > 0,
           "semantic: --resolution must be > 0 m, got " + std::to_string(o.resolution));
   require(o.step >= 1, "semantic: --step must be >= 1");
+  warn_untuned_grid_resolution("semantic", o.resolution, err);
   require(fs::exists(o.input), "semantic: " + o.input.string() + ": no such file or folder");
   OutputFolder folder("semantic", o.out_dir, o.force, {kOutputs.begin(), kOutputs.end()});
   const compute::Context context = backend_context(o.backend, o.backend_source);

@@ -50,6 +50,9 @@ io::OpenedSequence open_input(const std::filesystem::path& folder,
                               const SequenceInputOptions& options, std::ostream& err,
                               const geometry::DepthRange& range = {});
 registration::OdometryParams odometry_params(const SequenceRunOptions& options);
+// A warning on err when the semantic grid's cells are not the 0.05 m its thresholds were set for
+// (its walls and doors are less reliable there; docs/user-guide.md, "Grid resolution").
+void warn_untuned_grid_resolution(const std::string& command, double resolution, std::ostream& err);
 compute::Context make_run_context(const SequenceRunOptions& options);
 // --tracking and --model-voxel.
 mapping::ModelTrackingParams model_tracking_params(const SequenceRunOptions& options);
