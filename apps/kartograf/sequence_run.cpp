@@ -16,6 +16,7 @@
 #include "kartograf/formats/tum.hpp"
 #include "kartograf/pipeline/sequence_frame_source.hpp"
 #include "kartograf/pipeline/tracking_choices.hpp"
+#include "kartograf/semantic/semantic_grid.hpp"
 #include "option_checks.hpp"
 
 namespace kartograf::cli {
@@ -132,8 +133,8 @@ io::OpenedSequence open_input(const std::filesystem::path& folder, const Sequenc
 
 void warn_untuned_grid_resolution(const std::string& command, double resolution,
                                   std::ostream& err) {
-  constexpr double kTunedResolution = 0.05;
-  if (std::fabs(resolution - kTunedResolution) <= 1e-9) return;
+  // The default cell size is the one the thresholds were set for.
+  if (std::fabs(resolution - semantic::SemanticGridParams{}.resolution) <= 1e-9) return;
   err << command << ": warning: --resolution " << resolution
       << " m: the semantic grid's thresholds are set for 0.05 m cells, and at other sizes its "
          "walls and doors are less reliable (synthetic survey seed 1, the truth's poses: wall "

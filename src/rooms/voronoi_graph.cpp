@@ -55,26 +55,24 @@ int count_bits(int config) {
 
 // The stretch lengths for this map's resolution (VoronoiGraphParams::reference_resolution).
 VoronoiGraphParams at_resolution(VoronoiGraphParams params, double resolution) {
-  const double scale = params.reference_resolution / resolution;
-  const auto scaled = [](double cells) {
-    return static_cast<int>(std::clamp(std::lround(cells), 1L, long{1} << 30));
-  };
-  params.neighbourhood_index = scaled(params.neighbourhood_index * scale * scale);
-  params.max_iterations = scaled(params.max_iterations * scale);
+  const double reference = params.reference_resolution;
+  params.neighbourhood_index =
+      cells_at_resolution(params.neighbourhood_index, reference, resolution, 2);
+  params.max_iterations = cells_at_resolution(params.max_iterations, reference, resolution);
   return params;
 }
 
 // The free space where the graph may run: opened by a 3x3 square, then eroded twice (reference).
-Image<std::uint8_t> graph_domain(const Image<std::uint8_t>& free_cells, double scale) {
+Image<std::uint8_t> graph_domain(const Image<std::uint8_t>& free_cells, double reference,
+                                 double resolution) {
   const int width = free_cells.width(), height = free_cells.height();
   cv::Mat m(height, width, CV_8UC1);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x) m.at<std::uint8_t>(y, x) = free_cells(x, y) ? 255 : 0;
-  const int open = std::max(1, static_cast<int>(std::lround(scale)));
+  const int open = cells_at_resolution(1, reference, resolution);
   cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), open);
   cv::dilate(m, m, cv::Mat(), cv::Point(-1, -1), open);
-  cv::erode(m, m, cv::Mat(), cv::Point(-1, -1),
-            std::max(1, static_cast<int>(std::lround(2 * scale))));
+  cv::erode(m, m, cv::Mat(), cv::Point(-1, -1), cells_at_resolution(2, reference, resolution));
   Image<std::uint8_t> domain(width, height, 0);
   for (int y = 0; y < height; ++y)
     for (int x = 0; x < width; ++x)
@@ -436,6 +434,11 @@ NearestObstacles nearest_obstacles(const Image<std::uint8_t>& free_cells) {
   return out;
 }
 
+int cells_at_resolution(double count, double reference_resolution, double resolution, int power) {
+  const double scaled = count * std::pow(reference_resolution / resolution, power);
+  return static_cast<int>(std::clamp(std::lround(scaled), 1L, long{1} << 30));
+}
+
 VoronoiGraph build_voronoi_graph(const OccupancyGrid& map, const VoronoiGraphParams& params) {
   const std::string what = "Voronoi graph";
   check_map(map, what);
@@ -458,7 +461,7 @@ VoronoiGraph build_voronoi_graph(const OccupancyGrid& map, const VoronoiGraphPar
 
   NearestObstacles near = nearest_obstacles(free_cells);
   const Image<std::uint8_t> domain =
-      graph_domain(free_cells, params.reference_resolution / map.resolution);
+      graph_domain(free_cells, params.reference_resolution, map.resolution);
   VoronoiGraph result;
   result.graph =
       thin(domain, medial_anchors(near, domain, params.feature_separation), near.clearance);

@@ -78,12 +78,9 @@ VrfNodeGraph vrf_node_graph(const OccupancyGrid& map, const VrfNodeParams& param
           what + ": node_spacing must be >= 1, got " + std::to_string(params.node_spacing));
   VrfNodeGraph result;
   result.voronoi = build_voronoi_graph(map, params.graph);  // checks the reference resolution
-  const double scale = params.graph.reference_resolution / map.resolution;
-  const auto steps = [scale](int reference) {
-    return static_cast<int>(std::clamp(std::lround(reference * scale), 1L, long{1} << 20));
-  };
-  result.node_spacing = steps(params.node_spacing);
-  result.graph_radius = steps(kVrfGraphRadius);
+  const double reference = params.graph.reference_resolution;
+  result.node_spacing = cells_at_resolution(params.node_spacing, reference, map.resolution);
+  result.graph_radius = cells_at_resolution(kVrfGraphRadius, reference, map.resolution);
   const Image<std::uint8_t>& graph = result.voronoi.graph;
   const int width = graph.width();
   const auto index = [&](const Eigen::Vector2i& c) {

@@ -66,6 +66,12 @@ struct VoronoiGraph {
   std::vector<CriticalLine> critical_lines;  // those kept
 };
 
+// A count of cells or graph steps set for maps of `reference_resolution`, on a map of
+// `resolution` (both m/cell): count x (reference / resolution)^power, rounded, at least 1 (power 2
+// for a count that measures an area).
+int cells_at_resolution(double count, double reference_resolution, double resolution,
+                        int power = 1);
+
 // Throws Error naming the input for an empty map, one without free cells or bad parameters.
 VoronoiGraph build_voronoi_graph(const OccupancyGrid& map, const VoronoiGraphParams& params = {});
 
