@@ -113,6 +113,34 @@ TEST(Odometry, ReestimationAgainstFrameKBackReducesDrift) {
   EXPECT_EQ(chained.constraints().size(), tour().frames.size() - 1);
 }
 
+// A pose graph gets the chain the odometry keeps: every step constraint's motion is the motion
+// between the final poses, the re-estimates' corrections included. The poses themselves do not
+// depend on it.
+TEST(Odometry, StepConstraintsFollowTheReestimatedChain) {
+  const compute::Context context = compute::Context::cpu();
+  const auto largest_gap_m = [](const RgbdOdometry& odometry) {
+    double gap = 0;
+    for (const auto& c : odometry.constraints()) {
+      if (c.from + 1 != c.to) continue;
+      const Eigen::Isometry3d chain = odometry.poses()[c.from].inverse() * odometry.poses()[c.to];
+      gap = std::max(gap, (chain.inverse() * c.motion).translation().norm());
+    }
+    return gap;
+  };
+  OdometryParams params = synthetic_params(5);
+  params.anchor = {0, 0, 0};  // the paper's rule: frame n-k, a correction every 5th frame
+  const RgbdOdometry following = track_all(context, tour(), params);
+  params.steps_follow_reestimates = false;
+  const RgbdOdometry measured = track_all(context, tour(), params);
+  RecordProperty("gap_as_measured_m", testing::scientific(largest_gap_m(measured)));
+  EXPECT_LT(largest_gap_m(following), 1e-9);
+  EXPECT_GT(largest_gap_m(measured), 1e-5);  // the re-estimates did correct the steps
+  ASSERT_EQ(following.poses().size(), measured.poses().size());
+  for (std::size_t i = 0; i < following.poses().size(); ++i) {
+    EXPECT_TRUE(following.poses()[i].isApprox(measured.poses()[i], 1e-12)) << "frame " << i;
+  }
+}
+
 // A hand-held camera that sways about one spot (5 cm, 3 degrees) for 60 frames.
 const RenderedSequence& lingering() {
   static const RenderedSequence sequence = [] {

@@ -64,8 +64,8 @@ TEST(Slam, ClosesTheLoopAndBuildsAColouredMapWithNormals) {
   RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
   RecordProperty("slam_ate_m", testing::scientific(slam_ate));
   EXPECT_LT(slam_ate, 0.01);
-  // The odometry's anchored re-estimates already hold this stretch to ~2 mm: the loops must not
-  // make it worse (measured: SLAM 2.13 mm, odometry 2.09 mm).
+  // The odometry's anchored re-estimates already hold this stretch to ~1-2 mm: the loops must not
+  // make it worse (measured: SLAM 2.13 mm, odometry 2.09 mm; on 2026-12-07 0.60 and 1.11 mm).
   EXPECT_LE(slam_ate, odometry_ate * 1.1);
 
   ASSERT_GT(result.map.size(), 1000u);
@@ -95,6 +95,32 @@ TEST(Slam, LoopClosuresTakeOutTheOdometrysDrift) {
   RecordProperty("odometry_ate_m", testing::scientific(odometry_ate));
   RecordProperty("slam_ate_m", testing::scientific(slam_ate));
   EXPECT_LT(slam_ate, 0.6 * odometry_ate);
+}
+
+// Without loop closures the pose graph has nothing to add to the odometry's chain: its step
+// edges are the chain as the re-estimates left it (OdometryParams::steps_follow_reestimates), so
+// it returns the odometry's poses. With the steps as first measured it weighed them against the
+// re-estimates and moved the poses.
+TEST(Slam, WithoutLoopsTheGraphReturnsTheOdometrysChain) {
+  const testing::MemoryFrameSource source(testing::out_and_back());
+  const compute::Context context = compute::Context::cpu();
+  mapping::SlamParams params = loop_params();
+  params.loop_closure = false;
+  params.odometry.anchor = {0, 0, 0};  // the paper's n-5: a correction at every 5th frame
+  const auto largest_move_m = [&](const mapping::SlamResult& result) {
+    double move = 0;
+    for (std::size_t i = 0; i < result.poses.size(); ++i) {
+      move = std::max(
+          move, (result.poses[i].translation() - result.odometry.poses[i].translation()).norm());
+    }
+    return move;
+  };
+  const mapping::SlamResult following = mapping::run_slam(context, source, params);
+  params.odometry.steps_follow_reestimates = false;
+  const mapping::SlamResult measured = mapping::run_slam(context, source, params);
+  RecordProperty("graph_move_as_measured_m", testing::scientific(largest_move_m(measured)));
+  EXPECT_LT(largest_move_m(following), 1e-6);
+  EXPECT_GT(largest_move_m(measured), 1e-4);
 }
 
 // Known poses (the frames' ground truth): nothing estimated, the poses are the truth relative to
