@@ -1320,15 +1320,14 @@ void RgbdOdometry::reestimate(OdometryFrame& frame) {
     poses_[j] = orthonormalized(anchor_pose * se3::exp(share * correction) *
                                 (anchor_pose.inverse() * poses_[j]));
   }
-  if (params_.steps_follow_reestimates) rechain_steps(n - k + 1, n);
+  if (params_.steps_follow_reestimates) rechain_steps_from(n - k + 1);
   if (moves_anchor(n)) anchor_ = n;
 }
 
-void RgbdOdometry::rechain_steps(std::size_t first, std::size_t last) {
-  // Constraints are appended frame by frame: the steps to first..last are the newest.
+void RgbdOdometry::rechain_steps_from(std::size_t first) {
+  // Constraints are appended frame by frame: the steps to frames first.. are the newest.
   for (auto c = constraints_.rbegin(); c != constraints_.rend() && c->to >= first; ++c) {
-    if (c->from + 1 == c->to && c->to <= last)
-      c->motion = poses_[c->from].inverse() * poses_[c->to];
+    if (c->from + 1 == c->to) c->motion = poses_[c->from].inverse() * poses_[c->to];
   }
 }
 

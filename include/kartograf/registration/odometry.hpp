@@ -784,8 +784,8 @@ class RgbdOdometry {
   Eigen::Vector3d travel_on_arc(const Eigen::Isometry3d& step) const;
   void keep_images_for_features(const DepthImage& depth, const RgbImage* color);
   void reestimate(OdometryFrame& frame);
-  // The motions of the step constraints to frames first..last, from the poses as they are now.
-  void rechain_steps(std::size_t first, std::size_t last);
+  // The motions of the step constraints to frame `first` and later, from the poses as they are.
+  void rechain_steps_from(std::size_t first);
   // The re-estimate of the current frame against `anchor` from `chained`, with its pose-graph
   // information, judged on what the anchor sees (OdometryParams::reestimate_on_overlap).
   struct AnchoredAttempt {
