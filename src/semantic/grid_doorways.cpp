@@ -152,9 +152,18 @@ bool is_wall(const SemanticGrid& grid, const Eigen::Vector2d& p) {
   return grid.contains(c) && grid.classes(c.x(), c.y()) == SemanticClass::wall;
 }
 
+// Whether there is wall at `p` or a cell either side of the line (`n`).
+bool wall_at(const SemanticGrid& grid, const Eigen::Vector2d& p, const Eigen::Vector2d& n) {
+  const double res = grid.resolution;
+  return is_wall(grid, p) || is_wall(grid, p + res * n) || is_wall(grid, p - res * n);
+}
+
 // From one end of a wall piece (`from`, walking along `dir`; `n` across the line), walk on along
 // its line: floor for a door's width, then wall again (any wall cell, within a cell of the line)
-// is an opening.
+// is an opening. An obstacle (furniture) in the line ends the walk, unless wall follows it within
+// two cells: then it stands against the far jamb (on seed 29 with the SLAM's poses a furniture
+// cell at a jamb's corner, where the walk reached the jamb, hid a 1 m doorway) and is the
+// opening's end.
 std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
                                           const SemanticGridParams& options,
                                           const Eigen::Vector2d& from, const Eigen::Vector2d& dir,
@@ -167,8 +176,10 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
     const Eigen::Vector2d p = from + t * dir;
     const Eigen::Vector2i c = grid.cell_of(p);
     if (!grid.contains(c)) break;
+    const bool obstacle = grid.weight(c.x(), c.y()) == 0.0f && !is_wall(grid, p);
     const bool wall_here =
-        is_wall(grid, p) || is_wall(grid, p + res * n) || is_wall(grid, p - res * n);
+        wall_at(grid, p, n) ||
+        (obstacle && (wall_at(grid, p + res * dir, n) || wall_at(grid, p + 2 * res * dir, n)));
     if (open_from < 0) {
       if (!wall_here)
         open_from = t;
@@ -185,7 +196,7 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
       if (width >= options.min_door_width && width <= options.max_door_width) hit = t;
       break;
     }
-    if (grid.weight(c.x(), c.y()) == 0.0f) break;  // furniture or another obstacle
+    if (obstacle) break;  // furniture or another obstacle across the opening
   }
   if (hit < 0) return std::nullopt;
   return WallGap{from + open_from * dir, from + hit * dir};
