@@ -276,10 +276,6 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   LoopClosure closure;
   closure.candidate = candidate;
   closure.report = registration::judge_registration(result, expected, limits, geometry.degeneracy);
-  if (closure.report.accepted() && !candidate.by_appearance &&
-      closure.report.correction_m > params_.min_correction_m) {
-    confirm_large_correction(closure, expected, result.source_to_target, expected_uncertainty);
-  }
   // Where the query's geometry barely constrains a direction (along a corridor, along the line
   // where a wall meets the floor), ICP slides to answers that fit as well as the right one (on
   // the synthetic surveys 5-23 cm off the truth with fitness 0.5-0.8): the loop keeps the expected
@@ -287,6 +283,8 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   const double weak = params_.weak_direction_ratio;
   const std::size_t free = weak > 0 ? registration::weak_directions(geometry, weak).size() : 0;
   closure.free_directions = free;
+  if (needs_confirmation(closure))
+    confirm_correction(closure, expected, result.source_to_target, expected_uncertainty);
   const Eigen::Isometry3d motion = free == 0
                                        ? result.source_to_target
                                        : registration::keep_constrained_directions(
@@ -302,6 +300,13 @@ LoopClosure LoopClosureDetector::verify(const LoopCandidate& candidate,
   return closure;
 }
 
+bool LoopClosureDetector::needs_confirmation(const LoopClosure& closure) const {
+  if (!closure.report.accepted() || closure.candidate.by_appearance) return false;
+  if (closure.report.correction_m > params_.min_correction_m) return true;
+  return closure.free_directions == 0 &&
+         closure.report.eigenvalue_ratio < 2 * params_.weak_direction_ratio;
+}
+
 FeatureConfirmation LoopClosureDetector::confirm_by_features(
     std::size_t query, std::size_t match, const Eigen::Isometry3d& motion) const {
   if (!features_ || !archive_->has_features(query) || !archive_->has_features(match))
@@ -314,7 +319,7 @@ FeatureConfirmation LoopClosureDetector::confirm_by_features(
                                               : FeatureConfirmation::disagree;
 }
 
-void LoopClosureDetector::confirm_large_correction(
+void LoopClosureDetector::confirm_correction(
     LoopClosure& closure, const Eigen::Isometry3d& expected, const Eigen::Isometry3d& motion,
     const ExpectedUncertainty& expected_uncertainty) const {
   const LoopCandidate& candidate = closure.candidate;
