@@ -176,7 +176,7 @@ std::optional<WallGap> opening_beyond_end(const SemanticGrid& grid,
     const Eigen::Vector2d p = from + t * dir;
     const Eigen::Vector2i c = grid.cell_of(p);
     if (!grid.contains(c)) break;
-    const bool obstacle = grid.weight(c.x(), c.y()) == 0.0f && !is_wall(grid, p);
+    const bool obstacle = grid.weight(c.x(), c.y()) == 0.0f;  // wall cells are wall_here first
     const bool wall_here =
         wall_at(grid, p, n) ||
         (obstacle && (wall_at(grid, p + res * dir, n) || wall_at(grid, p + 2 * res * dir, n)));
