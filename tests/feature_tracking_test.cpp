@@ -307,8 +307,8 @@ const Counterfactual kCounterfactuals[] = {
     // 0.88 m straight into frame 400. The turn predicted on, ICP from the prediction settled 12.2
     // degrees and 0.23 m off at a fitness of 0.38, above recheck_fitness, so no other start was
     // tried, and the next step followed it. Checked against the other starts, the straight step
-    // wins. Without the recheck, the motion prior as it was (0.03): with a weaker one (0.01,
-    // tried 2026-12-07) ICP from the prediction settled within 0.5 mm.
+    // wins. Without the recheck, the motion prior as it was (0.03): with the weaker one
+    // (2026-12-07) ICP from the prediction settles right on the arc's first, smaller steps.
     {"ALargeMotionIsCheckedAgainstTheOtherStarts", 100, 32, 30,
      [](registration::OdometryParams& p) {
        p.recheck_large_motions = false;

@@ -263,8 +263,8 @@ TEST(DoubtfulRegistration, ASidewaysErrorAtAnArcsOnsetIsNotRepeated) {
   };
   registration::OdometryParams adaptive_alone;
   adaptive_alone.heading_prior = false;
-  // The motion prior as it was: a weaker one (0.01, tried 2026-12-07) keeps the camera frame's
-  // sideways steps within 2.1 mm itself.
+  // The motion prior as it was: the weaker one (2026-12-07) keeps the camera frame's sideways
+  // steps within 2.1 mm itself.
   adaptive_alone.motion_prior = 0.03;
   registration::OdometryParams camera = adaptive_alone;
   camera.step_frame = registration::StepFrame::camera;
@@ -302,8 +302,8 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   free_only.photometric.mask_depth_edges = false;
   // The scan along the free line (2026-12-06) mends part of it (19 mm): off, as before it.
   free_only.free_translation_scan = false;
-  // A weaker motion prior (0.01, tried 2026-12-07) pulls less towards the wrong prediction (8.6
-  // mm): the prior as it was.
+  // The weaker motion prior (2026-12-07) pulls less towards the wrong prediction (8.6 mm): the
+  // prior as it was.
   free_only.motion_prior = 0.03;
   EXPECT_GT(worst_step(cabinet, free_only).first, 0.02);
 
@@ -313,7 +313,7 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   images_alone.photometric_geometry_weight = 0;
   EXPECT_LT(worst_step(stripes, images_alone).first, 0.015);
   images_alone.photometric.mask_depth_edges = false;
-  images_alone.motion_prior = 0.03;  // as measured (at 0.01: 4.0 cm)
+  images_alone.motion_prior = 0.03;  // as measured (the weaker prior since: 4.0 cm)
   EXPECT_GT(worst_step(stripes, images_alone).first, 0.05);
 }
 
@@ -359,8 +359,8 @@ TEST(Reestimation, AnImagesCorrectionBeyondTheLimitsNeedsTheImagesToFitIt) {
   const std::size_t frame = 150 - straight.first;
   registration::OdometryParams limits_alone;
   limits_alone.heading_prior = false;
-  // The motion prior as it was: a weaker one (0.01, tried 2026-12-07) lets ICP's own answer stand
-  // against the images' (0.08 degrees with any fit).
+  // The motion prior as it was: the weaker one (2026-12-07) lets ICP's own answer stand against
+  // the images' (0.08 degrees with any fit).
   limits_alone.motion_prior = 0.03;
   const StepError limited = track_frames(straight, limits_alone).error_at(frame);
   registration::OdometryParams any_fit = limits_alone;
