@@ -307,14 +307,10 @@ const Counterfactual kCounterfactuals[] = {
     // 0.88 m straight into frame 400. The turn predicted on, ICP from the prediction settled 12.2
     // degrees and 0.23 m off at a fitness of 0.38, above recheck_fitness, so no other start was
     // tried, and the next step followed it. Checked against the other starts, the straight step
-    // wins. Without the recheck, the motion prior as it was (0.03): with the weaker one
-    // (2026-12-07) ICP from the prediction settles right on the arc's first, smaller steps.
+    // wins.
     {"ALargeMotionIsCheckedAgainstTheOtherStarts", 100, 32, 30,
-     [](registration::OdometryParams& p) {
-       p.recheck_large_motions = false;
-       p.motion_prior = 0.03;
-     },
-     0.05, 0.15, 4, 1, 5, true},
+     [](registration::OdometryParams& p) { p.recheck_large_motions = false; }, 0.05, 0.15, 4, 1, 5,
+     true},
     // Seed 3's survey, frames 0-200 as `kartograf synth` writes them and with the map's features:
     // the robot turns on the spot, 36 degrees a frame, towards a striped wall. Into frame 190 ICP
     // from the prediction finds the turn at a fitness of 0.29 (a grey-level RMSE of 13.8 there,

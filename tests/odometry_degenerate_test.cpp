@@ -263,9 +263,6 @@ TEST(DoubtfulRegistration, ASidewaysErrorAtAnArcsOnsetIsNotRepeated) {
   };
   registration::OdometryParams adaptive_alone;
   adaptive_alone.heading_prior = false;
-  // The motion prior as it was: the weaker one (2026-12-07) keeps the camera frame's sideways
-  // steps within 2.1 mm itself.
-  adaptive_alone.motion_prior = 0.03;
   registration::OdometryParams camera = adaptive_alone;
   camera.step_frame = registration::StepFrame::camera;
   const double adaptive = worst_after_onset(adaptive_alone);
@@ -302,9 +299,6 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   free_only.photometric.mask_depth_edges = false;
   // The scan along the free line (2026-12-06) mends part of it (19 mm): off, as before it.
   free_only.free_translation_scan = false;
-  // The weaker motion prior (2026-12-07) pulls less towards the wrong prediction (8.6 mm): the
-  // prior as it was.
-  free_only.motion_prior = 0.03;
   EXPECT_GT(worst_step(cabinet, free_only).first, 0.02);
 
   const DegenerateStretch stripes{8, 674, 24, true};
@@ -313,7 +307,6 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   images_alone.photometric_geometry_weight = 0;
   EXPECT_LT(worst_step(stripes, images_alone).first, 0.015);
   images_alone.photometric.mask_depth_edges = false;
-  images_alone.motion_prior = 0.03;  // as measured (the weaker prior since: 4.0 cm)
   EXPECT_GT(worst_step(stripes, images_alone).first, 0.05);
 }
 
@@ -359,9 +352,6 @@ TEST(Reestimation, AnImagesCorrectionBeyondTheLimitsNeedsTheImagesToFitIt) {
   const std::size_t frame = 150 - straight.first;
   registration::OdometryParams limits_alone;
   limits_alone.heading_prior = false;
-  // The motion prior as it was: the weaker one (2026-12-07) lets ICP's own answer stand against
-  // the images' (0.08 degrees with any fit).
-  limits_alone.motion_prior = 0.03;
   const StepError limited = track_frames(straight, limits_alone).error_at(frame);
   registration::OdometryParams any_fit = limits_alone;
   any_fit.photometric_doubt_rmse = 1e3;
@@ -440,18 +430,11 @@ TEST(HeadingPriorOnTheSurvey, HoldsTheSlideAlongAWallAhead) {
 // frame. The weak directions' refinement, held by ICP's answer and the heading together, kept
 // each step 2-5 mm longer than the truth; the images alone along the heading measure it
 // (OdometryParams::photometric_travel_length).
-//
-// Found with the motion prior at 0.03, whose pull towards the prediction the refinement's holds
-// kept; with the weaker prior (2026-12-07) less is left to mend (12.1 mm off at the last frame
-// without the images' measurement, 4.6 with it): both as found, and the defaults within a
-// centimetre.
 TEST(HeadingPriorOnTheSurvey, TheImagesMeasureTheLengthOfASlowingStepOverAFloor) {
   const DegenerateStretch slowing{16, 389, 52, true};
-  registration::OdometryParams as_found;
-  as_found.motion_prior = 0.03;
-  const TrackedFrames measured = track_frames(slowing, as_found);
-  as_found.photometric_travel_length = false;
-  const TrackedFrames kept = track_frames(slowing, as_found);
+  const TrackedFrames measured = track_frames(slowing, {});
+  const TrackedFrames kept =
+      track_frames_without(slowing, &registration::OdometryParams::photometric_travel_length);
   const std::size_t last = slowing.count - 1;
   const std::size_t degenerate = frames_where(
       measured, [](const registration::OdometryFrame& frame) { return frame.degenerate; });
@@ -465,27 +448,6 @@ TEST(HeadingPriorOnTheSurvey, TheImagesMeasureTheLengthOfASlowingStepOverAFloor)
   EXPECT_LT(measured.error_at(last).metres, 0.01);
   EXPECT_LT(measured.error_at(last).metres, 0.25 * kept.error_at(last).metres);
   EXPECT_LT(stretch_of(measured).ate, stretch_of(kept).ate / 3);
-  EXPECT_LT(track_frames(slowing, {}).error_at(last).metres, 0.01);
-}
-
-// Held-out seed 24, frames 1060-1105: the robot slows from 11 to 7 cm a frame towards a far
-// wall over the floor, the view degenerate (the far wall's depth the only, weak, hold along the
-// travel). At the motion prior's former strength (0.03) ICP's step was pulled a quarter of the way
-// back to the motion model's prediction, which lags a robot that changes speed, and the images'
-// refinement held it there: in the whole run the steps came out 2-5 mm long each. Started here
-// (the heading and speed not yet learned) both are worse than in the run: measured 22.2 mm off at
-// the last frame against 33.5 (ATE 10.3 against 14.8 mm).
-TEST(HeadingPriorOnTheSurvey, AChangeOfSpeedIsNotPulledBackToThePrediction) {
-  const DegenerateStretch slowing{24, 1060, 45, true};
-  registration::OdometryParams former;
-  former.motion_prior = 0.03;
-  const TrackedFrames weaker = track_frames(slowing, {});
-  const TrackedFrames pulled = track_frames(slowing, former);
-  const std::size_t last = slowing.count - 1;
-  RecordProperty("last_frame_error_mm", std::to_string(1000 * weaker.error_at(last).metres));
-  RecordProperty("last_frame_error_mm_former", std::to_string(1000 * pulled.error_at(last).metres));
-  EXPECT_LT(weaker.error_at(last).metres, 0.8 * pulled.error_at(last).metres);
-  EXPECT_LT(stretch_of(weaker).ate, 0.8 * stretch_of(pulled).ate);
 }
 
 // The tracked frames after a pose graph of their odometry edges and one loop closure from the
@@ -510,19 +472,13 @@ TrackedFrames closed_by_a_loop(TrackedFrames tracked, const Eigen::Isometry3d& l
 // the graph spreads that error over the steps that measured less; without the images' share the
 // free directions of the degenerate steps held only the fallback prior's 5 cm, and they took
 // the whole centimetre (held-out seed 12's loops bent its degenerate stretches so).
-//
-// With the motion prior as found (0.03): with the weaker one (2026-12-07) the steps themselves
-// are nearer the truth and the images' share halves less (span error 3.9 mm with it, 6.8 mm
-// without).
 TEST(HeadingPriorOnTheSurvey, ALoopDoesNotBendTheStepsTheImagesMeasured) {
   const DegenerateStretch slowing{16, 389, 52, true};
-  registration::OdometryParams as_found;
-  as_found.motion_prior = 0.03;
-  registration::OdometryParams without_images = as_found;
+  registration::OdometryParams without_images;
   without_images.photometric_graph_sigma_factor = 0;
   Eigen::Isometry3d loop_error = Eigen::Isometry3d::Identity();
   loop_error.translation() = Eigen::Vector3d(0, 0, 0.01);  // the camera looks along the travel
-  const TrackedFrames held = closed_by_a_loop(track_frames(slowing, as_found), loop_error);
+  const TrackedFrames held = closed_by_a_loop(track_frames(slowing, {}), loop_error);
   const TrackedFrames bent = closed_by_a_loop(track_frames(slowing, without_images), loop_error);
   // The error the degenerate steps gather: from the frame before the first degenerate one to the
   // last degenerate one.

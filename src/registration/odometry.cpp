@@ -62,8 +62,7 @@ void validate(const OdometryParams& params) {
   require(params.reestimate_interval >= 0, "odometry: reestimate_interval must be >= 0");
   require(params.icp_width > 0 && params.information_width > 0 && params.min_icp_level >= 0,
           "odometry: icp_width and information_width must be > 0, min_icp_level >= 0");
-  require(params.motion_prior >= 0 && params.motion_prior_large_step >= 0,
-          "odometry: motion_prior and motion_prior_large_step must be >= 0");
+  require(params.motion_prior >= 0, "odometry: motion_prior must be >= 0");
   require(params.recheck_correction_m > 0, "odometry: recheck_correction_m must be > 0");
   require(params.recheck_fitness >= 0 && params.recheck_fitness <= 1,
           "odometry: recheck_fitness must be in [0, 1]");
@@ -272,11 +271,10 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   }
   // Degenerate views: the motion model, as a prior, decides the weak directions while ICP
   // solves; the other frames solve the pairs' system alone.
-  const double prior = motion_prior_for(target + 1 == current, initial);
   const IcpResult result =
-      geometry_.degeneracy.degenerate && prior > 0
+      geometry_.degeneracy.degenerate && params_.motion_prior > 0
           ? engine->align(source_views, target_views, initial,
-                          {initial, motion_prior_information(geometry_, prior)})
+                          {initial, motion_prior_information(geometry_, params_.motion_prior)})
           : engine->align(source_views, target_views, initial);
   Attempt attempt;
   attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
@@ -284,11 +282,11 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   attempt.motion = result.source_to_target;
   if (!attempt.report.accepted() || !geometry_.degeneracy.degenerate) return attempt;
   // A step from the frame before: a robot's sideways slide comes from its heading.
-  if (target + 1 == current) hold_across_heading(attempt, prior);
+  if (target + 1 == current) hold_across_heading(attempt);
 
   // What the geometry cannot tell comes from the initial guess (the motion model)...
   const double ratio = params_.icp.min_eigenvalue_ratio;
-  if (prior == 0) {
+  if (params_.motion_prior == 0) {
     attempt.motion =
         keep_constrained_directions(result.source_to_target, initial, geometry_, ratio);
   }
@@ -380,12 +378,12 @@ se3::Matrix6d RgbdOdometry::images_information(
   return information_along(prior_information(sigma_m / 2.0, sigma_m), free_directions);
 }
 
-void RgbdOdometry::hold_across_heading(Attempt& attempt, double motion_prior) const {
+void RgbdOdometry::hold_across_heading(Attempt& attempt) const {
   if (!params_.heading_prior || !heading_prior_.ready()) return;
   // ICP's answer was already the minimum of the pairs and the motion model's prior: both weigh
   // against the heading's (a hand-held camera's wide spread leaves the motion model in charge).
   const se3::Matrix6d icp =
-      geometry_.information + motion_prior_information(geometry_, motion_prior);
+      geometry_.information + motion_prior_information(geometry_, params_.motion_prior);
   attempt.motion = heading_prior_.combine(
       attempt.motion, edge_information(icp, attempt.inlier_rmse, params_.information));
   attempt.across_heading = heading_prior_.information(attempt.motion);
@@ -541,14 +539,6 @@ RegistrationLimits RgbdOdometry::frame_limits_now() const {
     limits.max_correction_m = std::max(limits.max_correction_m, largest_step_m_);
   }
   return limits;
-}
-
-double RgbdOdometry::motion_prior_for(bool step_from_previous,
-                                      const Eigen::Isometry3d& initial) const {
-  // A step's start may be large where its prediction was not: the features' motion at the
-  // sequence's start, before the motion model knows the speed.
-  const bool large = large_step_ || (step_from_previous && is_large(initial));
-  return large ? params_.motion_prior_large_step : params_.motion_prior;
 }
 
 bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
@@ -1117,7 +1107,6 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   const std::size_t n = frame.index;
   frame.step_frame = step_frame_in_use();
   const Eigen::Isometry3d predicted = predict(frame.step_frame);
-  large_step_ = is_large(predicted);
   speed_bound_decided_ = false;
   const GeometricInformation whole_frame = geometry_;
   const Attempt attempt =
