@@ -263,6 +263,9 @@ TEST(DoubtfulRegistration, ASidewaysErrorAtAnArcsOnsetIsNotRepeated) {
   };
   registration::OdometryParams adaptive_alone;
   adaptive_alone.heading_prior = false;
+  // The motion prior's translations as they were: weaker (0.015, 2026-12-07) they keep the camera
+  // frame's sideways steps within 2.8 mm themselves.
+  adaptive_alone.motion_prior_translation = 0.03;
   registration::OdometryParams camera = adaptive_alone;
   camera.step_frame = registration::StepFrame::camera;
   const double adaptive = worst_after_onset(adaptive_alone);
@@ -299,6 +302,9 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   free_only.photometric.mask_depth_edges = false;
   // The scan along the free line (2026-12-06) mends part of it (19 mm): off, as before it.
   free_only.free_translation_scan = false;
+  // The motion prior's weaker translations (2026-12-07) pull less towards the wrong prediction
+  // (14.8 mm): as they were.
+  free_only.motion_prior_translation = 0.03;
   EXPECT_GT(worst_step(cabinet, free_only).first, 0.02);
 
   const DegenerateStretch stripes{8, 674, 24, true};
@@ -307,6 +313,7 @@ TEST(PhotometricRefinement, TheBarelyConstrainedDirectionsAreMeasuredHeldByTheGe
   images_alone.photometric_geometry_weight = 0;
   EXPECT_LT(worst_step(stripes, images_alone).first, 0.015);
   images_alone.photometric.mask_depth_edges = false;
+  images_alone.motion_prior_translation = 0.03;  // as measured (at 0.015: 3.4 cm)
   EXPECT_GT(worst_step(stripes, images_alone).first, 0.05);
 }
 
@@ -352,6 +359,9 @@ TEST(Reestimation, AnImagesCorrectionBeyondTheLimitsNeedsTheImagesToFitIt) {
   const std::size_t frame = 150 - straight.first;
   registration::OdometryParams limits_alone;
   limits_alone.heading_prior = false;
+  // The motion prior's translations as they were: weaker (0.015, 2026-12-07) they let ICP's own
+  // answer stand against the images' (0.16 degrees with any fit).
+  limits_alone.motion_prior_translation = 0.03;
   const StepError limited = track_frames(straight, limits_alone).error_at(frame);
   registration::OdometryParams any_fit = limits_alone;
   any_fit.photometric_doubt_rmse = 1e3;
@@ -430,11 +440,18 @@ TEST(HeadingPriorOnTheSurvey, HoldsTheSlideAlongAWallAhead) {
 // frame. The weak directions' refinement, held by ICP's answer and the heading together, kept
 // each step 2-5 mm longer than the truth; the images alone along the heading measure it
 // (OdometryParams::photometric_travel_length).
+//
+// Found with the motion prior's translations at 0.03, whose pull towards the prediction the
+// refinement's holds kept; weaker (0.015, 2026-12-07) less is left to mend (12.2 mm off at the
+// last frame without the images' measurement, 4.6 with it): both as found, and the defaults
+// within a centimetre.
 TEST(HeadingPriorOnTheSurvey, TheImagesMeasureTheLengthOfASlowingStepOverAFloor) {
   const DegenerateStretch slowing{16, 389, 52, true};
-  const TrackedFrames measured = track_frames(slowing, {});
-  const TrackedFrames kept =
-      track_frames_without(slowing, &registration::OdometryParams::photometric_travel_length);
+  registration::OdometryParams as_found;
+  as_found.motion_prior_translation = 0.03;
+  const TrackedFrames measured = track_frames(slowing, as_found);
+  as_found.photometric_travel_length = false;
+  const TrackedFrames kept = track_frames(slowing, as_found);
   const std::size_t last = slowing.count - 1;
   const std::size_t degenerate = frames_where(
       measured, [](const registration::OdometryFrame& frame) { return frame.degenerate; });
@@ -444,10 +461,33 @@ TEST(HeadingPriorOnTheSurvey, TheImagesMeasureTheLengthOfASlowingStepOverAFloor)
   RecordProperty("ate_mm", std::to_string(1000 * stretch_of(measured).ate));
   RecordProperty("ate_mm_held", std::to_string(1000 * stretch_of(kept).ate));
   EXPECT_GE(degenerate, 25u);  // measured 29: frames 411-440
-  // Measured 3.0 mm against 41.7 mm held (ATE 1.3 against 15.1 mm).
+  // Measured 4.0 mm against 41.7 mm held (ATE 1.4 against 15.1 mm).
   EXPECT_LT(measured.error_at(last).metres, 0.01);
   EXPECT_LT(measured.error_at(last).metres, 0.25 * kept.error_at(last).metres);
   EXPECT_LT(stretch_of(measured).ate, stretch_of(kept).ate / 3);
+  EXPECT_LT(track_frames(slowing, {}).error_at(last).metres, 0.01);
+}
+
+// Held-out seed 24, frames 1060-1105: the robot slows from 11 to 7 cm a frame towards a far
+// wall over the floor, the view degenerate (the far wall's depth the only, weak, hold along the
+// travel). With the motion prior's translations at 0.03 ICP's step was pulled a quarter of the
+// way back to the motion model's prediction, which lags a robot that changes speed, and the
+// images' refinement held it there: in the whole run the steps came out 2-5 mm long each.
+// Started here (the heading and speed not yet learned) both are worse than in the run: measured
+// 22.1 mm off at the last frame against 33.5 (ATE 10.3 against 14.8 mm).
+TEST(HeadingPriorOnTheSurvey, AChangeOfSpeedIsNotPulledBackToThePrediction) {
+  const DegenerateStretch slowing{24, 1060, 45, true};
+  registration::OdometryParams former;
+  former.motion_prior_translation = 0.03;
+  const TrackedFrames weaker = track_frames(slowing, {});
+  const TrackedFrames pulled = track_frames(slowing, former);
+  const std::size_t last = slowing.count - 1;
+  RecordProperty("last_frame_error_mm", std::to_string(1000 * weaker.error_at(last).metres));
+  RecordProperty("last_frame_error_mm_former", std::to_string(1000 * pulled.error_at(last).metres));
+  RecordProperty("ate_mm", std::to_string(1000 * stretch_of(weaker).ate));
+  RecordProperty("ate_mm_former", std::to_string(1000 * stretch_of(pulled).ate));
+  EXPECT_LT(weaker.error_at(last).metres, 0.8 * pulled.error_at(last).metres);
+  EXPECT_LT(stretch_of(weaker).ate, 0.8 * stretch_of(pulled).ate);
 }
 
 // The tracked frames after a pose graph of their odometry edges and one loop closure from the
@@ -472,13 +512,19 @@ TrackedFrames closed_by_a_loop(TrackedFrames tracked, const Eigen::Isometry3d& l
 // the graph spreads that error over the steps that measured less; without the images' share the
 // free directions of the degenerate steps held only the fallback prior's 5 cm, and they took
 // the whole centimetre (held-out seed 12's loops bent its degenerate stretches so).
+//
+// With the motion prior's translations as found (0.03): weaker (0.015, 2026-12-07) the steps
+// themselves are nearer the truth and the images' share halves less (span error 3.8 mm with it,
+// 6.8 mm without; as found 3.2 and 7.0).
 TEST(HeadingPriorOnTheSurvey, ALoopDoesNotBendTheStepsTheImagesMeasured) {
   const DegenerateStretch slowing{16, 389, 52, true};
-  registration::OdometryParams without_images;
+  registration::OdometryParams as_found;
+  as_found.motion_prior_translation = 0.03;
+  registration::OdometryParams without_images = as_found;
   without_images.photometric_graph_sigma_factor = 0;
   Eigen::Isometry3d loop_error = Eigen::Isometry3d::Identity();
   loop_error.translation() = Eigen::Vector3d(0, 0, 0.01);  // the camera looks along the travel
-  const TrackedFrames held = closed_by_a_loop(track_frames(slowing, {}), loop_error);
+  const TrackedFrames held = closed_by_a_loop(track_frames(slowing, as_found), loop_error);
   const TrackedFrames bent = closed_by_a_loop(track_frames(slowing, without_images), loop_error);
   // The error the degenerate steps gather: from the frame before the first degenerate one to the
   // last degenerate one.

@@ -623,6 +623,27 @@ TEST(GeometricInformation, FindsTheFreeDirectionOfAWallAndTheFloor) {
   EXPECT_LT(kept.translation().norm(), 2e-3);
 }
 
+// The motion prior's information: diagonal about the camera, its rotations and translations each
+// scaling with their own strength (OdometryParams::motion_prior, motion_prior_translation), the
+// single strength the same as both at it; no information, no prior.
+TEST(GeometricInformation, TheMotionPriorsRotationsAndTranslationsHaveTheirOwnStrength) {
+  const compute::Context context = compute::Context::cpu();
+  const testing::Scene wall_and_floor{
+      std::nullopt, {}, {{Eigen::Vector3d(0, 0, 1), 3.0}, {Eigen::Vector3d(0, 1, 0), 1.2}}};
+  const registration::GeometricInformation geometry = information_of(wall_and_floor, context);
+  const se3::Matrix6d even = registration::motion_prior_information(geometry, 0.03);
+  const se3::Matrix6d split = registration::motion_prior_information(geometry, {0.03, 0.015});
+  ASSERT_GT(even.trace(), 0);
+  EXPECT_TRUE(even.isApprox(registration::motion_prior_information(geometry, {0.03, 0.03})));
+  EXPECT_TRUE(even.isDiagonal());
+  const Eigen::Matrix3d rotations = split.topLeftCorner(3, 3);
+  const Eigen::Matrix3d translations = split.bottomRightCorner(3, 3);
+  EXPECT_TRUE(rotations.isApprox(even.topLeftCorner(3, 3)));
+  EXPECT_TRUE(translations.isApprox(0.5 * even.bottomRightCorner(3, 3)));
+  EXPECT_TRUE(split.topRightCorner(3, 3).isZero());
+  EXPECT_TRUE(registration::motion_prior_information({}, {0.03, 0.015}).isZero());
+}
+
 // A corner seen from the reference camera (320 x 240), as a three-level pyramid: its coarsest
 // level (80 x 60) is where the odometry judges what two frames share.
 registration::FramePyramid corner_pyramid(const compute::Context& context) {

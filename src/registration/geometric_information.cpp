@@ -187,12 +187,21 @@ se3::Matrix6d constrained_information(const GeometricInformation& geometry,
 }
 
 se3::Matrix6d motion_prior_information(const GeometricInformation& geometry, double strength) {
+  return motion_prior_information(geometry, MotionPriorStrength{strength, strength});
+}
+
+se3::Matrix6d motion_prior_information(const GeometricInformation& geometry,
+                                       const MotionPriorStrength& strength) {
   const BalancedEigen eigen = balanced_eigen(geometry);
   if (!eigen.valid) return se3::Matrix6d::Zero();
   // strength x the identity in balanced coordinates (trace 6: the mean direction's information),
-  // about the camera: H = S^-1 (strength normaliser I) S^-1.
+  // about the camera: H = S^-1 (strength normaliser I) S^-1, rotations first.
+  se3::Vector6d strengths;
+  strengths << Eigen::Vector3d::Constant(strength.rotation),
+      Eigen::Vector3d::Constant(strength.translation);
   const se3::Vector6d inverse_scale = eigen.scale.cwiseInverse();
-  return strength * eigen.normaliser * inverse_scale.cwiseProduct(inverse_scale).asDiagonal();
+  return eigen.normaliser *
+         strengths.cwiseProduct(inverse_scale.cwiseProduct(inverse_scale)).asDiagonal();
 }
 
 std::vector<se3::Vector6d> weak_directions(const GeometricInformation& geometry,

@@ -62,7 +62,8 @@ void validate(const OdometryParams& params) {
   require(params.reestimate_interval >= 0, "odometry: reestimate_interval must be >= 0");
   require(params.icp_width > 0 && params.information_width > 0 && params.min_icp_level >= 0,
           "odometry: icp_width and information_width must be > 0, min_icp_level >= 0");
-  require(params.motion_prior >= 0, "odometry: motion_prior must be >= 0");
+  require(params.motion_prior >= 0 && params.motion_prior_translation >= 0,
+          "odometry: motion_prior and motion_prior_translation must be >= 0");
   require(params.recheck_correction_m > 0, "odometry: recheck_correction_m must be > 0");
   require(params.recheck_fitness >= 0 && params.recheck_fitness <= 1,
           "odometry: recheck_fitness must be in [0, 1]");
@@ -271,10 +272,11 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   }
   // Degenerate views: the motion model, as a prior, decides the weak directions while ICP
   // solves; the other frames solve the pairs' system alone.
+  const MotionPriorStrength prior = motion_prior_for(target + 1 == current, initial);
   const IcpResult result =
       geometry_.degeneracy.degenerate && params_.motion_prior > 0
           ? engine->align(source_views, target_views, initial,
-                          {initial, motion_prior_information(geometry_, params_.motion_prior)})
+                          {initial, motion_prior_information(geometry_, prior)})
           : engine->align(source_views, target_views, initial);
   Attempt attempt;
   attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
@@ -282,7 +284,7 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   attempt.motion = result.source_to_target;
   if (!attempt.report.accepted() || !geometry_.degeneracy.degenerate) return attempt;
   // A step from the frame before: a robot's sideways slide comes from its heading.
-  if (target + 1 == current) hold_across_heading(attempt);
+  if (target + 1 == current) hold_across_heading(attempt, prior);
 
   // What the geometry cannot tell comes from the initial guess (the motion model)...
   const double ratio = params_.icp.min_eigenvalue_ratio;
@@ -378,12 +380,11 @@ se3::Matrix6d RgbdOdometry::images_information(
   return information_along(prior_information(sigma_m / 2.0, sigma_m), free_directions);
 }
 
-void RgbdOdometry::hold_across_heading(Attempt& attempt) const {
+void RgbdOdometry::hold_across_heading(Attempt& attempt, const MotionPriorStrength& prior) const {
   if (!params_.heading_prior || !heading_prior_.ready()) return;
   // ICP's answer was already the minimum of the pairs and the motion model's prior: both weigh
   // against the heading's (a hand-held camera's wide spread leaves the motion model in charge).
-  const se3::Matrix6d icp =
-      geometry_.information + motion_prior_information(geometry_, params_.motion_prior);
+  const se3::Matrix6d icp = geometry_.information + motion_prior_information(geometry_, prior);
   attempt.motion = heading_prior_.combine(
       attempt.motion, edge_information(icp, attempt.inlier_rmse, params_.information));
   attempt.across_heading = heading_prior_.information(attempt.motion);
@@ -539,6 +540,14 @@ RegistrationLimits RgbdOdometry::frame_limits_now() const {
     limits.max_correction_m = std::max(limits.max_correction_m, largest_step_m_);
   }
   return limits;
+}
+
+MotionPriorStrength RgbdOdometry::motion_prior_for(bool step_from_previous,
+                                                   const Eigen::Isometry3d& initial) const {
+  // A step's start may be large where its prediction was not: the features' motion at the
+  // sequence's start, before the motion model knows the speed.
+  const bool large = large_step_ || (step_from_previous && is_large(initial));
+  return {params_.motion_prior, large ? params_.motion_prior : params_.motion_prior_translation};
 }
 
 bool RgbdOdometry::is_large(const Eigen::Isometry3d& motion) const {
@@ -1107,6 +1116,7 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   const std::size_t n = frame.index;
   frame.step_frame = step_frame_in_use();
   const Eigen::Isometry3d predicted = predict(frame.step_frame);
+  large_step_ = is_large(predicted);
   speed_bound_decided_ = false;
   const GeometricInformation whole_frame = geometry_;
   const Attempt attempt =

