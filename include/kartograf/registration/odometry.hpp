@@ -166,7 +166,7 @@ struct OdometryParams {
   // (worse in 3).
   double photometric_travel_max_rmse = 1.5;
   // Degenerate frames: ICP solves with the motion model as a prior (geometric_information.hpp's
-  // motion_prior_information), isotropic about the camera, this many times the mean direction's
+  // motion_prior_information), diagonal about the camera, this many times the mean direction's
   // information: it decides the directions the geometry leaves free and barely moves the others
   // (0: off; ICP runs free and its weak directions are replaced by the prediction's about the
   // centroid afterwards, which moved the camera 4 cm sideways per frame when a turn began on the
