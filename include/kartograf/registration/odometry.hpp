@@ -184,9 +184,10 @@ struct OdometryParams {
   // of the way to the prediction, and a robot speeding up or slowing down towards a far wall
   // (held-out survey seed 24, frames 1010-1100: steps of 2-11 cm, the far wall's depth the only
   // hold along the travel) lagged the truth by 2-5 mm a step, 3 cm in ten frames. The rotations
-  // keep 0.03: weaker there, the images' refinement found a basin 3 degrees off on seed 3's
-  // corridor (the DegenerateViews test, frame 924) and seed 5's sparse tour turned 9 degrees wrong
-  // (docs/slam.md, "The motion prior's strength").
+  // keep 0.03: the lag is along the travel, and with the rotations at 0.015 too held-out seed 35
+  // slid sideways at its start (SLAM ATE 1.35 cm; 0.68 with them kept). At 0.01 the images'
+  // refinement found a basin 3 degrees off on seed 3's corridor (the DegenerateViews test, frame
+  // 924), whatever the rotations' (docs/slam.md, "The motion prior's strength").
   double motion_prior_translation = 0.015;
   // Degenerate steps from the frame before: the step's component across the direction of travel
   // is held at zero with the spread learned from the well-constrained steps
