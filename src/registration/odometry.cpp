@@ -544,6 +544,7 @@ RegistrationLimits RgbdOdometry::frame_limits_now() const {
 
 MotionPriorStrength RgbdOdometry::motion_prior_for(bool step_from_previous,
                                                    const Eigen::Isometry3d& initial) const {
+  if (params_.motion_prior == 0) return {};  // off, the translations' too
   // A step's start may be large where its prediction was not: the features' motion at the
   // sequence's start, before the motion model knows the speed.
   const bool large = large_step_ || (step_from_previous && is_large(initial));
