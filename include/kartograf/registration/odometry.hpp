@@ -176,8 +176,8 @@ struct OdometryParams {
   // feature_seed_deg: a sequence taken sparsely) or whose step ICP starts from a large motion (the
   // features' at the sequence's start, before the motion model knows the speed), where ICP's
   // answer in a barely constrained direction is more often a neighbouring basin's than a
-  // measurement (with the weaker one below the surveys taken every 10th frame lost a 0.8 m step at
-  // a corridor's start, seed 8's).
+  // measurement (with 0.01 everywhere, tried 2026-12-07, the surveys taken every 10th frame lost
+  // a 0.8 m step at a corridor's start, seed 8's).
   double motion_prior = 0.03;
   // ...and the camera translations' on the other frames: half as strong. The largest eigenvalue is
   // 2-3 times the mean, so at 0.03 the prior pulled a direction just over the threshold a quarter
