@@ -578,7 +578,7 @@ RgbdOdometry::Attempt RgbdOdometry::chosen_previous(const Eigen::Isometry3d& pre
   std::optional<Attempt> seeded;
   if (is_large(predicted)) seeded = register_from_features();
   // On a degenerate view their step may be a tile over where their turn is right.
-  if (seeded) seeded = features_turn_on_the_arc(predicted, std::move(*seeded));
+  if (seeded) seeded = features_turn_on_the_arc(frame.step_frame, predicted, std::move(*seeded));
   Attempt attempt = accelerating_if_better(
       frame.step_frame, predicted, register_frames(previous, predicted, frame_limits_now()));
   if (images_left_open(attempt)) {
@@ -1395,7 +1395,8 @@ std::optional<RgbdOdometry::Attempt> RgbdOdometry::register_from_features() {
   return attempt;
 }
 
-RgbdOdometry::Attempt RgbdOdometry::features_turn_on_the_arc(const Eigen::Isometry3d& predicted,
+RgbdOdometry::Attempt RgbdOdometry::features_turn_on_the_arc(StepFrame step_frame,
+                                                             const Eigen::Isometry3d& predicted,
                                                              Attempt seeded) {
   if (!params_.features_turn_on_the_arc || !geometry_.degeneracy.degenerate) return seeded;
   const Eigen::Vector3d travel = travel_on_arc(seeded.motion);
@@ -1405,9 +1406,38 @@ RgbdOdometry::Attempt RgbdOdometry::features_turn_on_the_arc(const Eigen::Isomet
   Attempt on_the_arc = register_frames(frames_.size() - 1, start, frame_limits_now());
   if (params_.features_along_the_drive && !heading_prior_.ready() && on_the_arc.report.accepted() &&
       across_the_drive(seeded.motion, travel)) {
-    return on_the_arc;
+    return speeding_up_on_the_arc(step_frame, predicted, start, travel, std::move(on_the_arc));
   }
-  return agrees_better(on_the_arc, seeded) ? on_the_arc : seeded;
+  Attempt chosen = agrees_better(on_the_arc, seeded) ? std::move(on_the_arc) : std::move(seeded);
+  return speeding_up_on_the_arc(step_frame, predicted, start, travel, std::move(chosen));
+}
+
+RgbdOdometry::Attempt RgbdOdometry::speeding_up_on_the_arc(StepFrame step_frame,
+                                                           const Eigen::Isometry3d& predicted,
+                                                           Eigen::Isometry3d start,
+                                                           const Eigen::Vector3d& travel,
+                                                           Attempt chosen) {
+  // As acceleration_start does for the prediction: the robot may be speeding up on that turn,
+  // or slowing down as much.
+  if (!params_.acceleration_start || !params_.acceleration_on_the_arc) return chosen;
+  const double accelerated = predict(step_frame, MotionModel::acceleration).translation().norm();
+  const double velocity = predicted.translation().norm();
+  const double change = accelerated - velocity;
+  if (std::abs(change) <= params_.feature_arbitration_m) return chosen;
+  for (const double length : {velocity + change, velocity - change}) {
+    if (length <= 0) continue;
+    start.translation() = length * travel;
+    Attempt changed = register_frames(frames_.size() - 1, start, frame_limits_now());
+    // Only a step the images measured, and fit clearly better: unrefined, or refined but barely
+    // better, they can prefer a shorter step on a floor.
+    const bool images_fit =
+        changed.photometric &&
+        changed.photometric_rmse < params_.acceleration_on_the_arc_ratio * chosen.photometric_rmse;
+    if (!images_fit || !agrees_better(changed, chosen)) continue;
+    changed.accelerated = true;
+    chosen = std::move(changed);
+  }
+  return chosen;
 }
 
 bool RgbdOdometry::across_the_drive(const Eigen::Isometry3d& step,
