@@ -4,8 +4,8 @@
 Usage: step-errors.py [--poses odometry.txt] [--min-m 0.05] [--min-deg 2] [--show 8]
                       [--frames FIRST:LAST] RUN...
 
-RUN is a `kartograf slam` or `kartograf odometry` output folder with the estimate (odometry.txt by
-default; trajectory.txt for the SLAM's), groundtruth.txt and stats.json (the per-frame flags). Each
+RUN is a `kartograf slam` output folder: the estimate (odometry.txt by default; trajectory.txt for
+the SLAM's), groundtruth.txt and stats.json (the per-frame flags; without it no step is marked). Each
 step (frame i-1 to i) is compared with the true one, both in the camera frame of i-1, so a wrong
 step counts once, where it happened, however far the chain drifts after it. Per run, one line:
 the steps, the wrong ones (over --min-m or --min-deg), the summed translation error, the part of it
