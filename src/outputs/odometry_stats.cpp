@@ -66,6 +66,7 @@ RunJson frame_json(const registration::OdometryFrame& frame) {
   json["degenerate_overlap"] = frame.degenerate_overlap;
   json["reestimate_degenerate_overlap"] = frame.reestimate_degenerate_overlap;
   json["photometric"] = frame.photometric;
+  json["deep_photometric"] = frame.deep_photometric;
   json["heading_sigma_m"] = frame.heading_sigma_m;
   json["accelerated"] = frame.accelerated;
   json["speed_bounded"] = frame.speed_bounded;
@@ -96,6 +97,9 @@ RunJson frame_counts_json(const std::vector<registration::OdometryFrame>& frames
   json["degenerate_frames"] = counts.degenerate_frames;
   json["degenerate_overlap_frames"] = counts.degenerate_overlap_frames;
   json["photometric_frames"] = counts.photometric_frames;
+  json["deep_photometric_frames"] = counts.deep_photometric_frames;
+  json["colour_registration"] = std::string(registration::to_string(counts.colour_registration));
+  json["colour_edge_contrast"] = counts.colour_edge_contrast;
   json["heading_prior_frames"] = counts.heading_prior_frames;
   json["accelerated_frames"] = counts.accelerated_frames;
   json["speed_bounded_frames"] = counts.speed_bounded_frames;
@@ -159,6 +163,11 @@ OdometryFrameCounts count_odometry_frames(const std::vector<registration::Odomet
     counts.reestimates += f.reestimate.has_value();
     counts.reestimates_rejected += f.reestimate && !f.reestimate->accepted();
     counts.reestimates_on_degenerate_overlap += f.reestimate_degenerate_overlap;
+    counts.deep_photometric_frames += f.deep_photometric;
+  }
+  if (!frames.empty()) {
+    counts.colour_registration = frames.back().colour_registration;
+    counts.colour_edge_contrast = frames.back().colour_edge_contrast;
   }
   return counts;
 }
@@ -184,6 +193,17 @@ std::string speed_changes_text(const OdometryFrameCounts& c) {
   return text;
 }
 
+// Runs with colour: whether it is registered to the depth, and the deep views the images measured
+// (OdometryParams::photometric_deep_weight).
+std::string colour_text(const OdometryFrameCounts& c) {
+  if (c.colour_edge_contrast <= 0) return "";
+  char contrast[32];
+  std::snprintf(contrast, sizeof(contrast), "%.2f", c.colour_edge_contrast);
+  return "; colour " + std::string(registration::to_string(c.colour_registration)) +
+         " to depth (edge contrast " + contrast + "), deep views measured with the images " +
+         std::to_string(c.deep_photometric_frames);
+}
+
 std::string reestimates_on_overlap_text(const OdometryFrameCounts& c) {
   if (c.reestimates_on_degenerate_overlap == 0) return "";
   return ", " + std::to_string(c.reestimates_on_degenerate_overlap) +
@@ -207,7 +227,8 @@ std::string frame_counts_line(const OdometryFrameCounts& c) {
          ", re-estimates " + count(c.reestimates) + " (rejected " + count(c.reestimates_rejected) +
          reestimates_on_overlap_text(c) + "), degenerate frames " + count(c.degenerate_frames) +
          " (" + count(c.photometric_frames) + " measured by image intensity, " +
-         count(c.heading_prior_frames) + " held to the heading" + speed_changes_text(c) + ")";
+         count(c.heading_prior_frames) + " held to the heading" + speed_changes_text(c) + ")" +
+         colour_text(c);
 }
 
 OdometryThroughput odometry_throughput(const mapping::OdometryRun& run) {

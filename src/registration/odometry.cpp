@@ -83,6 +83,9 @@ void validate(const OdometryParams& params) {
   require(params.information.effective_pairs > 0 && params.information.min_sigma > 0,
           "odometry: information model values must be > 0");
   params.depth_noise_gate.validate();
+  require(std::isfinite(params.photometric_deep_weight) && params.photometric_deep_weight >= 0,
+          "odometry: photometric_deep_weight must be finite and >= 0");
+  params.colour_registration.validate();
 }
 
 // Composing poses (and inverting them by transposition, as Isometry3d does) lets rounding errors
@@ -193,6 +196,7 @@ RgbdOdometry::RgbdOdometry(const compute::Context& context, const PinholeIntrins
       engine_(context, params_.icp, finder_for(context, params_)),
       speed_bound_(params_.speed_change_margin, params_.feature_arbitration_m) {
   validate(params_);
+  colour_check_ = ColourRegistrationCheck(params_.colour_registration);
   // The frame being tracked, the previous one and, with re-estimation, the anchor: whatever k and
   // the anchor policy, no other frame is registered against again.
   const std::size_t slots = params_.reestimate_interval > 0 ? 3 : 2;
@@ -282,10 +286,10 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
   attempt.report = judge_registration(result, initial, limits, geometry_.degeneracy);
   attempt.inlier_rmse = result.inlier_rmse;
   attempt.motion = result.source_to_target;
+  measure_deep_view(attempt, current, target, initial, limits);
   if (!attempt.report.accepted() || !geometry_.degeneracy.degenerate) return attempt;
   // A step from the frame before: a robot's sideways slide comes from its heading.
   if (target + 1 == current) hold_across_heading(attempt, prior);
-
   // What the geometry cannot tell comes from the initial guess (the motion model)...
   const double ratio = params_.icp.min_eigenvalue_ratio;
   if (params_.motion_prior == 0) {
@@ -323,6 +327,32 @@ RgbdOdometry::Attempt RgbdOdometry::register_frames(std::size_t target,
     }
   }
   return attempt;
+}
+
+void RgbdOdometry::measure_deep_view(Attempt& attempt, std::size_t current, std::size_t target,
+                                     const Eigen::Isometry3d& initial,
+                                     const RegistrationLimits& limits) const {
+  // Deep: the depth noise widened ICP's finest gate for this frame (set_finest_gate).
+  const bool deep =
+      !planar_ && engine_.params().levels[0].max_distance > params_.icp.levels[0].max_distance;
+  if (!attempt.report.accepted() || geometry_.degeneracy.degenerate ||
+      params_.photometric_deep_weight <= 0 || !deep ||
+      colour_check_.verdict() != ColourRegistration::registered)
+    return;
+  const PhotometricFrame& source = images_[slot_of(current)];
+  const PhotometricFrame& onto = images_[slot_of(target)];
+  if (source.empty() || onto.empty()) return;
+  // All six directions; ICP's answer holds them by what it measured.
+  const std::vector<se3::Vector6d> directions = weak_directions(geometry_, 2.0);
+  const double pairs = params_.photometric_deep_weight * static_cast<double>(geometry_.points);
+  const se3::Matrix6d held =
+      edge_information(constrained_information(geometry_, params_.icp.min_eigenvalue_ratio),
+                       attempt.inlier_rmse, {pairs, params_.information.min_sigma});
+  const PhotometricResult refined = refine_photometrically(
+      source, onto, builder_.camera(), attempt.motion, directions, params_.photometric, held, 0);
+  if (!keeps_refinement(initial, refined, limits, params_.photometric_doubt_rmse)) return;
+  attempt.motion = refined.motion;
+  attempt.deep_photometric = true;
 }
 
 void RgbdOdometry::measure_travel_length(Attempt& attempt, const Eigen::Isometry3d& initial,
@@ -429,6 +459,10 @@ const OdometryFrame& RgbdOdometry::track(const DepthImage& depth, const RgbImage
       params_.photometric_refinement && color && !color->empty()
           ? PhotometricFrame(*color, depth, params_.depth_range.units_per_metre)
           : PhotometricFrame();
+  if (params_.photometric_deep_weight > 0 && !images_[slot_of(frame.index)].empty())
+    colour_check_.add(depth, *color);
+  frame.colour_registration = colour_check_.verdict();
+  frame.colour_edge_contrast = colour_check_.contrast();
   geometry_ = level_geometry(pyramid.level(information_level_).view());
   set_finest_gate(depth);
   frame.degenerate = geometry_.degeneracy.degenerate;
@@ -1127,6 +1161,7 @@ void RgbdOdometry::track_previous(OdometryFrame& frame) {
   frame.scanned = attempt.scanned;
   frame.speed_bounded = speed_bound_decided_;
   frame.photometric = attempt.photometric;
+  frame.deep_photometric = attempt.deep_photometric;
   frame.heading_sigma_m = attempt.heading_sigma_m;
   // What the motion model, the heading prior and the bounds learn from stays with the whole
   // frame's geometry: a wide turn's step held on the overlap still measured its turn, and they

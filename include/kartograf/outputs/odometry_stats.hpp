@@ -37,8 +37,14 @@ struct OdometryFrameCounts {
               from_features = 0, degenerate_frames = 0, photometric_frames = 0, reestimates = 0,
               reestimates_rejected = 0, heading_prior_frames = 0, accelerated_frames = 0,
               speed_bounded_frames = 0, scanned_frames = 0, degenerate_overlap_frames = 0,
-              reestimates_on_degenerate_overlap = 0, motion_prior_frames = 0;
+              reestimates_on_degenerate_overlap = 0, motion_prior_frames = 0,
+              deep_photometric_frames = 0;
   MotionPriorDifference prior_difference;
+  // The odometry's verdict on the colour's registration to the depth, as at the last frame, and
+  // the edge contrast it judged (0: no colour).
+  registration::ColourRegistration colour_registration =
+      registration::ColourRegistration::undecided;
+  double colour_edge_contrast = 0;
 };
 OdometryFrameCounts count_odometry_frames(const std::vector<registration::OdometryFrame>& frames);
 // Those counts in one line, for the summaries on stdout.
