@@ -104,6 +104,29 @@ TEST(RunDocuments, FrameCountsLine) {
             "measured by image intensity, 0 held to the heading)");
 }
 
+TEST(RunDocuments, FrameCountsSayWhetherTheColourIsRegistered) {
+  mapping::OdometryRun run = two_frame_run();
+  for (registration::OdometryFrame& frame : run.frames) {
+    frame.colour_registration = registration::ColourRegistration::registered;
+    frame.colour_edge_contrast = 1.836;
+  }
+  run.frames[1].deep_photometric = true;
+  const io::OdometryFrameCounts counts = io::count_odometry_frames(run.frames);
+  EXPECT_EQ(counts.deep_photometric_frames, 1u);
+  const std::string line = io::frame_counts_line(counts);
+  EXPECT_NE(line.find("held to the heading); colour registered to depth (edge contrast 1.84), deep "
+                      "views measured with the images 1"),
+            std::string::npos)
+      << line;
+  const nlohmann::json json = nlohmann::json::parse(io::odometry_stats_json(
+      {"seq", "p2plane", "cpu", "host"}, two_frame_sequence(), {}, run, {}));
+  EXPECT_EQ(json["summary"]["colour_registration"], "registered");
+  EXPECT_DOUBLE_EQ(json["summary"]["colour_edge_contrast"].get<double>(), 1.836);
+  EXPECT_EQ(json["summary"]["deep_photometric_frames"], 1);
+  EXPECT_TRUE(json["per_frame"][1]["deep_photometric"].get<bool>());
+  EXPECT_FALSE(json["per_frame"][0]["deep_photometric"].get<bool>());
+}
+
 TEST(RunDocuments, LoopClosureCounts) {
   mapping::SlamResult result;
   result.loop_closures.resize(3);
