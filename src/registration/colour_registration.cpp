@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "kartograf/core/error.hpp"
+#include "photometric_images.hpp"
 
 namespace kartograf::registration {
 
@@ -33,24 +34,13 @@ void ColourRegistrationParams::validate() const {
 
 namespace {
 
-// The grey level's gradient magnitude (central differences, one-sided at the border).
+// The grey level's gradient magnitude, as the photometric refinement sees it (zero at the border).
 std::vector<float> gradient_magnitude(const RgbImage& colour) {
-  const int width = colour.width(), height = colour.height();
-  std::vector<float> grey(colour.size());
-  for (std::size_t i = 0; i < grey.size(); ++i) {
-    const Rgb8& c = colour.data()[i];
-    grey[i] = 0.299f * c[0] + 0.587f * c[1] + 0.114f * c[2];
-  }
-  std::vector<float> magnitude(grey.size());
-  for (int y = 0; y < height; ++y) {
-    const int up = std::max(0, y - 1), down = std::min(height - 1, y + 1);
-    for (int x = 0; x < width; ++x) {
-      const int left = std::max(0, x - 1), right = std::min(width - 1, x + 1);
-      const float gx = (grey[y * width + right] - grey[y * width + left]) / float(right - left);
-      const float gy = (grey[down * width + x] - grey[up * width + x]) / float(down - up);
-      magnitude[static_cast<std::size_t>(y) * width + x] = std::sqrt(gx * gx + gy * gy);
-    }
-  }
+  const detail::Textured grey(detail::grey_of(colour));
+  const auto dx = grey.dx.pixels(), dy = grey.dy.pixels();
+  std::vector<float> magnitude(dx.size());
+  for (std::size_t i = 0; i < magnitude.size(); ++i)
+    magnitude[i] = std::sqrt(dx[i] * dx[i] + dy[i] * dy[i]);
   return magnitude;
 }
 
