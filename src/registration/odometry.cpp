@@ -694,12 +694,17 @@ RgbdOdometry::Attempt RgbdOdometry::accelerating_if_better(StepFrame step_frame,
   return other;
 }
 
+RgbdOdometry::ModelStepLengths RgbdOdometry::model_step_lengths(
+    StepFrame step_frame, const Eigen::Isometry3d& predicted) const {
+  return {predicted.translation().norm(),
+          predict(step_frame, MotionModel::acceleration).translation().norm()};
+}
+
 std::pair<double, double> RgbdOdometry::plausible_step_lengths(
     StepFrame step_frame, const Eigen::Isometry3d& predicted) const {
   // Around the velocity and acceleration models' steps by their difference: the speed keeps
   // changing as it did, or stops changing, or changes as much again the other way.
-  const double velocity = predicted.translation().norm();
-  const double accelerated = predict(step_frame, MotionModel::acceleration).translation().norm();
+  const auto [velocity, accelerated] = model_step_lengths(step_frame, predicted);
   const double change = std::abs(accelerated - velocity);
   double shortest = std::max(0.0, std::min(velocity, accelerated) - change);
   double longest = std::max(velocity, accelerated) + change;
@@ -1455,8 +1460,7 @@ RgbdOdometry::Attempt RgbdOdometry::speeding_up_on_the_arc(StepFrame step_frame,
   // As acceleration_start does for the prediction: the robot may be speeding up on that turn,
   // or slowing down as much.
   if (!params_.acceleration_start || !params_.acceleration_on_the_arc) return chosen;
-  const double accelerated = predict(step_frame, MotionModel::acceleration).translation().norm();
-  const double velocity = predicted.translation().norm();
+  const auto [velocity, accelerated] = model_step_lengths(step_frame, predicted);
   const double change = accelerated - velocity;
   if (std::abs(change) <= params_.feature_arbitration_m) return chosen;
   for (const double length : {velocity + change, velocity - change}) {

@@ -729,6 +729,12 @@ class RgbdOdometry {
   // their difference, within the speed bound once it is set.
   std::pair<double, double> plausible_step_lengths(StepFrame step_frame,
                                                    const Eigen::Isometry3d& predicted) const;
+  // The step's length by the velocity model (`predicted`) and by the acceleration model.
+  struct ModelStepLengths {
+    double velocity = 0, accelerated = 0;
+  };
+  ModelStepLengths model_step_lengths(StepFrame step_frame,
+                                      const Eigen::Isometry3d& predicted) const;
   // A registration worth checking from other starts (OdometryParams::recheck_*).
   bool is_doubtful(const Attempt& attempt) const;
   std::vector<Eigen::Isometry3d> other_starts(const Eigen::Isometry3d& predicted) const;
