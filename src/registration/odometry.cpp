@@ -1270,8 +1270,10 @@ double RgbdOdometry::view_weighed_fitness(std::size_t target, const Attempt& att
   };
   const double agreeing = count(ViewRelation::agrees);
   const double contradicting = count(ViewRelation::seen_through);
-  if (agreeing + contradicting == 0) return 0;
-  return attempt.report.fitness * agreeing / (agreeing + contradicting);
+  const double judged = agreeing + contradicting;
+  if (judged == 0) return 0;
+  const double excess = std::max(0.0, contradicting - params_.contradiction_floor * judged);
+  return attempt.report.fitness * (agreeing - params_.contradiction_weight * excess) / judged;
 }
 
 GeometricInformation RgbdOdometry::overlap_geometry(std::size_t current, std::size_t target,
