@@ -826,6 +826,12 @@ TEST(Odometry, RejectsFramesOfTheWrongSizeAndMissingColour) {
   EXPECT_THROW(color_odometry.track(tour().frames[0].depth), Error);
   OdometryParams negative = synthetic_params(-1);
   EXPECT_THROW(RgbdOdometry(context, testing::qvga_kinect(), negative), Error);
+  OdometryParams contradictions = synthetic_params();
+  contradictions.contradiction_weight = -1;
+  EXPECT_THROW(RgbdOdometry(context, testing::qvga_kinect(), contradictions), Error);
+  contradictions.contradiction_weight = 2;
+  contradictions.contradiction_floor = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_THROW(RgbdOdometry(context, testing::qvga_kinect(), contradictions), Error);
 }
 
 TEST(EdgeInformation, AddedErrorAddsCovariances) {

@@ -85,6 +85,9 @@ void validate(const OdometryParams& params) {
   params.depth_noise_gate.validate();
   require(std::isfinite(params.photometric_deep_weight) && params.photometric_deep_weight >= 0,
           "odometry: photometric_deep_weight must be finite and >= 0");
+  require(std::isfinite(params.contradiction_weight) && params.contradiction_weight >= 0 &&
+              params.contradiction_floor >= 0 && params.contradiction_floor <= 1,
+          "odometry: contradiction_weight must be finite and >= 0, contradiction_floor in [0, 1]");
   params.colour_registration.validate();
 }
 
