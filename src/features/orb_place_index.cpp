@@ -29,21 +29,22 @@ namespace {
 // cv::BFMatcher indexes train rows in 18 bits (IMGIDX_SHIFT): a larger store is searched in blocks.
 constexpr int kRowsPerSearch = 1 << 17;
 
-// Per query row, its two nearest stored rows (trainIdx in `stored`), nearest first.
-std::vector<std::vector<cv::DMatch>> two_nearest(const cv::Mat& query, const cv::Mat& stored) {
+// Per query row, its `count` nearest stored rows (trainIdx in `stored`), nearest first.
+std::vector<std::vector<cv::DMatch>> nearest_rows(const cv::Mat& query, const cv::Mat& stored,
+                                                  std::size_t count) {
   std::vector<std::vector<cv::DMatch>> best(static_cast<std::size_t>(query.rows));
   const cv::BFMatcher matcher(cv::NORM_HAMMING);
   for (int first = 0; first < stored.rows; first += kRowsPerSearch) {
     const int last = std::min(stored.rows, first + kRowsPerSearch);
     std::vector<std::vector<cv::DMatch>> knn;
-    matcher.knnMatch(query, stored.rowRange(first, last), knn, 2);
+    matcher.knnMatch(query, stored.rowRange(first, last), knn, static_cast<int>(count));
     for (const auto& neighbours : knn)
       for (cv::DMatch m : neighbours) {
         m.trainIdx += first;
         auto& kept = best[static_cast<std::size_t>(m.queryIdx)];
         kept.push_back(m);
         std::sort(kept.begin(), kept.end());  // DMatch orders by distance
-        if (kept.size() > 2) kept.pop_back();
+        if (kept.size() > count) kept.pop_back();
       }
   }
   return best;
@@ -52,18 +53,26 @@ std::vector<std::vector<cv::DMatch>> two_nearest(const cv::Mat& query, const cv:
 // Per place (position in the store), the query descriptors whose nearest stored row is its own.
 std::vector<std::size_t> count_votes(const cv::Mat& query, const cv::Mat& stored,
                                      const std::vector<int>& row_place, std::size_t place_count,
-                                     double ratio) {
+                                     const OrbPlaceParams& params) {
   std::vector<std::size_t> votes(place_count, 0);
   const auto place_of = [&](const cv::DMatch& m) {
     return static_cast<std::size_t>(row_place[static_cast<std::size_t>(m.trainIdx)]);
   };
-  for (const auto& neighbours : two_nearest(query, stored)) {
+  const auto same_place = [&](std::size_t a, std::size_t b) {
+    return (a > b ? a - b : b - a) <= params.same_place_span;
+  };
+  // The nearest row of each place within the span, and one more: the rival, if any.
+  const std::size_t searched = 2 * params.same_place_span + 2;
+  for (const auto& neighbours : nearest_rows(query, stored, searched)) {
     if (neighbours.empty()) continue;
     const std::size_t place = place_of(neighbours[0]);
-    // Two near rows of one place (repeated texture) still point to that place: the ratio test
-    // only weighs the best against a rival place.
-    if (neighbours.size() > 1 && place_of(neighbours[1]) != place &&
-        neighbours[0].distance >= ratio * neighbours[1].distance)
+    // Near rows of one place (repeated texture) or of the places beside it in the order added (the
+    // same view from the next keyframe) still point to that place: the ratio test only weighs the
+    // best against a rival elsewhere.
+    const auto rival =
+        std::find_if(neighbours.begin() + 1, neighbours.end(),
+                     [&](const cv::DMatch& m) { return !same_place(place_of(m), place); });
+    if (rival != neighbours.end() && neighbours[0].distance >= params.ratio * rival->distance)
       continue;
     ++votes[place];
   }
@@ -81,6 +90,7 @@ cv::Mat strongest_rows(const cv::Mat& descriptors, int count) {
 OrbPlaceIndex::OrbPlaceIndex(const OrbPlaceParams& params)
     : params_(params), store_(std::make_unique<Store>()) {
   require(params.ratio > 0 && params.ratio <= 1, "ORB place index: ratio must be in (0, 1]");
+  require(params.same_place_span <= 32, "ORB place index: same_place_span must be at most 32");
   require(params.descriptors_per_place > 0,
           "ORB place index: descriptors_per_place must be positive");
 }
@@ -113,7 +123,7 @@ std::vector<registration::PlaceMatch> OrbPlaceIndex::query(
   if (candidates == 0 || query.rows == 0 || s.end_row[candidates - 1] == 0) return result;
   const cv::Mat stored = s.descriptors.rowRange(0, s.end_row[candidates - 1]);
   const std::vector<std::size_t> votes =
-      count_votes(query, stored, s.row_place, candidates, params_.ratio);
+      count_votes(query, stored, s.row_place, candidates, params_);
   for (std::size_t k = 0; k < candidates; ++k)
     if (votes[k] >= params_.min_votes) result.push_back({s.ids[k], static_cast<double>(votes[k])});
   // Stable: equal votes keep the lower id first.

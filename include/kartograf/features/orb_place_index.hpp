@@ -1,8 +1,9 @@
 #pragma once
 // Place recognition over ORB descriptions (registration::PlaceIndex): every descriptor of a query
 // votes for the place that holds its nearest stored descriptor (Hamming, brute force over all
-// places added so far), unless the second nearest belongs to another place and is nearly as near
-// (Lowe's ratio test; two near rows of one place still vote for it). A place seen again shares many
+// places added so far), unless the nearest row of a place elsewhere is nearly as near (Lowe's
+// ratio test; near rows of one place, or of the places added just before and after it, which see
+// the same corners, still vote for it). A place seen again shares many
 // distinctive corners with the query; an unrelated one collects only scattered votes.
 #include <cstddef>
 #include <memory>
@@ -15,6 +16,11 @@ namespace kartograf::features {
 struct OrbPlaceParams {
   double ratio = 0.8;          // nearest vs second nearest, when that is another place's
   std::size_t min_votes = 20;  // the similarity floor: fewer votes, not reported
+  // Places this close in the order added (consecutive keyframes) see the same corners: a row of
+  // one of them is no rival in the ratio test. 0: every other place is a rival, so a place seen
+  // again lost the votes its neighbours shared (survey seed 11's tour back at its start: 12 votes
+  // for the place it began at, where 31 with this span).
+  std::size_t same_place_span = 3;
   // Only each place's and each query's strongest descriptors are matched: the search costs
   // (places x this) x this Hamming distances.
   int descriptors_per_place = 300;
