@@ -5,6 +5,7 @@
 // resolutions the world's smooth textures give too few corners.
 #include <gtest/gtest.h>
 
+#include <limits>
 #include <memory>
 #include <numbers>
 #include <string>
@@ -574,6 +575,32 @@ TEST(FeatureTracking, LoopClosureFindsByAppearanceWhatTheDriftHides) {
   blind.add_keyframe(0, views.frames[0].depth, 0.0, &views.frames[0].color);
   blind.add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
   EXPECT_TRUE(blind.find_appearance_candidates(1, poses).empty());
+}
+
+// The same room with the estimate 3 m farther off than the drift allowance (0.5 m + 5 % of 8 m):
+// the features' motion is a look-alike's unless as many inliers as decisive_feature_inliers agree.
+TEST(FeatureTracking, AnAppearanceLoopBeyondTheDriftNeedsDecisiveFeatures) {
+  const testing::RenderedSequence& views = revisited_room().views;
+  std::vector<Eigen::Isometry3d> poses = revisited_room().drifted;
+  poses[1] = Eigen::Translation3d(3, 0, 0) * poses[1];
+  const auto candidates = [&](std::size_t decisive) {
+    mapping::LoopClosureParams params;
+    params.min_frame_gap = 1;
+    params.decisive_feature_inliers = decisive;
+    mapping::LoopClosureDetector detector(compute::Context::cpu(), kKinect, revisited_room().range,
+                                          params, orb());
+    detector.add_keyframe(0, views.frames[0].depth, 0.0, &views.frames[0].color);
+    detector.add_keyframe(1, views.frames[1].depth, 8.0, &views.frames[1].color);
+    return detector.find_appearance_candidates(1, poses);
+  };
+  const auto beyond_any = candidates(std::numeric_limits<std::size_t>::max());
+  EXPECT_TRUE(beyond_any.empty());
+  const auto believed = candidates(30);
+  ASSERT_EQ(believed.size(), 1u);
+  const std::size_t inliers = believed[0].feature_inliers;
+  std::cout << "  the room seen again, 3 m beyond the allowance: " << inliers << " inliers\n";
+  EXPECT_EQ(candidates(inliers).size(), 1u);
+  EXPECT_TRUE(candidates(inliers + 1).empty());
 }
 
 // Keyframes whose depth, samples and features all went to the temporary files (no memory for

@@ -237,11 +237,14 @@ std::vector<LoopCandidate> LoopClosureDetector::find_appearance_candidates(
     if (!aligned) continue;
     LoopCandidate c = candidate_between(query, match, poses);
     // Buildings repeat their materials and furniture: a look-alike elsewhere is only believed
-    // where the estimate, with its drift allowance, could still be that wrong.
+    // where the estimate, with its drift allowance, could still be that wrong, or where so many
+    // features agree that no look-alike has matched as well.
     const Eigen::Isometry3d estimated = poses[c.match_frame].inverse() * poses[c.query_frame];
     const double disagreement =
         (estimated.translation() - aligned->source_to_target.translation()).norm();
-    if (disagreement > params_.max_distance + c.drift_allowance_m) continue;
+    if (disagreement > params_.max_distance + c.drift_allowance_m &&
+        aligned->inliers < params_.decisive_feature_inliers)
+      continue;
     c.by_appearance = true;
     c.feature_motion = aligned->source_to_target;
     c.feature_inliers = aligned->inliers;

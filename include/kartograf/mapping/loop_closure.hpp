@@ -76,6 +76,13 @@ struct LoopClosureParams {
   registration::DepthWeightParams depth_weights;
   registration::RegistrationLimits verification{500, 0.15, 0.02, true, 0, 20};
   double min_correction_m = 0.2;  // correction allowance at no path (plus drift_fraction x path)
+  // An appearance candidate whose features put the query farther from the estimate than
+  // max_distance + the drift allowance is a look-alike (buildings repeat materials and furniture)
+  // unless this many RANSAC inliers agree: on the synthetic tours every 10th frame of seeds 1-12,
+  // 17 and 29 the look-alikes so far off reached 16-91 inliers, the places seen again after a drift
+  // beyond the allowance 152-310 (seed 12's tour back at its start 2 m off the estimate, seed 17's
+  // 1.9 m off); chosen on those tours (2026-12-08).
+  std::size_t decisive_feature_inliers = 150;
   registration::InformationModel information{200, 0.002};
   // Wide-baseline registrations carry a systematic error that ICP's residuals do not show: the
   // depth camera's calibration (7-Scenes: ICP between views 0.35-0.55 m apart, Kartograf's and
