@@ -20,7 +20,8 @@
 // min_frame_gap frames back) it finds most similar are candidates whatever the pose estimate
 // says, each with the relative pose of its matched features (RANSAC in 3-D), kept when that pose
 // puts j's camera within max_distance + drift_fraction x path of where the estimate puts it
-// (buildings repeat materials and furniture: a look-alike room elsewhere matches too). Those are
+// (buildings repeat materials and furniture: a look-alike room elsewhere matches too), or when at
+// least decisive_feature_inliers agree (the place seen again after a larger drift). Those are
 // the loops whose view angle, overlap or ICP basin the drift spoiled for the tests above.
 //
 // Verification: point-to-plane ICP of j's frame against i's from the estimated relative pose (for
