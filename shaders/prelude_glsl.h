@@ -25,7 +25,16 @@
 #define KG_DOUBLE3(x, y, z) dvec3(x, y, z)
 #define KG_INT64(x) int64_t(x)
 #define KG_UINT64(x) uint64_t(x)
-#define kg_round_even_int64(x) int64_t(roundEven(x))
+// Round half to even by hand: Mesa's lavapipe (22.3.6, LLVM 15, on an AMD EPYC host) rounded
+// roundEven(double) down, and the segment moments' fixed-point sums came out ~2^-31 low per point
+// against the CPU's (2026-12-08).
+int64_t kg_round_even_int64(double x) {
+  const double lower = floor(x);
+  const double rest = x - lower;
+  int64_t rounded = int64_t(lower);
+  if (rest > 0.5 || (rest == 0.5 && (rounded & int64_t(1)) != int64_t(0))) rounded += int64_t(1);
+  return rounded;
+}
 
 // A function on 64-bit integers that the CPU may also instantiate with a wider type.
 #define KG_WIDE_INT_TEMPLATE
